@@ -1,0 +1,54 @@
+// imufit apply — corrects raw samples with a calibration.
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/correct_file.h"
+#include "imufit/io/output_file.h"
+
+namespace imufit {
+namespace {
+
+struct ApplyArguments {
+  std::string calibration;
+  std::string samples;
+  std::string output;
+  bool quiet = false;
+};
+
+int RunApply(const ApplyArguments& args) {
+  RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
+  const Calibration calibration = ReadCalibration(args.calibration);
+  const CorrectFileReport report = CorrectSamplesFile(calibration, args.samples, args.output);
+  if (report.outside_temp_range > 0) {
+    std::fprintf(stderr,
+                 "imufit: warning: %lld of %lld samples (%.1f %%) lie outside the calibration's fit "
+                 "temperature range [%g, %g] degC (the run spans [%g, %g] degC): their correction is "
+                 "an extrapolation\n",
+                 report.outside_temp_range, report.samples, 100.0 * report.outside_temp_range / report.samples,
+                 calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1], report.min_temp_c,
+                 report.max_temp_c);
+  }
+  if (!args.quiet) {
+    std::printf("corrected %lld samples -> %s\n", report.samples, args.output.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner AddApplyCommand(CLI::App* root) {
+  auto args = std::make_shared<ApplyArguments>();
+  CLI::App* command = root->add_subcommand(
+      "apply",
+      "Correct raw samples with a calibration: writes time_s, temp_c, segment (if present), gyro in "
+      "rad/s and accel in m/s^2, body frame.");
+  command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")->required();
+  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
+  command->add_option("--output,-o", args->output, "corrected samples CSV to write (.gz compresses)")->required();
+  command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
+  return [args] { return RunApply(*args); };
+}
+
+}  // namespace imufit

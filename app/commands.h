@@ -1,0 +1,25 @@
+// imufit — the subcommands of the `imufit` program. Each Add*Command registers its options on
+// `root` and returns the function that runs it once the command line has been parsed; that
+// function returns the exit status of SPEC.md section 4 (0 done, 1 could not be done, 2 bad
+// input) and lets InputError escape to main(), which prints it and returns 2.
+#ifndef IMUFIT_APP_COMMANDS_H_
+#define IMUFIT_APP_COMMANDS_H_
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace imufit {
+
+using CommandRunner = std::function<int()>;
+
+CommandRunner AddApplyCommand(CLI::App* root);
+CommandRunner AddSimulateCommand(CLI::App* root);
+
+// "imufit 0.1.0 (git abc123)" — the software string written into calibration files.
+std::string SoftwareVersion();
+
+}  // namespace imufit
+
+#endif  // IMUFIT_APP_COMMANDS_H_

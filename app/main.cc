@@ -1,0 +1,52 @@
+// imufit — the command. Thin: parse the command line, call the libraries, print, and return
+// the exit status of SPEC.md section 4.
+#include <cstdio>
+#include <exception>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+#include "imufit/io/error.h"
+
+namespace imufit {
+
+std::string SoftwareVersion() { return std::string("imufit ") + IMUFIT_VERSION; }
+
+}  // namespace imufit
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "imufit: thermal calibration of inertial measurement units.\n"
+      "Fits gyro and accelerometer biases, scale factors, misalignments, gyro g-sensitivity and\n"
+      "their cubic temperature dependence from rate-table runs, applies calibrations, simulates\n"
+      "runs and characterises noise. Exit status: 0 done, 1 the job could not be done, 2 bad\n"
+      "invocation or bad input.",
+      "imufit"};
+  app.set_version_flag("--version", std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
+  app.require_subcommand(1);
+  std::vector<std::pair<CLI::App*, imufit::CommandRunner>> commands;
+  const auto add = [&](imufit::CommandRunner runner) { commands.emplace_back(app.get_subcommands().back(), std::move(runner)); };
+  add(imufit::AddApplyCommand(&app));
+  add(imufit::AddSimulateCommand(&app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int status = app.exit(e);
+    return status == 0 ? 0 : 2;
+  }
+  try {
+    for (auto& [command, run] : commands) {
+      if (command->parsed()) return run();
+    }
+    return 2;
+  } catch (const imufit::InputError& e) {
+    std::fprintf(stderr, "imufit: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "imufit: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,131 @@
+// imufit simulate — writes a rate-table run for a plan from a calibration used as truth.
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "commands.h"
+#include "imufit/fit/simulator.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
+#include "imufit/io/plan.h"
+#include "imufit/io/samples.h"
+
+namespace imufit {
+namespace {
+
+struct SimulateArguments {
+  std::string plan;
+  std::string calibration;
+  std::string output;
+  std::string truth_output;
+  std::vector<double> soak_temps_c;
+  std::vector<double> ramp_c;
+  bool quiet = false;
+  SimulationOptions options;
+};
+
+int RunSimulate(SimulateArguments args) {
+  RefuseToOverwriteInputs(args.output, {args.plan, args.calibration});
+  if (!args.truth_output.empty()) {
+    RefuseToOverwriteInputs(args.truth_output, {args.plan, args.calibration});
+    if (args.truth_output == args.output) throw InputError(args.output, "--truth must differ from --output");
+  }
+  SimulationOptions& options = args.options;
+  if (!args.ramp_c.empty()) {
+    options.ramp = true;
+    options.ramp_from_c = args.ramp_c[0];
+    options.ramp_to_c = args.ramp_c[1];
+  } else if (!args.soak_temps_c.empty()) {
+    options.soak_temps_c = args.soak_temps_c;
+  }
+  if (const std::string problem = options.Validate(); !problem.empty()) {
+    throw InputError("imufit simulate", problem);
+  }
+  const Plan plan = ReadPlan(args.plan);
+  const Calibration truth = ReadCalibration(args.calibration);
+
+  std::ostringstream comment;
+  comment << "simulated by " << SoftwareVersion() << " from plan " << args.plan << " and calibration "
+          << args.calibration << ", seed " << options.seed;
+  SamplesWriter samples(args.output, /*with_segment=*/true, comment.str());
+  std::optional<SamplesWriter> truth_samples;
+  if (!args.truth_output.empty()) {
+    truth_samples.emplace(args.truth_output, true,
+                          "true angular rate (rad/s) and specific force (m/s^2) of " + args.output);
+  }
+  long long count = 0;
+  SimulateRun(options, plan.site, plan.segments, truth.model, [&](const Sample& raw, const SegmentTruth& truth_of) {
+    samples.Write(raw);
+    if (truth_samples) {
+      Sample true_sample = raw;
+      true_sample.gyro = truth_of.omega_radps;
+      true_sample.accel = truth_of.a_mps2;
+      truth_samples->Write(true_sample);
+    }
+    ++count;
+  });
+  samples.Commit();
+  if (truth_samples) truth_samples->Commit();
+  if (!args.quiet) {
+    std::printf("simulated %lld samples (%zu segments, %s) -> %s\n", count, plan.segments.size(),
+                options.ramp ? "temperature ramp" : "temperature soaks", args.output.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner AddSimulateCommand(CLI::App* root) {
+  auto args = std::make_shared<SimulateArguments>();
+  SimulationOptions& o = args->options;
+  CLI::App* command = root->add_subcommand(
+      "simulate",
+      "Write a rate-table run for a plan from a known calibration (the truth), with noise, a "
+      "temperature schedule and a seed. Noise densities are in Kalibr's units.");
+  command->add_option("--plan,-p", args->plan, "plan YAML")->required();
+  command->add_option("--calibration,-c", args->calibration, "calibration YAML used as the truth")->required();
+  command->add_option("--output,-o", args->output, "samples CSV to write (.gz compresses)")->required();
+  command->add_option("--truth", args->truth_output,
+                      "also write the true rate (rad/s) and specific force (m/s^2) of every sample, in "
+                      "the corrected-samples layout");
+  auto* soak = command->add_option("--temps", args->soak_temps_c,
+                                   "soak temperatures, degC, comma-separated: one pass through the plan at each")
+                   ->delimiter(',')
+                   ->default_str("25");
+  command->add_option("--ramp", args->ramp_c, "a linear temperature ramp FROM,TO in degC across --passes passes")
+      ->delimiter(',')
+      ->expected(2)
+      ->excludes(soak);
+  command->add_option("--passes", o.passes, "passes through the plan during a ramp")->capture_default_str();
+  command->add_option("--dwell", o.dwell_s, "seconds in each segment")->capture_default_str();
+  command->add_option("--transition", o.transition_s, "seconds the table moves between segments (segment -1)")
+      ->capture_default_str();
+  command->add_option("--rate", o.rate_hz, "sample rate, Hz")->capture_default_str();
+  command->add_option("--start-time", o.start_time_s, "time_s of the first sample")->capture_default_str();
+  command->add_option("--gyro-noise-density", o.gyro_noise_density, "gyro white noise, rad/s/sqrt(Hz)")
+      ->capture_default_str();
+  command->add_option("--accel-noise-density", o.accel_noise_density, "accel white noise, m/s^2/sqrt(Hz)")
+      ->capture_default_str();
+  command->add_option("--gyro-random-walk", o.gyro_random_walk, "gyro bias random walk, rad/s^2/sqrt(Hz)")
+      ->capture_default_str();
+  command->add_option("--accel-random-walk", o.accel_random_walk, "accel bias random walk, m/s^3/sqrt(Hz)")
+      ->capture_default_str();
+  command->add_option("--gyro-bias-instability", o.gyro_bias_instability,
+                      "gyro Gauss-Markov bias, steady-state sigma, rad/s")
+      ->capture_default_str();
+  command->add_option("--accel-bias-instability", o.accel_bias_instability,
+                      "accel Gauss-Markov bias, steady-state sigma, m/s^2")
+      ->capture_default_str();
+  command->add_option("--bias-correlation", o.bias_correlation_s, "correlation time of the Gauss-Markov bias, s")
+      ->capture_default_str();
+  command->add_option("--temp-noise", o.temp_noise_c, "white noise of the temperature reading, degC")
+      ->capture_default_str();
+  command->add_flag("--quantize", o.quantize, "round raw outputs to integer counts");
+  command->add_option("--seed", o.seed, "random seed: the same seed gives the same file")->capture_default_str();
+  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  return [args] { return RunSimulate(*args); };
+}
+
+}  // namespace imufit

@@ -1,0 +1,209 @@
+#include "imufit/fit/simulator.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+
+namespace imufit {
+namespace {
+
+// Standard normal deviates from mt19937_64 (whose output the C++ standard fixes) by the
+// Box-Muller transform, so a seed gives the same run with every standard library.
+class NormalSource {
+ public:
+  explicit NormalSource(std::uint64_t seed) : engine_(seed) {}
+  double Next() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
+    const double u1 = Uniform();
+    const double u2 = Uniform();
+    const double radius = std::sqrt(-2.0 * std::log(u1));
+    spare_ = radius * std::sin(2.0 * M_PI * u2);
+    has_spare_ = true;
+    return radius * std::cos(2.0 * M_PI * u2);
+  }
+  Eigen::Vector3d Next3() {
+    const double x = Next();
+    const double y = Next();
+    const double z = Next();
+    return Eigen::Vector3d(x, y, z);
+  }
+
+ private:
+  double Uniform() {  // in (0, 1]
+    return (static_cast<double>(engine_() >> 11) + 1.0) * 0x1.0p-53;
+  }
+  std::mt19937_64 engine_;
+  double spare_ = 0.0;
+  bool has_spare_ = false;
+};
+
+// A sensor's bias process: random walk plus first-order Gauss-Markov, and white noise.
+struct NoiseProcess {
+  double white_sigma = 0.0;     // per sample
+  double walk_sigma = 0.0;      // per sample step
+  double markov_decay = 0.0;    // exp(-dt / tau)
+  double markov_sigma = 0.0;    // per sample drive
+  Eigen::Vector3d walk = Eigen::Vector3d::Zero();
+  Eigen::Vector3d markov = Eigen::Vector3d::Zero();
+
+  NoiseProcess(double density, double random_walk, double instability, double tau_s, double dt) {
+    white_sigma = density / std::sqrt(dt);
+    walk_sigma = random_walk * std::sqrt(dt);
+    markov_decay = std::exp(-dt / tau_s);
+    markov_sigma = instability * std::sqrt(1.0 - markov_decay * markov_decay);
+  }
+  void Start(NormalSource* normal, double instability) {
+    if (instability > 0.0) markov = instability * normal->Next3();
+  }
+  Eigen::Vector3d Step(NormalSource* normal) {
+    Eigen::Vector3d error = Eigen::Vector3d::Zero();
+    if (white_sigma > 0.0) error += white_sigma * normal->Next3();
+    if (walk_sigma > 0.0) {
+      walk += walk_sigma * normal->Next3();
+      error += walk;
+    }
+    if (markov_sigma > 0.0) {
+      markov = markov_decay * markov + markov_sigma * normal->Next3();
+      error += markov;
+    }
+    return error;
+  }
+};
+
+// What the table does over one stretch of the run.
+struct Phase {
+  int from = 0;  // segment index (dwell: from == to)
+  int to = 0;
+  bool transition = false;
+  long long samples = 0;
+  double soak_temp_c = 0.0;
+};
+
+Eigen::Vector3d PerpendicularTo(const Eigen::Vector3d& v) {
+  const Eigen::Vector3d trial = std::abs(v.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  return v.cross(trial).normalized();
+}
+
+// Truth while the table moves from segment `a` to segment `b`, at fraction u of the move.
+SegmentTruth TransitionTruth(const TableSite& site, const TableSegment& a, const TableSegment& b, double u,
+                             double duration_s) {
+  const double cos_angle = std::clamp(a.up.dot(b.up), -1.0, 1.0);
+  const double angle = std::acos(cos_angle);
+  Eigen::Vector3d axis = a.up.cross(b.up);
+  axis = axis.norm() > 1e-9 ? axis.normalized() : PerpendicularTo(a.up);
+  const double s = u * u * (3.0 - 2.0 * u);
+  const double s_dot = 6.0 * u * (1.0 - u) / duration_s;
+  const Eigen::Vector3d up = Eigen::AngleAxisd(angle * s, axis) * a.up;
+  const double rate = a.rate_radps + (b.rate_radps - a.rate_radps) * u;
+  SegmentTruth truth;
+  // A world-fixed direction seen from the body turns as d(up)/dt = -omega x up, so turning up
+  // by +angle about `axis` needs omega = -angle' axis.
+  truth.omega_radps = rate * up - angle * s_dot * axis;
+  if (site.latitude_rad) truth.omega_radps += kEarthRateRadps * std::sin(*site.latitude_rad) * up;
+  truth.a_mps2 = site.gravity_mps2 * up;
+  return truth;
+}
+
+}  // namespace
+
+std::string SimulationOptions::Validate() const {
+  if (!(rate_hz > 0.0)) return "the sample rate must be positive";
+  if (!(dwell_s > 0.0)) return "the dwell time must be positive";
+  if (!(transition_s >= 0.0)) return "the transition time cannot be negative";
+  if (ramp && passes < 1) return "a ramp needs at least one pass";
+  if (!ramp && soak_temps_c.empty()) return "give at least one soak temperature";
+  if (!(bias_correlation_s > 0.0)) return "the bias correlation time must be positive";
+  for (double v : {gyro_noise_density, accel_noise_density, gyro_random_walk, accel_random_walk,
+                   gyro_bias_instability, accel_bias_instability, temp_noise_c}) {
+    if (!(v >= 0.0)) return "noise figures cannot be negative";
+  }
+  return "";
+}
+
+long long SimulationOptions::SampleCount(size_t segment_count) const {
+  const long long dwell = std::llround(dwell_s * rate_hz);
+  const long long move = std::llround(transition_s * rate_hz);
+  const long long passes_run = ramp ? passes : static_cast<long long>(soak_temps_c.size());
+  const long long segments = passes_run * static_cast<long long>(segment_count);
+  return segments * dwell + (segments - 1) * move;
+}
+
+void SimulateRun(const SimulationOptions& options, const TableSite& site,
+                 const std::vector<TableSegment>& segments, const SensorModel& truth_model,
+                 const SimulationSink& sink) {
+  const double dt = 1.0 / options.rate_hz;
+  const long long dwell_samples = std::llround(options.dwell_s * options.rate_hz);
+  const long long move_samples = std::llround(options.transition_s * options.rate_hz);
+  const int passes = options.ramp ? options.passes : static_cast<int>(options.soak_temps_c.size());
+
+  std::vector<Phase> phases;
+  for (int pass = 0; pass < passes; ++pass) {
+    const double soak_c = options.ramp ? 0.0 : options.soak_temps_c[pass];
+    for (int i = 0; i < static_cast<int>(segments.size()); ++i) {
+      if (!phases.empty() && move_samples > 0) {
+        phases.push_back(Phase{phases.back().to, i, true, move_samples, soak_c});
+      }
+      phases.push_back(Phase{i, i, false, dwell_samples, soak_c});
+    }
+  }
+  const long long total = options.SampleCount(segments.size());
+
+  NormalSource normal(options.seed);
+  NoiseProcess gyro_noise(options.gyro_noise_density, options.gyro_random_walk,
+                          options.gyro_bias_instability, options.bias_correlation_s, dt);
+  NoiseProcess accel_noise(options.accel_noise_density, options.accel_random_walk,
+                           options.accel_bias_instability, options.bias_correlation_s, dt);
+  gyro_noise.Start(&normal, options.gyro_bias_instability);
+  accel_noise.Start(&normal, options.accel_bias_instability);
+
+  std::vector<SegmentTruth> dwell_truth;
+  for (const TableSegment& segment : segments) dwell_truth.push_back(TruthOf(site, segment));
+
+  long long k = 0;
+  Sample raw;
+  for (const Phase& phase : phases) {
+    for (long long j = 0; j < phase.samples; ++j, ++k) {
+      raw.time_s = options.start_time_s + static_cast<double>(k) * dt;
+      if (options.ramp) {
+        const double progress = total > 1 ? static_cast<double>(k) / static_cast<double>(total - 1) : 0.0;
+        raw.temp_c = options.ramp_from_c + (options.ramp_to_c - options.ramp_from_c) * progress;
+      } else {
+        raw.temp_c = phase.soak_temp_c;
+      }
+      SegmentTruth truth;
+      if (phase.transition) {
+        const double u = (static_cast<double>(j) + 0.5) / static_cast<double>(phase.samples);
+        truth = TransitionTruth(site, segments[phase.from], segments[phase.to], u, options.transition_s);
+        raw.segment = kTransitionSegment;
+      } else {
+        truth = dwell_truth[phase.from];
+        raw.segment = segments[phase.from].id;
+      }
+      const Eigen::Vector3d omega_sensed = truth.omega_radps + gyro_noise.Step(&normal);
+      const Eigen::Vector3d a_sensed = truth.a_mps2 + accel_noise.Step(&normal);
+      const double true_temp_c = raw.temp_c;
+      if (options.temp_noise_c > 0.0) raw.temp_c += options.temp_noise_c * normal.Next();
+      // The unit behaves according to its true temperature; it reports a noisy reading.
+      Eigen::Vector3d accel_m;
+      Eigen::Vector3d gyro_m;
+      const double x = truth_model.basis.Argument(true_temp_c);
+      const SensorCoefficients<double> accel = CoefficientsAt(truth_model.accel.data(), kAccelCoefficients, x);
+      const SensorCoefficients<double> gyro = CoefficientsAt(truth_model.gyro.data(), kGyroCoefficients, x);
+      accel_m = ForwardSensor(accel, a_sensed, Eigen::Vector3d::Zero().eval());
+      gyro_m = ForwardSensor(gyro, omega_sensed, truth.a_mps2);
+      if (options.quantize) {
+        accel_m = accel_m.array().round();
+        gyro_m = gyro_m.array().round();
+      }
+      raw.gyro = gyro_m;
+      raw.accel = accel_m;
+      sink(raw, truth);
+    }
+  }
+}
+
+}  // namespace imufit

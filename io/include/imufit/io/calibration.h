@@ -1,0 +1,49 @@
+// imufit — the calibration file (SPEC.md section 3): what the fit exports and consumers read.
+//
+// Coefficients are written as lists c0..c3 of powers of dT = T - 25 degC, each number in its
+// shortest round-trip form, so write -> read gives back the same doubles (==). An optional
+// `sigma` tree mirrors the coefficients with their 1-sigma uncertainties. Keys the reader does
+// not know are kept in `extra` (and written back); a `format` other than imufit-calibration or
+// a version above kCalibrationFormatVersion is refused.
+#ifndef IMUFIT_IO_CALIBRATION_H_
+#define IMUFIT_IO_CALIBRATION_H_
+
+#include <array>
+#include <optional>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+#include "imufit/model/sensor_model.h"
+
+namespace imufit {
+
+inline constexpr int kCalibrationFormatVersion = 1;
+
+struct Calibration {
+  std::string serial;
+  std::string created_utc;  // ISO 8601, e.g. "2026-11-22T06:00:00Z"
+  std::string software;     // e.g. "imufit 0.1.0"
+  std::array<double, 2> fit_temp_range_c{-40.0, 85.0};
+  // The coefficients, in powers of x = T - reference_temp_c (basis.center_c; half_range_c = 1).
+  // imufit writes reference_temp_c = 25 degC; a reader honours whatever the file states.
+  SensorModel model;
+  // 1-sigma of every parameter, same layout as `model` (its basis is not used).
+  std::optional<SensorModel> sigma;
+  // Further top-level keys (fit diagnostics, noise figures): a YAML map, written after the
+  // coefficients; on reading, every key this reader does not know.
+  YAML::Node extra;
+};
+
+Calibration ReadCalibration(const std::string& path);
+// The file's text; `calibration.model.basis.half_range_c` must be 1.
+std::string CalibrationToYaml(const Calibration& calibration);
+// Writes atomically (OutputFile).
+void WriteCalibration(const std::string& path, const Calibration& calibration);
+
+// The current UTC time as "YYYY-MM-DDTHH:MM:SSZ".
+std::string UtcNow();
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_CALIBRATION_H_

@@ -1,0 +1,29 @@
+// imufit — correcting a whole samples file with a calibration (`imufit apply`).
+//
+// Streams `samples_path` row by row through the shared model (SensorModel::Correct: the
+// accelerometer first, then the gyro with the corrected specific force of the same row) and
+// writes the corrected layout of SPEC.md (time_s, temp_c, segment if the input had it, gyro in
+// rad/s, accel in m/s^2) to `output_path`, atomically.
+#ifndef IMUFIT_IO_CORRECT_FILE_H_
+#define IMUFIT_IO_CORRECT_FILE_H_
+
+#include <string>
+
+#include "imufit/io/calibration.h"
+
+namespace imufit {
+
+struct CorrectFileReport {
+  long long samples = 0;
+  // Samples whose temperature lies outside the calibration's fit_temp_range_c.
+  long long outside_temp_range = 0;
+  double min_temp_c = 0.0;
+  double max_temp_c = 0.0;
+};
+
+CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
+                                     const std::string& output_path);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_CORRECT_FILE_H_

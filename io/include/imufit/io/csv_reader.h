@@ -1,0 +1,74 @@
+// imufit — a streaming reader for the CSV files of SPEC.md (plain or gzip-compressed).
+//
+// The first line that is neither empty nor a comment (starting with '#') is the header; columns
+// are found by name, in any order; columns nobody asks for are never parsed. Rows are read in
+// blocks of a few MiB, so memory does not grow with the file. Fields may be quoted ("...", with
+// "" for a quote) but may not span lines. Numbers are parsed with std::from_chars.
+//
+// Errors are InputErrors located at file:line:field, e.g.
+//   samples.csv:412:5: gyro_y: "1.2.3" is not a number
+#ifndef IMUFIT_IO_CSV_READER_H_
+#define IMUFIT_IO_CSV_READER_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace imufit {
+
+class CsvReader {
+ public:
+  // Opens `path` (gzip when it ends in ".gz") and reads its header. Throws InputError.
+  explicit CsvReader(std::string path);
+  ~CsvReader();
+  CsvReader(const CsvReader&) = delete;
+  CsvReader& operator=(const CsvReader&) = delete;
+
+  const std::vector<std::string>& header() const { return header_; }
+  // The index of the column called `name`, if there is one.
+  std::optional<int> FindColumn(std::string_view name) const;
+  // The index of the column called `name`; throws InputError naming the header line if absent.
+  int RequireColumn(std::string_view name) const;
+
+  // Advances to the next data row (skipping comments and blank lines); false at the end.
+  bool NextRow();
+  // The text of field `column` of the current row (unquoted). Throws InputError when the row is
+  // too short. Valid until the next NextRow().
+  std::string_view Field(int column) const;
+  // Field `column` as a finite number; throws InputError naming line, field and column name.
+  double Number(int column) const;
+  // Field `column` as an integer; an empty field gives `if_empty`.
+  long Integer(int column, long if_empty) const;
+
+  // Throws an InputError located at the current row and `column` (1-based field = column + 1).
+  [[noreturn]] void Fail(int column, const std::string& message) const;
+  [[noreturn]] void FailRow(const std::string& message) const;
+
+  const std::string& path() const { return path_; }
+  long line_number() const { return line_number_; }
+  // Bytes of (decompressed) input consumed so far.
+  long long bytes_read() const { return bytes_read_; }
+
+ private:
+  class Source;
+  bool NextLine(std::string_view* line);
+  void SplitLine(std::string_view line);
+
+  std::string path_;
+  std::unique_ptr<Source> source_;
+  std::vector<char> buffer_;
+  size_t begin_ = 0;  // start of unconsumed bytes in buffer_
+  size_t end_ = 0;    // end of valid bytes in buffer_
+  bool eof_ = false;
+  long line_number_ = 0;
+  long long bytes_read_ = 0;
+  std::vector<std::string> header_;
+  std::vector<std::string_view> fields_;
+  std::vector<std::string> unquoted_;  // storage for fields that had quotes
+};
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_CSV_READER_H_

@@ -1,0 +1,34 @@
+// imufit — the plan file (SPEC.md section 2): what the rate table did, segment by segment.
+//
+// The reader converts at the edge: rate_dps -> rad/s, latitude_deg -> rad; `up` and `north` are
+// normalised, and `north` is made exactly perpendicular to `up` (it may be off by at most 1
+// degree in the file). A plan is refused (InputError) when a vector is zero or not three
+// numbers, `north` is not horizontal, an id repeats, a key is unknown, or format/version are
+// not ones this reader knows.
+#ifndef IMUFIT_IO_PLAN_H_
+#define IMUFIT_IO_PLAN_H_
+
+#include <string>
+#include <vector>
+
+#include "imufit/model/rate_table.h"
+
+namespace imufit {
+
+inline constexpr int kPlanFormatVersion = 1;
+
+struct Plan {
+  std::string path;    // the file it was read from
+  std::string serial;  // may be empty
+  TableSite site;
+  std::vector<TableSegment> segments;
+
+  // The segment with `id`, or nullptr.
+  const TableSegment* Find(int id) const;
+};
+
+Plan ReadPlan(const std::string& path);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_PLAN_H_

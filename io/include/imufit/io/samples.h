@@ -1,0 +1,61 @@
+// imufit — samples files (SPEC.md section 2): what the unit said, sample by sample.
+//
+// Columns, by name and in any order: time_s (s, strictly increasing), temp_c (degC), segment
+// (plan segment id, -1 or empty while the table moves), gyro_x..z (raw B), accel_x..z (raw A).
+// The reader streams: one row at a time, nothing kept. The writer writes the same layout, numbers
+// in their shortest round-trip form, so a written file reads back bit-exactly.
+#ifndef IMUFIT_IO_SAMPLES_H_
+#define IMUFIT_IO_SAMPLES_H_
+
+#include <memory>
+#include <string>
+
+#include "imufit/io/csv_reader.h"
+#include "imufit/io/output_file.h"
+#include "imufit/model/sample.h"
+
+namespace imufit {
+
+class SamplesReader {
+ public:
+  // Opens a samples file; `require_segment` makes the segment column mandatory (imufit fit).
+  // Throws InputError naming the missing column.
+  SamplesReader(std::string path, bool require_segment);
+
+  // Reads the next sample; false at the end. Throws InputError on a bad value, a time that does
+  // not increase, or a segment id below -1.
+  bool Next(Sample* sample);
+
+  bool has_segment() const { return segment_column_ >= 0; }
+  const std::string& path() const { return csv_.path(); }
+  long line_number() const { return csv_.line_number(); }
+  long long bytes_read() const { return csv_.bytes_read(); }
+
+ private:
+  CsvReader csv_;
+  int time_column_;
+  int temp_column_;
+  int segment_column_ = -1;
+  int gyro_columns_[3];
+  int accel_columns_[3];
+  bool first_ = true;
+  double last_time_s_ = 0.0;
+};
+
+class SamplesWriter {
+ public:
+  // Starts `path` (atomically: nothing appears until Commit()). `with_segment` adds the
+  // segment column. `comment`, if not empty, is written first as '#' lines.
+  SamplesWriter(std::string path, bool with_segment, const std::string& comment = "");
+
+  void Write(const Sample& sample);
+  void Commit() { file_.Commit(); }
+
+ private:
+  OutputFile file_;
+  bool with_segment_;
+};
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_SAMPLES_H_

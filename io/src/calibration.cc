@@ -1,0 +1,157 @@
+#include "imufit/io/calibration.h"
+
+#include <cassert>
+#include <ctime>
+#include <sstream>
+
+#include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
+#include "yaml_util.h"
+
+namespace imufit {
+namespace {
+
+constexpr const char* kKnownKeys[] = {"format",  "version",          "serial",           "created_utc",
+                                      "software", "reference_temp_c", "fit_temp_range_c", "gyro",
+                                      "accel",    "sigma"};
+
+std::string Quoted(const std::string& text) {
+  YAML::Emitter emitter;
+  emitter << YAML::DoubleQuoted << text;
+  return emitter.c_str();
+}
+
+// Appends one sensor's coefficient tree (bias, scale, misalignment[, g_sensitivity]).
+void AppendSensor(const double* params, int coefficients, const std::string& indent, std::string* out) {
+  const char* group = nullptr;
+  for (int i = 0; i < coefficients; ++i) {
+    const CoefficientName& name = kCoefficientNames[i];
+    if (group == nullptr || std::string(group) != name.group) {
+      group = name.group;
+      *out += indent + group + ":\n";
+    }
+    *out += indent + "  " + name.axis + ": [";
+    for (int k = 0; k < kPolynomialTerms; ++k) {
+      *out += (k ? ", " : "") + FormatDouble(params[i * kPolynomialTerms + k]);
+    }
+    *out += "]\n";
+  }
+}
+
+void ReadSensor(const yaml::Located& sensor, double* params, int coefficients) {
+  for (int i = 0; i < coefficients; ++i) {
+    const CoefficientName& name = kCoefficientNames[i];
+    const std::vector<double> terms = sensor[name.group][name.axis].Doubles(kPolynomialTerms);
+    for (int k = 0; k < kPolynomialTerms; ++k) params[i * kPolynomialTerms + k] = terms[k];
+  }
+}
+
+void CheckUnit(const yaml::Located& sensor, const std::string& expected) {
+  if (sensor.Has("unit") && sensor["unit"].String() != expected) {
+    sensor["unit"].Fail(QuoteForMessage(sensor["unit"].String()) + " is not supported (expected " + expected + ")");
+  }
+}
+
+}  // namespace
+
+Calibration ReadCalibration(const std::string& path) {
+  const YAML::Node root_node = yaml::LoadFile(path);
+  if (!root_node.IsMap()) throw InputError(path, "not an imufit calibration (expected a YAML mapping)");
+  const yaml::Located root{&path, root_node, ""};
+  const std::string format = root["format"].String();
+  if (format != "imufit-calibration") {
+    root["format"].Fail(QuoteForMessage(format) + " is not \"imufit-calibration\"");
+  }
+  const long version = root["version"].Integer();
+  if (version < 1 || version > kCalibrationFormatVersion) {
+    root["version"].Fail("version " + std::to_string(version) +
+                         " is not supported (this imufit reads up to version " +
+                         std::to_string(kCalibrationFormatVersion) + ")");
+  }
+  Calibration calibration;
+  if (root.Has("serial")) calibration.serial = root["serial"].String();
+  if (root.Has("created_utc")) calibration.created_utc = root["created_utc"].String();
+  if (root.Has("software")) calibration.software = root["software"].String();
+  calibration.model.basis.center_c = root.Has("reference_temp_c") ? root["reference_temp_c"].Double() : kReferenceTempC;
+  calibration.model.basis.half_range_c = 1.0;
+  if (root.Has("fit_temp_range_c")) {
+    const std::vector<double> range = root["fit_temp_range_c"].Doubles(2);
+    if (!(range[0] <= range[1])) root["fit_temp_range_c"].Fail("the range must be [low, high]");
+    calibration.fit_temp_range_c = {range[0], range[1]};
+  }
+  const yaml::Located gyro = root["gyro"];
+  CheckUnit(gyro, "rad/s");
+  ReadSensor(gyro, calibration.model.gyro.data(), kGyroCoefficients);
+  const yaml::Located accel = root["accel"];
+  CheckUnit(accel, "m/s^2");
+  ReadSensor(accel, calibration.model.accel.data(), kAccelCoefficients);
+  for (int axis = 0; axis < 3; ++axis) {
+    // A zero scale factor would divide by zero in every consumer: refuse it here.
+    const int c0 = (kScaleCoefficient + axis) * kPolynomialTerms;
+    if (calibration.model.gyro[c0] == 0.0) gyro["scale"][kCoefficientNames[3 + axis].axis].Fail("scale c0 is zero");
+    if (calibration.model.accel[c0] == 0.0) accel["scale"][kCoefficientNames[3 + axis].axis].Fail("scale c0 is zero");
+  }
+  if (root.Has("sigma")) {
+    const yaml::Located sigma = root["sigma"];
+    SensorModel sigmas;
+    sigmas.basis = calibration.model.basis;
+    ReadSensor(sigma["gyro"], sigmas.gyro.data(), kGyroCoefficients);
+    ReadSensor(sigma["accel"], sigmas.accel.data(), kAccelCoefficients);
+    calibration.sigma = sigmas;
+  }
+  calibration.extra = YAML::Node(YAML::NodeType::Map);
+  for (const auto& entry : root_node) {
+    const std::string key = entry.first.Scalar();
+    bool known = false;
+    for (const char* k : kKnownKeys) known = known || key == k;
+    if (!known) calibration.extra[key] = entry.second;
+  }
+  return calibration;
+}
+
+std::string CalibrationToYaml(const Calibration& calibration) {
+  assert(calibration.model.basis.half_range_c == 1.0);
+  std::string out;
+  out += "format: imufit-calibration\n";
+  out += "version: " + std::to_string(kCalibrationFormatVersion) + "\n";
+  out += "serial: " + Quoted(calibration.serial) + "\n";
+  out += "created_utc: " + Quoted(calibration.created_utc) + "\n";
+  out += "software: " + Quoted(calibration.software) + "\n";
+  out += "reference_temp_c: " + FormatDouble(calibration.model.basis.center_c) + "\n";
+  out += "fit_temp_range_c: [" + FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+         FormatDouble(calibration.fit_temp_range_c[1]) + "]\n";
+  out += "gyro:\n  unit: rad/s\n";
+  AppendSensor(calibration.model.gyro.data(), kGyroCoefficients, "  ", &out);
+  out += "accel:\n  unit: m/s^2\n";
+  AppendSensor(calibration.model.accel.data(), kAccelCoefficients, "  ", &out);
+  if (calibration.sigma) {
+    out += "# 1-sigma uncertainty of every coefficient above, same layout and units\n";
+    out += "sigma:\n  gyro:\n";
+    AppendSensor(calibration.sigma->gyro.data(), kGyroCoefficients, "    ", &out);
+    out += "  accel:\n";
+    AppendSensor(calibration.sigma->accel.data(), kAccelCoefficients, "    ", &out);
+  }
+  if (calibration.extra.IsMap() && calibration.extra.size() > 0) {
+    YAML::Emitter emitter;
+    emitter.SetDoublePrecision(17);
+    emitter << calibration.extra;
+    out += emitter.c_str();
+    out += "\n";
+  }
+  return out;
+}
+
+void WriteCalibration(const std::string& path, const Calibration& calibration) {
+  WriteFileAtomically(path, CalibrationToYaml(calibration));
+}
+
+std::string UtcNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+}  // namespace imufit

@@ -1,0 +1,34 @@
+#include "imufit/io/correct_file.h"
+
+#include <algorithm>
+
+#include "imufit/io/samples.h"
+
+namespace imufit {
+
+CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
+                                     const std::string& output_path) {
+  SamplesReader reader(samples_path, /*require_segment=*/false);
+  SamplesWriter writer(output_path, reader.has_segment());
+  CorrectFileReport report;
+  Sample raw;
+  Sample corrected;
+  while (reader.Next(&raw)) {
+    corrected.time_s = raw.time_s;
+    corrected.temp_c = raw.temp_c;
+    corrected.segment = raw.segment;
+    calibration.model.Correct(raw.temp_c, raw.gyro, raw.accel, &corrected.gyro, &corrected.accel);
+    writer.Write(corrected);
+    if (report.samples == 0) report.min_temp_c = report.max_temp_c = raw.temp_c;
+    report.min_temp_c = std::min(report.min_temp_c, raw.temp_c);
+    report.max_temp_c = std::max(report.max_temp_c, raw.temp_c);
+    if (raw.temp_c < calibration.fit_temp_range_c[0] || raw.temp_c > calibration.fit_temp_range_c[1]) {
+      ++report.outside_temp_range;
+    }
+    ++report.samples;
+  }
+  writer.Commit();
+  return report;
+}
+
+}  // namespace imufit

@@ -1,0 +1,87 @@
+#include "imufit/io/plan.h"
+
+#include <cmath>
+#include <set>
+
+#include "imufit/io/error.h"
+#include "yaml_util.h"
+
+namespace imufit {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+// `north` may be this far from perpendicular to `up` (SPEC.md: 1 degree).
+constexpr double kNorthToleranceRad = 1.0 * kDegToRad;
+
+Eigen::Vector3d ReadDirection(const yaml::Located& value) {
+  const std::vector<double> xyz = value.Doubles(3);
+  const Eigen::Vector3d v(xyz[0], xyz[1], xyz[2]);
+  if (v.norm() == 0.0) value.Fail("a direction cannot be the zero vector");
+  return v;
+}
+
+}  // namespace
+
+const TableSegment* Plan::Find(int id) const {
+  for (const TableSegment& segment : segments) {
+    if (segment.id == id) return &segment;
+  }
+  return nullptr;
+}
+
+Plan ReadPlan(const std::string& path) {
+  const YAML::Node root_node = yaml::LoadFile(path);
+  const yaml::Located root{&path, root_node, ""};
+  if (!root_node.IsMap()) throw InputError(path, "not an imufit plan (expected a YAML mapping)");
+  root.RejectUnknownKeys({"format", "version", "gravity_mps2", "latitude_deg", "serial", "segments"});
+  if (root["format"].String() != "imufit-plan") {
+    root["format"].Fail(QuoteForMessage(root["format"].String()) + " is not \"imufit-plan\"");
+  }
+  const long version = root["version"].Integer();
+  if (version < 1 || version > kPlanFormatVersion) {
+    root["version"].Fail("version " + std::to_string(version) + " is not supported (this imufit reads version " +
+                         std::to_string(kPlanFormatVersion) + ")");
+  }
+  Plan plan;
+  plan.path = path;
+  plan.site.gravity_mps2 = root["gravity_mps2"].Double();
+  if (!(plan.site.gravity_mps2 > 0.0)) root["gravity_mps2"].Fail("gravity must be positive");
+  if (root.Has("latitude_deg")) {
+    const double latitude_deg = root["latitude_deg"].Double();
+    if (std::abs(latitude_deg) > 90.0) root["latitude_deg"].Fail("latitude must be within [-90, 90] degrees");
+    plan.site.latitude_rad = latitude_deg * kDegToRad;
+  }
+  if (root.Has("serial")) plan.serial = root["serial"].String();
+
+  const yaml::Located segments = root["segments"];
+  if (segments.Size() == 0) segments.Fail("a plan needs at least one segment");
+  std::set<int> ids;
+  for (size_t i = 0; i < segments.Size(); ++i) {
+    const yaml::Located entry = segments.At(i);
+    entry.RejectUnknownKeys({"id", "up", "rate_dps", "north", "lever_arm_m"});
+    TableSegment segment;
+    const long id = entry["id"].Integer();
+    if (id < 0 || id > 1000000000L) entry["id"].Fail("an id is an integer >= 0");
+    segment.id = static_cast<int>(id);
+    if (!ids.insert(segment.id).second) entry["id"].Fail("id " + std::to_string(id) + " repeats");
+    segment.up = ReadDirection(entry["up"]).normalized();
+    if (entry.Has("rate_dps")) segment.rate_radps = entry["rate_dps"].Double() * kDegToRad;
+    if (entry.Has("north")) {
+      const Eigen::Vector3d north = ReadDirection(entry["north"]).normalized();
+      if (std::abs(north.dot(segment.up)) > std::sin(kNorthToleranceRad)) {
+        entry["north"].Fail("north is not horizontal: it is " +
+                            std::to_string(std::asin(std::abs(north.dot(segment.up))) / kDegToRad) +
+                            " degrees from perpendicular to up (at most 1 allowed)");
+      }
+      segment.north = (north - segment.up * north.dot(segment.up)).normalized();
+    }
+    if (entry.Has("lever_arm_m")) {
+      const std::vector<double> r = entry["lever_arm_m"].Doubles(3);
+      segment.lever_arm_m = Eigen::Vector3d(r[0], r[1], r[2]);
+    }
+    plan.segments.push_back(segment);
+  }
+  return plan;
+}
+
+}  // namespace imufit

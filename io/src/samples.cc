@@ -1,0 +1,85 @@
+#include "imufit/io/samples.h"
+
+#include <sstream>
+
+#include "imufit/io/error.h"
+
+namespace imufit {
+namespace {
+
+constexpr const char* kGyroNames[3] = {"gyro_x", "gyro_y", "gyro_z"};
+constexpr const char* kAccelNames[3] = {"accel_x", "accel_y", "accel_z"};
+
+}  // namespace
+
+SamplesReader::SamplesReader(std::string path, bool require_segment) : csv_(std::move(path)) {
+  time_column_ = csv_.RequireColumn("time_s");
+  temp_column_ = csv_.RequireColumn("temp_c");
+  for (int axis = 0; axis < 3; ++axis) {
+    gyro_columns_[axis] = csv_.RequireColumn(kGyroNames[axis]);
+    accel_columns_[axis] = csv_.RequireColumn(kAccelNames[axis]);
+  }
+  if (require_segment) {
+    segment_column_ = csv_.RequireColumn("segment");
+  } else if (const auto column = csv_.FindColumn("segment")) {
+    segment_column_ = *column;
+  }
+}
+
+bool SamplesReader::Next(Sample* sample) {
+  if (!csv_.NextRow()) return false;
+  sample->time_s = csv_.Number(time_column_);
+  if (!first_ && !(sample->time_s > last_time_s_)) {
+    csv_.Fail(time_column_, FormatDouble(sample->time_s) + " s does not increase (the row before has " +
+                                FormatDouble(last_time_s_) + " s)");
+  }
+  first_ = false;
+  last_time_s_ = sample->time_s;
+  sample->temp_c = csv_.Number(temp_column_);
+  for (int axis = 0; axis < 3; ++axis) {
+    sample->gyro(axis) = csv_.Number(gyro_columns_[axis]);
+    sample->accel(axis) = csv_.Number(accel_columns_[axis]);
+  }
+  sample->segment = kTransitionSegment;
+  if (segment_column_ >= 0) {
+    const long segment = csv_.Integer(segment_column_, kTransitionSegment);
+    if (segment < kTransitionSegment || segment > 1000000000L) {
+      csv_.Fail(segment_column_, std::to_string(segment) +
+                                     " is not a segment id (an id >= 0, or -1 while the table moves)");
+    }
+    sample->segment = static_cast<int>(segment);
+  }
+  return true;
+}
+
+SamplesWriter::SamplesWriter(std::string path, bool with_segment, const std::string& comment)
+    : file_(std::move(path)), with_segment_(with_segment) {
+  if (!comment.empty()) {
+    std::istringstream lines(comment);
+    std::string line;
+    while (std::getline(lines, line)) file_.Write("# " + line + "\n");
+  }
+  file_.Write(with_segment_ ? "time_s,temp_c,segment," : "time_s,temp_c,");
+  file_.Write("gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
+}
+
+void SamplesWriter::Write(const Sample& sample) {
+  file_.WriteNumber(sample.time_s);
+  file_.Write(",");
+  file_.WriteNumber(sample.temp_c);
+  if (with_segment_) {
+    file_.Write(",");
+    file_.Write(std::to_string(sample.segment));
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    file_.Write(",");
+    file_.WriteNumber(sample.gyro(axis));
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    file_.Write(",");
+    file_.WriteNumber(sample.accel(axis));
+  }
+  file_.Write("\n");
+}
+
+}  // namespace imufit

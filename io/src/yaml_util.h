@@ -1,0 +1,38 @@
+// Helpers for reading YAML files with errors located at file:line:column and key path.
+#ifndef IMUFIT_IO_SRC_YAML_UTIL_H_
+#define IMUFIT_IO_SRC_YAML_UTIL_H_
+
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace imufit::yaml {
+
+// Parses `path`; throws InputError located where the YAML syntax is broken.
+YAML::Node LoadFile(const std::string& path);
+
+// A node with the file and the dotted key path it was reached by, for error messages.
+struct Located {
+  const std::string* file;
+  YAML::Node node;
+  std::string key;  // e.g. "segments[3].up"
+
+  [[noreturn]] void Fail(const std::string& message) const;
+  bool Has(const std::string& name) const;
+  Located operator[](const std::string& name) const;    // required map key
+  Located At(size_t index) const;                       // sequence element
+  size_t Size() const;                                  // sequence length; fails if not one
+  void RequireMap() const;
+  // Fails on any key not in `allowed`.
+  void RejectUnknownKeys(std::initializer_list<const char*> allowed) const;
+  double Double() const;
+  long Integer() const;
+  std::string String() const;
+  std::vector<double> Doubles(size_t count) const;  // a sequence of exactly `count` numbers
+};
+
+}  // namespace imufit::yaml
+
+#endif  // IMUFIT_IO_SRC_YAML_UTIL_H_
