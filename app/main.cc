@@ -27,7 +27,11 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, imufit::CommandRunner>> commands;
-  const auto add = [&](imufit::CommandRunner runner) { commands.emplace_back(app.get_subcommands().back(), std::move(runner)); };
+  // Each Add*Command adds one subcommand: the newest of all of them (parsed or not).
+  const auto add = [&](imufit::CommandRunner runner) {
+    commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(runner));
+  };
+  add(imufit::AddFitCommand(&app));
   add(imufit::AddApplyCommand(&app));
   add(imufit::AddSimulateCommand(&app));
 
