@@ -160,6 +160,11 @@ int RunFit(FitArguments args) {
   if (fit.status == FitStatus::kUndetermined) {
     std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n", args.samples.c_str());
     for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
+    std::fprintf(stderr,
+                 "  (the run: %lld samples, %lld in transitions, %lld trimmed after moves, %d windows used, %lld windows "
+                 "shorter than %d samples dropped)\n",
+                 stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used, stats.short_windows,
+                 args.windows.min_samples);
     return 1;
   }
   if (!fit.IsSolutionUsable()) {
@@ -257,6 +262,8 @@ CommandRunner AddFitCommand(CLI::App* root) {
                       "a window closes when its temperature has moved this far, degC")
       ->capture_default_str();
   command->add_option("--window-max-duration", w.max_duration_s, "a window closes after this many seconds (0: never)")
+      ->capture_default_str();
+  command->add_option("--window-min-samples", w.min_samples, "windows with fewer samples are dropped")
       ->capture_default_str();
   command->add_option("--max-iterations", f.max_iterations, "solver iterations at most, per pass")->capture_default_str();
   command->add_option("--threads", f.num_threads, "solver threads")->capture_default_str();

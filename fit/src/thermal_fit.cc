@@ -29,6 +29,8 @@ constexpr int kStartNodes = 9;
 constexpr double kSigmaFloorFraction = 0.1;
 // The robust spread of normalised residuals from their median absolute value (Gaussian).
 constexpr double kMadToSigma = 1.4826;
+// The robust loss never acts on normalised residuals below this (round-off of noise-free runs).
+constexpr double kMinLossThreshold = 1e-6;
 
 // One sensor's share of the problem.
 struct SensorProblem {
@@ -283,6 +285,14 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     const bool is_gyro = sensor == &gyro;
     SetSigmas(fit_windows, is_gyro, sensor);   // raw units until the start is known
     LinearStart(fit_windows, is_gyro, sensor);
+    if (!options.closed_form_start) {
+      // Keep only the nominal scale factors: the solver must find everything else itself.
+      for (int i = 0; i < sensor->parameters; ++i) {
+        const int c = i / kPolynomialTerms;
+        const bool nominal_scale = c >= kScaleCoefficient && c < kMisalignmentCoefficient && i % kPolynomialTerms == 0;
+        if (!nominal_scale) sensor->p0[i] = 0.0;
+      }
+    }
     SetSigmas(fit_windows, is_gyro, sensor);   // now in SI
     SetSteps(sensor);
     sensor->q.assign(sensor->parameters, 0.0);
@@ -344,7 +354,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       std::vector<double> components;
       for (double norm : normalised_norms(*sensor)) components.push_back(norm / std::sqrt(3.0));
       const double spread = kMadToSigma * Median(components);
-      sensor->loss_threshold = options.loss_scale * (spread > 0.0 ? spread : 1.0);
+      // Noise-free data (simulations) leave only round-off: the loss must not act on that.
+      sensor->loss_threshold = std::max(options.loss_scale * spread, kMinLossThreshold);
       if (options.loss == RobustLoss::kHuber) {
         sensor->loss->Reset(new ceres::HuberLoss(sensor->loss_threshold), ceres::TAKE_OWNERSHIP);
       } else {

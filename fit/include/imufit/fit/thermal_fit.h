@@ -57,6 +57,9 @@ struct FitOptions {
   double loss_scale = 3.0;
   // Levenberg-Marquardt iterations at most, per pass.
   int max_iterations = 50;
+  // Start from the closed-form solution (true), or from nominal scale factors and nothing else
+  // (false: slower; for checking that the solver converges from a poor start).
+  bool closed_form_start = true;
   // Threads for Ceres.
   int num_threads = 2;
   // Temperatures within this span count as one when counting distinct temperatures, degC.
