@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, imufit::CommandRunner>> commands;
-  // Each Add*Command adds one subcommand: the newest of all of them (parsed or not).
+  // The subcommand an Add*Command just registered is the last one defined. (get_subcommands()
+  // without a filter lists only the *parsed* subcommands, which is empty before parse().)
   const auto add = [&](imufit::CommandRunner runner) {
     commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(runner));
   };
