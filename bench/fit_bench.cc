@@ -36,6 +36,7 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 // Runs a command, returns wall seconds; *max_rss_kb gets the child's peak memory.
 double RunChild(const std::vector<std::string>& argv, long* max_rss_kb) {
+  std::fflush(stdout);  // or the child inherits (and prints again) what is buffered
   const auto start = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid == 0) {

@@ -66,7 +66,12 @@ class CsvReader {
   long header_line_ = 0;  // line number of the header, for errors about columns
   long long bytes_read_ = 0;
   std::vector<std::string> header_;
-  std::vector<std::string_view> fields_;
+  void AddField(std::string_view field) {
+    if (field_count_ == fields_.size()) fields_.resize(2 * fields_.size() + 16);
+    fields_[field_count_++] = field;
+  }
+  std::vector<std::string_view> fields_;  // the first field_count_ are the current row's
+  size_t field_count_ = 0;
   std::vector<std::string> unquoted_;  // storage for fields that had quotes
 };
 
