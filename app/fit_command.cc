@@ -2,7 +2,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <set>
 
 #include "commands.h"
 #include "imufit/fit/thermal_fit.h"
@@ -12,7 +11,7 @@
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
-#include "imufit/io/samples.h"
+#include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
 namespace {
@@ -30,32 +29,11 @@ struct FitArguments {
   bool no_g_sensitivity = false;
   bool validate = false;
   bool quiet = false;
+  double gyro_bias_stability_dph = 0.0;
+  double accel_bias_stability_ug = 0.0;
   FitOptions fit;
   WindowOptions windows;
 };
-
-// Reads a run into windows, refusing samples whose segment the plan does not have.
-std::vector<Window> ReadWindows(const Plan& plan, const std::string& samples_path, const WindowOptions& options,
-                                WindowStats* stats) {
-  std::set<int> ids;
-  for (const TableSegment& segment : plan.segments) ids.insert(segment.id);
-  SamplesReader reader(samples_path, /*require_segment=*/true);
-  WindowBuilder builder(options);
-  Sample sample;
-  int last_checked = kTransitionSegment;
-  while (reader.Next(&sample)) {
-    if (sample.segment != kTransitionSegment && sample.segment != last_checked) {
-      if (ids.count(sample.segment) == 0) {
-        reader.Fail("segment", "segment " + std::to_string(sample.segment) + " is not in the plan " + plan.path);
-      }
-      last_checked = sample.segment;
-    }
-    builder.Add(sample);
-  }
-  std::vector<Window> windows = builder.Finish();
-  *stats = builder.stats();
-  return windows;
-}
 
 std::string Format(const char* format, double a, double b) {
   char text[96];
@@ -130,6 +108,9 @@ YAML::Node Diagnostics(const FitSummary& fit, const WindowStats& stats, const Fi
   node["accel_temp_order"] = args.fit.accel_temp_order;
   node["g_sensitivity_fitted"] = args.fit.fit_g_sensitivity;
   node["loss"] = RobustLossName(args.fit.loss);
+  node["gyro_bias_stability_radps"] = args.fit.gyro_bias_stability_radps;
+  node["accel_bias_stability_mps2"] = args.fit.accel_bias_stability_mps2;
+  node["bias_correlation_s"] = args.fit.bias_correlation_s;
   return node;
 }
 
@@ -138,6 +119,8 @@ int RunFit(FitArguments args) {
   std::string error;
   if (!ParseRobustLoss(args.loss, &args.fit.loss, &error)) throw InputError("--loss", error);
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
+  args.fit.gyro_bias_stability_radps = args.gyro_bias_stability_dph / kRadToDeg / 3600.0;
+  args.fit.accel_bias_stability_mps2 = args.accel_bias_stability_ug * 1e-6 * kStandardGravity;
   if (const std::string problem = args.fit.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
   if (const std::string problem = args.windows.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
   if (args.check_samples.empty() != args.check_plan.empty() && args.check_samples.empty()) {
@@ -145,15 +128,15 @@ int RunFit(FitArguments args) {
   }
 
   const Plan plan = ReadPlan(args.plan);
-  WindowStats stats;
-  const std::vector<Window> windows = ReadWindows(plan, args.samples, args.windows, &stats);
+  const RunWindows run = ReadRunWindows(plan, args.samples, args.windows);
+  const std::vector<Window>& windows = run.windows;
+  const WindowStats& stats = run.stats;
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   std::vector<Window> check_windows;
   Plan check_plan;
   if (!args.check_samples.empty()) {
     check_plan = ReadPlan(args.check_plan.empty() ? args.plan : args.check_plan);
-    WindowStats check_stats;
-    check_windows = ReadWindows(check_plan, args.check_samples, args.windows, &check_stats);
+    check_windows = ReadRunWindows(check_plan, args.check_samples, args.windows).windows;
   }
 
   const FitSummary fit = FitThermalModel(windows, plan.site, plan.segments, args.fit);
@@ -256,6 +239,16 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--loss", args->loss, "robust loss: none, huber, cauchy")->capture_default_str();
   command->add_option("--loss-scale", f.loss_scale,
                       "where the robust loss acts, in robust spreads of the windows' normalised residuals")
+      ->capture_default_str();
+  command->add_option("--gyro-bias-stability-dph", args->gyro_bias_stability_dph,
+                      "the unit's in-run gyro bias stability, deg/h 1-sigma (bias instability and random walk over "
+                      "--bias-correlation): added to the reported uncertainty")
+      ->capture_default_str();
+  command->add_option("--accel-bias-stability-ug", args->accel_bias_stability_ug,
+                      "the unit's in-run accel bias stability, micro-g 1-sigma: added to the reported uncertainty")
+      ->capture_default_str();
+  command->add_option("--bias-correlation", f.bias_correlation_s,
+                      "seconds over which the wandering bias is taken as constant")
       ->capture_default_str();
   command->add_option("--trim", w.trim_s, "seconds dropped at the start of each segment occurrence")->capture_default_str();
   command->add_option("--window-temp-span", w.max_temp_span_c,

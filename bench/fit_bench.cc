@@ -25,6 +25,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/pipeline/run_windows.h"
 
 namespace fs = std::filesystem;
 
@@ -118,11 +119,7 @@ int main(int argc, char** argv) {
   double window_s = 1e300;
   for (int trial = 0; trial < 3; ++trial) {
     const auto start = std::chrono::steady_clock::now();
-    imufit::SamplesReader reader(samples_path, true);
-    imufit::WindowBuilder builder;
-    imufit::Sample sample;
-    while (reader.Next(&sample)) builder.Add(sample);
-    builder.Finish();
+    imufit::ReadRunWindows(plan, samples_path, imufit::WindowOptions());
     window_s = std::min(window_s, Seconds(start));
   }
   // 3. The whole command, as a user runs it.

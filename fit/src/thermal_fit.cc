@@ -46,6 +46,8 @@ struct SensorProblem {
   std::vector<Eigen::Vector3d> sigma;  // per window, SI
   std::vector<ceres::ResidualBlockId> blocks;
   ceres::LossFunctionWrapper* loss = nullptr;  // owned by the problem
+  Eigen::MatrixXd jacobian;  // of the normalised residuals in q, free parameters only
+  std::vector<int> free;     // jacobian column -> parameter
   double loss_threshold = 0.0;  // normalised residual norm where the robust loss starts
   std::vector<double> Parameters() const {
     std::vector<double> p(parameters);
@@ -189,6 +191,62 @@ std::string ParameterName(const SensorProblem& sensor, int parameter) {
          (k == 0 ? "" : k == 1 ? " (linear term)" : k == 2 ? " (quadratic term)" : " (cubic term)");
 }
 
+// Blocks of windows within which a slowly wandering bias is taken as constant: a new block starts
+// when a window starts more than `correlation_s` after the block's first window (or after a
+// gap of that length). Returns the block of each window.
+std::vector<int> TimeBlocks(const std::vector<FitWindow>& windows, double correlation_s) {
+  std::vector<int> order(windows.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return windows[a].window->start_s < windows[b].window->start_s; });
+  std::vector<int> block(windows.size(), 0);
+  int current = -1;
+  double block_start = 0.0;
+  for (int w : order) {
+    const double start = windows[w].window->start_s;
+    if (current < 0 || start - block_start > correlation_s) {
+      ++current;
+      block_start = start;
+    }
+    block[w] = current;
+  }
+  return block;
+}
+
+// The covariance (in q, all parameters) that a bias wandering by `stability` (SI, 1-sigma, per
+// axis, constant within a time block and independent between blocks) adds to the estimate. The
+// fit's own covariance cannot see it: a soak's common offset is absorbed by the temperature
+// polynomial, so the residuals do not show it. By linear response, an offset b on axis a of the
+// windows of block k moves the estimate by dq = C J^T dr with dr = b / sigma_w on those rows,
+// C = (J^T J)^-1 (`unscaled_covariance`); the blocks and axes add up independently.
+Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor, const Eigen::MatrixXd& unscaled_covariance,
+                                        const std::vector<int>& time_blocks, double stability) {
+  const int blocks = time_blocks.empty() ? 0 : *std::max_element(time_blocks.begin(), time_blocks.end()) + 1;
+  const int n = static_cast<int>(sensor.free.size());
+  Eigen::MatrixXd free_covariance(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) free_covariance(i, j) = unscaled_covariance(sensor.free[i], sensor.free[j]);
+  }
+  Eigen::MatrixXd added = Eigen::MatrixXd::Zero(n, n);
+  for (int block = 0; block < blocks; ++block) {
+    for (int axis = 0; axis < 3; ++axis) {
+      Eigen::VectorXd gradient = Eigen::VectorXd::Zero(n);  // J^T dr
+      for (size_t w = 0; w < time_blocks.size(); ++w) {
+        if (time_blocks[w] != block) continue;
+        const int row = 3 * static_cast<int>(w) + axis;
+        gradient += sensor.jacobian.row(row).transpose() * (stability / sensor.sigma[w](axis));
+      }
+      const Eigen::VectorXd shift = free_covariance * gradient;
+      added += shift * shift.transpose();
+    }
+  }
+  Eigen::MatrixXd ambient = Eigen::MatrixXd::Zero(sensor.parameters, sensor.parameters);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) ambient(sensor.free[i], sensor.free[j]) = added(i, j);
+  }
+  return ambient;
+}
+
 }  // namespace
 
 std::string RobustLossName(RobustLoss loss) {
@@ -215,6 +273,10 @@ std::string FitOptions::Validate() const {
   if (gyro_temp_order < 0 || gyro_temp_order > 3) return "the gyro temperature order must be 0..3";
   if (accel_temp_order < 0 || accel_temp_order > 3) return "the accel temperature order must be 0..3";
   if (!(loss_scale > 0.0)) return "the loss scale must be positive";
+  if (!(gyro_bias_stability_radps >= 0.0 && accel_bias_stability_mps2 >= 0.0)) {
+    return "the bias stability cannot be negative";
+  }
+  if (!(bias_correlation_s > 0.0)) return "the bias correlation time must be positive";
   if (max_iterations < 1) return "at least one iteration is needed";
   if (num_threads < 1) return "at least one thread is needed";
   if (!(distinct_temp_c > 0.0)) return "the distinct-temperature span must be positive";
@@ -387,11 +449,12 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     for (int r = 0; r < crs.num_rows; ++r) {
       for (int e = crs.rows[r]; e < crs.rows[r + 1]; ++e) jacobian(r, crs.cols[e]) = crs.values[e];
     }
-    std::vector<int> free;  // tangent column -> parameter
+    std::vector<int>& free = sensor->free;  // tangent column -> parameter
     for (int i = 0; i < sensor->parameters; ++i) {
       if (!sensor->IsHeld(i)) free.push_back(i);
     }
     assert(static_cast<int>(free.size()) == jacobian.cols());
+    sensor->jacobian = jacobian;
     const Eigen::VectorXd column_norm = jacobian.colwise().norm().transpose();
     for (int c = 0; c < jacobian.cols(); ++c) {
       if (column_norm(c) > 0.0) jacobian.col(c) /= column_norm(c);
@@ -459,6 +522,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   const std::vector<std::pair<const double*, const double*>> covariance_blocks = {{gyro.q.data(), gyro.q.data()},
                                                                                   {accel.q.data(), accel.q.data()}};
   const bool have_covariance = covariance.Compute(covariance_blocks, &problem);
+  const std::vector<int> time_blocks = TimeBlocks(fit_windows, options.bias_correlation_s);
   const Eigen::Matrix4d to_reference = RebaseTemperaturePolynomial(basis, TemperatureBasis::Reference());
   summary.model.basis = TemperatureBasis::Reference();
   summary.sigma.basis = TemperatureBasis::Reference();
@@ -472,6 +536,11 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       cov_q = block;
     }
     const double scale2 = is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2;
+    cov_q *= scale2;
+    const double stability = is_gyro ? options.gyro_bias_stability_radps : options.accel_bias_stability_mps2;
+    if (have_covariance && stability > 0.0) {
+      cov_q += BiasStabilityCovariance(*sensor, cov_q / scale2, time_blocks, stability);
+    }
     double* model_out = is_gyro ? summary.model.gyro.data() : summary.model.accel.data();
     double* sigma_out = is_gyro ? summary.sigma.gyro.data() : summary.sigma.accel.data();
     for (int c = 0; c < sensor->coefficients; ++c) {
@@ -479,7 +548,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       const Eigen::Vector4d coefficients = to_reference * Eigen::Map<const Eigen::Vector4d>(p.data() + first);
       Eigen::Matrix4d cov_p = cov_q.block<4, 4>(first, first);
       const Eigen::Vector4d step = Eigen::Map<const Eigen::Vector4d>(sensor->step.data() + first);
-      cov_p = step.asDiagonal() * cov_p * step.asDiagonal() * scale2;
+      cov_p = step.asDiagonal() * cov_p * step.asDiagonal();
       const Eigen::Matrix4d cov_reference = to_reference * cov_p * to_reference.transpose();
       for (int k = 0; k < kPolynomialTerms; ++k) {
         model_out[first + k] = coefficients(k);

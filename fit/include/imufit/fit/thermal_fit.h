@@ -24,7 +24,8 @@
 // the rank of the column-normalised Jacobian is checked as a backstop.
 //
 // Uncertainty. ceres::Covariance at the solution, scaled per sensor by the measured reduced
-// chi-square, converted exactly to powers of dT = T - 25 degC.
+// chi-square, plus (when the unit's bias stability is given) the covariance a bias that wanders
+// between time blocks adds, converted exactly to powers of dT = T - 25 degC.
 #ifndef IMUFIT_FIT_THERMAL_FIT_H_
 #define IMUFIT_FIT_THERMAL_FIT_H_
 
@@ -55,6 +56,14 @@ struct FitOptions {
   // the run's robust residual spread (1.4826 x the median absolute normalised residual).
   RobustLoss loss = RobustLoss::kHuber;
   double loss_scale = 3.0;
+  // The unit's in-run bias stability, 1-sigma (rad/s, m/s^2): how far its bias wanders over
+  // bias_correlation_s (bias instability and random walk together; `imufit allan` on a long static
+  // log measures it). A wandering bias looks like a bias to any estimator; it cannot be removed,
+  // but it is added to the reported uncertainty. 0: the uncertainty reflects white noise only.
+  double gyro_bias_stability_radps = 0.0;
+  double accel_bias_stability_mps2 = 0.0;
+  // Windows closer in time than this share one realisation of the wandering bias, s.
+  double bias_correlation_s = 100.0;
   // Levenberg-Marquardt iterations at most, per pass.
   int max_iterations = 50;
   // Start from the closed-form solution (true), or from nominal scale factors and nothing else

@@ -1,0 +1,31 @@
+#include "imufit/pipeline/run_windows.h"
+
+#include <set>
+
+#include "imufit/io/samples.h"
+
+namespace imufit {
+
+RunWindows ReadRunWindows(const Plan& plan, const std::string& samples_path, const WindowOptions& options) {
+  std::set<int> ids;
+  for (const TableSegment& segment : plan.segments) ids.insert(segment.id);
+  SamplesReader reader(samples_path, /*require_segment=*/true);
+  WindowBuilder builder(options);
+  Sample sample;
+  int last_checked = kTransitionSegment;
+  while (reader.Next(&sample)) {
+    if (sample.segment != kTransitionSegment && sample.segment != last_checked) {
+      if (ids.count(sample.segment) == 0) {
+        reader.Fail("segment", "segment " + std::to_string(sample.segment) + " is not in the plan " + plan.path);
+      }
+      last_checked = sample.segment;
+    }
+    builder.Add(sample);
+  }
+  RunWindows run;
+  run.windows = builder.Finish();
+  run.stats = builder.stats();
+  return run;
+}
+
+}  // namespace imufit
