@@ -197,6 +197,13 @@ int RunFit(FitArguments args) {
     std::printf("%s\n", fit.windows_downweighted > 10 ? " ..." : "");
   }
   PrintCoefficients(fit);
+  if (args.fit.gyro_bias_stability_radps == 0.0 || args.fit.accel_bias_stability_mps2 == 0.0) {
+    std::printf("  note: the sigmas reflect white noise only%s; give the unit's in-run bias stability\n"
+                "        (--gyro-bias-stability-dph, --accel-bias-stability-ug) if its bias wanders\n",
+                args.fit.gyro_bias_stability_radps == 0.0 && args.fit.accel_bias_stability_mps2 == 0.0
+                    ? ""
+                    : args.fit.gyro_bias_stability_radps == 0.0 ? " for the gyro" : " for the accelerometer");
+  }
   if (args.validate) {
     std::printf("  leave-one-temperature-out validation:\n");
     if (folds.empty()) std::printf("    not enough temperatures (needs at least 3 groups)\n");
