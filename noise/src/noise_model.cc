@@ -1,0 +1,209 @@
+#include "imufit/noise/noise_model.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace imufit {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// sqrt(2 ln 2 / pi): the flicker floor of the Allan deviation is 0.664 B.
+const double kFlickerFloor = std::sqrt(2.0 * std::log(2.0) / kPi);
+// A read-out slope must be within this of its target (-1/2 or +1/2) to count.
+constexpr double kReadoutSlopeTolerance = 0.25;
+
+struct Point {
+  double tau_s;
+  double variance;
+  double edf;
+};
+
+// Weighted least squares on the terms of `mask`; returns false when rank-deficient. `c` gets all
+// five coefficients (zeros outside the mask), `covariance` the 5x5 covariance (zeros outside).
+bool SolveSubset(const std::vector<Point>& points, const std::vector<double>& weight_sqrt, unsigned mask,
+                 Eigen::Matrix<double, 5, 1>* c, Eigen::Matrix<double, 5, 5>* covariance, double* cost) {
+  std::vector<int> terms;
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    if (mask & (1u << k)) terms.push_back(k);
+  }
+  const int rows = static_cast<int>(points.size());
+  const int cols = static_cast<int>(terms.size());
+  if (cols == 0 || rows < cols) return false;
+  Eigen::MatrixXd a(rows, cols);
+  Eigen::VectorXd b(rows);
+  for (int i = 0; i < rows; ++i) {
+    for (int j = 0; j < cols; ++j) a(i, j) = NoiseTermBasis(terms[j], points[i].tau_s) * weight_sqrt[i];
+    b(i) = points[i].variance * weight_sqrt[i];
+  }
+  // Unit-norm columns: the basis spans tau^-2 .. tau^2 over many decades.
+  Eigen::VectorXd scale(cols);
+  for (int j = 0; j < cols; ++j) {
+    scale(j) = a.col(j).norm();
+    if (!(scale(j) > 0.0)) return false;
+    a.col(j) /= scale(j);
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+  if (qr.rank() < cols) return false;
+  const Eigen::VectorXd x = qr.solve(b);
+  const Eigen::MatrixXd information = a.transpose() * a;
+  const Eigen::MatrixXd inverse = information.inverse();
+  c->setZero();
+  covariance->setZero();
+  for (int j = 0; j < cols; ++j) {
+    (*c)(terms[j]) = x(j) / scale(j);
+    for (int l = 0; l < cols; ++l) (*covariance)(terms[j], terms[l]) = inverse(j, l) / (scale(j) * scale(l));
+  }
+  *cost = (a * x - b).squaredNorm();
+  return true;
+}
+
+double SqrtSigma(double v, double s) {
+  return 0.5 * (std::sqrt(std::max(v, 0.0) + s) - std::sqrt(std::max(v - s, 0.0)));
+}
+
+}  // namespace
+
+const char* NoiseTermName(int term) {
+  static constexpr const char* kNames[kNoiseTerms] = {"quantization", "random_walk", "bias_instability",
+                                                      "rate_random_walk", "rate_ramp"};
+  return (term >= 0 && term < kNoiseTerms) ? kNames[term] : "?";
+}
+
+double NoiseTermBasis(int term, double tau_s) {
+  switch (term) {
+    case kQuantization: return 3.0 / (tau_s * tau_s);
+    case kRandomWalk: return 1.0 / tau_s;
+    case kBiasInstability: return kFlickerFloor * kFlickerFloor;
+    case kRateRandomWalk: return tau_s / 3.0;
+    case kRateRamp: return 0.5 * tau_s * tau_s;
+  }
+  return 0.0;
+}
+
+std::string NoiseFitOptions::Validate() const {
+  if (!(min_clusters >= 2.0)) return "min_clusters must be at least 2";
+  if (iterations < 1) return "iterations must be at least 1";
+  return "";
+}
+
+double NoiseFitSummary::ModelDeviation(double tau_s) const {
+  double sum = 0.0;
+  for (int k = 0; k < kNoiseTerms; ++k) sum += variance[k] * NoiseTermBasis(k, tau_s);
+  return std::sqrt(sum);
+}
+
+double NoiseFitSummary::TermDeviation(int term, double tau_s) const {
+  return std::sqrt(variance[term] * NoiseTermBasis(term, tau_s));
+}
+
+NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t n_samples,
+                              const NoiseFitOptions& options) {
+  NoiseFitSummary summary;
+  std::vector<Point> points;
+  for (const AllanPoint& p : all_points) {
+    const double clusters = static_cast<double>(n_samples) / static_cast<double>(p.m);
+    if (clusters < options.min_clusters || !(p.dev > 0.0) || !std::isfinite(p.edf) || !(p.edf > 0.0)) continue;
+    points.push_back({p.tau_s, p.dev * p.dev, p.edf});
+  }
+  summary.points_used = static_cast<int>(points.size());
+
+  // Classic read-outs from the measured curve.
+  if (!points.empty()) {
+    const auto lowest = std::min_element(points.begin(), points.end(),
+                                         [](const Point& a, const Point& b) { return a.variance < b.variance; });
+    summary.readout_bias_instability = std::sqrt(lowest->variance) / kFlickerFloor;
+    summary.readout_bias_tau_s = lowest->tau_s;
+    double best_arw = kReadoutSlopeTolerance;
+    double best_rrw = kReadoutSlopeTolerance;
+    for (size_t i = 0; i + 1 < points.size(); ++i) {
+      const double slope = 0.5 * std::log(points[i + 1].variance / points[i].variance) /
+                           std::log(points[i + 1].tau_s / points[i].tau_s);
+      const double dev = std::sqrt(points[i].variance);
+      if (std::fabs(slope + 0.5) < best_arw) {
+        best_arw = std::fabs(slope + 0.5);
+        summary.readout_random_walk = dev * std::sqrt(points[i].tau_s);  // sigma = N / sqrt(tau)
+      }
+      if (std::fabs(slope - 0.5) < best_rrw) {
+        best_rrw = std::fabs(slope - 0.5);
+        summary.readout_rate_random_walk = dev * std::sqrt(3.0 / points[i].tau_s);  // sigma = K sqrt(tau/3)
+      }
+    }
+  }
+
+  unsigned enabled_mask = 0;
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    if (options.enabled[k]) enabled_mask |= 1u << k;
+  }
+  if (points.size() < 2) {
+    summary.message = "too few points for a noise fit (" + std::to_string(points.size()) +
+                      " with at least " + std::to_string(static_cast<int>(options.min_clusters)) +
+                      " averaging intervals in the record)";
+    return summary;
+  }
+
+  Eigen::Matrix<double, 5, 1> best_c = Eigen::Matrix<double, 5, 1>::Zero();
+  Eigen::Matrix<double, 5, 5> best_covariance = Eigen::Matrix<double, 5, 5>::Zero();
+  unsigned best_mask = 0;
+  double best_cost = 0.0;
+  std::vector<double> model(points.size());
+  for (size_t i = 0; i < points.size(); ++i) model[i] = points[i].variance;
+  std::vector<double> weight_sqrt(points.size());
+  for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    // var(s^2) = 2 sigma^4 / edf  =>  weight^(1/2) = sqrt(edf / 2) / sigma^2.
+    for (size_t i = 0; i < points.size(); ++i) weight_sqrt[i] = std::sqrt(0.5 * points[i].edf) / model[i];
+    best_cost = std::numeric_limits<double>::infinity();
+    best_mask = 0;
+    for (unsigned mask = 1; mask < (1u << kNoiseTerms); ++mask) {
+      if ((mask & enabled_mask) != mask) continue;
+      Eigen::Matrix<double, 5, 1> c;
+      Eigen::Matrix<double, 5, 5> covariance;
+      double cost = 0.0;
+      if (!SolveSubset(points, weight_sqrt, mask, &c, &covariance, &cost)) continue;
+      if ((c.array() < 0.0).any()) continue;
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_mask = mask;
+        best_c = c;
+        best_covariance = covariance;
+      }
+    }
+    if (best_mask == 0) break;
+    for (size_t i = 0; i < points.size(); ++i) {
+      double v = 0.0;
+      for (int k = 0; k < kNoiseTerms; ++k) v += best_c(k) * NoiseTermBasis(k, points[i].tau_s);
+      model[i] = std::max(v, 1e-300);
+    }
+  }
+  if (best_mask == 0) {
+    summary.message = "the noise model could not be fitted (no feasible combination of terms)";
+    return summary;
+  }
+  int free_terms = 0;
+  for (int k = 0; k < kNoiseTerms; ++k) free_terms += (best_mask >> k) & 1u;
+  const int dof = static_cast<int>(points.size()) - free_terms;
+  summary.reduced_chi_square = dof > 0 ? best_cost / dof : std::nan("");
+  const double inflate = (dof > 0 && summary.reduced_chi_square > 1.0) ? summary.reduced_chi_square : 1.0;
+  summary.fitted = true;
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    summary.free[k] = (best_mask >> k) & 1u;
+    summary.variance[k] = best_c(k);
+    double variance_of_c = best_covariance(k, k);
+    if (!summary.free[k] && options.enabled[k]) {
+      // The uncertainty this term would have if it were freed alongside the others.
+      Eigen::Matrix<double, 5, 1> c;
+      Eigen::Matrix<double, 5, 5> covariance;
+      double cost = 0.0;
+      variance_of_c = SolveSubset(points, weight_sqrt, best_mask | (1u << k), &c, &covariance, &cost)
+                          ? covariance(k, k)
+                          : std::nan("");
+    }
+    summary.variance_sigma[k] = std::sqrt(std::max(0.0, variance_of_c) * inflate);
+    summary.value[k] = std::sqrt(summary.variance[k]);
+    summary.sigma[k] = options.enabled[k] ? SqrtSigma(summary.variance[k], summary.variance_sigma[k]) : 0.0;
+  }
+  return summary;
+}
+
+}  // namespace imufit

@@ -1,0 +1,176 @@
+// Tests of noise/: Allan-family deviations against the published reference values of NIST SP 1065
+// (section 12.5, the NBS 9-point set and the 1000-point pseudo-random set), confidence intervals
+// against Stable32's bounds, the statistics behind them, and the IEEE 952 noise fit on signals of
+// known truth.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "imufit/noise/allan.h"
+#include "imufit/noise/noise_model.h"
+#include "imufit/noise/statistics.h"
+
+namespace imufit {
+namespace {
+
+// Relative, worst case: the published deviations have 7 significant digits.
+constexpr double kReferenceTolerance = 1e-6;
+// Relative, worst case: Stable32 prints its bounds with 5 significant digits.
+constexpr double kStable32BoundTolerance = 1e-3;
+
+// ---------------------------------------------------------------- reference data sets
+
+// The NBS 9-point frequency data set (SP 1065 section 12.5, table 31).
+const std::vector<double> kNbs9 = {892, 809, 823, 798, 671, 644, 883, 903, 677};
+
+// The 1000-point test set of SP 1065 section 12.5 (and Riley's test suite): the minimal-standard
+// generator n(i+1) = 16807 n(i) mod (2^31 - 1), n(0) = 1234567890, scaled to (0, 1).
+std::vector<double> Nbs1000() {
+  std::vector<double> y;
+  long long n = 1234567890;
+  for (int i = 0; i < 1000; ++i) {
+    y.push_back(static_cast<double>(n) / 2147483647.0);
+    n = (16807 * n) % 2147483647;
+  }
+  return y;
+}
+
+TEST(NoiseReferenceTest, GeneratorMatchesPublishedStart) {
+  // The first numbers after the seed are printed in the test-suite description.
+  long long n = 1234567890;
+  const long long expected[] = {395529916, 1209410747, 633705974};
+  for (long long e : expected) {
+    n = (16807 * n) % 2147483647;
+    EXPECT_EQ(n, e);
+  }
+}
+
+struct Reference {
+  AllanEstimator estimator;
+  std::vector<double> devs;
+};
+
+void ExpectDeviations(const std::vector<double>& rates, const std::vector<int64_t>& factors,
+                      const std::vector<Reference>& references) {
+  for (const Reference& reference : references) {
+    AllanOptions options;
+    options.estimator = reference.estimator;
+    const AllanResult result = ComputeAllanFromRates(rates, 1.0, factors, options);
+    ASSERT_EQ(result.points.size(), reference.devs.size());
+    for (size_t i = 0; i < reference.devs.size(); ++i) {
+      EXPECT_NEAR(result.points[i].dev / reference.devs[i], 1.0, kReferenceTolerance)
+          << ToString(reference.estimator) << " m=" << factors[i] << " got " << result.points[i].dev
+          << " published " << reference.devs[i];
+    }
+  }
+}
+
+TEST(NoiseReferenceTest, Nbs9PointEveryEstimator) {
+  // SP 1065 table 32 (tau = 1, 2).
+  ExpectDeviations(kNbs9, {1, 2},
+                   {{AllanEstimator::kAdev, {91.22945, 115.8082}},
+                    {AllanEstimator::kOadev, {91.22945, 85.95287}},
+                    {AllanEstimator::kMdev, {91.22945, 74.78849}},
+                    {AllanEstimator::kTdev, {52.67135, 86.35831}},
+                    {AllanEstimator::kHdev, {70.80608, 116.7980}},
+                    {AllanEstimator::kOhdev, {70.80607, 85.61487}},
+                    {AllanEstimator::kTotdev, {91.22945, 93.90379}}});
+}
+
+TEST(NoiseReferenceTest, Nbs1000PointEveryEstimator) {
+  // SP 1065 table 34 (tau = 1, 10, 100); totdev by the doubly reflected method.
+  ExpectDeviations(Nbs1000(), {1, 10, 100},
+                   {{AllanEstimator::kAdev, {2.922319e-01, 9.965736e-02, 3.897804e-02}},
+                    {AllanEstimator::kOadev, {2.922319e-01, 9.159953e-02, 3.241343e-02}},
+                    {AllanEstimator::kMdev, {2.922319e-01, 6.172376e-02, 2.170921e-02}},
+                    {AllanEstimator::kTdev, {1.687202e-01, 3.563623e-01, 1.253382e+00}},
+                    {AllanEstimator::kHdev, {2.943883e-01, 1.052754e-01, 3.910860e-02}},
+                    {AllanEstimator::kOhdev, {2.943883e-01, 9.581083e-02, 3.237638e-02}},
+                    {AllanEstimator::kTotdev, {2.922319e-01, 9.134743e-02, 3.406530e-02}}});
+}
+
+// Stable32 1.60 on PHASE.DAT (the 1000-point set as phase), octave taus, confidence factor 0.683,
+// noise white FM (alpha = 0) at every tau: terms, min sigma, sigma, max sigma.
+struct Stable32Row {
+  int64_t m;
+  int64_t terms;
+  double lo, dev, hi;
+};
+struct Stable32Table {
+  AllanEstimator estimator;
+  std::vector<Stable32Row> rows;
+};
+
+const std::vector<Stable32Table>& Stable32Tables() {
+  static const std::vector<Stable32Table> tables = {
+      {AllanEstimator::kAdev,
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 499, 1.9787e-01, 2.0510e-01, 2.1319e-01},
+        {4, 249, 1.4201e-01, 1.4943e-01, 1.5815e-01}, {8, 124, 1.0254e-01, 1.1013e-01, 1.1971e-01},
+        {16, 61, 5.6510e-02, 6.2381e-02, 7.0567e-02}, {32, 30, 4.9153e-02, 5.6233e-02, 6.7635e-02},
+        {64, 14, 2.7109e-02, 3.2550e-02, 4.3537e-02}, {128, 6, 2.6481e-02, 3.3855e-02, 5.5744e-02}}},
+      {AllanEstimator::kOadev,
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 997, 1.9520e-01, 2.0102e-01, 2.0738e-01},
+        {4, 993, 1.3931e-01, 1.4479e-01, 1.5098e-01}, {8, 985, 1.0038e-01, 1.0570e-01, 1.1198e-01},
+        {16, 969, 5.7696e-02, 6.1915e-02, 6.7217e-02}, {32, 937, 4.3654e-02, 4.8082e-02, 5.4202e-02},
+        {64, 873, 3.1755e-02, 3.6237e-02, 4.3377e-02}, {128, 745, 2.3045e-02, 2.7674e-02, 3.7027e-02}}},
+      {AllanEstimator::kMdev,
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 996, 1.5336e-01, 1.5821e-01, 1.6355e-01},
+        {4, 990, 1.0322e-01, 1.0780e-01, 1.1304e-01}, {8, 978, 6.9840e-02, 7.4192e-02, 7.9481e-02},
+        {16, 954, 3.8022e-02, 4.1376e-02, 4.5809e-02}, {32, 906, 3.0466e-02, 3.4255e-02, 3.9933e-02},
+        {64, 810, 2.3687e-02, 2.7871e-02, 3.5511e-02}, {128, 618, 1.4874e-02, 1.8669e-02, 2.8584e-02}}},
+      {AllanEstimator::kTdev,
+       {{1, 999, 1.6463e-01, 1.6872e-01, 1.7313e-01}, {2, 996, 1.7709e-01, 1.8268e-01, 1.8885e-01},
+        {4, 990, 2.3838e-01, 2.4895e-01, 2.6106e-01}, {8, 978, 3.2258e-01, 3.4268e-01, 3.6710e-01},
+        {16, 954, 3.5123e-01, 3.8221e-01, 4.2317e-01}, {32, 906, 5.6287e-01, 6.3287e-01, 7.3777e-01},
+        {64, 810, 8.7525e-01, 1.0298e+00, 1.3122e+00}, {128, 618, 1.0992e+00, 1.3797e+00, 2.1124e+00}}},
+      {AllanEstimator::kHdev,
+       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01}, {2, 498, 1.9887e-01, 2.0716e-01, 2.1659e-01},
+        {4, 248, 1.4054e-01, 1.4890e-01, 1.5896e-01}, {8, 123, 1.0744e-01, 1.1649e-01, 1.2829e-01},
+        {16, 60, 5.3296e-02, 5.9589e-02, 6.8811e-02}, {32, 29, 4.6987e-02, 5.4697e-02, 6.8092e-02},
+        {64, 13, 2.4870e-02, 3.0569e-02, 4.3652e-02}, {128, 5, 2.8841e-02, 3.8060e-02, 7.3807e-02}}},
+      {AllanEstimator::kOhdev,
+       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01}, {2, 995, 1.9491e-01, 2.0125e-01, 2.0825e-01},
+        {4, 989, 1.3777e-01, 1.4368e-01, 1.5043e-01}, {8, 977, 1.0388e-01, 1.0987e-01, 1.1704e-01},
+        {16, 953, 5.6173e-02, 6.0638e-02, 6.6369e-02}, {32, 905, 4.0664e-02, 4.5095e-02, 5.1382e-02},
+        {64, 809, 2.9271e-02, 3.3824e-02, 4.1477e-02}, {128, 617, 2.3761e-02, 2.9147e-02, 4.1367e-02}}},
+      {AllanEstimator::kTotdev,
+       {{1, 999, 2.8707e-01, 2.9223e-01, 2.9768e-01}, {2, 999, 1.9592e-01, 2.0089e-01, 2.0625e-01},
+        {4, 999, 1.3947e-01, 1.4444e-01, 1.4998e-01}, {8, 999, 1.0039e-01, 1.0540e-01, 1.1126e-01},
+        {16, 999, 5.7732e-02, 6.1788e-02, 6.6839e-02}, {32, 999, 4.4255e-02, 4.8580e-02, 5.4484e-02},
+        {64, 999, 3.1639e-02, 3.5905e-02, 4.2546e-02}, {128, 999, 2.6406e-02, 3.1259e-02, 4.0383e-02},
+        {256, 999, 1.0734e-02, 1.3369e-02, 1.9924e-02}}},
+  };
+  return tables;
+}
+
+TEST(NoiseReferenceTest, ConfidenceIntervalsMatchStable32) {
+  const std::vector<double> rates = Nbs1000();
+  for (const Stable32Table& table : Stable32Tables()) {
+    AllanOptions options;
+    options.estimator = table.estimator;
+    options.edf_noise = EdfNoise::kWhiteFm;
+    std::vector<int64_t> expected_factors;
+    for (const Stable32Row& row : table.rows) expected_factors.push_back(row.m);
+    // The octave set stops where Stable32's does.
+    std::vector<int64_t> factors;
+    ASSERT_EQ(AveragingFactors(TauSpec(), table.estimator, 1000, 1.0, &factors), "");
+    EXPECT_EQ(factors, expected_factors) << ToString(table.estimator);
+    const AllanResult result = ComputeAllanFromRates(rates, 1.0, expected_factors, options);
+    for (size_t i = 0; i < table.rows.size(); ++i) {
+      const Stable32Row& row = table.rows[i];
+      const AllanPoint& point = result.points[i];
+      const std::string where = std::string(ToString(table.estimator)) + " m=" + std::to_string(row.m);
+      // Stable32 counts totdev terms as N - 2 phase points, others as we do.
+      EXPECT_EQ(point.terms, row.terms) << where;
+      EXPECT_NEAR(point.dev / row.dev, 1.0, kStable32BoundTolerance) << where;
+      EXPECT_NEAR(point.dev_lo / row.lo, 1.0, kStable32BoundTolerance) << where << " lo " << point.dev_lo;
+      EXPECT_NEAR(point.dev_hi / row.hi, 1.0, kStable32BoundTolerance) << where << " hi " << point.dev_hi;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace imufit
