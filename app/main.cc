@@ -27,7 +27,12 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, imufit::CommandRunner>> commands;
-  const auto add = [&](imufit::CommandRunner runner) { commands.emplace_back(app.get_subcommands().back(), std::move(runner)); };
+  // The subcommand an Add*Command just registered is the last one defined. (get_subcommands()
+  // without a filter lists only the *parsed* subcommands, which is empty before parse().)
+  const auto add = [&](imufit::CommandRunner runner) {
+    commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(runner));
+  };
+  add(imufit::AddFitCommand(&app));
   add(imufit::AddApplyCommand(&app));
   add(imufit::AddSimulateCommand(&app));
 

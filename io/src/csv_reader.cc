@@ -81,6 +81,7 @@ CsvReader::CsvReader(std::string path) : path_(std::move(path)) {
   while (NextLine(&line)) {
     if (Trim(line).empty() || line.front() == '#') continue;
     SplitLine(line);
+    header_line_ = line_number_;
     for (size_t i = 0; i < fields_.size(); ++i) {
       const std::string name(Trim(fields_[i]));
       if (name.empty()) {
@@ -112,7 +113,7 @@ int CsvReader::RequireColumn(std::string_view name) const {
   if (const std::optional<int> column = FindColumn(name)) return *column;
   std::string have;
   for (const std::string& h : header_) have += (have.empty() ? "" : ",") + h;
-  throw InputError(path_, 0, 0,
+  throw InputError(path_, header_line_, 0,
                    "no column " + QuoteForMessage(name) + " in the header (it has: " + have + ")");
 }
 

@@ -52,6 +52,12 @@ bool SamplesReader::Next(Sample* sample) {
   return true;
 }
 
+void SamplesReader::Fail(const std::string& column, const std::string& message) const {
+  const std::optional<int> index = csv_.FindColumn(column);
+  if (!index) csv_.FailRow(message);
+  csv_.Fail(*index, message);
+}
+
 SamplesWriter::SamplesWriter(std::string path, bool with_segment, const std::string& comment)
     : file_(std::move(path)), with_segment_(with_segment) {
   if (!comment.empty()) {

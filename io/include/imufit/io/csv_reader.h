@@ -63,6 +63,7 @@ class CsvReader {
   size_t end_ = 0;    // end of valid bytes in buffer_
   bool eof_ = false;
   long line_number_ = 0;
+  long header_line_ = 0;  // line number of the header, for errors about columns
   long long bytes_read_ = 0;
   std::vector<std::string> header_;
   std::vector<std::string_view> fields_;

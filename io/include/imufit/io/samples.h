@@ -27,6 +27,8 @@ class SamplesReader {
   bool Next(Sample* sample);
 
   bool has_segment() const { return segment_column_ >= 0; }
+  // Throws an InputError located at the current row and the column called `column`.
+  [[noreturn]] void Fail(const std::string& column, const std::string& message) const;
   const std::string& path() const { return csv_.path(); }
   long line_number() const { return csv_.line_number(); }
   long long bytes_read() const { return csv_.bytes_read(); }

@@ -1,0 +1,136 @@
+// imufit — the thermal fit: every coefficient of the model of SPEC.md section 1, with its cubic
+// temperature dependence, estimated jointly from all windows of a multi-position,
+// multi-temperature rate-table run.
+//
+// Problem. For each window w (windows.h) with true rate omega_w and specific force a_w (from the
+// plan, Earth rate and lever arms included, model/rate_table.h) and temperature x_w in the fit
+// basis (x = (T - centre) / half range, about [-1, 1] over the run):
+//
+//   minimise  sum_w rho(|(correct_g(B_w; x_w, a_w) - omega_w) / sigma_g,w|^2)
+//                 + rho(|(correct_a(A_w; x_w) - a_w) / sigma_a,w|^2)
+//
+// with window_cost.h's residual, the shared model's correction. Gyro and accelerometer
+// parameters form two blocks (84 and 48); terms above the chosen temperature order, and the
+// g-sensitivity when it is left out, are held at zero.
+//
+// Start. The forward model raw = K(x) truth + V(x) + H(x) a with K = diag(S) inv(M) is linear
+// in the polynomial coefficients of K, V and H: a weighted linear least-squares solve gives
+// them; S and M follow from K^-1 = M diag(1/S) at Chebyshev nodes, and a cubic fit through
+// those. Levenberg-Marquardt then converges in a few iterations.
+//
+// Observability. Before solving, the coverage of the run is checked coefficient group by group
+// (rate about each axis, gravity along +-each axis, distinct temperatures), so that a run that
+// cannot determine the model is refused with a message naming what is missing. After solving,
+// the rank of the column-normalised Jacobian is checked as a backstop.
+//
+// Uncertainty. ceres::Covariance at the solution, scaled per sensor by the measured reduced
+// chi-square, converted exactly to powers of dT = T - 25 degC.
+#ifndef IMUFIT_FIT_THERMAL_FIT_H_
+#define IMUFIT_FIT_THERMAL_FIT_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "imufit/fit/windows.h"
+#include "imufit/model/rate_table.h"
+#include "imufit/model/sensor_model.h"
+
+namespace imufit {
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+// "none", "huber", "cauchy".
+std::string RobustLossName(RobustLoss loss);
+// Parses a name; on failure returns false and sets `error` to a message listing the names.
+bool ParseRobustLoss(const std::string& name, RobustLoss* loss, std::string* error);
+
+struct FitOptions {
+  // Order of the temperature polynomial of every gyro / accelerometer coefficient (0..3).
+  int gyro_temp_order = 3;
+  int accel_temp_order = 3;
+  // Fit the gyro g-sensitivity H; when false it is held at zero.
+  bool fit_g_sensitivity = true;
+  // Robust loss on each window's normalised residual, and where it starts to act, in units of
+  // the run's robust residual spread (1.4826 x the median absolute normalised residual).
+  RobustLoss loss = RobustLoss::kHuber;
+  double loss_scale = 3.0;
+  // Levenberg-Marquardt iterations at most, per pass.
+  int max_iterations = 50;
+  // Start from the closed-form solution (true), or from nominal scale factors and nothing else
+  // (false: slower; for checking that the solver converges from a poor start).
+  bool closed_form_start = true;
+  // Threads for Ceres.
+  int num_threads = 2;
+  // Temperatures within this span count as one when counting distinct temperatures, degC.
+  double distinct_temp_c = 1.0;
+  // A rate segment excites an axis when its true rate about it is at least this, rad/s.
+  double min_excitation_rate_radps = 0.1;
+  // The backstop rank check: a direction of the column-normalised Jacobian whose singular value
+  // is below this fraction of the largest is undetermined.
+  double rank_tolerance = 1e-8;
+
+  // An empty string when usable, else what is wrong.
+  std::string Validate() const;
+};
+
+// The residual of one window after the fit, SI units, body frame.
+struct WindowResidual {
+  int window = 0;                 // index into the windows given to the fit
+  Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_sigma_radps = Eigen::Vector3d::Zero();  // the weights used
+  Eigen::Vector3d accel_sigma_mps2 = Eigen::Vector3d::Zero();
+  bool downweighted = false;      // the robust loss acted on this window
+};
+
+enum class FitStatus {
+  kNotRun,        // FitThermalModel() has not run
+  kConverged,     // solved; the calibration is usable
+  kNotConverged,  // the solver stopped without converging
+  kUndetermined,  // the data do not determine the model; see `undetermined`
+};
+
+struct FitSummary {
+  FitStatus status = FitStatus::kNotRun;
+  std::string termination = "not run";  // the solver's own words
+  int iterations = -1;                  // over all passes
+  double initial_cost = -1.0;           // Ceres cost, first pass
+  double final_cost = -1.0;             // Ceres cost, last pass
+  int windows_used = 0;
+  int windows_downweighted = 0;
+  // What the data do not determine, one readable finding each, with what would determine it.
+  std::vector<std::string> undetermined;
+  // Distinct temperatures of the run (cluster centres), degC, and the range it covers.
+  std::vector<double> distinct_temps_c;
+  std::array<double, 2> temp_range_c{0.0, 0.0};
+  // Residual RMS over windows and axes, SI, unweighted.
+  double gyro_rms_radps = -1.0;
+  double accel_rms_mps2 = -1.0;
+  // Reduced chi-square of the normalised residuals, per sensor (the covariance scale).
+  double gyro_reduced_chi2 = -1.0;
+  double accel_reduced_chi2 = -1.0;
+  // The fitted model in powers of dT = T - 25 degC, and the 1-sigma of every parameter.
+  SensorModel model;
+  SensorModel sigma;
+  std::vector<WindowResidual> residuals;
+
+  bool IsSolutionUsable() const { return status == FitStatus::kConverged; }
+  // One line: status, residuals, iterations.
+  std::string BriefReport() const;
+  // Several lines: the brief report, windows, temperatures, findings, termination.
+  std::string FullReport() const;
+};
+
+// Fits the model to `windows` of a run on `site` whose segments are `segments` (every window's
+// segment id must be among them: a programmer error otherwise).
+FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& site,
+                           const std::vector<TableSegment>& segments, const FitOptions& options);
+
+// Clusters temperatures: sorted, a new cluster whenever a value lies more than `span_c` above
+// the first of the current cluster. Returns the cluster means.
+std::vector<double> DistinctTemperatures(std::vector<double> temps_c, double span_c);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FIT_THERMAL_FIT_H_

@@ -1,0 +1,65 @@
+// imufit — how well a calibration predicts data it was not fitted on.
+//
+// PredictWindows() corrects each window's mean raw output with a calibration (through the shared
+// model, exactly as `imufit apply` corrects a sample: accelerometer first, the gyro's
+// g-sensitivity from the corrected specific force) and compares it with the window's truth.
+// Because the model is affine in the raw outputs at a fixed temperature, the correction of a
+// window's mean is the mean of its samples' corrections.
+//
+// LeaveOneTemperatureOut() refits without each interior temperature group in turn and predicts
+// the windows left out. The lowest and highest groups are not left out: that would test
+// extrapolation, not calibration.
+#ifndef IMUFIT_FIT_VALIDATION_H_
+#define IMUFIT_FIT_VALIDATION_H_
+
+#include <string>
+#include <vector>
+
+#include "imufit/fit/thermal_fit.h"
+#include "imufit/fit/windows.h"
+
+namespace imufit {
+
+// The prediction error of one window, SI, body frame: corrected minus true.
+struct WindowError {
+  int window = 0;
+  int segment = 0;
+  double temp_c = 0.0;
+  Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+};
+
+// Errors aggregated over the windows of one segment (or of one held-out group).
+struct ErrorStats {
+  int segment = -1;  // -1 for "all"
+  int windows = 0;
+  double gyro_rms_radps = 0.0;
+  double gyro_max_radps = 0.0;
+  double accel_rms_mps2 = 0.0;
+  double accel_max_mps2 = 0.0;
+};
+
+std::vector<WindowError> PredictWindows(const SensorModel& model, const std::vector<Window>& windows,
+                                        const TableSite& site, const std::vector<TableSegment>& segments);
+
+// All windows together.
+ErrorStats SummariseErrors(const std::vector<WindowError>& errors);
+// One entry per segment id, in id order.
+std::vector<ErrorStats> ErrorsBySegment(const std::vector<WindowError>& errors);
+
+struct HeldOutGroup {
+  double temp_c = 0.0;       // centre of the held-out group
+  bool fitted = false;       // false: the rest of the run did not determine the model
+  std::string why_not;       // when !fitted
+  ErrorStats errors;         // of the held-out windows
+};
+
+// Temperature groups: the distinct temperatures of the run, or at most `max_groups` bands of
+// equal width when there are more (a ramp).
+std::vector<HeldOutGroup> LeaveOneTemperatureOut(const std::vector<Window>& windows, const TableSite& site,
+                                                 const std::vector<TableSegment>& segments,
+                                                 const FitOptions& options, int max_groups = 6);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FIT_VALIDATION_H_

@@ -1,0 +1,98 @@
+// imufit — window statistics: a run reduced, in one streaming pass, to what the fit needs.
+//
+// Each occurrence of a segment (a contiguous stretch of samples with one id >= 0) is cut into
+// windows. A window closes when its temperature has moved by more than max_temp_span_c since it
+// opened (so on a ramp the temperature is effectively constant within each window and the fit
+// stays exact: a cubic evaluated at the mean temperature differs from the mean of the cubic by
+// at most c2 * span^2 / 4 plus smaller terms), when it reaches max_duration_s, or when the
+// occurrence ends. The first trim_s seconds of every occurrence are dropped (the table settles
+// after a move). Samples with segment -1 are skipped. Only running sums are kept: memory does
+// not grow with the run.
+//
+// Units: whatever the samples carry (raw for a fit, SI for a check of a corrected run).
+#ifndef IMUFIT_FIT_WINDOWS_H_
+#define IMUFIT_FIT_WINDOWS_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "imufit/model/sample.h"
+
+namespace imufit {
+
+struct WindowOptions {
+  // Seconds dropped at the start of every occurrence of a segment, while the table settles.
+  double trim_s = 0.5;
+  // A window closes once its temperature has moved this far from where it opened, degC.
+  double max_temp_span_c = 0.5;
+  // A window closes after this many seconds (0: only at the end of the occurrence).
+  double max_duration_s = 0.0;
+  // Windows with fewer samples are dropped (counted in WindowStats::short_windows).
+  int min_samples = 20;
+
+  // An empty string when usable, else what is wrong.
+  std::string Validate() const;
+};
+
+// The statistics of one window.
+struct Window {
+  int segment = 0;
+  int occurrence = 0;      // 0 for the first contiguous stretch of this segment id, 1 ...
+  long long samples = 0;
+  double start_s = 0.0;
+  double end_s = 0.0;
+  double temp_c = 0.0;     // mean temperature reading
+  Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_std = Eigen::Vector3d::Zero();   // sample standard deviation
+  Eigen::Vector3d accel_std = Eigen::Vector3d::Zero();
+};
+
+// Counts of what went into the windows and what did not.
+struct WindowStats {
+  long long samples = 0;             // all samples seen
+  long long transition_samples = 0;  // segment -1
+  long long trimmed_samples = 0;     // dropped by trim_s
+  long long short_windows = 0;       // windows dropped for having fewer than min_samples
+  double min_temp_c = 0.0;           // over all samples
+  double max_temp_c = 0.0;
+  double first_time_s = 0.0;
+  double last_time_s = 0.0;
+};
+
+class WindowBuilder {
+ public:
+  explicit WindowBuilder(const WindowOptions& options = WindowOptions());
+
+  // Adds the next sample of the run (in time order).
+  void Add(const Sample& sample);
+  // Closes the open window and returns all windows, in time order.
+  std::vector<Window> Finish();
+  const WindowStats& stats() const { return stats_; }
+
+ private:
+  void Close();
+
+  WindowOptions options_;
+  WindowStats stats_;
+  std::vector<Window> windows_;
+  std::vector<std::pair<int, int>> occurrences_;  // segment id -> occurrences so far
+  // The open window: running mean and sum of squared deviations (Welford), per channel.
+  bool open_ = false;
+  int current_segment_ = kTransitionSegment;
+  int current_occurrence_ = 0;
+  double occurrence_start_s_ = 0.0;
+  double window_first_temp_c_ = 0.0;
+  long long n_ = 0;
+  double start_s_ = 0.0;
+  double end_s_ = 0.0;
+  double temp_mean_ = 0.0;
+  Eigen::Matrix<double, 6, 1> mean_ = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> m2_ = Eigen::Matrix<double, 6, 1>::Zero();
+};
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FIT_WINDOWS_H_

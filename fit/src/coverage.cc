@@ -1,0 +1,131 @@
+#include "coverage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+
+namespace imufit::internal {
+namespace {
+
+constexpr char kAxis[] = "xyz";
+// Gravity counts as "along" an axis when its component there is at least half of g.
+constexpr double kAlongFraction = 0.5;
+
+const char* Plural(size_t n, const char* one, const char* many) { return n == 1 ? one : many; }
+
+// Distinct temperatures of the windows that satisfy `pick`.
+std::vector<double> TempsWhere(const std::vector<FitWindow>& windows, const FitOptions& options,
+                               const std::function<bool(const FitWindow&)>& pick) {
+  std::vector<double> temps;
+  for (const FitWindow& w : windows) {
+    if (pick(w)) temps.push_back(w.window->temp_c);
+  }
+  return DistinctTemperatures(temps, options.distinct_temp_c);
+}
+
+// "no positions with gravity along -y" or "gravity along -y at only 2 distinct temperatures
+// (25.0, 55.0 degC), the gyro temperature order 3 needs 4"; empty when enough.
+std::string Shortfall(const std::vector<double>& temps, size_t needed, const std::string& what,
+                      const std::string& none, const char* sensor, int order) {
+  if (temps.empty()) return none;
+  if (temps.size() >= needed) return "";
+  char text[256];
+  std::snprintf(text, sizeof text, "%s at only %zu distinct %s (%s), the %s temperature order %d needs %zu",
+                what.c_str(), temps.size(), Plural(temps.size(), "temperature", "temperatures"),
+                FormatTemperatures(temps).c_str(), sensor, order, needed);
+  return text;
+}
+
+std::string OffDiagonalColumn(int column) {
+  std::string names;
+  for (int row = 0; row < 3; ++row) {
+    if (row == column) continue;
+    names += (names.empty() ? "" : ", ") + std::string(1, kAxis[row]) + kAxis[column];
+  }
+  return names;
+}
+
+}  // namespace
+
+std::string FormatTemperatures(const std::vector<double>& temps_c) {
+  std::string text;
+  char value[32];
+  for (size_t i = 0; i < temps_c.size() && i < 8; ++i) {
+    std::snprintf(value, sizeof value, "%.1f", temps_c[i]);
+    text += (i ? ", " : "") + std::string(value);
+  }
+  if (temps_c.size() > 8) text += ", ...";
+  return text + " degC";
+}
+
+std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, double gravity_mps2,
+                                       const FitOptions& options) {
+  std::vector<std::string> findings;
+  if (windows.empty()) {
+    findings.push_back("the run has no usable windows: no samples with a segment id of the plan that last longer "
+                       "than the trim time");
+    return findings;
+  }
+  const std::vector<double> all_temps = TempsWhere(windows, options, [](const FitWindow&) { return true; });
+  const int gyro_order = options.gyro_temp_order;
+  const int accel_order = options.accel_temp_order;
+  const size_t most_needed = static_cast<size_t>(std::max(gyro_order, accel_order)) + 1;
+  bool temps_short = false;
+  if (all_temps.size() < most_needed) {
+    temps_short = true;
+    const char* model = most_needed == 4 ? "a cubic" : most_needed == 3 ? "a quadratic" : "a linear";
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "too few temperatures for %s temperature model: %zu distinct %s (%s), at least %zu needed "
+                  "(add soaks at other temperatures, or fit a lower order with --gyro-temp-order / "
+                  "--accel-temp-order)",
+                  model, all_temps.size(), Plural(all_temps.size(), "temperature", "temperatures"),
+                  FormatTemperatures(all_temps).c_str(), most_needed);
+    findings.push_back(text);
+  }
+  // With too few temperatures overall, ask each group only to be present at all.
+  const size_t gyro_needed = temps_short ? 1 : static_cast<size_t>(gyro_order) + 1;
+  const size_t accel_needed = temps_short ? 1 : static_cast<size_t>(accel_order) + 1;
+  const double along = kAlongFraction * gravity_mps2;
+
+  for (int j = 0; j < 3; ++j) {
+    const std::string axis(1, kAxis[j]);
+    // Gyro column j of K = diag(S) inv(M): scale j and the misalignments of column j.
+    const auto spinning = TempsWhere(windows, options, [&](const FitWindow& w) {
+      return std::abs(w.truth.omega_radps(j)) >= options.min_excitation_rate_radps;
+    });
+    const std::string rate = Shortfall(spinning, gyro_needed, "rate segments about " + axis,
+                                       "no rate segments about the " + axis + " axis (the table must spin with " +
+                                           axis + " up or down)",
+                                       "gyro", gyro_order);
+    if (!rate.empty()) {
+      findings.push_back("gyro scale " + axis + " and misalignment " + OffDiagonalColumn(j) +
+                         " are undetermined: " + rate);
+    }
+    // Gravity along +j and -j separates H's column j (gyro) and K's column j (accel) from the bias.
+    const auto up = TempsWhere(windows, options, [&](const FitWindow& w) { return w.truth.a_mps2(j) >= along; });
+    const auto down = TempsWhere(windows, options, [&](const FitWindow& w) { return w.truth.a_mps2(j) <= -along; });
+    for (const auto& [sensor, order, needed] :
+         {std::tuple<const char*, int, size_t>{"gyro", gyro_order, gyro_needed},
+          std::tuple<const char*, int, size_t>{"accel", accel_order, accel_needed}}) {
+      if (std::string(sensor) == "gyro" && !options.fit_g_sensitivity) continue;
+      std::string missing = Shortfall(up, needed, "gravity along +" + axis,
+                                      "no positions with gravity along +" + axis, sensor, order);
+      const std::string missing_down = Shortfall(down, needed, "gravity along -" + axis,
+                                                 "no positions with gravity along -" + axis, sensor, order);
+      if (!missing_down.empty()) missing += (missing.empty() ? "" : "; ") + missing_down;
+      if (missing.empty()) continue;
+      if (std::string(sensor) == "gyro") {
+        findings.push_back("gyro g_sensitivity column " + axis + " (x" + axis + ", y" + axis + ", z" + axis +
+                           ") is undetermined: " + missing + " (or leave g-sensitivity out with --no-g-sensitivity)");
+      } else {
+        findings.push_back("accel scale " + axis + " and misalignment " + OffDiagonalColumn(j) +
+                           " are undetermined: " + missing);
+      }
+    }
+  }
+  return findings;
+}
+
+}  // namespace imufit::internal

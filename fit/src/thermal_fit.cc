@@ -1,0 +1,540 @@
+#include "imufit/fit/thermal_fit.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <numeric>
+
+#include <ceres/ceres.h>
+#include <Eigen/Dense>
+#include <Eigen/SVD>
+
+#include "coverage.h"
+#include "imufit/fit/window_cost.h"
+
+namespace imufit {
+namespace {
+
+using internal::FitWindow;
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr char kAxis[] = "xyz";
+// Chebyshev nodes used to turn the closed-form K(x) into S(x) and M(x).
+constexpr int kStartNodes = 9;
+// Floor on a window's noise, as a fraction of the median window noise of its sensor: a window
+// whose samples happen to be all equal must not get an infinite weight.
+constexpr double kSigmaFloorFraction = 0.1;
+// The robust spread of normalised residuals from their median absolute value (Gaussian).
+constexpr double kMadToSigma = 1.4826;
+// The robust loss never acts on normalised residuals below this (round-off of noise-free runs).
+constexpr double kMinLossThreshold = 1e-6;
+
+// One sensor's share of the problem.
+struct SensorProblem {
+  const char* name = "";
+  int parameters = 0;
+  int coefficients = 0;
+  int order = 3;
+  bool with_g_sensitivity = false;
+  std::vector<double> p0;    // start, fit basis
+  std::vector<double> step;  // scale of each parameter
+  std::vector<double> q;     // the solver's variables
+  std::vector<int> held;     // parameters held at zero (p0 = 0 there)
+  std::vector<Eigen::Vector3d> sigma;  // per window, SI
+  std::vector<ceres::ResidualBlockId> blocks;
+  ceres::LossFunctionWrapper* loss = nullptr;  // owned by the problem
+  double loss_threshold = 0.0;  // normalised residual norm where the robust loss starts
+  std::vector<double> Parameters() const {
+    std::vector<double> p(parameters);
+    for (int i = 0; i < parameters; ++i) p[i] = p0[i] + step[i] * q[i];
+    return p;
+  }
+  bool IsHeld(int i) const { return std::find(held.begin(), held.end(), i) != held.end(); }
+};
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+// What a window's sensor responds to: (truth, specific force) for its rows.
+const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) { return gyro ? w.truth.omega_radps : w.truth.a_mps2; }
+const Eigen::Vector3d& RawFor(const FitWindow& w, bool gyro) {
+  return gyro ? w.window->gyro_mean : w.window->accel_mean;
+}
+Eigen::Vector3d RawSigmaFor(const FitWindow& w, bool gyro) {
+  const Eigen::Vector3d& std_dev = gyro ? w.window->gyro_std : w.window->accel_std;
+  return std_dev / std::sqrt(static_cast<double>(w.window->samples));
+}
+
+// The closed-form start of one sensor: raw_i = sum_j K_ij(x) truth_j + V_i(x) + sum_j H_ij(x) a_j
+// by weighted linear least squares per axis, then S and M from K^-1 = M diag(1/S).
+void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem* sensor) {
+  const int terms = sensor->order + 1;
+  const int blocks = 4 + (sensor->with_g_sensitivity ? 3 : 0);  // K row (3), V (1), H row (3)
+  const int n = blocks * terms;
+  const int m = static_cast<int>(windows.size());
+  // K_ij, V_i, H_ij polynomials in the fit basis.
+  Eigen::Matrix<double, 9, 4> K = Eigen::Matrix<double, 9, 4>::Zero();
+  Eigen::Matrix<double, 3, 4> V = Eigen::Matrix<double, 3, 4>::Zero();
+  Eigen::Matrix<double, 9, 4> H = Eigen::Matrix<double, 9, 4>::Zero();
+  for (int i = 0; i < 3; ++i) {
+    Eigen::MatrixXd design(m, n);
+    Eigen::VectorXd rhs(m);
+    for (int r = 0; r < m; ++r) {
+      const FitWindow& w = windows[r];
+      const double weight = 1.0 / sensor->sigma[r](i);  // SI sigma: a common scale per axis is harmless
+      Eigen::Matrix<double, 7, 1> regressor;
+      regressor << TruthFor(w, gyro), 1.0, w.truth.a_mps2;
+      double power = 1.0;
+      for (int k = 0; k < terms; ++k, power *= w.x) {
+        for (int b = 0; b < blocks; ++b) design(r, b * terms + k) = weight * regressor(b) * power;
+      }
+      rhs(r) = weight * RawFor(w, gyro)(i);
+    }
+    const Eigen::VectorXd column_norm = design.colwise().norm().transpose().cwiseMax(1e-300);
+    const Eigen::VectorXd solution =
+        design.array().rowwise().operator/(column_norm.transpose().array()).matrix().completeOrthogonalDecomposition().solve(rhs).cwiseQuotient(column_norm);
+    for (int k = 0; k < terms; ++k) {
+      for (int j = 0; j < 3; ++j) K(3 * i + j, k) = solution(j * terms + k);
+      V(i, k) = solution(3 * terms + k);
+      if (sensor->with_g_sensitivity) {
+        for (int j = 0; j < 3; ++j) H(3 * i + j, k) = solution((4 + j) * terms + k);
+      }
+    }
+  }
+  // S and M at Chebyshev nodes over the run's temperatures, then a polynomial through them.
+  double x_min = windows.front().x;
+  double x_max = x_min;
+  for (const FitWindow& w : windows) {
+    x_min = std::min(x_min, w.x);
+    x_max = std::max(x_max, w.x);
+  }
+  Eigen::MatrixXd vandermonde(kStartNodes, terms);
+  Eigen::MatrixXd values(kStartNodes, 9);  // S x, y, z, M xy xz yx yz zx zy
+  for (int node = 0; node < kStartNodes; ++node) {
+    const double x = 0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(M_PI * (node + 0.5) / kStartNodes);
+    Eigen::Matrix3d k_at;
+    for (int e = 0; e < 9; ++e) {
+      const Eigen::Vector4d c = K.row(e).transpose();
+      k_at(e / 3, e % 3) = EvaluateTemperaturePolynomial(c.data(), x);
+    }
+    const Eigen::Matrix3d k_inverse = k_at.inverse();  // = M diag(1/S)
+    for (int j = 0; j < 3; ++j) values(node, j) = 1.0 / k_inverse(j, j);
+    for (int m_index = 0; m_index < 6; ++m_index) {
+      const int row = kMisalignmentRow[m_index];
+      const int col = kMisalignmentCol[m_index];
+      values(node, 3 + m_index) = k_inverse(row, col) * values(node, col);
+    }
+    double power = 1.0;
+    for (int k = 0; k < terms; ++k, power *= x) vandermonde(node, k) = power;
+  }
+  const Eigen::MatrixXd fitted = vandermonde.colPivHouseholderQr().solve(values);  // terms x 9
+
+  sensor->p0.assign(sensor->parameters, 0.0);
+  const auto set = [&](int coefficient, int k, double value) { sensor->p0[coefficient * kPolynomialTerms + k] = value; };
+  for (int k = 0; k < terms; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      set(kBiasCoefficient + i, k, V(i, k));
+      set(kScaleCoefficient + i, k, fitted(k, i));
+    }
+    for (int m_index = 0; m_index < 6; ++m_index) set(kMisalignmentCoefficient + m_index, k, fitted(k, 3 + m_index));
+    if (sensor->with_g_sensitivity) {
+      for (int h = 0; h < 9; ++h) set(kGSensitivityCoefficient + h, k, H(h, k));
+    }
+  }
+}
+
+// Parameter magnitudes for the solver's scaling: about 1 mrad/s (gyro) or 1 mm/s^2 (accel) of
+// bias, 1e-3 of scale, 1 mrad of misalignment, 1e-4 rad/s per m/s^2 of g-sensitivity.
+void SetSteps(SensorProblem* sensor) {
+  sensor->step.assign(sensor->parameters, 1.0);
+  for (int c = 0; c < sensor->coefficients; ++c) {
+    double step = 1e-3;
+    const int row = c < kMisalignmentCoefficient ? (c % 3) : c >= kGSensitivityCoefficient ? (c - kGSensitivityCoefficient) / 3 : 0;
+    const double scale = std::abs(sensor->p0[(kScaleCoefficient + row) * kPolynomialTerms]);
+    if (c < kMisalignmentCoefficient) step = 1e-3 * scale;               // bias, scale
+    else if (c >= kGSensitivityCoefficient) step = 1e-4 * scale;         // g-sensitivity
+    for (int k = 0; k < kPolynomialTerms; ++k) sensor->step[c * kPolynomialTerms + k] = step > 0.0 ? step : 1e-3;
+  }
+}
+
+// Window noise in SI: the noise of the raw mean divided by the scale factor, floored.
+void SetSigmas(const std::vector<FitWindow>& windows, bool gyro, SensorProblem* sensor) {
+  sensor->sigma.assign(windows.size(), Eigen::Vector3d::Ones());
+  for (int axis = 0; axis < 3; ++axis) {
+    const double scale = std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
+    std::vector<double> values;
+    for (size_t w = 0; w < windows.size(); ++w) {
+      sensor->sigma[w](axis) = RawSigmaFor(windows[w], gyro)(axis) / (scale > 0.0 ? scale : 1.0);
+      values.push_back(sensor->sigma[w](axis));
+    }
+    const double floor = kSigmaFloorFraction * Median(values);
+    for (size_t w = 0; w < windows.size(); ++w) {
+      double& s = sensor->sigma[w](axis);
+      s = floor > 0.0 ? std::max(s, floor) : 1.0;
+    }
+  }
+}
+
+std::string ParameterName(const SensorProblem& sensor, int parameter) {
+  const CoefficientName& name = kCoefficientNames[parameter / kPolynomialTerms];
+  const int k = parameter % kPolynomialTerms;
+  return std::string(sensor.name) + " " + name.group + " " + name.axis +
+         (k == 0 ? "" : k == 1 ? " (linear term)" : k == 2 ? " (quadratic term)" : " (cubic term)");
+}
+
+}  // namespace
+
+std::string RobustLossName(RobustLoss loss) {
+  switch (loss) {
+    case RobustLoss::kNone: return "none";
+    case RobustLoss::kHuber: return "huber";
+    case RobustLoss::kCauchy: return "cauchy";
+  }
+  return "?";
+}
+
+bool ParseRobustLoss(const std::string& name, RobustLoss* loss, std::string* error) {
+  for (RobustLoss candidate : {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    if (name == RobustLossName(candidate)) {
+      *loss = candidate;
+      return true;
+    }
+  }
+  *error = "\"" + name + "\" is not a robust loss (none, huber, cauchy)";
+  return false;
+}
+
+std::string FitOptions::Validate() const {
+  if (gyro_temp_order < 0 || gyro_temp_order > 3) return "the gyro temperature order must be 0..3";
+  if (accel_temp_order < 0 || accel_temp_order > 3) return "the accel temperature order must be 0..3";
+  if (!(loss_scale > 0.0)) return "the loss scale must be positive";
+  if (max_iterations < 1) return "at least one iteration is needed";
+  if (num_threads < 1) return "at least one thread is needed";
+  if (!(distinct_temp_c > 0.0)) return "the distinct-temperature span must be positive";
+  if (!(min_excitation_rate_radps > 0.0)) return "the minimum excitation rate must be positive";
+  if (!(rank_tolerance > 0.0 && rank_tolerance < 1.0)) return "the rank tolerance must be in (0, 1)";
+  return "";
+}
+
+std::vector<double> DistinctTemperatures(std::vector<double> temps_c, double span_c) {
+  std::sort(temps_c.begin(), temps_c.end());
+  std::vector<double> centres;
+  size_t begin = 0;
+  for (size_t i = 1; i <= temps_c.size(); ++i) {
+    if (i == temps_c.size() || temps_c[i] > temps_c[begin] + span_c) {
+      if (i > begin) {
+        centres.push_back(std::accumulate(temps_c.begin() + begin, temps_c.begin() + i, 0.0) /
+                          static_cast<double>(i - begin));
+      }
+      begin = i;
+    }
+  }
+  return centres;
+}
+
+FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& site,
+                           const std::vector<TableSegment>& segments, const FitOptions& options) {
+  assert(options.Validate().empty());
+  FitSummary summary;
+
+  // Truth and temperature basis.
+  std::vector<double> temps;
+  for (const Window& w : windows) temps.push_back(w.temp_c);
+  summary.distinct_temps_c = DistinctTemperatures(temps, options.distinct_temp_c);
+  TemperatureBasis basis;
+  if (!temps.empty()) {
+    const auto [lo, hi] = std::minmax_element(temps.begin(), temps.end());
+    summary.temp_range_c = {*lo, *hi};
+    basis.center_c = 0.5 * (*lo + *hi);
+    basis.half_range_c = std::max(0.5 * (*hi - *lo), 1.0);
+  }
+  std::vector<FitWindow> fit_windows;
+  for (const Window& w : windows) {
+    const auto segment = std::find_if(segments.begin(), segments.end(), [&](const TableSegment& s) { return s.id == w.segment; });
+    assert(segment != segments.end() && "every window's segment must be in the plan");
+    fit_windows.push_back(FitWindow{&w, TruthOf(site, *segment), basis.Argument(w.temp_c)});
+  }
+  summary.windows_used = static_cast<int>(fit_windows.size());
+
+  summary.undetermined = internal::CheckCoverage(fit_windows, site.gravity_mps2, options);
+  if (!summary.undetermined.empty()) {
+    summary.status = FitStatus::kUndetermined;
+    summary.termination = "the run does not determine the model";
+    return summary;
+  }
+
+  SensorProblem gyro;
+  gyro.name = "gyro";
+  gyro.parameters = kGyroParameters;
+  gyro.coefficients = kGyroCoefficients;
+  gyro.order = options.gyro_temp_order;
+  gyro.with_g_sensitivity = options.fit_g_sensitivity;
+  SensorProblem accel;
+  accel.name = "accel";
+  accel.parameters = kAccelParameters;
+  accel.coefficients = kAccelCoefficients;
+  accel.order = options.accel_temp_order;
+  for (SensorProblem* sensor : {&gyro, &accel}) {
+    const bool is_gyro = sensor == &gyro;
+    SetSigmas(fit_windows, is_gyro, sensor);   // raw units until the start is known
+    LinearStart(fit_windows, is_gyro, sensor);
+    if (!options.closed_form_start) {
+      // Keep only the nominal scale factors: the solver must find everything else itself.
+      for (int i = 0; i < sensor->parameters; ++i) {
+        const int c = i / kPolynomialTerms;
+        const bool nominal_scale = c >= kScaleCoefficient && c < kMisalignmentCoefficient && i % kPolynomialTerms == 0;
+        if (!nominal_scale) sensor->p0[i] = 0.0;
+      }
+    }
+    SetSigmas(fit_windows, is_gyro, sensor);   // now in SI
+    SetSteps(sensor);
+    sensor->q.assign(sensor->parameters, 0.0);
+    for (int c = 0; c < sensor->coefficients; ++c) {
+      for (int k = 0; k < kPolynomialTerms; ++k) {
+        const bool g_sensitivity_off = c >= kGSensitivityCoefficient && !sensor->with_g_sensitivity;
+        if (k > sensor->order || g_sensitivity_off) sensor->held.push_back(c * kPolynomialTerms + k);
+      }
+    }
+  }
+
+  // One problem, solved twice: least squares, then (if asked) with the robust loss scaled by the
+  // spread of the first pass's residuals.
+  ceres::Problem problem;
+  for (SensorProblem* sensor : {&gyro, &accel}) {
+    sensor->loss = new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP);
+    for (size_t w = 0; w < fit_windows.size(); ++w) {
+      const FitWindow& fw = fit_windows[w];
+      ceres::CostFunction* cost = nullptr;
+      if (sensor == &gyro) {
+        cost = new ceres::AutoDiffCostFunction<WindowCost<kGyroParameters>, 3, kGyroParameters>(
+            new WindowCost<kGyroParameters>(RawFor(fw, true), TruthFor(fw, true), fw.truth.a_mps2, fw.x,
+                                            sensor->sigma[w], sensor->p0.data(), sensor->step.data()));
+      } else {
+        cost = new ceres::AutoDiffCostFunction<WindowCost<kAccelParameters>, 3, kAccelParameters>(
+            new WindowCost<kAccelParameters>(RawFor(fw, false), TruthFor(fw, false), fw.truth.a_mps2, fw.x,
+                                             sensor->sigma[w], sensor->p0.data(), sensor->step.data()));
+      }
+      sensor->blocks.push_back(problem.AddResidualBlock(cost, sensor->loss, sensor->q.data()));
+    }
+    if (!sensor->held.empty()) {
+      problem.SetManifold(sensor->q.data(), new ceres::SubsetManifold(sensor->parameters, sensor->held));
+    }
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.num_threads = options.num_threads;
+  solver_options.function_tolerance = 1e-10;
+  solver_options.parameter_tolerance = 1e-10;
+  ceres::Solver::Summary solver_summary;
+  ceres::Solve(solver_options, &problem, &solver_summary);
+  summary.iterations = static_cast<int>(solver_summary.iterations.size()) - 1;
+  summary.initial_cost = solver_summary.initial_cost;
+  const auto normalised_norms = [&](const SensorProblem& sensor) {
+    std::vector<double> norms;
+    for (ceres::ResidualBlockId block : sensor.blocks) {
+      double residual[3];
+      double cost = 0.0;
+      problem.EvaluateResidualBlock(block, /*apply_loss_function=*/false, &cost, residual, nullptr);
+      norms.push_back(Eigen::Map<const Eigen::Vector3d>(residual).norm());
+    }
+    return norms;
+  };
+  if (options.loss != RobustLoss::kNone && solver_summary.termination_type == ceres::CONVERGENCE) {
+    for (SensorProblem* sensor : {&gyro, &accel}) {
+      // The robust spread of one residual component; a window's 3-vector norm is compared with
+      // loss_scale times it.
+      std::vector<double> components;
+      for (double norm : normalised_norms(*sensor)) components.push_back(norm / std::sqrt(3.0));
+      const double spread = kMadToSigma * Median(components);
+      // Noise-free data (simulations) leave only round-off: the loss must not act on that.
+      sensor->loss_threshold = std::max(options.loss_scale * spread, kMinLossThreshold);
+      if (options.loss == RobustLoss::kHuber) {
+        sensor->loss->Reset(new ceres::HuberLoss(sensor->loss_threshold), ceres::TAKE_OWNERSHIP);
+      } else {
+        sensor->loss->Reset(new ceres::CauchyLoss(sensor->loss_threshold), ceres::TAKE_OWNERSHIP);
+      }
+    }
+    ceres::Solve(solver_options, &problem, &solver_summary);
+    summary.iterations += static_cast<int>(solver_summary.iterations.size()) - 1;
+  }
+  summary.final_cost = solver_summary.final_cost;
+  summary.termination = solver_summary.message;
+  if (solver_summary.termination_type != ceres::CONVERGENCE) {
+    summary.status = FitStatus::kNotConverged;
+    summary.termination = std::string(ceres::TerminationTypeToString(solver_summary.termination_type)) + ": " +
+                          solver_summary.message;
+    return summary;
+  }
+
+  // Backstop: the rank of the column-normalised Jacobian at the solution, per sensor.
+  for (SensorProblem* sensor : {&gyro, &accel}) {
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = {sensor->q.data()};
+    evaluate.residual_blocks = sensor->blocks;
+    evaluate.apply_loss_function = false;
+    evaluate.num_threads = options.num_threads;
+    ceres::CRSMatrix crs;
+    problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r) {
+      for (int e = crs.rows[r]; e < crs.rows[r + 1]; ++e) jacobian(r, crs.cols[e]) = crs.values[e];
+    }
+    std::vector<int> free;  // tangent column -> parameter
+    for (int i = 0; i < sensor->parameters; ++i) {
+      if (!sensor->IsHeld(i)) free.push_back(i);
+    }
+    assert(static_cast<int>(free.size()) == jacobian.cols());
+    const Eigen::VectorXd column_norm = jacobian.colwise().norm().transpose();
+    for (int c = 0; c < jacobian.cols(); ++c) {
+      if (column_norm(c) > 0.0) jacobian.col(c) /= column_norm(c);
+    }
+    const Eigen::BDCSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
+    const Eigen::VectorXd& singular = svd.singularValues();
+    for (int d = 0; d < singular.size(); ++d) {
+      if (singular(d) > options.rank_tolerance * singular(0)) continue;
+      const Eigen::VectorXd direction = svd.matrixV().col(d);
+      std::string names;
+      for (int c = 0; c < direction.size(); ++c) {
+        if (std::abs(direction(c)) < 0.3) continue;
+        names += (names.empty() ? "" : ", ") + ParameterName(*sensor, free[c]);
+      }
+      summary.undetermined.push_back("the run cannot separate " + names +
+                                     " (a combination of them does not change any residual)");
+    }
+  }
+  if (!summary.undetermined.empty()) {
+    summary.status = FitStatus::kUndetermined;
+    summary.termination = "the run does not determine the model";
+    return summary;
+  }
+
+  // Residuals, the covariance scale and the robust loss's verdicts.
+  summary.residuals.resize(fit_windows.size());
+  for (SensorProblem* sensor : {&gyro, &accel}) {
+    const bool is_gyro = sensor == &gyro;
+    const std::vector<double> norms = normalised_norms(*sensor);
+    double chi2 = 0.0;
+    int rows = 0;
+    double sum_squares = 0.0;
+    for (size_t w = 0; w < fit_windows.size(); ++w) {
+      double residual[3];
+      double cost = 0.0;
+      problem.EvaluateResidualBlock(sensor->blocks[w], false, &cost, residual, nullptr);
+      const Eigen::Vector3d si = Eigen::Map<const Eigen::Vector3d>(residual).cwiseProduct(sensor->sigma[w]);
+      WindowResidual& out = summary.residuals[w];
+      out.window = static_cast<int>(w);
+      (is_gyro ? out.gyro_radps : out.accel_mps2) = si;
+      (is_gyro ? out.gyro_sigma_radps : out.accel_sigma_mps2) = sensor->sigma[w];
+      const bool downweighted = options.loss != RobustLoss::kNone && norms[w] > sensor->loss_threshold;
+      out.downweighted = out.downweighted || downweighted;
+      sum_squares += si.squaredNorm();
+      if (!downweighted) {
+        chi2 += norms[w] * norms[w];
+        rows += 3;
+      }
+    }
+    const int free_parameters = sensor->parameters - static_cast<int>(sensor->held.size());
+    const double rms = std::sqrt(sum_squares / (3.0 * fit_windows.size()));
+    const double reduced_chi2 = rows > free_parameters ? chi2 / (rows - free_parameters) : 1.0;
+    (is_gyro ? summary.gyro_rms_radps : summary.accel_rms_mps2) = rms;
+    (is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2) = reduced_chi2;
+  }
+  summary.windows_downweighted = static_cast<int>(
+      std::count_if(summary.residuals.begin(), summary.residuals.end(), [](const WindowResidual& r) { return r.downweighted; }));
+
+  // Covariance of q, to p (times step), scaled by the reduced chi-square, to powers of dT.
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.num_threads = options.num_threads;
+  covariance_options.apply_loss_function = true;
+  ceres::Covariance covariance(covariance_options);
+  const std::vector<std::pair<const double*, const double*>> covariance_blocks = {{gyro.q.data(), gyro.q.data()},
+                                                                                  {accel.q.data(), accel.q.data()}};
+  const bool have_covariance = covariance.Compute(covariance_blocks, &problem);
+  const Eigen::Matrix4d to_reference = RebaseTemperaturePolynomial(basis, TemperatureBasis::Reference());
+  summary.model.basis = TemperatureBasis::Reference();
+  summary.sigma.basis = TemperatureBasis::Reference();
+  for (SensorProblem* sensor : {&gyro, &accel}) {
+    const bool is_gyro = sensor == &gyro;
+    const std::vector<double> p = sensor->Parameters();
+    Eigen::MatrixXd cov_q = Eigen::MatrixXd::Zero(sensor->parameters, sensor->parameters);
+    if (have_covariance) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> block(sensor->parameters, sensor->parameters);
+      covariance.GetCovarianceBlock(sensor->q.data(), sensor->q.data(), block.data());
+      cov_q = block;
+    }
+    const double scale2 = is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2;
+    double* model_out = is_gyro ? summary.model.gyro.data() : summary.model.accel.data();
+    double* sigma_out = is_gyro ? summary.sigma.gyro.data() : summary.sigma.accel.data();
+    for (int c = 0; c < sensor->coefficients; ++c) {
+      const int first = c * kPolynomialTerms;
+      const Eigen::Vector4d coefficients = to_reference * Eigen::Map<const Eigen::Vector4d>(p.data() + first);
+      Eigen::Matrix4d cov_p = cov_q.block<4, 4>(first, first);
+      const Eigen::Vector4d step = Eigen::Map<const Eigen::Vector4d>(sensor->step.data() + first);
+      cov_p = step.asDiagonal() * cov_p * step.asDiagonal() * scale2;
+      const Eigen::Matrix4d cov_reference = to_reference * cov_p * to_reference.transpose();
+      for (int k = 0; k < kPolynomialTerms; ++k) {
+        model_out[first + k] = coefficients(k);
+        sigma_out[first + k] = have_covariance ? std::sqrt(std::max(0.0, cov_reference(k, k))) : -1.0;
+      }
+    }
+  }
+  if (!have_covariance) {
+    summary.undetermined.push_back("the covariance could not be computed (the problem is numerically rank deficient)");
+    summary.status = FitStatus::kUndetermined;
+    summary.termination = "the run does not determine the model";
+    return summary;
+  }
+  summary.status = FitStatus::kConverged;
+  return summary;
+}
+
+std::string FitSummary::BriefReport() const {
+  char text[512];
+  switch (status) {
+    case FitStatus::kNotRun:
+      return "fit not run";
+    case FitStatus::kUndetermined:
+      std::snprintf(text, sizeof text, "fit refused: the run does not determine the model (%zu finding%s)",
+                    undetermined.size(), undetermined.size() == 1 ? "" : "s");
+      return text;
+    case FitStatus::kNotConverged:
+      return "fit did not converge: " + termination;
+    case FitStatus::kConverged:
+      break;
+  }
+  std::snprintf(text, sizeof text,
+                "converged in %d iterations; residual RMS gyro %.3g deg/s, accel %.3g mg; %d windows (%d down-weighted) "
+                "over %zu temperatures",
+                iterations, gyro_rms_radps * kRadToDeg, accel_rms_mps2 / 9.80665 * 1e3, windows_used,
+                windows_downweighted, distinct_temps_c.size());
+  return text;
+}
+
+std::string FitSummary::FullReport() const {
+  std::string report = BriefReport() + "\n";
+  char line[512];
+  std::snprintf(line, sizeof line, "  windows: %d used, %d down-weighted by the robust loss\n", windows_used,
+                windows_downweighted);
+  report += line;
+  report += "  temperatures: " + std::to_string(distinct_temps_c.size()) + " distinct (" +
+            internal::FormatTemperatures(distinct_temps_c) + ")\n";
+  if (status == FitStatus::kConverged) {
+    std::snprintf(line, sizeof line, "  reduced chi-square: gyro %.3g, accel %.3g (covariance scale)\n",
+                  gyro_reduced_chi2, accel_reduced_chi2);
+    report += line;
+  }
+  for (const std::string& finding : undetermined) report += "  undetermined: " + finding + "\n";
+  report += "  termination: " + termination + "\n";
+  return report;
+}
+
+}  // namespace imufit

@@ -1,0 +1,106 @@
+#include "imufit/fit/validation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace imufit {
+
+std::vector<WindowError> PredictWindows(const SensorModel& model, const std::vector<Window>& windows,
+                                        const TableSite& site, const std::vector<TableSegment>& segments) {
+  std::vector<WindowError> errors;
+  for (size_t w = 0; w < windows.size(); ++w) {
+    const Window& window = windows[w];
+    const auto segment = std::find_if(segments.begin(), segments.end(),
+                                      [&](const TableSegment& s) { return s.id == window.segment; });
+    if (segment == segments.end()) continue;
+    const SegmentTruth truth = TruthOf(site, *segment);
+    WindowError error;
+    error.window = static_cast<int>(w);
+    error.segment = window.segment;
+    error.temp_c = window.temp_c;
+    Eigen::Vector3d omega_hat;
+    Eigen::Vector3d a_hat;
+    model.Correct(window.temp_c, window.gyro_mean, window.accel_mean, &omega_hat, &a_hat);
+    error.gyro_radps = omega_hat - truth.omega_radps;
+    error.accel_mps2 = a_hat - truth.a_mps2;
+    errors.push_back(error);
+  }
+  return errors;
+}
+
+ErrorStats SummariseErrors(const std::vector<WindowError>& errors) {
+  ErrorStats stats;
+  double gyro_sum = 0.0;
+  double accel_sum = 0.0;
+  for (const WindowError& e : errors) {
+    ++stats.windows;
+    gyro_sum += e.gyro_radps.squaredNorm();
+    accel_sum += e.accel_mps2.squaredNorm();
+    stats.gyro_max_radps = std::max(stats.gyro_max_radps, e.gyro_radps.cwiseAbs().maxCoeff());
+    stats.accel_max_mps2 = std::max(stats.accel_max_mps2, e.accel_mps2.cwiseAbs().maxCoeff());
+  }
+  if (stats.windows > 0) {
+    // RMS per axis component.
+    stats.gyro_rms_radps = std::sqrt(gyro_sum / (3.0 * stats.windows));
+    stats.accel_rms_mps2 = std::sqrt(accel_sum / (3.0 * stats.windows));
+  }
+  return stats;
+}
+
+std::vector<ErrorStats> ErrorsBySegment(const std::vector<WindowError>& errors) {
+  std::map<int, std::vector<WindowError>> by_segment;
+  for (const WindowError& e : errors) by_segment[e.segment].push_back(e);
+  std::vector<ErrorStats> stats;
+  for (const auto& [segment, segment_errors] : by_segment) {
+    stats.push_back(SummariseErrors(segment_errors));
+    stats.back().segment = segment;
+  }
+  return stats;
+}
+
+std::vector<HeldOutGroup> LeaveOneTemperatureOut(const std::vector<Window>& windows, const TableSite& site,
+                                                 const std::vector<TableSegment>& segments,
+                                                 const FitOptions& options, int max_groups) {
+  std::vector<double> temps;
+  for (const Window& w : windows) temps.push_back(w.temp_c);
+  std::vector<double> centres = DistinctTemperatures(temps, options.distinct_temp_c);
+  std::vector<HeldOutGroup> groups;
+  if (centres.size() < 3) return groups;
+  // Group edges: midway between distinct temperatures, or equal bands for a ramp.
+  std::vector<double> edges;
+  if (static_cast<int>(centres.size()) > max_groups) {
+    const double lo = centres.front();
+    const double hi = centres.back();
+    centres.clear();
+    for (int g = 0; g < max_groups; ++g) {
+      centres.push_back(lo + (hi - lo) * (g + 0.5) / max_groups);
+      if (g > 0) edges.push_back(lo + (hi - lo) * g / max_groups);
+    }
+  } else {
+    for (size_t g = 1; g < centres.size(); ++g) edges.push_back(0.5 * (centres[g - 1] + centres[g]));
+  }
+  const auto group_of = [&](double temp_c) {
+    return static_cast<int>(std::upper_bound(edges.begin(), edges.end(), temp_c) - edges.begin());
+  };
+  for (int g = 1; g + 1 < static_cast<int>(centres.size()); ++g) {
+    std::vector<Window> kept;
+    std::vector<Window> held;
+    for (const Window& w : windows) (group_of(w.temp_c) == g ? held : kept).push_back(w);
+    HeldOutGroup group;
+    group.temp_c = centres[g];
+    FitOptions fold = options;
+    fold.num_threads = options.num_threads;
+    const FitSummary fit = FitThermalModel(kept, site, segments, fold);
+    if (!fit.IsSolutionUsable()) {
+      group.why_not = fit.undetermined.empty() ? fit.termination : fit.undetermined.front();
+    } else {
+      group.fitted = true;
+      group.errors = SummariseErrors(PredictWindows(fit.model, held, site, segments));
+    }
+    groups.push_back(group);
+  }
+  return groups;
+}
+
+}  // namespace imufit

@@ -1,0 +1,102 @@
+#include "imufit/fit/windows.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace imufit {
+
+std::string WindowOptions::Validate() const {
+  if (!(trim_s >= 0.0)) return "the trim time cannot be negative";
+  if (!(max_temp_span_c > 0.0)) return "the window temperature span must be positive";
+  if (!(max_duration_s >= 0.0)) return "the window duration cannot be negative";
+  if (min_samples < 2) return "a window needs at least 2 samples";
+  return "";
+}
+
+WindowBuilder::WindowBuilder(const WindowOptions& options) : options_(options) {}
+
+void WindowBuilder::Add(const Sample& sample) {
+  if (stats_.samples == 0) {
+    stats_.min_temp_c = stats_.max_temp_c = sample.temp_c;
+    stats_.first_time_s = sample.time_s;
+  }
+  ++stats_.samples;
+  stats_.last_time_s = sample.time_s;
+  stats_.min_temp_c = std::min(stats_.min_temp_c, sample.temp_c);
+  stats_.max_temp_c = std::max(stats_.max_temp_c, sample.temp_c);
+
+  if (sample.segment != current_segment_) {
+    // A new occurrence starts (or a transition).
+    Close();
+    current_segment_ = sample.segment;
+    if (sample.segment != kTransitionSegment) {
+      auto it = std::find_if(occurrences_.begin(), occurrences_.end(),
+                             [&](const auto& entry) { return entry.first == sample.segment; });
+      if (it == occurrences_.end()) {
+        occurrences_.emplace_back(sample.segment, 0);
+        it = occurrences_.end() - 1;
+      }
+      current_occurrence_ = it->second++;
+      occurrence_start_s_ = sample.time_s;
+    }
+  }
+  if (sample.segment == kTransitionSegment) {
+    ++stats_.transition_samples;
+    return;
+  }
+  if (sample.time_s - occurrence_start_s_ < options_.trim_s) {
+    ++stats_.trimmed_samples;
+    return;
+  }
+  if (open_ && (std::abs(sample.temp_c - window_first_temp_c_) > options_.max_temp_span_c ||
+                (options_.max_duration_s > 0.0 && sample.time_s - start_s_ >= options_.max_duration_s))) {
+    Close();
+  }
+  if (!open_) {
+    open_ = true;
+    n_ = 0;
+    start_s_ = sample.time_s;
+    window_first_temp_c_ = sample.temp_c;
+    temp_mean_ = 0.0;
+    mean_.setZero();
+    m2_.setZero();
+  }
+  ++n_;
+  end_s_ = sample.time_s;
+  const double inv_n = 1.0 / static_cast<double>(n_);
+  temp_mean_ += (sample.temp_c - temp_mean_) * inv_n;
+  Eigen::Matrix<double, 6, 1> value;
+  value << sample.gyro, sample.accel;
+  const Eigen::Matrix<double, 6, 1> delta = value - mean_;
+  mean_ += delta * inv_n;
+  m2_ += delta.cwiseProduct(value - mean_);
+}
+
+void WindowBuilder::Close() {
+  if (!open_) return;
+  open_ = false;
+  if (n_ < options_.min_samples) {
+    ++stats_.short_windows;
+    return;
+  }
+  Window window;
+  window.segment = current_segment_;
+  window.occurrence = current_occurrence_;
+  window.samples = n_;
+  window.start_s = start_s_;
+  window.end_s = end_s_;
+  window.temp_c = temp_mean_;
+  const Eigen::Matrix<double, 6, 1> std_dev = (m2_ / static_cast<double>(n_ - 1)).cwiseSqrt();
+  window.gyro_mean = mean_.head<3>();
+  window.accel_mean = mean_.tail<3>();
+  window.gyro_std = std_dev.head<3>();
+  window.accel_std = std_dev.tail<3>();
+  windows_.push_back(window);
+}
+
+std::vector<Window> WindowBuilder::Finish() {
+  Close();
+  return std::move(windows_);
+}
+
+}  // namespace imufit

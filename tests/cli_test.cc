@@ -1,0 +1,822 @@
+// End-to-end tests of the `imufit` command (SPEC.md section 4): the built program (IMUFIT_EXE) is
+// run on fixtures (IMUFIT_FIXTURES_DIR) and on files written into a fresh temporary folder per
+// test, never the working directory.
+//
+// The key acceptance test: a run simulated without noise from a known calibration, corrected by
+// `imufit apply` with that calibration, gives back the true rate and specific force of every
+// sample, transitions included, to kRecoveryToleranceSi. It is done twice: on `imufit simulate`'s
+// own output and truth, and on samples this file computes with its own forward model written
+// from SPEC.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
+// neither the simulator nor imufit's reader and model are checked only against themselves.
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include "imufit/model/sensor_model.h"
+
+extern char** environ;
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Worst-case absolute error of a recovered rate (rad/s) or specific force (m/s^2).
+constexpr double kRecoveryToleranceSi = 1e-9;
+// Worst-case relative difference between two forward models that do the same arithmetic in a
+// different order.
+constexpr double kForwardAgreementRelative = 1e-12;
+// Earth's rotation rate, rad/s, as SPEC.md section 2 states it.
+constexpr double kEarthRate = 7.292115e-5;
+constexpr double kDegToRad = M_PI / 180.0;
+
+const std::string kFixtures = IMUFIT_FIXTURES_DIR;
+
+std::string Fixture(const std::string& name) { return kFixtures + "/" + name; }
+
+// Reads a file, decompressing it when it is gzip (zlib passes other files through unchanged).
+std::string ReadFile(const std::string& path) {
+  gzFile file = gzopen(path.c_str(), "rb");
+  if (file == nullptr) return "<cannot open " + path + ">";
+  std::string text;
+  char block[1 << 16];
+  int n = 0;
+  while ((n = gzread(file, block, sizeof block)) > 0) text.append(block, n);
+  gzclose(file);
+  return text;
+}
+
+// Reads a file's bytes as they are on disk.
+std::string ReadBytes(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::stringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+// A CSV file split into its header and rows ('#' lines skipped), for checking outputs.
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+
+  int Column(const std::string& name) const {
+    for (size_t i = 0; i < header.size(); ++i) {
+      if (header[i] == name) return static_cast<int>(i);
+    }
+    ADD_FAILURE() << "no column " << name;
+    return 0;
+  }
+  double Number(size_t row, const std::string& name) const { return std::stod(rows[row][Column(name)]); }
+  Eigen::Vector3d Vector(size_t row, const std::string& prefix) const {
+    return Eigen::Vector3d(Number(row, prefix + "_x"), Number(row, prefix + "_y"), Number(row, prefix + "_z"));
+  }
+};
+
+std::vector<std::string> Split(const std::string& line, char separator) {
+  std::vector<std::string> fields;
+  std::stringstream stream(line);
+  std::string field;
+  while (std::getline(stream, field, separator)) fields.push_back(field);
+  if (!line.empty() && line.back() == separator) fields.emplace_back();
+  return fields;
+}
+
+Table ReadTable(const std::string& path) {
+  Table table;
+  std::stringstream lines(ReadFile(path));
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (table.header.empty()) {
+      table.header = Split(line, ',');
+    } else {
+      table.rows.push_back(Split(line, ','));
+    }
+  }
+  return table;
+}
+
+std::string FormatExactly(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+// ------------------------------------------------------------------------------------------
+// A forward model written from SPEC.md section 1, independent of imufit's reader and model:
+//   B = diag(S_g) inv(M_g) omega + V_g + H a,   A = diag(S_a) inv(M_a) a + V_a,
+// every coefficient c0 + c1 dT + c2 dT^2 + c3 dT^3 with dT = T - reference_temp_c.
+class SpecForwardModel {
+ public:
+  explicit SpecForwardModel(const std::string& calibration_path) {
+    const YAML::Node root = YAML::LoadFile(calibration_path);
+    reference_c_ = root["reference_temp_c"] ? root["reference_temp_c"].as<double>() : 25.0;
+    gyro_ = root["gyro"];
+    accel_ = root["accel"];
+  }
+
+  // The calibration's coefficient `group`.`name` (e.g. "bias", "x") at temp_c.
+  static double Coefficient(const YAML::Node& sensor, const std::string& group, const std::string& name,
+                            double dT) {
+    const YAML::Node c = sensor[group][name];
+    EXPECT_EQ(c.size(), 4u) << group << "." << name;
+    return c[0].as<double>() + c[1].as<double>() * dT + c[2].as<double>() * dT * dT +
+           c[3].as<double>() * dT * dT * dT;
+  }
+
+  Eigen::Vector3d Raw(const YAML::Node& sensor, double temp_c, const Eigen::Vector3d& truth,
+                      const Eigen::Vector3d& specific_force, bool with_g_sensitivity) const {
+    const double dT = temp_c - reference_c_;
+    const char* axes[3] = {"x", "y", "z"};
+    Eigen::Vector3d bias;
+    Eigen::Vector3d scale;
+    Eigen::Matrix3d misalignment = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d g_sensitivity = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      bias(i) = Coefficient(sensor, "bias", axes[i], dT);
+      scale(i) = Coefficient(sensor, "scale", axes[i], dT);
+      for (int j = 0; j < 3; ++j) {
+        const std::string name = std::string(axes[i]) + axes[j];  // row i, column j
+        if (i != j) misalignment(i, j) = Coefficient(sensor, "misalignment", name, dT);
+        if (with_g_sensitivity) g_sensitivity(i, j) = Coefficient(sensor, "g_sensitivity", name, dT);
+      }
+    }
+    const Eigen::Vector3d sensor_frame = misalignment.fullPivLu().inverse() * truth;
+    return scale.asDiagonal() * sensor_frame + bias + g_sensitivity * specific_force;
+  }
+
+  Eigen::Vector3d Gyro(double temp_c, const Eigen::Vector3d& omega, const Eigen::Vector3d& a) const {
+    return Raw(gyro_, temp_c, omega, a, true);
+  }
+  Eigen::Vector3d Accel(double temp_c, const Eigen::Vector3d& a) const {
+    return Raw(accel_, temp_c, a, Eigen::Vector3d::Zero(), false);
+  }
+
+  // The same coefficients in imufit's parameter layout (sensor_model.h), to cross-check the
+  // model header's forward form against this one.
+  SensorModel ToSensorModel() const {
+    SensorModel model;
+    model.basis.center_c = reference_c_;
+    Fill(gyro_, kGyroCoefficients, model.gyro.data());
+    Fill(accel_, kAccelCoefficients, model.accel.data());
+    return model;
+  }
+
+ private:
+  static void Fill(const YAML::Node& sensor, int coefficients, double* params) {
+    for (int i = 0; i < coefficients; ++i) {
+      const YAML::Node c = sensor[kCoefficientNames[i].group][kCoefficientNames[i].axis];
+      for (int k = 0; k < kPolynomialTerms; ++k) params[i * kPolynomialTerms + k] = c[k].as<double>();
+    }
+  }
+
+  double reference_c_ = 25.0;
+  YAML::Node gyro_;
+  YAML::Node accel_;
+};
+
+// The truth of a plan's dwell segments, written from SPEC.md section 2 (rad/s, m/s^2, body).
+std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> SpecTruthOfPlan(const std::string& plan_path) {
+  const YAML::Node plan = YAML::LoadFile(plan_path);
+  const auto vector = [](const YAML::Node& v) {
+    return Eigen::Vector3d(v[0].as<double>(), v[1].as<double>(), v[2].as<double>());
+  };
+  const double g = plan["gravity_mps2"].as<double>();
+  const bool has_latitude = static_cast<bool>(plan["latitude_deg"]);
+  const double phi = has_latitude ? plan["latitude_deg"].as<double>() * kDegToRad : 0.0;
+  std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> truth;
+  for (const YAML::Node& segment : plan["segments"]) {
+    const Eigen::Vector3d up = vector(segment["up"]).normalized();
+    const double rate = segment["rate_dps"] ? segment["rate_dps"].as<double>() * kDegToRad : 0.0;
+    Eigen::Vector3d omega = rate * up;
+    if (has_latitude) {
+      omega += kEarthRate * std::sin(phi) * up;
+      if (rate == 0.0 && segment["north"]) omega += kEarthRate * std::cos(phi) * vector(segment["north"]).normalized();
+    }
+    Eigen::Vector3d a = g * up;
+    if (rate != 0.0 && segment["lever_arm_m"]) {
+      const Eigen::Vector3d r = vector(segment["lever_arm_m"]);
+      a -= rate * rate * (r - up * r.dot(up));
+    }
+    truth[segment["id"].as<int>()] = {omega, a};
+  }
+  return truth;
+}
+
+// ------------------------------------------------------------------------------------------
+
+struct RunResult {
+  int status = -1;  // exit status, or 128 + signal
+  std::string out;
+  std::string err;
+};
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("imufit_cli_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "work");
+    work_ = dir_ / "work";
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  // A path in this test's work folder (where outputs go; the captured stdout and stderr of each
+  // run live one level up so that folder listings see only what imufit wrote).
+  std::string Path(const std::string& name) const { return (work_ / name).string(); }
+
+  std::string Write(const std::string& name, const std::string& text) const {
+    const std::string path = Path(name);
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+
+  // Runs imufit with `args`, stdin from /dev/null, and captures its output.
+  RunResult Run(const std::vector<std::string>& args) const {
+    const std::string out_path = (dir_ / "stdout.txt").string();
+    const std::string err_path = (dir_ / "stderr.txt").string();
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<std::string> argv_storage = {IMUFIT_EXE};
+    argv_storage.insert(argv_storage.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& arg : argv_storage) argv.push_back(arg.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    RunResult result;
+    const int spawned = posix_spawn(&pid, IMUFIT_EXE, &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (spawned != 0) {
+      ADD_FAILURE() << "cannot run " << IMUFIT_EXE << ": " << std::strerror(spawned);
+      return result;
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = ReadBytes(out_path);
+    result.err = ReadBytes(err_path);
+    return result;
+  }
+
+  // The names in the work folder.
+  std::set<std::string> Listing() const {
+    std::set<std::string> names;
+    for (const auto& entry : fs::directory_iterator(work_)) names.insert(entry.path().filename().string());
+    return names;
+  }
+
+  // Runs a noiseless simulation at 20 Hz with 1 s dwells and 0.75 s transitions (`extra` adds
+  // options or overrides these) and returns the paths of {samples, truth}.
+  std::pair<std::string, std::string> SimulateNoiseless(const std::string& plan, const std::string& calibration,
+                                                        const std::string& stem,
+                                                        const std::vector<std::string>& extra = {}) {
+    const std::string samples = Path(stem + ".csv");
+    const std::string truth = Path(stem + "_truth.csv");
+    std::vector<std::string> args = {"simulate", "--plan", plan,    "--calibration", calibration,
+                                     "-o",       samples,  "--truth", truth,          "--quiet"};
+    for (const auto& [option, value] : {std::pair<std::string, std::string>{"--rate", "20"},
+                                        {"--dwell", "1"},
+                                        {"--transition", "0.75"}}) {
+      if (std::find(extra.begin(), extra.end(), option) == extra.end()) {
+        args.push_back(option);
+        args.push_back(value);
+      }
+    }
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return {samples, truth};
+  }
+
+  // Expects `corrected` (imufit apply's output) to hold the truth of `truth` in every row.
+  static void ExpectRecovered(const std::string& corrected, const std::string& truth_path) {
+    const Table got = ReadTable(corrected);
+    const Table truth = ReadTable(truth_path);
+    ASSERT_EQ(got.header, truth.header);
+    ASSERT_EQ(got.rows.size(), truth.rows.size());
+    ASSERT_GT(got.rows.size(), 0u);
+    double worst_gyro = 0.0;
+    double worst_accel = 0.0;
+    for (size_t i = 0; i < got.rows.size(); ++i) {
+      ASSERT_EQ(got.rows[i][0], truth.rows[i][0]) << "time_s, row " << i;
+      ASSERT_EQ(got.rows[i][1], truth.rows[i][1]) << "temp_c, row " << i;
+      worst_gyro = std::max(worst_gyro, (got.Vector(i, "gyro") - truth.Vector(i, "gyro")).cwiseAbs().maxCoeff());
+      worst_accel =
+          std::max(worst_accel, (got.Vector(i, "accel") - truth.Vector(i, "accel")).cwiseAbs().maxCoeff());
+    }
+    EXPECT_LE(worst_gyro, kRecoveryToleranceSi) << "rad/s";
+    EXPECT_LE(worst_accel, kRecoveryToleranceSi) << "m/s^2";
+  }
+
+  fs::path dir_;
+  fs::path work_;
+};
+
+// ------------------------------------------------------------------------------------------ help
+
+// The subcommands listed by `imufit --help` (CLI11 lists them under "Subcommands:").
+std::vector<std::string> SubcommandsIn(const std::string& help) {
+  std::vector<std::string> names;
+  std::stringstream lines(help);
+  std::string line;
+  bool in_list = false;
+  while (std::getline(lines, line)) {
+    if (line.rfind("Subcommands:", 0) == 0) {
+      in_list = true;
+    } else if (in_list && line.size() > 2 && line[0] == ' ') {
+      std::stringstream words(line);
+      std::string name;
+      words >> name;
+      names.push_back(name);
+    } else if (in_list) {
+      in_list = !line.empty() && line[0] == ' ';
+    }
+  }
+  return names;
+}
+
+TEST_F(CliTest, HelpOfTheProgramAndOfEverySubcommandExitsZero) {
+  const RunResult help = Run({"--help"});
+  EXPECT_EQ(help.status, 0) << help.err;
+  const std::vector<std::string> commands = SubcommandsIn(help.out);
+  EXPECT_NE(std::find(commands.begin(), commands.end(), "apply"), commands.end()) << help.out;
+  EXPECT_NE(std::find(commands.begin(), commands.end(), "simulate"), commands.end()) << help.out;
+  for (const std::string& command : commands) {
+    const RunResult r = Run({command, "--help"});
+    EXPECT_EQ(r.status, 0) << command << ": " << r.err;
+    EXPECT_NE(r.out.find("--help"), std::string::npos) << command << ": " << r.out;
+  }
+  const RunResult version = Run({"--version"});
+  EXPECT_EQ(version.status, 0);
+  EXPECT_NE(version.out.find("imufit"), std::string::npos);
+}
+
+TEST_F(CliTest, BadInvocationsExitTwo) {
+  EXPECT_EQ(Run({}).status, 2);
+  EXPECT_EQ(Run({"no-such-command"}).status, 2);
+  EXPECT_EQ(Run({"apply", "--samples", "x.csv"}).status, 2);  // --calibration and -o missing
+  EXPECT_EQ(Run({"apply", "--no-such-option"}).status, 2);
+  const RunResult r = Run({"simulate", "--plan", Fixture("plan_6pos.yaml"), "--calibration",
+                           Fixture("mems_truth.yaml"), "-o", Path("s.csv"), "--rate", "-5"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("sample rate"), std::string::npos) << r.err;
+  EXPECT_EQ(Listing(), std::set<std::string>{});
+}
+
+// ------------------------------------------------------------------------------------------ simulate
+
+TEST_F(CliTest, SimulateIsDeterministic) {
+  const auto simulate = [&](const std::string& name, const std::string& seed) {
+    const RunResult r = Run({"simulate", "--plan", Fixture("plan_6pos.yaml"), "--calibration",
+                             Fixture("mems_truth.yaml"), "-o", Path(name), "--ramp=-40,85", "--passes", "2",
+                             "--rate", "25", "--dwell", "1", "--transition", "0.5", "--gyro-noise-density",
+                             "8.7e-5", "--accel-noise-density", "1.5e-3", "--gyro-bias-instability", "2.4e-5",
+                             "--accel-random-walk", "3e-5", "--temp-noise", "0.05", "--quantize", "--seed", seed,
+                             "--quiet"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out, "");  // --quiet
+    return ReadBytes(Path(name));
+  };
+  const std::string a = simulate("a.csv", "11");
+  const std::string b = simulate("b.csv", "11");
+  const std::string c = simulate("c.csv", "12");
+  EXPECT_GT(a.size(), 10000u);
+  EXPECT_EQ(a, b) << "the same seed must give the same bytes";
+  EXPECT_NE(a, c) << "another seed must give another run";
+  // Only the seed in the provenance comment differs? No: the samples themselves differ.
+  EXPECT_NE(a.substr(a.find("time_s")), c.substr(c.find("time_s")));
+}
+
+// The truth that `imufit simulate --truth` writes for dwell samples is the truth SPEC.md section 2
+// defines (Earth rate with and without `north`, centripetal term of the lever arm).
+TEST_F(CliTest, SimulatedTruthFollowsTheSpec) {
+  for (const char* plan : {"plan_6pos.yaml", "plan_24pos.yaml"}) {
+    const auto [samples, truth_path] = SimulateNoiseless(Fixture(plan), Fixture("mems_truth.yaml"), "run");
+    const auto expected = SpecTruthOfPlan(Fixture(plan));
+    const Table truth = ReadTable(truth_path);
+    std::set<int> seen;
+    int transitions = 0;
+    for (size_t i = 0; i < truth.rows.size(); ++i) {
+      const int segment = std::stoi(truth.rows[i][truth.Column("segment")]);
+      if (segment < 0) {
+        ++transitions;
+        continue;
+      }
+      seen.insert(segment);
+      ASSERT_TRUE(expected.count(segment)) << segment;
+      EXPECT_LE((truth.Vector(i, "gyro") - expected.at(segment).first).norm(), 1e-14) << plan << " " << segment;
+      EXPECT_LE((truth.Vector(i, "accel") - expected.at(segment).second).norm(), 1e-13) << plan << " " << segment;
+    }
+    EXPECT_EQ(seen.size(), expected.size()) << plan;
+    EXPECT_GT(transitions, 0) << plan;
+  }
+}
+
+// ------------------------------------------------------------------------------------------ apply
+
+// THE acceptance test of issue 2: a noiseless simulation from a known calibration, corrected by
+// `imufit apply` with that calibration, gives back the truth of every sample, transitions
+// included, across the whole temperature range, with Earth rate and lever arms in the plan.
+TEST_F(CliTest, ApplyRecoversTheTruthOfANoiselessSimulation) {
+  for (const char* calibration : {"mems_truth.yaml", "tactical_truth.yaml"}) {
+    for (const char* plan : {"plan_6pos.yaml", "plan_24pos.yaml"}) {
+      SCOPED_TRACE(std::string(calibration) + " " + plan);
+      const auto [samples, truth] =
+          SimulateNoiseless(Fixture(plan), Fixture(calibration), "run", {"--ramp=-40,85", "--passes", "2"});
+      const std::string corrected = Path("corrected.csv");
+      const RunResult r = Run({"apply", "--calibration", Fixture(calibration), "--samples", samples, "-o", corrected});
+      ASSERT_EQ(r.status, 0) << r.err;
+      EXPECT_EQ(r.err, "") << "no warning expected inside the fit range";
+      ExpectRecovered(corrected, truth);
+      const Table table = ReadTable(corrected);
+      EXPECT_EQ(table.header, (std::vector<std::string>{"time_s", "temp_c", "segment", "gyro_x", "gyro_y", "gyro_z",
+                                                        "accel_x", "accel_y", "accel_z"}));
+    }
+  }
+}
+
+// The bundled golden pair: fixtures/mems_6pos_noiseless.csv.gz corrected with mems_truth.yaml is
+// fixtures/mems_6pos_noiseless_truth.csv.gz.
+TEST_F(CliTest, ApplyTurnsTheNoiselessFixtureIntoItsTruth) {
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Fixture("mems_6pos_noiseless.csv.gz"),
+                           "-o", Path("corrected.csv.gz"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  ExpectRecovered(Path("corrected.csv.gz"), Fixture("mems_6pos_noiseless_truth.csv.gz"));
+}
+
+// The same acceptance check without imufit's simulator: raw samples computed here from chosen
+// truths with the forward model of SPEC.md (SpecForwardModel), at random temperatures in
+// -40..85 degC, written as a CSV with the columns in another order, an extra column, comments
+// and CRLF line ends.
+TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
+  for (const char* calibration : {"mems_truth.yaml", "tactical_truth.yaml"}) {
+    SCOPED_TRACE(calibration);
+    const SpecForwardModel spec(Fixture(calibration));
+    const SensorModel header_model = spec.ToSensorModel();
+    std::mt19937_64 engine(2026);
+    std::uniform_real_distribution<double> temp(-40.0, 85.0);
+    std::uniform_real_distribution<double> rate(-6.0, 6.0);     // rad/s
+    std::uniform_real_distribution<double> force(-30.0, 30.0);  // m/s^2
+    std::string samples = "# hand-made raw samples\r\nnote,accel_z,gyro_y,segment,temp_c,accel_x,gyro_z,time_s,gyro_x,"
+                          "accel_y\r\n";
+    std::string truth = "time_s,temp_c,segment,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
+    constexpr int kSamples = 2000;
+    for (int i = 0; i < kSamples; ++i) {
+      const double t = 0.01 * i;
+      const double temp_c = temp(engine);
+      const int segment = i % 7 == 0 ? -1 : i / 50;
+      const Eigen::Vector3d omega(rate(engine), rate(engine), rate(engine));
+      const Eigen::Vector3d a(force(engine), force(engine), force(engine));
+      const Eigen::Vector3d gyro_m = spec.Gyro(temp_c, omega, a);
+      const Eigen::Vector3d accel_m = spec.Accel(temp_c, a);
+      // The model header's forward form agrees with SPEC.md's.
+      Eigen::Vector3d header_gyro;
+      Eigen::Vector3d header_accel;
+      header_model.Forward(temp_c, omega, a, &header_gyro, &header_accel);
+      ASSERT_LE((header_gyro - gyro_m).norm(), kForwardAgreementRelative * gyro_m.norm()) << i;
+      ASSERT_LE((header_accel - accel_m).norm(), kForwardAgreementRelative * accel_m.norm()) << i;
+      const auto f = FormatExactly;
+      samples += "\"row " + std::to_string(i) + ", hand-made\"," + f(accel_m.z()) + "," + f(gyro_m.y()) + "," +
+                 std::to_string(segment) + "," + f(temp_c) + "," + f(accel_m.x()) + "," + f(gyro_m.z()) + "," +
+                 f(t) + "," + f(gyro_m.x()) + "," + f(accel_m.y()) + "\r\n";
+      if (i == kSamples / 2) samples += "# a comment half way\r\n";
+      truth += f(t) + "," + f(temp_c) + "," + std::to_string(segment) + "," + f(omega.x()) + "," + f(omega.y()) +
+               "," + f(omega.z()) + "," + f(a.x()) + "," + f(a.y()) + "," + f(a.z()) + "\n";
+    }
+    const std::string samples_path = Write("raw.csv", samples);
+    const std::string truth_path = Write("truth.csv", truth);
+    const RunResult r =
+        Run({"apply", "--calibration", Fixture(calibration), "--samples", samples_path, "-o", Path("out.csv")});
+    ASSERT_EQ(r.status, 0) << r.err;
+    // Compare numerically: ExpectRecovered compares time and temperature text, which differ in
+    // spelling between %.17g and the shortest round-trip form.
+    const Table got = ReadTable(Path("out.csv"));
+    const Table expected = ReadTable(truth_path);
+    ASSERT_EQ(got.header, expected.header);
+    ASSERT_EQ(got.rows.size(), static_cast<size_t>(kSamples));
+    double worst = 0.0;
+    for (int i = 0; i < kSamples; ++i) {
+      ASSERT_EQ(got.Number(i, "time_s"), expected.Number(i, "time_s"));
+      ASSERT_EQ(got.Number(i, "temp_c"), expected.Number(i, "temp_c"));
+      ASSERT_EQ(got.rows[i][2], expected.rows[i][2]) << "segment";
+      worst = std::max(worst, (got.Vector(i, "gyro") - expected.Vector(i, "gyro")).cwiseAbs().maxCoeff());
+      worst = std::max(worst, (got.Vector(i, "accel") - expected.Vector(i, "accel")).cwiseAbs().maxCoeff());
+    }
+    EXPECT_LE(worst, kRecoveryToleranceSi);
+  }
+}
+
+TEST_F(CliTest, ApplyWithoutSegmentColumnWritesNone) {
+  const std::string samples = Write("raw.csv",
+                                    "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n"
+                                    "0,25,23.4,-41.7,12.9,35.2,-18.6,52.9\n"
+                                    "0.01,25,23.4,-41.7,12.9,35.2,-18.6,52.9\n");
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table out = ReadTable(Path("out.csv"));
+  EXPECT_EQ(out.header, (std::vector<std::string>{"time_s", "temp_c", "gyro_x", "gyro_y", "gyro_z", "accel_x",
+                                                  "accel_y", "accel_z"}));
+  ASSERT_EQ(out.rows.size(), 2u);
+  // Raw = bias at 25 degC: nothing moves and there is no specific force.
+  for (const char* column : {"gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"}) {
+    EXPECT_EQ(out.Number(0, column), 0.0) << column;
+  }
+}
+
+TEST_F(CliTest, GzipInputsAndOutputsWork) {
+  const std::vector<std::string> simulate = {"simulate", "--plan", Fixture("plan_6pos.yaml"), "--calibration",
+                                             Fixture("mems_truth.yaml"), "--rate", "20", "--dwell", "2",
+                                             "--gyro-noise-density", "1e-4", "--seed", "5", "-q", "-o"};
+  const auto with = [](std::vector<std::string> args, const std::string& last) {
+    args.push_back(last);
+    return args;
+  };
+  ASSERT_EQ(Run(with(simulate, Path("raw.csv"))).status, 0);
+  ASSERT_EQ(Run(with(simulate, Path("raw.csv.gz"))).status, 0);
+  const std::string gz = ReadBytes(Path("raw.csv.gz"));
+  ASSERT_GT(gz.size(), 2u);
+  EXPECT_EQ(static_cast<unsigned char>(gz[0]), 0x1f);  // gzip magic
+  EXPECT_EQ(static_cast<unsigned char>(gz[1]), 0x8b);
+  EXPECT_LT(gz.size(), ReadBytes(Path("raw.csv")).size() / 2);
+  EXPECT_EQ(ReadFile(Path("raw.csv.gz")), ReadBytes(Path("raw.csv")));
+
+  const auto apply = [&](const std::string& in, const std::string& out) {
+    const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Path(in), "-o", Path(out), "-q"});
+    EXPECT_EQ(r.status, 0) << r.err;
+  };
+  apply("raw.csv", "plain_plain.csv");
+  apply("raw.csv.gz", "gz_gz.csv.gz");
+  apply("raw.csv.gz", "gz_plain.csv");
+  const std::string expected = ReadBytes(Path("plain_plain.csv"));
+  EXPECT_GT(expected.size(), 1000u);
+  EXPECT_EQ(ReadFile(Path("gz_gz.csv.gz")), expected);
+  EXPECT_EQ(ReadBytes(Path("gz_plain.csv")), expected);
+  EXPECT_EQ(static_cast<unsigned char>(ReadBytes(Path("gz_gz.csv.gz"))[0]), 0x1f);
+}
+
+TEST_F(CliTest, ApplyWarnsOnceWithACountOutsideTheFitTemperatureRange) {
+  std::string narrow = ReadBytes(Fixture("mems_truth.yaml"));
+  const std::string range = "fit_temp_range_c: [-40, 85]";
+  ASSERT_NE(narrow.find(range), std::string::npos);
+  narrow.replace(narrow.find(range), range.size(), "fit_temp_range_c: [-10, 60]");
+  const std::string calibration = Write("narrow.yaml", narrow);
+  const auto [samples, truth] =
+      SimulateNoiseless(Fixture("plan_6pos.yaml"), Fixture("mems_truth.yaml"), "ramp", {"--ramp=-40,85"});
+  const Table raw = ReadTable(samples);
+  long long outside = 0;
+  for (size_t i = 0; i < raw.rows.size(); ++i) {
+    const double t = raw.Number(i, "temp_c");
+    outside += (t < -10.0 || t > 60.0) ? 1 : 0;
+  }
+  ASSERT_GT(outside, 0);
+  ASSERT_LT(outside, static_cast<long long>(raw.rows.size()));
+  const RunResult r = Run({"apply", "-c", calibration, "-s", samples, "-o", Path("out.csv")});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;  // once
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(std::to_string(outside) + " of " + std::to_string(raw.rows.size()) + " samples"),
+            std::string::npos)
+      << r.err;
+  ExpectRecovered(Path("out.csv"), truth);  // a warning, not a refusal
+}
+
+// ------------------------------------------------------------------------------------------ bad input
+
+struct BadInput {
+  const char* what;     // test case name
+  const char* file;     // which input is bad: plan, samples or calibration
+  const char* from;     // text in the good file ...
+  const char* to;       // ... replaced by this
+  long line;            // the line the message must name (0: only the file)
+  const char* message;  // a piece of the expected message
+};
+
+const char kGoodPlan[] =
+    "# a plan\n"
+    "format: imufit-plan\n"
+    "version: 1\n"
+    "gravity_mps2: 9.81\n"
+    "latitude_deg: 52.27\n"
+    "segments:\n"
+    "  - id: 1\n"
+    "    up: [0, 0, 1]\n"
+    "    north: [1, 0, 0]\n"
+    "  - id: 2\n"
+    "    up: [1, 0, 0]\n"
+    "    rate_dps: 100\n"
+    "    lever_arm_m: [0.01, 0, 0]\n";
+
+const char kGoodSamples[] =
+    "# raw samples\n"
+    "time_s,temp_c,segment,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n"
+    "0,25,1,23,-41,12,35,-18,2100\n"
+    "0.01,25,1,24,-42,13,36,-19,2101\n"
+    "0.02,25,-1,25,-43,14,37,-20,2102\n"
+    "0.03,25,2,1600,-44,15,38,-21,2103\n";
+
+const BadInput kBadInputs[] = {
+    // plan
+    {"plan_malformed_number", "plan", "gravity_mps2: 9.81", "gravity_mps2: 9.8.1", 4, "\"9.8.1\" is not a number"},
+    {"plan_unknown_key", "plan", "gravity_mps2: 9.81", "gravity: 9.81", 4, "unknown key \"gravity\""},
+    {"plan_unknown_segment_key", "plan", "    rate_dps: 100\n", "    rate_dps: 100\n    speed: 3\n", 13,
+     "unknown key \"speed\""},
+    {"plan_north_not_horizontal", "plan", "north: [1, 0, 0]", "north: [1, 0, 0.1]", 9, "not horizontal"},
+    {"plan_repeated_id", "plan", "id: 2", "id: 1", 10, "repeats"},
+    {"plan_wrong_format", "plan", "format: imufit-plan", "format: imufit-calibration", 2, "imufit-plan"},
+    {"plan_wrong_version", "plan", "version: 1", "version: 2", 3, "not supported"},
+    {"plan_zero_vector", "plan", "up: [1, 0, 0]", "up: [0, 0, 0]", 11, "zero"},
+    {"plan_two_numbers", "plan", "up: [1, 0, 0]", "up: [1, 0]", 11, "3 numbers"},
+    {"plan_rate_not_a_number", "plan", "rate_dps: 100", "rate_dps: fast", 12, "\"fast\" is not a number"},
+    {"plan_latitude_out_of_range", "plan", "latitude_deg: 52.27", "latitude_deg: 95", 5, "latitude"},
+    // yaml-cpp reports where it noticed the unclosed list: the next line.
+    {"plan_yaml_syntax", "plan", "up: [0, 0, 1]", "up: [0, 0, 1", 9, "YAML"},
+    {"plan_missing_gravity", "plan", "gravity_mps2: 9.81\n", "", 2, "gravity_mps2: missing"},
+    {"plan_negative_id", "plan", "id: 2", "id: -2", 10, "id"},
+    // samples
+    {"samples_malformed_number", "samples", "24,-42", "24,-4.2.2", 4, "gyro_y: \"-4.2.2\" is not a number"},
+    {"samples_missing_column", "samples", "gyro_z,accel_x", "accel_x", 2, "no column \"gyro_z\""},
+    {"samples_time_not_increasing", "samples", "0.02,25,-1", "0.01,25,-1", 5, "does not increase"},
+    {"samples_short_row", "samples", "37,-20,2102", "37,-20", 5, "fields"},
+    {"samples_not_finite", "samples", "0.03,25,2,1600", "0.03,25,2,inf", 6, "not a finite number"},
+    {"samples_bad_segment", "samples", "0.02,25,-1", "0.02,25,-3", 5, "not a segment id"},
+    {"samples_segment_not_integer", "samples", "0.02,25,-1", "0.02,25,x", 5, "not an integer"},
+    {"samples_empty_value", "samples", "0.01,25,1,24", "0.01,,1,24", 4, "temp_c: empty value"},
+    {"samples_duplicate_column", "samples", "accel_x,accel_y", "accel_x,accel_x", 2, "appears twice"},
+    // calibration
+    {"calibration_wrong_format", "calibration", "format: imufit-calibration", "format: imufit-plan", 8,
+     "imufit-calibration"},
+    {"calibration_higher_version", "calibration", "version: 1", "version: 2", 9, "not supported"},
+    {"calibration_malformed_number", "calibration", "x: [23.4, 0.118,", "x: [23.4, 0.1.18,", 18,
+     "\"0.1.18\" is not a number"},
+    {"calibration_three_terms", "calibration", "y: [931.52, -0.0895, -0.00017, 2.6e-06]",
+     "y: [931.52, -0.0895, -0.00017]", 23, "4 numbers"},
+    {"calibration_wrong_unit", "calibration", "unit: rad/s", "unit: deg/s", 16, "deg/s"},
+    {"calibration_zero_scale", "calibration", "z: [209.97,", "z: [0,", 51, "scale c0 is zero"},
+    {"calibration_missing_group", "calibration", "  misalignment:\n    xy: [-0.00214", "  misalign:\n    xy: [-0.00214",
+     43, "accel.misalignment: missing"},  // the line where the `accel` mapping starts
+    {"calibration_reversed_range", "calibration", "fit_temp_range_c: [-40, 85]", "fit_temp_range_c: [85, -40]", 14,
+     "range"},
+};
+
+void PrintTo(const BadInput& input, std::ostream* os) { *os << input.what; }
+
+class BadInputTest : public CliTest, public ::testing::WithParamInterface<BadInput> {};
+
+TEST_P(BadInputTest, ExitsTwoWithFileAndLineAndWritesNothing) {
+  const BadInput& c = GetParam();
+  const std::string kind = c.file;
+  std::string text = kind == "plan"      ? std::string(kGoodPlan)
+                     : kind == "samples" ? std::string(kGoodSamples)
+                                         : ReadBytes(Fixture("mems_truth.yaml"));
+  const size_t at = text.find(c.from);
+  ASSERT_NE(at, std::string::npos) << c.from;
+  text.replace(at, std::strlen(c.from), c.to);
+  const std::string bad = Write(kind == "samples" ? "bad.csv" : "bad.yaml", text);
+  const std::string plan = kind == "plan" ? bad : Write("plan.yaml", kGoodPlan);
+  const std::string samples = kind == "samples" ? bad : Write("samples.csv", kGoodSamples);
+  const std::string calibration = kind == "calibration" ? bad : Fixture("mems_truth.yaml");
+
+  // A plan is read by simulate; samples and calibrations by apply (calibrations by both).
+  std::vector<std::vector<std::string>> commands;
+  if (kind != "samples") {
+    commands.push_back({"simulate", "--plan", plan, "--calibration", calibration, "-o", Path("out.csv"), "--dwell",
+                        "0.1"});
+  }
+  if (kind != "plan") commands.push_back({"apply", "-c", calibration, "-s", samples, "-o", Path("out.csv")});
+  const std::set<std::string> before = Listing();
+  for (const auto& command : commands) {
+    SCOPED_TRACE(command[0]);
+    const RunResult r = Run(command);
+    EXPECT_EQ(r.status, 2) << r.err;
+    const std::string location = bad + ":" + std::to_string(c.line) + ":";
+    EXPECT_EQ(r.err.rfind("imufit: " + location, 0), 0u) << "expected " << location << " in: " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+    EXPECT_EQ(Listing(), before) << "nothing written";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryBadInput, BadInputTest, ::testing::ValuesIn(kBadInputs),
+                         [](const ::testing::TestParamInfo<BadInput>& info) { return info.param.what; });
+
+TEST_F(CliTest, MissingOrEmptyInputFilesExitTwoNamingTheFile) {
+  const std::string plan = Write("plan.yaml", kGoodPlan);
+  const std::string samples = Write("samples.csv", kGoodSamples);
+  const std::string missing = Path("no-such-file.yaml");
+  const std::string missing_csv = Path("no-such-file.csv");
+  const std::string empty = Write("empty.csv", "# nothing but a comment\n");
+  const std::string cal = Fixture("mems_truth.yaml");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"simulate", "-p", missing, "-c", cal, "-o", Path("o.csv")}, missing},
+      {{"simulate", "-p", plan, "-c", missing, "-o", Path("o.csv")}, missing},
+      {{"apply", "-c", missing, "-s", samples, "-o", Path("o.csv")}, missing},
+      {{"apply", "-c", cal, "-s", missing_csv, "-o", Path("o.csv")}, missing_csv},
+      {{"apply", "-c", cal, "-s", missing_csv + ".gz", "-o", Path("o.csv")}, missing_csv + ".gz"},
+      {{"apply", "-c", cal, "-s", empty, "-o", Path("o.csv")}, empty},
+      {{"apply", "-c", cal, "-s", samples, "-o", Path("no-such-folder/o.csv")}, Path("no-such-folder/o.csv")},
+  };
+  const std::set<std::string> before = Listing();
+  for (const auto& [args, file] : cases) {
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("imufit: " + file + ":", 0), 0u) << r.err;
+    EXPECT_EQ(Listing(), before);
+  }
+}
+
+// ------------------------------------------------------------------------------------------ outputs
+
+// A failing run never damages an existing output and leaves no temporary file: the error comes
+// after more than two megabytes of output were written (so part of it reached the temporary file).
+TEST_F(CliTest, AFailingRunLeavesAnExistingOutputUntouched) {
+  const auto [samples, truth] = SimulateNoiseless(Fixture("plan_24pos.yaml"), Fixture("mems_truth.yaml"), "run",
+                                                  {"--rate", "100", "--dwell", "2", "--temps=-40,85"});
+  std::string text = ReadBytes(samples);
+  ASSERT_GT(text.size(), 2u << 20);  // the output is about as long: beyond the 1 MiB write buffer
+  text += "1e9,25,1,1,2,3,4,5,oops\n";  // the last row is bad
+  const std::string bad_samples = Write("bad.csv", text);
+  fs::remove(samples);
+  fs::remove(truth);
+  const std::string sentinel = "precious: an earlier result\n";
+  for (const char* name : {"out.csv", "out.csv.gz"}) {
+    SCOPED_TRACE(name);
+    const std::string out = Write(name, sentinel);
+    const std::set<std::string> before = Listing();
+    const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", bad_samples, "-o", out});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("bad.csv:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"oops\""), std::string::npos) << r.err;
+    EXPECT_EQ(ReadBytes(out), sentinel);
+    EXPECT_EQ(Listing(), before) << "a temporary file was left behind";
+  }
+  // simulate onto existing outputs, failing on its calibration: both outputs stay.
+  const std::string out = Write("sim.csv", sentinel);
+  const std::string truth_out = Write("sim_truth.csv", sentinel);
+  const std::string bad_calibration = Write("bad.yaml", "format: imufit-calibration\nversion: 1\ngyro: 3\n");
+  const std::set<std::string> before = Listing();
+  const RunResult r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", bad_calibration, "-o", out, "--truth",
+                           truth_out});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(ReadBytes(out), sentinel);
+  EXPECT_EQ(ReadBytes(truth_out), sentinel);
+  EXPECT_EQ(Listing(), before);
+}
+
+TEST_F(CliTest, AnOutputThatIsAlsoAnInputIsRefused) {
+  const std::string plan = Write("plan.yaml", kGoodPlan);
+  const std::string samples = Write("samples.csv", kGoodSamples);
+  const std::string calibration = Write("cal.yaml", ReadBytes(Fixture("mems_truth.yaml")));
+  fs::create_symlink(samples, Path("link.csv"));
+  const std::string plan_text = ReadBytes(plan);
+  const std::string samples_text = ReadBytes(samples);
+  const std::string calibration_text = ReadBytes(calibration);
+  const std::vector<std::vector<std::string>> cases = {
+      {"apply", "-c", calibration, "-s", samples, "-o", samples},
+      {"apply", "-c", calibration, "-s", samples, "-o", (work_ / "." / "samples.csv").string()},
+      {"apply", "-c", calibration, "-s", samples, "-o", Path("link.csv")},
+      {"apply", "-c", calibration, "-s", samples, "-o", calibration},
+      {"simulate", "-p", plan, "-c", calibration, "-o", plan},
+      {"simulate", "-p", plan, "-c", calibration, "-o", calibration},
+      {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", plan},
+      {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", Path("new.csv")},
+  };
+  const std::set<std::string> before = Listing();
+  for (const auto& args : cases) {
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 2) << args.back() << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(ReadBytes(plan), plan_text);
+    EXPECT_EQ(ReadBytes(samples), samples_text);
+    EXPECT_EQ(ReadBytes(calibration), calibration_text);
+    EXPECT_EQ(Listing(), before) << args.back();
+  }
+}
+
+}  // namespace
+}  // namespace imufit

@@ -1,0 +1,500 @@
+// Tests of fit/: windows, the residual's identity with the correction `imufit apply` runs,
+// gradients, known-truth recovery within the reported uncertainty, a Monte-Carlo check of that
+// uncertainty, and every way a run can fail to determine the model.
+#include <cmath>
+#include <random>
+
+#include <ceres/ceres.h>
+#include <gtest/gtest.h>
+
+#include "imufit/fit/simulator.h"
+#include "imufit/fit/thermal_fit.h"
+#include "imufit/fit/validation.h"
+#include "imufit/fit/window_cost.h"
+#include "imufit/fit/windows.h"
+#include "test_models.h"
+
+namespace imufit {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+// Recovery: every 25 degC coefficient within this many of its reported sigmas (worst case).
+constexpr double kRecoverySigmas = 3.0;
+// Monte-Carlo: the RMS of (estimate - truth) / reported sigma over seeds and coefficients must lie
+// in this band. With 8 seeds x 33 coefficients the RMS of unit normals is within +-0.15 of 1
+// with ~99 % probability if the estimates were independent; they are correlated, so the band is
+// wider, and its lower edge still catches sigmas that are twice too large.
+constexpr double kMonteCarloZRmsLow = 0.6;
+constexpr double kMonteCarloZRmsHigh = 1.4;
+// Held-out run: RMS prediction error at most this multiple of the noise of a window mean plus
+// the calibration's own uncertainty (RMS).
+constexpr double kHeldOutNoiseMultiple = 3.0;
+
+TableSite Site() {
+  TableSite site;
+  site.gravity_mps2 = 9.79285;
+  site.latitude_rad = 30.27 * kDegToRad;
+  return site;
+}
+
+// Six static faces (with north) and +-100, +-300 deg/s about each axis (with a lever arm).
+std::vector<TableSegment> SixPositionPlan(bool with_rates = true) {
+  std::vector<TableSegment> segments;
+  int id = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double sign : {1.0, -1.0}) {
+      TableSegment s;
+      s.id = id++;
+      s.up = sign * Eigen::Vector3d::Unit(axis);
+      s.north = Eigen::Vector3d::Unit((axis + 1) % 3);
+      segments.push_back(s);
+    }
+  }
+  if (!with_rates) return segments;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double rate_dps : {100.0, -100.0, 300.0, -300.0}) {
+      TableSegment s;
+      s.id = id++;
+      s.up = Eigen::Vector3d::Unit(axis);
+      s.rate_radps = rate_dps * kDegToRad;
+      s.lever_arm_m = Eigen::Vector3d(0.01, 0.02, 0.005);
+      segments.push_back(s);
+    }
+  }
+  return segments;
+}
+
+SimulationOptions MemsNoise(std::uint64_t seed) {
+  SimulationOptions o;
+  o.soak_temps_c = {-40.0, -10.0, 25.0, 55.0, 85.0};
+  o.dwell_s = 6.0;
+  o.transition_s = 1.0;
+  o.rate_hz = 100.0;
+  o.gyro_noise_density = 1e-4;   // rad/s/sqrt(Hz), about 0.35 deg/sqrt(h)
+  o.accel_noise_density = 5e-4;  // m/s^2/sqrt(Hz), about 50 micro-g/sqrt(Hz)
+  o.quantize = true;
+  o.seed = seed;
+  return o;
+}
+
+std::vector<Window> Simulate(const SimulationOptions& options, const std::vector<TableSegment>& segments,
+                             const SensorModel& truth, const WindowOptions& window_options = WindowOptions()) {
+  WindowBuilder builder(window_options);
+  SimulateRun(options, Site(), segments, truth, [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
+  return builder.Finish();
+}
+
+// (estimate - truth) / sigma for every 25 degC coefficient (c0 in powers of dT).
+std::vector<double> ZScoresAt25(const FitSummary& fit, const SensorModel& truth) {
+  std::vector<double> z;
+  for (int c = 0; c < kGyroCoefficients; ++c) {
+    const int i = c * kPolynomialTerms;
+    z.push_back((fit.model.gyro[i] - truth.gyro[i]) / fit.sigma.gyro[i]);
+  }
+  for (int c = 0; c < kAccelCoefficients; ++c) {
+    const int i = c * kPolynomialTerms;
+    z.push_back((fit.model.accel[i] - truth.accel[i]) / fit.sigma.accel[i]);
+  }
+  return z;
+}
+
+// ---------------------------------------------------------------- windows
+
+TEST(Windows, OccurrencesTrimmingAndTemperatureSpans) {
+  WindowOptions options;
+  options.trim_s = 0.5;
+  options.max_temp_span_c = 1.0;
+  options.min_samples = 5;
+  WindowBuilder builder(options);
+  Sample s;
+  double t = 0.0;
+  const auto add = [&](int segment, int count, double temp_start, double temp_step) {
+    for (int i = 0; i < count; ++i, t += 0.125) {  // exact binary times
+      s.time_s = t;
+      s.segment = segment;
+      s.temp_c = temp_start + temp_step * i;
+      s.gyro = Eigen::Vector3d(i % 2, 1.0, 2.0);
+      s.accel = Eigen::Vector3d(3.0, 4.0, 5.0);
+      builder.Add(s);
+    }
+  };
+  add(3, 20, 25.0, 0.0);   // 4 trimmed (0 .. 0.375 s), 16 kept
+  add(-1, 10, 25.0, 0.0);  // transition
+  add(3, 30, 20.0, 0.1);   // second occurrence; ramp of 0.1 degC per sample -> several windows
+  add(4, 7, 25.0, 0.0);    // 4 trimmed, 3 left: a short window
+  const std::vector<Window> windows = builder.Finish();
+  const WindowStats& stats = builder.stats();
+  EXPECT_EQ(stats.samples, 67);
+  EXPECT_EQ(stats.transition_samples, 10);
+  EXPECT_EQ(stats.trimmed_samples, 12);
+  // Segment 4's three samples, and the last 4 samples of the ramp (26 kept = 11 + 11 + 4).
+  EXPECT_EQ(stats.short_windows, 2);
+  ASSERT_GE(windows.size(), 3u);
+  EXPECT_EQ(windows[0].segment, 3);
+  EXPECT_EQ(windows[0].occurrence, 0);
+  EXPECT_EQ(windows[0].samples, 16);
+  EXPECT_NEAR(windows[0].gyro_mean.x(), 0.5, 1e-15);  // i = 4..19: eight odd values of 16
+  EXPECT_NEAR(windows[0].gyro_std.x(), std::sqrt(0.25 * 16.0 / 15.0), 1e-15);
+  EXPECT_EQ(windows[0].gyro_std.y(), 0.0);
+  for (size_t w = 1; w < windows.size(); ++w) {
+    EXPECT_EQ(windows[w].occurrence, 1);
+    EXPECT_LE(windows[w].samples, 11);  // a 1 degC span at 0.1 degC per sample
+  }
+}
+
+TEST(Windows, DistinctTemperaturesCluster) {
+  const std::vector<double> centres = DistinctTemperatures({25.2, -40.0, 24.8, 85.0, 85.4, -39.9}, 1.0);
+  ASSERT_EQ(centres.size(), 3u);
+  EXPECT_NEAR(centres[0], -39.95, 1e-12);
+  EXPECT_NEAR(centres[1], 25.0, 1e-12);
+  EXPECT_NEAR(centres[2], 85.2, 1e-12);
+}
+
+// ---------------------------------------------------------------- the shared function
+
+TEST(WindowCost, IsTheCorrectionImufitApplyRuns) {
+  // With p0 = the calibration, unit steps, q = 0, zero truth and unit sigma, the fit's residual
+  // is the corrected output itself: it must equal SensorModel::Correct bit for bit.
+  const SensorModel model = testing::RandomMemsModel(9);
+  std::mt19937_64 engine(1);
+  std::uniform_real_distribution<double> counts(-4000.0, 4000.0);
+  std::uniform_real_distribution<double> temp(-40.0, 85.0);
+  const std::vector<double> unit_steps(kGyroParameters, 1.0);
+  for (int i = 0; i < 50; ++i) {
+    const double temp_c = temp(engine);
+    const Eigen::Vector3d gyro_m(counts(engine), counts(engine), counts(engine));
+    const Eigen::Vector3d accel_m(counts(engine), counts(engine), counts(engine));
+    Eigen::Vector3d omega_hat;
+    Eigen::Vector3d a_hat;
+    model.Correct(temp_c, gyro_m, accel_m, &omega_hat, &a_hat);
+
+    const double x = model.basis.Argument(temp_c);
+    const WindowCost<kGyroParameters> gyro_cost(gyro_m, Eigen::Vector3d::Zero(), a_hat, x, Eigen::Vector3d::Ones(),
+                                                model.gyro.data(), unit_steps.data());
+    const WindowCost<kAccelParameters> accel_cost(accel_m, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), x,
+                                                  Eigen::Vector3d::Ones(), model.accel.data(), unit_steps.data());
+    const std::vector<double> q(kGyroParameters, 0.0);
+    Eigen::Vector3d gyro_residual;
+    Eigen::Vector3d accel_residual;
+    gyro_cost(q.data(), gyro_residual.data());
+    accel_cost(q.data(), accel_residual.data());
+    EXPECT_EQ(gyro_residual, omega_hat);
+    EXPECT_EQ(accel_residual, a_hat);
+  }
+}
+
+// Autodiff Jacobian of the fit's residual against central differences, at a random point and at
+// the closed-form start's typical neighbourhood (q = 0).
+TEST(WindowCost, AutodiffJacobianMatchesCentralDifferences) {
+  constexpr double kRelTol = 1e-6;
+  const SensorModel model = testing::RandomMemsModel(21);
+  std::vector<double> step(kGyroParameters);
+  for (int i = 0; i < kGyroParameters; ++i) step[i] = 1e-3 * (1.0 + std::abs(model.gyro[i]));
+  auto* functor = new WindowCost<kGyroParameters>(Eigen::Vector3d(120.0, -3000.0, 45.0), Eigen::Vector3d(0.1, -3.0, 0.05),
+                                                  Eigen::Vector3d(0.3, 9.7, -0.2), 0.4, Eigen::Vector3d(1e-3, 2e-3, 1e-3),
+                                                  model.gyro.data(), step.data());
+  ceres::AutoDiffCostFunction<WindowCost<kGyroParameters>, 3, kGyroParameters> cost(functor);
+  std::mt19937_64 engine(4);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int point = 0; point < 2; ++point) {
+    std::vector<double> q(kGyroParameters, 0.0);
+    if (point == 1) {
+      for (double& v : q) v = n(engine);
+    }
+    const double* parameters[] = {q.data()};
+    Eigen::Matrix<double, 3, kGyroParameters, Eigen::RowMajor> jacobian;
+    double* jacobians[] = {jacobian.data()};
+    Eigen::Vector3d residual;
+    ASSERT_TRUE(cost.Evaluate(parameters, residual.data(), jacobians));
+    for (int p = 0; p < kGyroParameters; ++p) {
+      constexpr double kStep = 1e-5;
+      std::vector<double> plus = q;
+      std::vector<double> minus = q;
+      plus[p] += kStep;
+      minus[p] -= kStep;
+      Eigen::Vector3d r_plus;
+      Eigen::Vector3d r_minus;
+      (*functor)(plus.data(), r_plus.data());
+      (*functor)(minus.data(), r_minus.data());
+      const Eigen::Vector3d numeric = (r_plus - r_minus) / (2.0 * kStep);
+      const double scale = std::max(1.0, jacobian.col(p).cwiseAbs().maxCoeff());
+      EXPECT_LE((numeric - jacobian.col(p)).cwiseAbs().maxCoeff(), kRelTol * scale) << "parameter " << p;
+    }
+  }
+}
+
+// ---------------------------------------------------------------- known truth
+
+class KnownTruth : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    truth_ = new SensorModel(testing::RandomMemsModel(2026));
+    windows_ = new std::vector<Window>(Simulate(MemsNoise(17), SixPositionPlan(), *truth_));
+    fit_ = new FitSummary(FitThermalModel(*windows_, Site(), SixPositionPlan(), FitOptions()));
+  }
+  static void TearDownTestSuite() {
+    delete truth_;
+    delete windows_;
+    delete fit_;
+  }
+  static SensorModel* truth_;
+  static std::vector<Window>* windows_;
+  static FitSummary* fit_;
+};
+SensorModel* KnownTruth::truth_ = nullptr;
+std::vector<Window>* KnownTruth::windows_ = nullptr;
+FitSummary* KnownTruth::fit_ = nullptr;
+
+TEST_F(KnownTruth, ConvergesQuicklyWithSensibleDiagnostics) {
+  ASSERT_TRUE(fit_->IsSolutionUsable()) << fit_->FullReport();
+  EXPECT_LE(fit_->iterations, 10);
+  EXPECT_EQ(fit_->windows_used, 90);
+  EXPECT_EQ(fit_->distinct_temps_c.size(), 5u);
+  EXPECT_NEAR(fit_->temp_range_c[0], -40.0, 1e-9);
+  EXPECT_NEAR(fit_->temp_range_c[1], 85.0, 1e-9);
+  // The weights are the measured noise: the reduced chi-square is about one.
+  EXPECT_GT(fit_->gyro_reduced_chi2, 0.5);
+  EXPECT_LT(fit_->gyro_reduced_chi2, 2.0);
+  EXPECT_GT(fit_->accel_reduced_chi2, 0.5);
+  EXPECT_LT(fit_->accel_reduced_chi2, 2.0);
+  EXPECT_NE(fit_->BriefReport().find("converged"), std::string::npos);
+}
+
+TEST_F(KnownTruth, RecoversCoefficientsAt25CWithinReportedSigmas) {
+  ASSERT_TRUE(fit_->IsSolutionUsable());
+  const std::vector<double> z = ZScoresAt25(*fit_, *truth_);
+  for (size_t i = 0; i < z.size(); ++i) {
+    const bool gyro = i < kGyroCoefficients;
+    const CoefficientName& name = kCoefficientNames[gyro ? i : i - kGyroCoefficients];
+    EXPECT_LE(std::abs(z[i]), kRecoverySigmas) << (gyro ? "gyro " : "accel ") << name.group << " " << name.axis;
+  }
+}
+
+TEST_F(KnownTruth, PredictsAHeldOutRunWithinTheNoiseFloor) {
+  ASSERT_TRUE(fit_->IsSolutionUsable());
+  // Other temperatures, tilted positions, other rates.
+  std::vector<TableSegment> segments;
+  int id = 100;
+  for (const Eigen::Vector3d& up : {Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(0, -1, 1), Eigen::Vector3d(1, -1, -1)}) {
+    TableSegment still;
+    still.id = id++;
+    still.up = up.normalized();
+    segments.push_back(still);
+    TableSegment spin = still;
+    spin.id = id++;
+    spin.rate_radps = 200.0 * kDegToRad;
+    segments.push_back(spin);
+  }
+  SimulationOptions options = MemsNoise(99);
+  options.soak_temps_c = {-25.0, 5.0, 40.0, 70.0};
+  const std::vector<Window> held_out = Simulate(options, segments, *truth_);
+  const std::vector<WindowError> errors = PredictWindows(fit_->model, held_out, Site(), segments);
+  ASSERT_EQ(errors.size(), held_out.size());
+  const ErrorStats stats = SummariseErrors(errors);
+  // The noise of a window mean, SI: white noise density / sqrt(window duration).
+  const double window_s = options.dwell_s - WindowOptions().trim_s;
+  const double gyro_floor = options.gyro_noise_density / std::sqrt(window_s);
+  const double accel_floor = options.accel_noise_density / std::sqrt(window_s);
+  // The calibration's own uncertainty adds about as much again (it is fitted on similar windows).
+  EXPECT_LT(stats.gyro_rms_radps, kHeldOutNoiseMultiple * std::sqrt(2.0) * gyro_floor)
+      << stats.gyro_rms_radps / kDegToRad << " deg/s";
+  EXPECT_LT(stats.accel_rms_mps2, kHeldOutNoiseMultiple * std::sqrt(2.0) * accel_floor) << stats.accel_rms_mps2 << " m/s^2";
+}
+
+TEST_F(KnownTruth, LeaveOneTemperatureOutReportsInteriorTemperatures) {
+  const std::vector<HeldOutGroup> folds = LeaveOneTemperatureOut(*windows_, Site(), SixPositionPlan(), FitOptions());
+  ASSERT_EQ(folds.size(), 3u);  // -10, 25, 55: the ends are not left out
+  EXPECT_NEAR(folds[1].temp_c, 25.0, 1e-9);
+  for (const HeldOutGroup& g : folds) {
+    ASSERT_TRUE(g.fitted) << g.why_not;
+    EXPECT_EQ(g.errors.windows, 18);
+    EXPECT_LT(g.errors.gyro_rms_radps, 0.01 * kDegToRad);
+  }
+}
+
+TEST(Fit, ExactOnANoiseFreeRampWithEarthRateAndLeverArms) {
+  // Without noise the fit must reproduce the truth to round-off: any modelling error (Earth
+  // rate, centripetal term, temperature inside a window) would show here.
+  const SensorModel truth = testing::RandomMemsModel(5);
+  SimulationOptions options;
+  options.ramp = true;
+  options.ramp_from_c = -40.0;
+  options.ramp_to_c = 85.0;
+  options.passes = 4;
+  options.dwell_s = 4.0;
+  options.rate_hz = 50.0;
+  WindowOptions window_options;
+  window_options.max_temp_span_c = 0.05;
+  window_options.min_samples = 2;
+  const std::vector<Window> windows = Simulate(options, SixPositionPlan(), truth, window_options);
+  const FitSummary fit = FitThermalModel(windows, Site(), SixPositionPlan(), FitOptions());
+  ASSERT_TRUE(fit.IsSolutionUsable()) << fit.FullReport();
+  EXPECT_LT(fit.gyro_rms_radps, 1e-6 * kDegToRad);
+  EXPECT_LT(fit.accel_rms_mps2, 1e-6);
+  for (int i = 0; i < kGyroParameters; i += kPolynomialTerms) {
+    EXPECT_NEAR(fit.model.gyro[i], truth.gyro[i], 1e-5 * (1e-3 + std::abs(truth.gyro[i]))) << i;
+  }
+}
+
+TEST(Fit, ConvergesFromAPoorStartAndReportsNonConvergence) {
+  const SensorModel truth = testing::RandomMemsModel(8);
+  const std::vector<Window> windows = Simulate(MemsNoise(3), SixPositionPlan(), truth);
+  FitOptions options;
+  options.closed_form_start = false;
+  const FitSummary slow = FitThermalModel(windows, Site(), SixPositionPlan(), options);
+  ASSERT_TRUE(slow.IsSolutionUsable()) << slow.FullReport();
+  const FitSummary fast = FitThermalModel(windows, Site(), SixPositionPlan(), FitOptions());
+  EXPECT_NEAR(slow.model.gyro[0], fast.model.gyro[0], 1e-3 * fast.sigma.gyro[0]);
+  options.max_iterations = 1;
+  const FitSummary stopped = FitThermalModel(windows, Site(), SixPositionPlan(), options);
+  EXPECT_EQ(stopped.status, FitStatus::kNotConverged);
+  EXPECT_FALSE(stopped.IsSolutionUsable());
+  EXPECT_NE(stopped.BriefReport().find("did not converge"), std::string::npos) << stopped.BriefReport();
+}
+
+TEST(Fit, RobustLossDownWeightsAnOutlierWindow) {
+  const SensorModel truth = testing::RandomMemsModel(12);
+  std::vector<Window> windows = Simulate(MemsNoise(5), SixPositionPlan(), truth);
+  windows[40].gyro_mean.y() += 50.0;  // a bump of ~3 deg/s in one window
+  const FitSummary robust = FitThermalModel(windows, Site(), SixPositionPlan(), FitOptions());
+  ASSERT_TRUE(robust.IsSolutionUsable());
+  EXPECT_TRUE(robust.residuals[40].downweighted);
+  EXPECT_LE(robust.windows_downweighted, 3);
+  FitOptions plain;
+  plain.loss = RobustLoss::kNone;
+  const FitSummary least_squares = FitThermalModel(windows, Site(), SixPositionPlan(), plain);
+  ASSERT_TRUE(least_squares.IsSolutionUsable());
+  EXPECT_EQ(least_squares.windows_downweighted, 0);
+  // The outlier pulls least squares further from the truth than the robust fit.
+  const int bias_y = (kBiasCoefficient + 1) * kPolynomialTerms;
+  EXPECT_LT(std::abs(robust.model.gyro[bias_y] - truth.gyro[bias_y]),
+            std::abs(least_squares.model.gyro[bias_y] - truth.gyro[bias_y]));
+}
+
+TEST(Fit, MonteCarloSigmasMatchTheSpread) {
+  const SensorModel truth = testing::RandomMemsModel(77);
+  double sum_z2 = 0.0;
+  int count = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const FitSummary fit =
+        FitThermalModel(Simulate(MemsNoise(1000 + seed), SixPositionPlan(), truth), Site(), SixPositionPlan(), FitOptions());
+    ASSERT_TRUE(fit.IsSolutionUsable());
+    for (double z : ZScoresAt25(fit, truth)) {
+      sum_z2 += z * z;
+      ++count;
+    }
+  }
+  const double z_rms = std::sqrt(sum_z2 / count);
+  EXPECT_GT(z_rms, kMonteCarloZRmsLow);
+  EXPECT_LT(z_rms, kMonteCarloZRmsHigh);
+}
+
+// ---------------------------------------------------------------- runs that cannot determine the model
+
+std::vector<std::string> Findings(const std::vector<TableSegment>& segments, const SimulationOptions& simulation,
+                                  const FitOptions& options = FitOptions()) {
+  const std::vector<Window> windows = Simulate(simulation, segments, testing::RandomMemsModel(1));
+  const FitSummary fit = FitThermalModel(windows, Site(), segments, options);
+  EXPECT_EQ(fit.status, FitStatus::kUndetermined);
+  EXPECT_FALSE(fit.IsSolutionUsable());
+  return fit.undetermined;
+}
+
+bool Mentions(const std::vector<std::string>& findings, const std::string& text) {
+  for (const std::string& f : findings) {
+    if (f.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(Undetermined, SingleTemperature) {
+  SimulationOptions o = MemsNoise(1);
+  o.soak_temps_c = {25.0};
+  const auto findings = Findings(SixPositionPlan(), o);
+  ASSERT_EQ(findings.size(), 1u) << findings[0];
+  EXPECT_NE(findings[0].find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
+                             "at least 4 needed"),
+            std::string::npos)
+      << findings[0];
+  // A constant model is determined by the same run.
+  FitOptions constant;
+  constant.gyro_temp_order = 0;
+  constant.accel_temp_order = 0;
+  const FitSummary fit = FitThermalModel(Simulate(o, SixPositionPlan(), testing::RandomMemsModel(1)), Site(),
+                                         SixPositionPlan(), constant);
+  EXPECT_TRUE(fit.IsSolutionUsable()) << fit.FullReport();
+}
+
+TEST(Undetermined, NoRatesAboutAnAxis) {
+  std::vector<TableSegment> segments = SixPositionPlan();
+  segments.erase(std::remove_if(segments.begin(), segments.end(),
+                                [](const TableSegment& s) { return !s.IsStatic() && s.up.z() != 0.0; }),
+                 segments.end());
+  const auto findings = Findings(segments, MemsNoise(1));
+  EXPECT_TRUE(Mentions(findings, "gyro scale z and misalignment xz, yz are undetermined: no rate segments about the z axis"))
+      << findings[0];
+}
+
+TEST(Undetermined, GravityNeverAlongMinusY) {
+  std::vector<TableSegment> segments = SixPositionPlan();
+  segments.erase(std::remove_if(segments.begin(), segments.end(), [](const TableSegment& s) { return s.up.y() < -0.5; }),
+                 segments.end());
+  const auto findings = Findings(segments, MemsNoise(1));
+  EXPECT_TRUE(Mentions(findings, "gyro g_sensitivity column y (xy, yy, zy) is undetermined: no positions with gravity along -y"))
+      << findings[0];
+  EXPECT_TRUE(Mentions(findings, "accel scale y and misalignment xy, zy are undetermined: no positions with gravity along -y"));
+  // Without g-sensitivity the gyro is fine; the accelerometer still is not.
+  FitOptions no_h;
+  no_h.fit_g_sensitivity = false;
+  const auto without_h = Findings(segments, MemsNoise(1), no_h);
+  EXPECT_FALSE(Mentions(without_h, "g_sensitivity"));
+  EXPECT_TRUE(Mentions(without_h, "accel scale y"));
+}
+
+TEST(Undetermined, RatesAboutAnAxisAtTooFewTemperatures) {
+  // Rates about x only in the first two soaks: a cubic in x's scale cannot be fitted.
+  const SensorModel truth = testing::RandomMemsModel(1);
+  std::vector<TableSegment> all = SixPositionPlan();
+  std::vector<TableSegment> no_x_rates;
+  for (const TableSegment& s : all) {
+    if (s.IsStatic() || s.up.x() == 0.0) no_x_rates.push_back(s);
+  }
+  SimulationOptions early = MemsNoise(1);
+  early.soak_temps_c = {-40.0, -10.0};
+  SimulationOptions late = MemsNoise(2);
+  late.soak_temps_c = {25.0, 55.0, 85.0};
+  late.start_time_s = 10000.0;
+  std::vector<Window> windows = Simulate(early, all, truth);
+  const std::vector<Window> rest = Simulate(late, no_x_rates, truth);
+  windows.insert(windows.end(), rest.begin(), rest.end());
+  const FitSummary fit = FitThermalModel(windows, Site(), all, FitOptions());
+  ASSERT_EQ(fit.status, FitStatus::kUndetermined);
+  EXPECT_TRUE(Mentions(fit.undetermined, "gyro scale x and misalignment yx, zx are undetermined: rate segments about x at "
+                                         "only 2 distinct temperatures (-40.0, -10.0 degC), the gyro temperature order 3 "
+                                         "needs 4"))
+      << fit.undetermined[0];
+}
+
+TEST(Undetermined, NoWindowsAtAll) {
+  const FitSummary fit = FitThermalModel({}, Site(), SixPositionPlan(), FitOptions());
+  EXPECT_EQ(fit.status, FitStatus::kUndetermined);
+  EXPECT_TRUE(Mentions(fit.undetermined, "no usable windows"));
+}
+
+TEST(FitOptions, ValidateAndLossNames) {
+  FitOptions options;
+  EXPECT_EQ(options.Validate(), "");
+  options.gyro_temp_order = 4;
+  EXPECT_NE(options.Validate(), "");
+  RobustLoss loss;
+  std::string error;
+  EXPECT_TRUE(ParseRobustLoss("cauchy", &loss, &error));
+  EXPECT_EQ(loss, RobustLoss::kCauchy);
+  EXPECT_FALSE(ParseRobustLoss("tukey", &loss, &error));
+  EXPECT_EQ(error, "\"tukey\" is not a robust loss (none, huber, cauchy)");
+  EXPECT_EQ(FitSummary().BriefReport(), "fit not run");
+}
+
+}  // namespace
+}  // namespace imufit
