@@ -13,8 +13,9 @@
 namespace imufit {
 namespace {
 
+// Name tables of the enums users type; `value` and `name` are what the helpers below read.
 struct EstimatorName {
-  AllanEstimator estimator;
+  AllanEstimator value;
   const char* name;
 };
 constexpr EstimatorName kEstimatorNames[] = {
@@ -23,13 +24,39 @@ constexpr EstimatorName kEstimatorNames[] = {
     {AllanEstimator::kTotdev, "totdev"}};
 
 struct EdfNoiseName {
-  EdfNoise noise;
+  EdfNoise value;
   const char* name;
   int alpha;
 };
 constexpr EdfNoiseName kEdfNoiseNames[] = {{EdfNoise::kIdentify, "auto", 0},      {EdfNoise::kWhitePm, "wpm", 2},
                                            {EdfNoise::kFlickerPm, "fpm", 1},      {EdfNoise::kWhiteFm, "wfm", 0},
                                            {EdfNoise::kFlickerFm, "ffm", -1},     {EdfNoise::kRandomWalkFm, "rwfm", -2}};
+
+template <typename Entry, size_t kCount, typename Value>
+const char* NameOf(const Entry (&table)[kCount], Value value) {
+  for (const Entry& entry : table) {
+    if (entry.value == value) return entry.name;
+  }
+  return "?";
+}
+
+template <typename Entry, size_t kCount, typename Value>
+bool ValueOf(const Entry (&table)[kCount], std::string_view text, Value* value) {
+  for (const Entry& entry : table) {
+    if (text == entry.name) {
+      *value = entry.value;
+      return true;
+    }
+  }
+  return false;
+}
+
+template <typename Entry, size_t kCount>
+std::string AllNames(const Entry (&table)[kCount]) {
+  std::string names;
+  for (const Entry& entry : table) names += (names.empty() ? "" : ", ") + std::string(entry.name);
+  return names;
+}
 
 // Work below this many terms per thread is not worth a thread.
 constexpr int64_t kMinTermsPerThread = 1 << 16;
@@ -246,51 +273,15 @@ std::optional<double> Edf(AllanEstimator estimator, int alpha, int64_t m, int64_
 
 }  // namespace
 
-const char* ToString(AllanEstimator estimator) {
-  for (const EstimatorName& entry : kEstimatorNames) {
-    if (entry.estimator == estimator) return entry.name;
-  }
-  return "?";
-}
-
+const char* ToString(AllanEstimator estimator) { return NameOf(kEstimatorNames, estimator); }
 bool ParseAllanEstimator(std::string_view text, AllanEstimator* estimator) {
-  for (const EstimatorName& entry : kEstimatorNames) {
-    if (text == entry.name) {
-      *estimator = entry.estimator;
-      return true;
-    }
-  }
-  return false;
+  return ValueOf(kEstimatorNames, text, estimator);
 }
+std::string AllanEstimatorNames() { return AllNames(kEstimatorNames); }
 
-std::string AllanEstimatorNames() {
-  std::string names;
-  for (const EstimatorName& entry : kEstimatorNames) names += (names.empty() ? "" : ", ") + std::string(entry.name);
-  return names;
-}
-
-const char* ToString(EdfNoise noise) {
-  for (const EdfNoiseName& entry : kEdfNoiseNames) {
-    if (entry.noise == noise) return entry.name;
-  }
-  return "?";
-}
-
-bool ParseEdfNoise(std::string_view text, EdfNoise* noise) {
-  for (const EdfNoiseName& entry : kEdfNoiseNames) {
-    if (text == entry.name) {
-      *noise = entry.noise;
-      return true;
-    }
-  }
-  return false;
-}
-
-std::string EdfNoiseNames() {
-  std::string names;
-  for (const EdfNoiseName& entry : kEdfNoiseNames) names += (names.empty() ? "" : ", ") + std::string(entry.name);
-  return names;
-}
+const char* ToString(EdfNoise noise) { return NameOf(kEdfNoiseNames, noise); }
+bool ParseEdfNoise(std::string_view text, EdfNoise* noise) { return ValueOf(kEdfNoiseNames, text, noise); }
+std::string EdfNoiseNames() { return AllNames(kEdfNoiseNames); }
 
 std::string ParseTauSpec(std::string_view text, TauSpec* spec) {
   const std::string allowed =
@@ -550,7 +541,7 @@ AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const 
   const int alpha_min = options.estimator == AllanEstimator::kTotdev ? -2 : std::max(-4, 2 - 2 * d);
   int carried_alpha = 0;  // white FM until something is identified
   for (const EdfNoiseName& entry : kEdfNoiseNames) {
-    if (entry.noise == options.edf_noise) carried_alpha = entry.alpha;
+    if (entry.value == options.edf_noise) carried_alpha = entry.alpha;
   }
   std::vector<double> means;
   for (size_t t = 0; t < factors.size(); ++t) {
