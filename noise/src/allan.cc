@@ -62,7 +62,9 @@ std::string AllNames(const Entry (&table)[kCount]) {
 constexpr int64_t kMinTermsPerThread = 1 << 16;
 // Terms per block of the sweep: the slices X[b + offset .. b + offset + kBlock) of all averaging
 // factors of one block stay in the L2 cache while the factors are evaluated.
-constexpr int64_t kBlock = 2048;
+constexpr int64_t kBlock = 4096;
+// Samples per run of the phase integration: a run is summed in double from a long double start.
+constexpr int64_t kPhaseRun = 256;
 // `--taus all` evaluates every factor; refuse when that would be absurdly slow.
 constexpr double kMaxAllWork = 2e10;
 
@@ -79,6 +81,63 @@ void RunParallel(int count, Work work) {
   for (int w = 1; w < count; ++w) pool.emplace_back([&work, w] { work(w); });
   work(0);
   for (std::thread& thread : pool) thread.join();
+}
+
+// Plain sum in four accumulators.
+double SumOf(const double* y, int64_t count) {
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  int64_t k = 0;
+  for (; k + 4 <= count; k += 4) {
+    s0 += y[k];
+    s1 += y[k + 1];
+    s2 += y[k + 2];
+    s3 += y[k + 3];
+  }
+  for (; k < count; ++k) s0 += y[k];
+  return (s0 + s1) + (s2 + s3);
+}
+
+// The hot loops of the overlapping estimators: sum over k of (p2 - 2 p1 + p0)^2 and of
+// (p3 - 3 p2 + 3 p1 - p0)^2, in eight accumulators. Compiled twice, for AVX2 and for the baseline,
+// and chosen at load time, so the build stays portable.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+#define IMUFIT_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define IMUFIT_VECTOR_CLONES
+#endif
+
+IMUFIT_VECTOR_CLONES double SecondDifferenceSquares(const double* p0, const double* p1, const double* p2,
+                                                     int64_t count) {
+  double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  int64_t k = 0;
+  for (; k + 8 <= count; k += 8) {
+    for (int l = 0; l < 8; ++l) {
+      const double d = p2[k + l] - 2.0 * p1[k + l] + p0[k + l];
+      s[l] += d * d;
+    }
+  }
+  for (; k < count; ++k) {
+    const double d = p2[k] - 2.0 * p1[k] + p0[k];
+    s[0] += d * d;
+  }
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+IMUFIT_VECTOR_CLONES double ThirdDifferenceSquares(const double* p0, const double* p1, const double* p2,
+                                                    const double* p3, int64_t count) {
+  double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  int64_t k = 0;
+  for (; k + 8 <= count; k += 8) {
+    for (int l = 0; l < 8; ++l) {
+      const double d = p3[k + l] - 3.0 * p2[k + l] + 3.0 * p1[k + l] - p0[k + l];
+      s[l] += d * d;
+    }
+  }
+  for (; k < count; ++k) {
+    const double d = p3[k] - 3.0 * p2[k] + 3.0 * p1[k] - p0[k];
+    s[0] += d * d;
+  }
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
 // Sum of squares of term(k), k = 0 .. count-1, in four independent accumulators (so the compiler
@@ -154,9 +213,7 @@ struct OadevKernel {  // second differences at stride 1
   double Block(size_t t, int64_t begin, int64_t end) const {
     const int64_t s = (*m)[t];
     const double* p0 = x + begin;
-    const double* p1 = p0 + s;
-    const double* p2 = p1 + s;
-    return SumSquares(end - begin, [=](int64_t k) { return p2[k] - 2.0 * p1[k] + p0[k]; });
+    return SecondDifferenceSquares(p0, p0 + s, p0 + 2 * s, end - begin);
   }
 };
 
@@ -179,10 +236,7 @@ struct OhdevKernel {  // third differences at stride 1
   double Block(size_t t, int64_t begin, int64_t end) const {
     const int64_t s = (*m)[t];
     const double* p0 = x + begin;
-    const double* p1 = p0 + s;
-    const double* p2 = p1 + s;
-    const double* p3 = p2 + s;
-    return SumSquares(end - begin, [=](int64_t k) { return p3[k] - 3.0 * p2[k] + 3.0 * p1[k] - p0[k]; });
+    return ThirdDifferenceSquares(p0, p0 + s, p0 + 2 * s, p0 + 3 * s, end - begin);
   }
 };
 
@@ -246,10 +300,7 @@ struct TotdevKernel {
       return sum;
     };
     const double* p0 = x + inner_begin + 1 - s;
-    const double* p1 = x + inner_begin + 1;
-    const double* p2 = x + inner_begin + 1 + s;
-    const double inner =
-        SumSquares(inner_end - inner_begin, [=](int64_t k) { return p2[k] - 2.0 * p1[k] + p0[k]; });
+    const double inner = SecondDifferenceSquares(p0, p0 + s, p0 + 2 * s, inner_end - inner_begin);
     return reflected(begin, inner_begin) + inner + reflected(inner_end, end);
   }
 };
@@ -444,34 +495,51 @@ double RatesToPhase(std::vector<double>* samples, int threads) {
   const int64_t n = static_cast<int64_t>(y.size());
   const int workers =
       static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(ResolveThreads(threads), n / kMinTermsPerThread)));
-  // Pass 1: chunk sums (long double), hence the mean.
+  // Pass 1: chunk sums, hence the mean. Short runs are summed in double, the runs in long double.
   std::vector<long double> chunk_sum(workers, 0.0L);
   RunParallel(workers, [&](int w) {
     long double sum = 0.0L;
-    for (int64_t i = n * w / workers; i < n * (w + 1) / workers; ++i) sum += y[i];
+    const int64_t end = n * (w + 1) / workers;
+    for (int64_t i = n * w / workers; i < end; i += kPhaseRun) {
+      const int64_t stop = std::min(i + kPhaseRun, end);
+      sum += SumOf(y.data() + i, stop - i);
+    }
     chunk_sum[w] = sum;
   });
   long double total = 0.0L;
   for (long double s : chunk_sum) total += s;
-  const long double mean = n > 0 ? total / n : 0.0L;
-  // Pass 2: each chunk integrates from the exact running sum at its start, in place: slot k takes
-  // X_k while y_k is read out of it.
+  const long double mean_exact = n > 0 ? total / n : 0.0L;
+  const double mean = static_cast<double>(mean_exact);
+  // The mean as double plus the rest, so that (y - mean) - rest is the exact deviation to long
+  // double precision while the inner loop stays in double.
+  const long double mean_rest = mean_exact - mean;
+  // Pass 2, in place (slot k takes X_k while y_k is read out of it). Within a run of kPhaseRun
+  // samples X is the run's start (long double) plus a short double sum, so rounding never
+  // accumulates beyond one run; each chunk starts from the exact running sum.
   std::vector<long double> start(workers, 0.0L);
   for (int w = 1; w < workers; ++w) {
     const int64_t length = n * w / workers - n * (w - 1) / workers;
-    start[w] = start[w - 1] + (chunk_sum[w - 1] - mean * length);
+    start[w] = start[w - 1] + (chunk_sum[w - 1] - mean_exact * length);
   }
   y.push_back(0.0);
   RunParallel(workers, [&](int w) {
-    long double x = start[w];
-    for (int64_t i = n * w / workers; i < n * (w + 1) / workers; ++i) {
-      const double rate = y[i];
-      y[i] = static_cast<double>(x);
-      x += rate - mean;
+    long double base = start[w];
+    const int64_t end = n * (w + 1) / workers;
+    for (int64_t i = n * w / workers; i < end; i += kPhaseRun) {
+      const int64_t stop = std::min(i + kPhaseRun, end);
+      const double origin = static_cast<double>(base);
+      const double origin_rest = static_cast<double>(base - origin);
+      double local = 0.0;
+      for (int64_t k = i; k < stop; ++k) {
+        const double rate = y[k];
+        y[k] = origin + (origin_rest + local);
+        local += rate - mean;
+      }
+      base += static_cast<long double>(local) - mean_rest * (stop - i);
     }
-    if (w == workers - 1) y[n] = static_cast<double>(x);
+    if (w == workers - 1) y[n] = static_cast<double>(base);
   });
-  return static_cast<double>(mean);
+  return mean;
 }
 
 std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s, const std::vector<int64_t>& factors,

@@ -105,7 +105,7 @@ struct AllanOptions {
   int threads = 0;
   // Noise identification uses at most this many rate averages per factor (the first ones): the
   // lag-1 autocorrelation is settled long before, and the cost stays bounded at m = 1.
-  int64_t max_noise_id_points = int64_t{1} << 22;
+  int64_t max_noise_id_points = int64_t{1} << 18;
 
   // "" when valid, else a readable reason.
   std::string Validate() const;
@@ -132,7 +132,8 @@ struct AllanResult {
 };
 
 // Integrates rates in place into the phase X of the header comment (n + 1 values; the vector
-// grows by one) and returns the removed mean. Uses `threads` threads (0 = all).
+// grows by one: reserve n + 1 to spare a reallocation) and returns the removed mean. Uses
+// `threads` threads (0 = all).
 double RatesToPhase(std::vector<double>* samples, int threads = 0);
 
 // Deviations only (no confidence intervals): deviation[i] for factors[i], from the phase X.
