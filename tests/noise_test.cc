@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -170,6 +171,279 @@ TEST(NoiseReferenceTest, ConfidenceIntervalsMatchStable32) {
       EXPECT_NEAR(point.dev_hi / row.hi, 1.0, kStable32BoundTolerance) << where << " hi " << point.dev_hi;
     }
   }
+}
+
+
+// ---------------------------------------------------------------- statistics
+
+// Relative, worst case, for the chi-squared quantile against tabulated values (which carry 15
+// significant digits).
+constexpr double kQuantileTolerance = 1e-12;
+
+TEST(NoiseStatisticsTest, ChiSquaredQuantileMatchesTables) {
+  struct Case {
+    double p, dof, quantile;
+  };
+  // Standard tables (dof 10), closed forms (dof 1 is the square of a normal quantile, dof 2 is
+  // exponential, x = -2 ln(1 - p)) and, for dof 100, an independent bisection on the series of
+  // P(50, x / 2) in Python.
+  const Case cases[] = {{0.5, 1, 0.4549364231195727},   {0.8415, 1, 1.9884790397914103},
+                        {0.95, 10, 18.307038053275146}, {0.05, 10, 3.940299136119804},
+                        {0.975, 100, 129.5611971858363}, {0.01, 2, 0.0201006717070029},
+                        {0.9, 2, 4.605170185988092}};
+  for (const Case& c : cases) {
+    EXPECT_NEAR(ChiSquaredQuantile(c.p, c.dof) / c.quantile, 1.0, kQuantileTolerance) << c.p << " " << c.dof;
+  }
+}
+
+TEST(NoiseStatisticsTest, ChiSquaredQuantileInvertsTheDistribution) {
+  for (double dof : {0.2, 1.0, 3.7, 30.0, 1e3, 1e5, 1e7, 1e9}) {
+    for (double p : {1e-6, 0.0125, 0.1585, 0.5, 0.8415, 0.9875, 1 - 1e-6}) {
+      const double x = ChiSquaredQuantile(p, dof);
+      double lower = 0.0;
+      double upper = 0.0;
+      RegularizedGamma(0.5 * dof, 0.5 * x, &lower, &upper);
+      // Compare the smaller tail, which the solver works with.
+      if (p <= 0.5) {
+        EXPECT_NEAR(lower / p, 1.0, 1e-9) << "dof " << dof << " p " << p;
+      } else {
+        EXPECT_NEAR(upper / (1.0 - p), 1.0, 1e-9) << "dof " << dof << " p " << p;
+      }
+    }
+  }
+  // Large dof: the Cornish-Fisher expansion is exact to O(1/dof) there.
+  const double dof = 1e8;
+  const double z = NormalQuantile(0.8415);
+  const double cornish_fisher = dof + z * std::sqrt(2 * dof) + 2.0 * (z * z - 1) / 3.0 +
+                                (z * z * z - 7 * z) / (9 * std::sqrt(2 * dof));
+  EXPECT_NEAR(ChiSquaredQuantile(0.8415, dof) / cornish_fisher, 1.0, kQuantileTolerance);
+}
+
+// Greenhall's algorithm switches from exact sums of squared correlations to fitted asymptotic
+// tables where the sums get long (J > 100). At the switch the two must agree: the edf continues
+// the trend of the last two exact values. This checks every table entry the estimators use (a
+// wrong digit in a table shows as a jump).
+TEST(NoiseStatisticsTest, GreenhallTablesContinueTheExactSums) {
+  // Relative: the tables are asymptotic fits (m -> infinity), a few percent off at m = 25..34.
+  constexpr double kTableSwitchTolerance = 0.05;
+  struct Family {
+    int d;
+    bool modified;
+    int min_alpha;
+  };
+  const int64_t n_phase = 100001;
+  for (const Family& family : {Family{2, false, -2}, Family{2, true, -2}, Family{3, false, -4}}) {
+    // Overlapping: J = (d + 1) m passes 100 between m = 100 / (d + 1) and the next integer.
+    const int64_t m_switch = 100 / (family.d + 1) + 1;
+    for (int alpha = 2; alpha >= family.min_alpha; --alpha) {
+      const auto earlier = GreenhallEdf(alpha, family.d, m_switch - 2, family.modified, true, n_phase);
+      const auto before = GreenhallEdf(alpha, family.d, m_switch - 1, family.modified, true, n_phase);
+      const auto after = GreenhallEdf(alpha, family.d, m_switch, family.modified, true, n_phase);
+      ASSERT_TRUE(earlier && before && after) << alpha;
+      const double trend = *before * (*before / *earlier);
+      EXPECT_NEAR(*after / trend, 1.0, kTableSwitchTolerance)
+          << "d=" << family.d << " modified=" << family.modified << " alpha=" << alpha << " edf " << *earlier
+          << ", " << *before << " -> " << *after;
+    }
+  }
+}
+
+// Rates of a given power-law type, from a fixed seed.
+std::vector<double> WhiteNoise(int64_t n, double sigma, uint32_t seed) {
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> normal(0.0, sigma);
+  std::vector<double> y(n);
+  for (double& v : y) v = normal(random);
+  return y;
+}
+
+std::vector<double> RandomWalk(int64_t n, double step, uint32_t seed) {
+  std::vector<double> y = WhiteNoise(n, step, seed);
+  for (int64_t i = 1; i < n; ++i) y[i] += y[i - 1];
+  return y;
+}
+
+TEST(NoiseStatisticsTest, Lag1IdentifiesPowerLawNoise) {
+  const int64_t n = 20000;
+  const std::vector<double> white = WhiteNoise(n, 1.0, 1);
+  std::vector<double> white_pm(n - 1);  // differenced white noise: white phase
+  for (int64_t i = 0; i + 1 < n; ++i) white_pm[i] = white[i + 1] - white[i];
+  const std::vector<double> walk = RandomWalk(n, 1.0, 2);
+  const auto id_white = IdentifyNoiseLag1(white.data(), n, 2);
+  const auto id_pm = IdentifyNoiseLag1(white_pm.data(), n - 1, 2);
+  const auto id_walk = IdentifyNoiseLag1(walk.data(), n, 2);
+  ASSERT_TRUE(id_white && id_pm && id_walk);
+  EXPECT_EQ(id_white->alpha, 0);
+  EXPECT_EQ(id_pm->alpha, 2);
+  EXPECT_EQ(id_walk->alpha, -2);
+  EXPECT_FALSE(IdentifyNoiseLag1(white.data(), kMinNoiseIdPoints - 1, 2));
+}
+
+TEST(NoiseStatisticsTest, AutomaticNoiseIdFindsWhiteFmInTheTestSet) {
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(Nbs1000(), 1.0, {1, 2, 4, 8, 16, 32}, options);
+  for (const AllanPoint& point : result.points) {
+    EXPECT_EQ(point.alpha, 0) << point.m;
+    EXPECT_TRUE(point.alpha_identified) << point.m;
+  }
+}
+
+// ---------------------------------------------------------------- numerics
+
+// Relative, worst case: what double arithmetic on mean-removed phase keeps.
+constexpr double kStabilityTolerance = 1e-10;
+
+// oadev straight from the definition (averages of y in long double), for comparison. The caller
+// knows the offset and removes it exactly (y - offset is exact in long double), which the code
+// under test is not told.
+double DirectOadev(const std::vector<double>& y, int64_t m, double offset) {
+  const int64_t n = static_cast<int64_t>(y.size());
+  std::vector<long double> prefix(n + 1, 0.0L);
+  for (int64_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (static_cast<long double>(y[i]) - offset);
+  long double sum = 0.0L;
+  const int64_t terms = n + 1 - 2 * m;
+  for (int64_t i = 0; i < terms; ++i) {
+    const long double a = (prefix[i + m] - prefix[i]) / m;
+    const long double b = (prefix[i + 2 * m] - prefix[i + m]) / m;
+    sum += (b - a) * (b - a);
+  }
+  return static_cast<double>(std::sqrt(sum / (2.0L * terms)));
+}
+
+TEST(NoiseNumericsTest, LargeOffsetLosesNoDigits) {
+  // A gyro with a 100 rad/s offset and 1e-3 rad/s noise: the offset is 1e5 times the noise.
+  std::vector<double> y = WhiteNoise(1 << 20, 1e-3, 7);
+  for (double& v : y) v += 100.0;
+  const std::vector<int64_t> factors = {1, 16, 1024, 65536};
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(y, 1.0, factors, options);
+  for (size_t i = 0; i < factors.size(); ++i) {
+    EXPECT_NEAR(result.points[i].dev / DirectOadev(y, factors[i], 100.0), 1.0, kStabilityTolerance) << factors[i];
+  }
+  EXPECT_NEAR(result.mean, 100.0, 1e-5);
+}
+
+TEST(NoiseNumericsTest, ThreadsDoNotChangeTheResult) {
+  const std::vector<double> y = RandomWalk(1 << 19, 1e-3, 9);
+  for (AllanEstimator estimator : {AllanEstimator::kOadev, AllanEstimator::kMdev, AllanEstimator::kOhdev,
+                                   AllanEstimator::kTotdev, AllanEstimator::kAdev}) {
+    std::vector<int64_t> factors;
+    ASSERT_EQ(AveragingFactors(TauSpec(), estimator, static_cast<int64_t>(y.size()), 1.0, &factors), "");
+    AllanOptions one;
+    one.estimator = estimator;
+    one.threads = 1;
+    AllanOptions four = one;
+    four.threads = 4;
+    const AllanResult a = ComputeAllanFromRates(y, 1.0, factors, one);
+    const AllanResult b = ComputeAllanFromRates(y, 1.0, factors, four);
+    for (size_t i = 0; i < factors.size(); ++i) {
+      EXPECT_NEAR(a.points[i].dev / b.points[i].dev, 1.0, kStabilityTolerance)
+          << ToString(estimator) << " m=" << factors[i];
+    }
+  }
+}
+
+TEST(NoiseTauTest, SetsAndErrors) {
+  TauSpec spec;
+  std::vector<int64_t> factors;
+  ASSERT_EQ(ParseTauSpec("decade", &spec), "");
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors), "");
+  EXPECT_EQ(factors, (std::vector<int64_t>{1, 2, 4, 10, 20, 40, 100, 200}));
+  ASSERT_EQ(ParseTauSpec("per-decade:3", &spec), "");
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors), "");
+  EXPECT_EQ(factors, (std::vector<int64_t>{1, 2, 5, 10, 22, 46, 100, 215}));
+  ASSERT_EQ(ParseTauSpec("0.01, 0.1,1", &spec), "");
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors), "");
+  EXPECT_EQ(factors, (std::vector<int64_t>{1, 10, 100}));
+  ASSERT_EQ(ParseTauSpec("0.015", &spec), "");
+  EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("not a whole multiple"),
+            std::string::npos);
+  ASSERT_EQ(ParseTauSpec("6", &spec), "");
+  EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("too long"), std::string::npos);
+  EXPECT_NE(ParseTauSpec("weekly", &spec).find("allowed: octave, decade, all, per-decade:K"), std::string::npos);
+  EXPECT_NE(AveragingFactors(TauSpec(), AllanEstimator::kOadev, 3, 0.01, &factors).find("too short"),
+            std::string::npos);
+  AllanEstimator estimator;
+  EXPECT_FALSE(ParseAllanEstimator("avar", &estimator));
+  EXPECT_EQ(AllanEstimatorNames(), "adev, oadev, mdev, tdev, hdev, ohdev, totdev");
+}
+
+// ---------------------------------------------------------------- IEEE 952 fit, known truth
+
+// The fit's uncertainty is honest: the truth lies within this many of its standard
+// uncertainties (3: a 0.3 % chance of a false alarm per check for a correct uncertainty).
+constexpr double kCoverageSigmas = 3.0;
+// And it is informative: the stated uncertainty is at most this fraction of the value.
+constexpr double kMaxRelativeUncertainty = 0.1;
+
+NoiseFitSummary FitRates(const std::vector<double>& y, double tau0, const char* taus = "per-decade:5") {
+  TauSpec spec;
+  EXPECT_EQ(ParseTauSpec(taus, &spec), "");
+  std::vector<int64_t> factors;
+  EXPECT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, static_cast<int64_t>(y.size()), tau0, &factors), "");
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(y, tau0, factors, options);
+  return FitNoiseModel(result.points, static_cast<int64_t>(y.size()));
+}
+
+void ExpectRecovered(const NoiseFitSummary& fit, int term, double truth) {
+  EXPECT_NEAR(fit.value[term], truth, kCoverageSigmas * fit.sigma[term])
+      << NoiseTermName(term) << ": fitted " << fit.value[term] << " +- " << fit.sigma[term] << ", truth " << truth;
+  EXPECT_LT(fit.sigma[term], kMaxRelativeUncertainty * truth) << NoiseTermName(term);
+}
+
+TEST(NoiseFitTest, WhiteNoiseGivesItsAngleRandomWalk) {
+  const double tau0 = 0.01;
+  const double arw = 2e-4;  // rad/sqrt(s): sigma of one sample is arw / sqrt(tau0)
+  const NoiseFitSummary fit = FitRates(WhiteNoise(400000, arw / std::sqrt(tau0), 11), tau0);
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  ExpectRecovered(fit, kRandomWalk, arw);
+  EXPECT_NEAR(fit.readout_random_walk / arw, 1.0, 0.02);
+}
+
+TEST(NoiseFitTest, RandomWalkGivesItsRateRandomWalk) {
+  const double tau0 = 0.1;
+  const double arw = 1e-4;  // rad/sqrt(s)
+  const double rrw = 2e-6;  // rad/s/sqrt(s): the rate's step per sample is rrw * sqrt(tau0)
+  std::vector<double> y = WhiteNoise(1000000, arw / std::sqrt(tau0), 12);
+  const std::vector<double> walk = RandomWalk(1000000, rrw * std::sqrt(tau0), 13);
+  for (size_t i = 0; i < y.size(); ++i) y[i] += walk[i];
+  const NoiseFitSummary fit = FitRates(y, tau0);
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  ExpectRecovered(fit, kRandomWalk, arw);
+  ExpectRecovered(fit, kRateRandomWalk, rrw);
+}
+
+TEST(NoiseFitTest, QuantizedAngleGivesItsQuantizationNoise) {
+  // A rate-integrating gyro that outputs angle in steps of `step`: the rate is the difference of
+  // quantized angles. Its angle error is uniform, so Q = step / sqrt(12).
+  const double tau0 = 0.01;
+  const double step = 1e-5;  // rad
+  const double rate = 0.0123456789;  // rad/s, incommensurate with the step
+  const int64_t n = 400000;
+  // An angle random walk of half a step per sample: enough to make successive quantization
+  // errors independent (their correlation is below 1e-2), small enough for the steps to show.
+  const std::vector<double> walk = WhiteNoise(n + 1, 0.5 * step, 14);
+  std::vector<double> y(n);
+  double angle = 0.0;
+  double previous = 0.0;
+  for (int64_t i = 0; i <= n; ++i) {
+    angle += rate * tau0 + walk[i];
+    const double quantized = step * std::round(angle / step);
+    if (i > 0) y[i - 1] = (quantized - previous) / tau0;
+    previous = quantized;
+  }
+  const NoiseFitSummary fit = FitRates(y, tau0);
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  ExpectRecovered(fit, kQuantization, step / std::sqrt(12.0));
+}
+
+TEST(NoiseFitTest, TooFewPointsIsReportedNotFitted) {
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(kNbs9, 1.0, {1, 2}, options);
+  const NoiseFitSummary fit = FitNoiseModel(result.points, 9);
+  EXPECT_FALSE(fit.fitted);
+  EXPECT_NE(fit.message.find("too few points"), std::string::npos);
 }
 
 }  // namespace

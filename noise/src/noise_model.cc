@@ -11,8 +11,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 // sqrt(2 ln 2 / pi): the flicker floor of the Allan deviation is 0.664 B.
 const double kFlickerFloor = std::sqrt(2.0 * std::log(2.0) / kPi);
-// A read-out slope must be within this of its target (-1/2 or +1/2) to count.
+// A read-out slope must be within kReadoutSlopeTolerance of its target (-1/2 or +1/2) to count;
+// within kReadoutSlopeNear the best-determined such segment is taken.
 constexpr double kReadoutSlopeTolerance = 0.25;
+constexpr double kReadoutSlopeNear = 0.05;
 
 struct Point {
   double tau_s;
@@ -115,21 +117,38 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
                                          [](const Point& a, const Point& b) { return a.variance < b.variance; });
     summary.readout_bias_instability = std::sqrt(lowest->variance) / kFlickerFloor;
     summary.readout_bias_tau_s = lowest->tau_s;
-    double best_arw = kReadoutSlopeTolerance;
-    double best_rrw = kReadoutSlopeTolerance;
+    // Among the segments whose slope is near the target, the one with the most degrees of
+    // freedom (the shortest tau); failing that, the segment whose slope is nearest within the
+    // looser tolerance.
+    struct Choice {
+      double near_edf = 0.0;
+      double near_value = std::nan("");
+      double best_distance = kReadoutSlopeTolerance;
+      double best_value = std::nan("");
+      void Offer(double distance, double edf, double value) {
+        if (distance < kReadoutSlopeNear && edf > near_edf) {
+          near_edf = edf;
+          near_value = value;
+        }
+        if (distance < best_distance) {
+          best_distance = distance;
+          best_value = value;
+        }
+      }
+      double Value() const { return std::isfinite(near_value) ? near_value : best_value; }
+    };
+    Choice arw;
+    Choice rrw;
     for (size_t i = 0; i + 1 < points.size(); ++i) {
       const double slope = 0.5 * std::log(points[i + 1].variance / points[i].variance) /
                            std::log(points[i + 1].tau_s / points[i].tau_s);
       const double dev = std::sqrt(points[i].variance);
-      if (std::fabs(slope + 0.5) < best_arw) {
-        best_arw = std::fabs(slope + 0.5);
-        summary.readout_random_walk = dev * std::sqrt(points[i].tau_s);  // sigma = N / sqrt(tau)
-      }
-      if (std::fabs(slope - 0.5) < best_rrw) {
-        best_rrw = std::fabs(slope - 0.5);
-        summary.readout_rate_random_walk = dev * std::sqrt(3.0 / points[i].tau_s);  // sigma = K sqrt(tau/3)
-      }
+      const double edf = std::min(points[i].edf, points[i + 1].edf);
+      arw.Offer(std::fabs(slope + 0.5), edf, dev * std::sqrt(points[i].tau_s));  // sigma = N / sqrt(tau)
+      rrw.Offer(std::fabs(slope - 0.5), edf, dev * std::sqrt(3.0 / points[i].tau_s));  // sigma = K sqrt(tau/3)
     }
+    summary.readout_random_walk = arw.Value();
+    summary.readout_rate_random_walk = rrw.Value();
   }
 
   unsigned enabled_mask = 0;

@@ -24,9 +24,9 @@
 // is s / (2 Q) when the term is well determined and stays finite when it is not.
 //
 // The classic read-outs of IEEE 952 are reported too, from the measured curve alone: N from the
-// slope -1/2 line through the point where the curve's slope is nearest -1/2, read at tau = 1 s;
-// B = minimum / 0.664; K from the slope +1/2 line through the point where the slope is nearest
-// +1/2, read at tau = 3 s.
+// slope -1/2 line through the curve where its slope is -1/2 (within 0.05, the segment with the
+// most degrees of freedom; else the nearest slope within 0.25), read at tau = 1 s;
+// B = minimum / 0.664; K likewise from the slope +1/2 line, read at tau = 3 s.
 #ifndef IMUFIT_NOISE_NOISE_MODEL_H_
 #define IMUFIT_NOISE_NOISE_MODEL_H_
 
