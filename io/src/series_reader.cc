@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
 
 namespace imufit {
 namespace {
@@ -63,8 +65,8 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
     } else {
       const double dt = time - previous_time;
       if (!(dt > 0.0)) {
-        csv.Fail(time_column, Format("%.17g s does not increase (the previous sample is at %.17g s)", time,
-                                     previous_time));
+        csv.Fail(time_column, FormatDouble(time) + " s does not increase (the previous sample is at " +
+                                  FormatDouble(previous_time) + " s)");
       }
       if (rows == 1) nominal = dt;
       const double deviation = (dt - nominal) / nominal;
@@ -77,14 +79,16 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
         series.bridged_time_s += dt - nominal;
       } else if (deviation > 0.0) {
         csv.Fail(time_column,
-                 Format("a gap in time: %.17g s follows %.17g s, %.4g sample intervals of %.9g s (tolerance "
-                        "%g intervals; --gaps bridge joins the data across gaps)",
-                        time, previous_time, dt / nominal, nominal, options.time_tolerance));
+                 "a gap in time: " + FormatDouble(time) + " s follows " + FormatDouble(previous_time) +
+                     Format(" s, %.4g sample intervals of %.9g s (tolerance %g intervals; --gaps bridge joins "
+                            "the data across gaps)",
+                            dt / nominal, nominal, options.time_tolerance));
       } else {
         csv.Fail(time_column,
-                 Format("time jitter: %.17g s follows %.17g s after %.4g of the sample interval %.9g s (the "
-                        "tolerance is +-%g intervals, --time-tolerance)",
-                        time, previous_time, dt / nominal, nominal, options.time_tolerance));
+                 "time jitter: " + FormatDouble(time) + " s follows " + FormatDouble(previous_time) +
+                     Format(" s after %.4g of the sample interval %.9g s (the tolerance is +-%g intervals, "
+                            "--time-tolerance)",
+                            dt / nominal, nominal, options.time_tolerance));
       }
     }
     previous_time = time;
@@ -104,7 +108,12 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
                                " sample(s); at least two are needed for the sample interval");
   }
   series.end_time_s = previous_time;
-  series.sample_interval_s = accepted > 0 ? static_cast<double>(accepted_sum / accepted) : nominal;
+  // Timestamps written in decimal carry rounding of about 1e-13 relative in each difference, so
+  // the mean interval is rounded to 12 significant digits: 0.01, not 0.009999999999999998.
+  const double mean_interval = accepted > 0 ? static_cast<double>(accepted_sum / accepted) : nominal;
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%.12g", mean_interval);
+  series.sample_interval_s = std::strtod(digits, nullptr);
   return series;
 }
 

@@ -9,7 +9,8 @@
 // interval dt must satisfy |dt - dt_0| <= time_tolerance * dt_0. A longer interval is a gap: an
 // InputError at the line and field of the sample after it, unless `bridge_gaps` joins the data on
 // both sides as if contiguous (counted in the result). A shorter one is jitter: always an error.
-// The sample interval reported is the mean of the accepted (not bridged) intervals.
+// The sample interval reported is the mean of the accepted (not bridged) intervals, rounded to 12
+// significant digits (decimal timestamps carry no more).
 #ifndef IMUFIT_IO_SERIES_READER_H_
 #define IMUFIT_IO_SERIES_READER_H_
 
@@ -29,7 +30,7 @@ struct UniformSeriesOptions {
 struct UniformSeries {
   std::vector<std::string> names;             // the columns read, in the order asked
   std::vector<std::vector<double>> columns;   // one per name, all the same length
-  double sample_interval_s = 0.0;             // mean accepted interval
+  double sample_interval_s = 0.0;             // mean accepted interval, 12 digits
   double start_time_s = 0.0;
   double end_time_s = 0.0;
   int64_t gaps_bridged = 0;
