@@ -39,7 +39,8 @@ constexpr double kSecondsPerHour = 3600.0;
 constexpr double kSqrtSecondsPerSqrtHour = 60.0;
 constexpr double kStandardGravityMps2 = 9.80665;
 constexpr double kMicro = 1e6;
-// A term is reported as resolved when its value exceeds this many of its standard uncertainties.
+// A term is reported as resolved when its variance coefficient (Q^2, N^2, ...) exceeds this many of
+// its standard uncertainties (on the coefficient itself: its square root is not Gaussian near 0).
 constexpr double kResolvedSigmas = 2.0;
 
 enum class ColumnKind { kGyro, kAccel, kOther };
@@ -385,6 +386,10 @@ std::string PlotScript(const std::string& output, const std::string& title, cons
       gp << (first_item ? "" : ", \\\n     ") << text;
       first_item = false;
     };
+    // The IEEE 952 model is the Allan variance's: drawn over Allan-variance curves only.
+    const AllanEstimator estimator = results.front().curve.estimator;
+    const bool draw_model = estimator == AllanEstimator::kOadev || estimator == AllanEstimator::kAdev ||
+                            estimator == AllanEstimator::kTotdev;
     bool any_fit = false;
     for (size_t c = 0; c < results.size(); ++c) {
       const ColumnResult& r = results[c];
@@ -392,7 +397,7 @@ std::string PlotScript(const std::string& output, const std::string& title, cons
       const std::string color = std::string("lc rgb '") + kColors[c % 8] + "'";
       item("$curve" + std::to_string(c) + " using 1:2:3:4 with yerrorbars " + color + " pt 7 ps 0.7 title " +
            GnuplotString(r.name));
-      if (!r.fit.fitted) continue;
+      if (!r.fit.fitted || !draw_model) continue;
       any_fit = true;
       item("$model" + std::to_string(c) + " using 1:2 with lines " + color + " lw 2 title " +
            GnuplotString(r.name + " model"));
@@ -477,7 +482,7 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
       const bool engineer = *units.engineer_key != '\0';
       const double scale = engineer ? units.engineer_per_si : 1.0;
       const char* unit = engineer ? units.engineer_unit : units.si_unit;
-      const bool resolved = fit.value[k] > kResolvedSigmas * fit.sigma[k];
+      const bool resolved = fit.variance[k] > kResolvedSigmas * fit.variance_sigma[k];
       std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(fit.value[k] * scale).c_str(),
                   Number(fit.sigma[k] * scale, 2).c_str(), unit);
       if (!resolved) std::printf(" (not resolved)");

@@ -294,7 +294,7 @@ TEST(NoiseStatisticsTest, AutomaticNoiseIdFindsWhiteFmInTheTestSet) {
   const AllanResult result = ComputeAllanFromRates(Nbs1000(), 1.0, {1, 2, 4, 8, 16, 32}, options);
   for (const AllanPoint& point : result.points) {
     EXPECT_EQ(point.alpha, 0) << point.m;
-    EXPECT_TRUE(point.alpha_identified) << point.m;
+    EXPECT_EQ(point.alpha_identified, 1000 / point.m >= kMinNoiseIdPoints) << point.m;
   }
 }
 
@@ -446,6 +446,38 @@ TEST(NoiseFitTest, QuantizedAngleGivesItsQuantizationNoise) {
   const NoiseFitSummary fit = FitRates(y, tau0);
   ASSERT_TRUE(fit.fitted) << fit.message;
   ExpectRecovered(fit, kQuantization, step / std::sqrt(12.0));
+}
+
+// The reported uncertainty matches the spread over independent records: the rms of
+// (fitted - true) / uncertainty of the variance coefficients N^2 and K^2 is near 1.
+TEST(NoiseFitTest, UncertaintyMatchesTheMonteCarloSpread) {
+  // Bounds on the rms z-score over kRecords records: 1 +- 0.5 (with 24 records the rms itself
+  // scatters by about 0.15; the model of correlated taus is good to about 20 %).
+  constexpr int kRecords = 24;
+  constexpr double kMinRmsZ = 0.5;
+  constexpr double kMaxRmsZ = 1.5;
+  const double tau0 = 0.01;
+  const double arw = 1e-3;
+  const double rrw = 2e-5;
+  double sum_n = 0.0;
+  double sum_k = 0.0;
+  for (int record = 0; record < kRecords; ++record) {
+    std::vector<double> y = WhiteNoise(100000, arw / std::sqrt(tau0), 1000 + record);
+    const std::vector<double> walk = RandomWalk(100000, rrw * std::sqrt(tau0), 2000 + record);
+    for (size_t i = 0; i < y.size(); ++i) y[i] += walk[i];
+    const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+    ASSERT_TRUE(fit.fitted);
+    const double z_n = (fit.variance[kRandomWalk] - arw * arw) / fit.variance_sigma[kRandomWalk];
+    const double z_k = (fit.variance[kRateRandomWalk] - rrw * rrw) / fit.variance_sigma[kRateRandomWalk];
+    sum_n += z_n * z_n;
+    sum_k += z_k * z_k;
+  }
+  const double rms_n = std::sqrt(sum_n / kRecords);
+  const double rms_k = std::sqrt(sum_k / kRecords);
+  EXPECT_GT(rms_n, kMinRmsZ);
+  EXPECT_LT(rms_n, kMaxRmsZ);
+  EXPECT_GT(rms_k, kMinRmsZ);
+  EXPECT_LT(rms_k, kMaxRmsZ);
 }
 
 TEST(NoiseFitTest, TooFewPointsIsReportedNotFitted) {

@@ -627,7 +627,11 @@ AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const 
           means[k] = (phase[(k + 1) * point.m] - phase[k * point.m]) / static_cast<double>(point.m);
         }
         if (const auto id = IdentifyNoiseLag1(means.data(), count, d)) {
-          carried_alpha = std::clamp(id->alpha, alpha_min, 2);
+          const int alpha = std::clamp(id->alpha, alpha_min, 2);
+          // With few averages the lag-1 estimate scatters by about 1/sqrt(count); a noise type
+          // identified too high would inflate the edf (white PM has ten times white FM's), so
+          // there the more conservative of this and the type from below is kept.
+          carried_alpha = count >= kReliableNoiseIdPoints ? alpha : std::min(alpha, carried_alpha);
           point.alpha_identified = true;
         }
       }

@@ -31,7 +31,9 @@
 //
 // Confidence intervals: chi-squared with Greenhall's equivalent degrees of freedom (statistics.h),
 // for a noise type identified per averaging factor by the lag-1 autocorrelation of the rate
-// averages, or assumed (EdfNoise).
+// averages, or assumed (EdfNoise). Identification needs 30 averages; with fewer than 100 it only
+// lowers alpha (the conservative side: fewer degrees of freedom); where it is impossible the type
+// of the previous factor is carried (white FM before any).
 #ifndef IMUFIT_NOISE_ALLAN_H_
 #define IMUFIT_NOISE_ALLAN_H_
 

@@ -71,6 +71,8 @@ struct NoiseIdentification {
   int differences = 0;        // d
 };
 inline constexpr int64_t kMinNoiseIdPoints = 30;
+// Below this many averages an identification is used only when it is the more conservative one.
+inline constexpr int64_t kReliableNoiseIdPoints = 100;
 std::optional<NoiseIdentification> IdentifyNoiseLag1(const double* means, int64_t count, int d_max);
 
 }  // namespace imufit
