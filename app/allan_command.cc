@@ -380,6 +380,8 @@ std::string PlotScript(const std::string& output, const std::string& title, cons
                                          ")")
        << "\n";
     if (y_max > 0.0 && y_min > 0.0) gp << "set yrange [" << y_min / 3.0 << ":" << y_max * 3.0 << "]\n";
+    const std::vector<AllanPoint>& taus = results.front().curve.points;
+    gp << "set xrange [" << taus.front().tau_s / 1.5 << ":" << taus.back().tau_s * 1.5 << "]\n";
     gp << "plot ";
     bool first_item = true;
     auto item = [&](const std::string& text) {
