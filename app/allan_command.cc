@@ -365,6 +365,7 @@ std::string PlotScript(const std::string& output, const std::string& title, cons
     for (const ColumnResult& r : results) {
       if (r.kind != kind) continue;
       for (const AllanPoint& p : r.curve.points) {
+        if (!(p.dev > 0.0)) continue;  // a constant column has nothing to show on a log scale
         y_min = std::min(y_min, std::isfinite(p.dev_lo) ? p.dev_lo : p.dev);
         y_max = std::max(y_max, std::isfinite(p.dev_hi) ? p.dev_hi : p.dev);
       }
