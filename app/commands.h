@@ -17,6 +17,7 @@ using CommandRunner = std::function<int()>;
 CommandRunner AddApplyCommand(CLI::App* root);
 CommandRunner AddFitCommand(CLI::App* root);
 CommandRunner AddSimulateCommand(CLI::App* root);
+CommandRunner AddAllanCommand(CLI::App* root);
 
 // "imufit 0.1.0 (git abc123)" — the software string written into calibration files.
 std::string SoftwareVersion();

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add(imufit::AddFitCommand(&app));
   add(imufit::AddApplyCommand(&app));
   add(imufit::AddSimulateCommand(&app));
+  add(imufit::AddAllanCommand(&app));
 
   try {
     app.parse(argc, argv);

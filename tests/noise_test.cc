@@ -1,0 +1,685 @@
+// Tests of noise/: Allan-family deviations against the published reference values of NIST SP 1065
+// (section 12.5, the NBS 9-point set and the 1000-point pseudo-random set), confidence intervals
+// against Stable32's bounds, the statistics behind them, and the IEEE 952 noise fit on signals of
+// known truth.
+#include <sys/wait.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include "imufit/noise/allan.h"
+#include "imufit/noise/noise_model.h"
+#include "imufit/noise/statistics.h"
+
+namespace imufit {
+namespace {
+
+// Relative, worst case: the published deviations have 7 significant digits.
+constexpr double kReferenceTolerance = 1e-6;
+// Relative, worst case: Stable32 prints its bounds with 5 significant digits.
+constexpr double kStable32BoundTolerance = 1e-3;
+
+// ---------------------------------------------------------------- reference data sets
+
+// The NBS 9-point frequency data set (SP 1065 section 12.5, table 31).
+const std::vector<double> kNbs9 = {892, 809, 823, 798, 671, 644, 883, 903, 677};
+
+// The 1000-point test set of SP 1065 section 12.5 (and Riley's test suite): the minimal-standard
+// generator n(i+1) = 16807 n(i) mod (2^31 - 1), n(0) = 1234567890, scaled to (0, 1).
+std::vector<double> Nbs1000() {
+  std::vector<double> y;
+  long long n = 1234567890;
+  for (int i = 0; i < 1000; ++i) {
+    y.push_back(static_cast<double>(n) / 2147483647.0);
+    n = (16807 * n) % 2147483647;
+  }
+  return y;
+}
+
+TEST(NoiseReferenceTest, GeneratorMatchesPublishedStart) {
+  // The first numbers after the seed are printed in the test-suite description.
+  long long n = 1234567890;
+  const long long expected[] = {395529916, 1209410747, 633705974};
+  for (long long e : expected) {
+    n = (16807 * n) % 2147483647;
+    EXPECT_EQ(n, e);
+  }
+}
+
+struct Reference {
+  AllanEstimator estimator;
+  std::vector<double> devs;
+};
+
+void ExpectDeviations(const std::vector<double>& rates, const std::vector<int64_t>& factors,
+                      const std::vector<Reference>& references) {
+  for (const Reference& reference : references) {
+    AllanOptions options;
+    options.estimator = reference.estimator;
+    const AllanResult result = ComputeAllanFromRates(rates, 1.0, factors, options);
+    ASSERT_EQ(result.points.size(), reference.devs.size());
+    for (size_t i = 0; i < reference.devs.size(); ++i) {
+      EXPECT_NEAR(result.points[i].dev / reference.devs[i], 1.0, kReferenceTolerance)
+          << ToString(reference.estimator) << " m=" << factors[i] << " got " << result.points[i].dev
+          << " published " << reference.devs[i];
+    }
+  }
+}
+
+TEST(NoiseReferenceTest, Nbs9PointEveryEstimator) {
+  // SP 1065 table 32 (tau = 1, 2).
+  ExpectDeviations(kNbs9, {1, 2},
+                   {{AllanEstimator::kAdev, {91.22945, 115.8082}},
+                    {AllanEstimator::kOadev, {91.22945, 85.95287}},
+                    {AllanEstimator::kMdev, {91.22945, 74.78849}},
+                    {AllanEstimator::kTdev, {52.67135, 86.35831}},
+                    {AllanEstimator::kHdev, {70.80608, 116.7980}},
+                    {AllanEstimator::kOhdev, {70.80607, 85.61487}},
+                    {AllanEstimator::kTotdev, {91.22945, 93.90379}}});
+}
+
+TEST(NoiseReferenceTest, Nbs1000PointEveryEstimator) {
+  // SP 1065 table 34 (tau = 1, 10, 100); totdev by the doubly reflected method.
+  ExpectDeviations(Nbs1000(), {1, 10, 100},
+                   {{AllanEstimator::kAdev, {2.922319e-01, 9.965736e-02, 3.897804e-02}},
+                    {AllanEstimator::kOadev, {2.922319e-01, 9.159953e-02, 3.241343e-02}},
+                    {AllanEstimator::kMdev, {2.922319e-01, 6.172376e-02, 2.170921e-02}},
+                    {AllanEstimator::kTdev, {1.687202e-01, 3.563623e-01, 1.253382e+00}},
+                    {AllanEstimator::kHdev, {2.943883e-01, 1.052754e-01, 3.910860e-02}},
+                    {AllanEstimator::kOhdev, {2.943883e-01, 9.581083e-02, 3.237638e-02}},
+                    {AllanEstimator::kTotdev, {2.922319e-01, 9.134743e-02, 3.406530e-02}}});
+}
+
+// Stable32 1.60 on PHASE.DAT (the 1000-point set as phase), octave taus, confidence factor 0.683,
+// noise white FM (alpha = 0) at every tau: terms, min sigma, sigma, max sigma.
+struct Stable32Row {
+  int64_t m;
+  int64_t terms;
+  double lo, dev, hi;
+};
+struct Stable32Table {
+  AllanEstimator estimator;
+  std::vector<Stable32Row> rows;
+};
+
+const std::vector<Stable32Table>& Stable32Tables() {
+  static const std::vector<Stable32Table> tables = {
+      {AllanEstimator::kAdev,
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 499, 1.9787e-01, 2.0510e-01, 2.1319e-01},
+        {4, 249, 1.4201e-01, 1.4943e-01, 1.5815e-01}, {8, 124, 1.0254e-01, 1.1013e-01, 1.1971e-01},
+        {16, 61, 5.6510e-02, 6.2381e-02, 7.0567e-02}, {32, 30, 4.9153e-02, 5.6233e-02, 6.7635e-02},
+        {64, 14, 2.7109e-02, 3.2550e-02, 4.3537e-02}, {128, 6, 2.6481e-02, 3.3855e-02, 5.5744e-02}}},
+      {AllanEstimator::kOadev,
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 997, 1.9520e-01, 2.0102e-01, 2.0738e-01},
+        {4, 993, 1.3931e-01, 1.4479e-01, 1.5098e-01}, {8, 985, 1.0038e-01, 1.0570e-01, 1.1198e-01},
+        {16, 969, 5.7696e-02, 6.1915e-02, 6.7217e-02}, {32, 937, 4.3654e-02, 4.8082e-02, 5.4202e-02},
+        {64, 873, 3.1755e-02, 3.6237e-02, 4.3377e-02}, {128, 745, 2.3045e-02, 2.7674e-02, 3.7027e-02}}},
+      {AllanEstimator::kMdev,
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 996, 1.5336e-01, 1.5821e-01, 1.6355e-01},
+        {4, 990, 1.0322e-01, 1.0780e-01, 1.1304e-01}, {8, 978, 6.9840e-02, 7.4192e-02, 7.9481e-02},
+        {16, 954, 3.8022e-02, 4.1376e-02, 4.5809e-02}, {32, 906, 3.0466e-02, 3.4255e-02, 3.9933e-02},
+        {64, 810, 2.3687e-02, 2.7871e-02, 3.5511e-02}, {128, 618, 1.4874e-02, 1.8669e-02, 2.8584e-02}}},
+      {AllanEstimator::kTdev,
+       {{1, 999, 1.6463e-01, 1.6872e-01, 1.7313e-01}, {2, 996, 1.7709e-01, 1.8268e-01, 1.8885e-01},
+        {4, 990, 2.3838e-01, 2.4895e-01, 2.6106e-01}, {8, 978, 3.2258e-01, 3.4268e-01, 3.6710e-01},
+        {16, 954, 3.5123e-01, 3.8221e-01, 4.2317e-01}, {32, 906, 5.6287e-01, 6.3287e-01, 7.3777e-01},
+        {64, 810, 8.7525e-01, 1.0298e+00, 1.3122e+00}, {128, 618, 1.0992e+00, 1.3797e+00, 2.1124e+00}}},
+      {AllanEstimator::kHdev,
+       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01}, {2, 498, 1.9887e-01, 2.0716e-01, 2.1659e-01},
+        {4, 248, 1.4054e-01, 1.4890e-01, 1.5896e-01}, {8, 123, 1.0744e-01, 1.1649e-01, 1.2829e-01},
+        {16, 60, 5.3296e-02, 5.9589e-02, 6.8811e-02}, {32, 29, 4.6987e-02, 5.4697e-02, 6.8092e-02},
+        {64, 13, 2.4870e-02, 3.0569e-02, 4.3652e-02}, {128, 5, 2.8841e-02, 3.8060e-02, 7.3807e-02}}},
+      {AllanEstimator::kOhdev,
+       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01}, {2, 995, 1.9491e-01, 2.0125e-01, 2.0825e-01},
+        {4, 989, 1.3777e-01, 1.4368e-01, 1.5043e-01}, {8, 977, 1.0388e-01, 1.0987e-01, 1.1704e-01},
+        {16, 953, 5.6173e-02, 6.0638e-02, 6.6369e-02}, {32, 905, 4.0664e-02, 4.5095e-02, 5.1382e-02},
+        {64, 809, 2.9271e-02, 3.3824e-02, 4.1477e-02}, {128, 617, 2.3761e-02, 2.9147e-02, 4.1367e-02}}},
+      {AllanEstimator::kTotdev,
+       {{1, 999, 2.8707e-01, 2.9223e-01, 2.9768e-01}, {2, 999, 1.9592e-01, 2.0089e-01, 2.0625e-01},
+        {4, 999, 1.3947e-01, 1.4444e-01, 1.4998e-01}, {8, 999, 1.0039e-01, 1.0540e-01, 1.1126e-01},
+        {16, 999, 5.7732e-02, 6.1788e-02, 6.6839e-02}, {32, 999, 4.4255e-02, 4.8580e-02, 5.4484e-02},
+        {64, 999, 3.1639e-02, 3.5905e-02, 4.2546e-02}, {128, 999, 2.6406e-02, 3.1259e-02, 4.0383e-02},
+        {256, 999, 1.0734e-02, 1.3369e-02, 1.9924e-02}}},
+  };
+  return tables;
+}
+
+TEST(NoiseReferenceTest, ConfidenceIntervalsMatchStable32) {
+  const std::vector<double> rates = Nbs1000();
+  for (const Stable32Table& table : Stable32Tables()) {
+    AllanOptions options;
+    options.estimator = table.estimator;
+    options.edf_noise = EdfNoise::kWhiteFm;
+    std::vector<int64_t> expected_factors;
+    for (const Stable32Row& row : table.rows) expected_factors.push_back(row.m);
+    // The octave set stops where Stable32's does.
+    std::vector<int64_t> factors;
+    ASSERT_EQ(AveragingFactors(TauSpec(), table.estimator, 1000, 1.0, &factors), "");
+    EXPECT_EQ(factors, expected_factors) << ToString(table.estimator);
+    const AllanResult result = ComputeAllanFromRates(rates, 1.0, expected_factors, options);
+    for (size_t i = 0; i < table.rows.size(); ++i) {
+      const Stable32Row& row = table.rows[i];
+      const AllanPoint& point = result.points[i];
+      const std::string where = std::string(ToString(table.estimator)) + " m=" + std::to_string(row.m);
+      // Stable32 counts totdev terms as N - 2 phase points, others as we do.
+      EXPECT_EQ(point.terms, row.terms) << where;
+      EXPECT_NEAR(point.dev / row.dev, 1.0, kStable32BoundTolerance) << where;
+      EXPECT_NEAR(point.dev_lo / row.lo, 1.0, kStable32BoundTolerance) << where << " lo " << point.dev_lo;
+      EXPECT_NEAR(point.dev_hi / row.hi, 1.0, kStable32BoundTolerance) << where << " hi " << point.dev_hi;
+    }
+  }
+}
+
+
+// ---------------------------------------------------------------- statistics
+
+// Relative, worst case, for the chi-squared quantile against tabulated values (which carry 15
+// significant digits).
+constexpr double kQuantileTolerance = 1e-12;
+
+TEST(NoiseStatisticsTest, ChiSquaredQuantileMatchesTables) {
+  struct Case {
+    double p, dof, quantile;
+  };
+  // Standard tables (dof 10), closed forms (dof 1 is the square of a normal quantile, dof 2 is
+  // exponential, x = -2 ln(1 - p)) and, for dof 100, an independent bisection on the series of
+  // P(50, x / 2) in Python.
+  const Case cases[] = {{0.5, 1, 0.4549364231195727},   {0.8415, 1, 1.9884790397914103},
+                        {0.95, 10, 18.307038053275146}, {0.05, 10, 3.940299136119804},
+                        {0.975, 100, 129.5611971858363}, {0.01, 2, 0.0201006717070029},
+                        {0.9, 2, 4.605170185988092}};
+  for (const Case& c : cases) {
+    EXPECT_NEAR(ChiSquaredQuantile(c.p, c.dof) / c.quantile, 1.0, kQuantileTolerance) << c.p << " " << c.dof;
+  }
+}
+
+TEST(NoiseStatisticsTest, ChiSquaredQuantileInvertsTheDistribution) {
+  for (double dof : {0.2, 1.0, 3.7, 30.0, 1e3, 1e5, 1e7, 1e9}) {
+    for (double p : {1e-6, 0.0125, 0.1585, 0.5, 0.8415, 0.9875, 1 - 1e-6}) {
+      const double x = ChiSquaredQuantile(p, dof);
+      double lower = 0.0;
+      double upper = 0.0;
+      RegularizedGamma(0.5 * dof, 0.5 * x, &lower, &upper);
+      // Compare the smaller tail, which the solver works with.
+      if (p <= 0.5) {
+        EXPECT_NEAR(lower / p, 1.0, 1e-9) << "dof " << dof << " p " << p;
+      } else {
+        EXPECT_NEAR(upper / (1.0 - p), 1.0, 1e-9) << "dof " << dof << " p " << p;
+      }
+    }
+  }
+  // Large dof: the Cornish-Fisher expansion is exact to O(1/dof) there.
+  const double dof = 1e8;
+  const double z = NormalQuantile(0.8415);
+  const double cornish_fisher = dof + z * std::sqrt(2 * dof) + 2.0 * (z * z - 1) / 3.0 +
+                                (z * z * z - 7 * z) / (9 * std::sqrt(2 * dof));
+  EXPECT_NEAR(ChiSquaredQuantile(0.8415, dof) / cornish_fisher, 1.0, kQuantileTolerance);
+}
+
+// Greenhall's algorithm switches from exact sums of squared correlations to fitted asymptotic
+// tables where the sums get long (J > 100). At the switch the two must agree: the edf continues
+// the trend of the last two exact values. This checks every table entry the estimators use (a
+// wrong digit in a table shows as a jump).
+TEST(NoiseStatisticsTest, GreenhallTablesContinueTheExactSums) {
+  // Relative: the tables are asymptotic fits (m -> infinity), a few percent off at m = 25..34.
+  constexpr double kTableSwitchTolerance = 0.05;
+  struct Family {
+    int d;
+    bool modified;
+    int min_alpha;
+  };
+  const int64_t n_phase = 100001;
+  for (const Family& family : {Family{2, false, -2}, Family{2, true, -2}, Family{3, false, -4}}) {
+    // Overlapping: J = (d + 1) m passes 100 between m = 100 / (d + 1) and the next integer.
+    const int64_t m_switch = 100 / (family.d + 1) + 1;
+    for (int alpha = 2; alpha >= family.min_alpha; --alpha) {
+      const auto earlier = GreenhallEdf(alpha, family.d, m_switch - 2, family.modified, true, n_phase);
+      const auto before = GreenhallEdf(alpha, family.d, m_switch - 1, family.modified, true, n_phase);
+      const auto after = GreenhallEdf(alpha, family.d, m_switch, family.modified, true, n_phase);
+      ASSERT_TRUE(earlier && before && after) << alpha;
+      const double trend = *before * (*before / *earlier);
+      EXPECT_NEAR(*after / trend, 1.0, kTableSwitchTolerance)
+          << "d=" << family.d << " modified=" << family.modified << " alpha=" << alpha << " edf " << *earlier
+          << ", " << *before << " -> " << *after;
+    }
+  }
+}
+
+// Rates of a given power-law type, from a fixed seed.
+std::vector<double> WhiteNoise(int64_t n, double sigma, uint32_t seed) {
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> normal(0.0, sigma);
+  std::vector<double> y(n);
+  for (double& v : y) v = normal(random);
+  return y;
+}
+
+std::vector<double> RandomWalk(int64_t n, double step, uint32_t seed) {
+  std::vector<double> y = WhiteNoise(n, step, seed);
+  for (int64_t i = 1; i < n; ++i) y[i] += y[i - 1];
+  return y;
+}
+
+TEST(NoiseStatisticsTest, Lag1IdentifiesPowerLawNoise) {
+  const int64_t n = 20000;
+  const std::vector<double> white = WhiteNoise(n, 1.0, 1);
+  std::vector<double> white_pm(n - 1);  // differenced white noise: white phase
+  for (int64_t i = 0; i + 1 < n; ++i) white_pm[i] = white[i + 1] - white[i];
+  const std::vector<double> walk = RandomWalk(n, 1.0, 2);
+  const auto id_white = IdentifyNoiseLag1(white.data(), n, 2);
+  const auto id_pm = IdentifyNoiseLag1(white_pm.data(), n - 1, 2);
+  const auto id_walk = IdentifyNoiseLag1(walk.data(), n, 2);
+  ASSERT_TRUE(id_white && id_pm && id_walk);
+  EXPECT_EQ(id_white->alpha, 0);
+  EXPECT_EQ(id_pm->alpha, 2);
+  EXPECT_EQ(id_walk->alpha, -2);
+  EXPECT_FALSE(IdentifyNoiseLag1(white.data(), kMinNoiseIdPoints - 1, 2));
+}
+
+TEST(NoiseStatisticsTest, AutomaticNoiseIdFindsWhiteFmInTheTestSet) {
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(Nbs1000(), 1.0, {1, 2, 4, 8, 16, 32}, options);
+  for (const AllanPoint& point : result.points) {
+    EXPECT_EQ(point.alpha, 0) << point.m;
+    EXPECT_EQ(point.alpha_identified, 1000 / point.m >= kMinNoiseIdPoints) << point.m;
+  }
+}
+
+// ---------------------------------------------------------------- numerics
+
+// Relative, worst case: what double arithmetic on mean-removed phase keeps.
+constexpr double kStabilityTolerance = 1e-10;
+
+// oadev straight from the definition (averages of y in long double), for comparison. The caller
+// knows the offset and removes it exactly (y - offset is exact in long double), which the code
+// under test is not told.
+double DirectOadev(const std::vector<double>& y, int64_t m, double offset) {
+  const int64_t n = static_cast<int64_t>(y.size());
+  std::vector<long double> prefix(n + 1, 0.0L);
+  for (int64_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (static_cast<long double>(y[i]) - offset);
+  long double sum = 0.0L;
+  const int64_t terms = n + 1 - 2 * m;
+  for (int64_t i = 0; i < terms; ++i) {
+    const long double a = (prefix[i + m] - prefix[i]) / m;
+    const long double b = (prefix[i + 2 * m] - prefix[i + m]) / m;
+    sum += (b - a) * (b - a);
+  }
+  return static_cast<double>(std::sqrt(sum / (2.0L * terms)));
+}
+
+TEST(NoiseNumericsTest, LargeOffsetLosesNoDigits) {
+  // A gyro with a 100 rad/s offset and 1e-3 rad/s noise: the offset is 1e5 times the noise.
+  std::vector<double> y = WhiteNoise(1 << 20, 1e-3, 7);
+  for (double& v : y) v += 100.0;
+  const std::vector<int64_t> factors = {1, 16, 1024, 65536};
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(y, 1.0, factors, options);
+  for (size_t i = 0; i < factors.size(); ++i) {
+    EXPECT_NEAR(result.points[i].dev / DirectOadev(y, factors[i], 100.0), 1.0, kStabilityTolerance) << factors[i];
+  }
+  EXPECT_NEAR(result.mean, 100.0, 1e-5);
+}
+
+TEST(NoiseNumericsTest, ThreadsDoNotChangeTheResult) {
+  const std::vector<double> y = RandomWalk(1 << 19, 1e-3, 9);
+  for (AllanEstimator estimator : {AllanEstimator::kOadev, AllanEstimator::kMdev, AllanEstimator::kOhdev,
+                                   AllanEstimator::kTotdev, AllanEstimator::kAdev}) {
+    std::vector<int64_t> factors;
+    ASSERT_EQ(AveragingFactors(TauSpec(), estimator, static_cast<int64_t>(y.size()), 1.0, &factors), "");
+    AllanOptions one;
+    one.estimator = estimator;
+    one.threads = 1;
+    AllanOptions four = one;
+    four.threads = 4;
+    const AllanResult a = ComputeAllanFromRates(y, 1.0, factors, one);
+    const AllanResult b = ComputeAllanFromRates(y, 1.0, factors, four);
+    for (size_t i = 0; i < factors.size(); ++i) {
+      EXPECT_NEAR(a.points[i].dev / b.points[i].dev, 1.0, kStabilityTolerance)
+          << ToString(estimator) << " m=" << factors[i];
+    }
+  }
+}
+
+TEST(NoiseTauTest, SetsAndErrors) {
+  TauSpec spec;
+  std::vector<int64_t> factors;
+  ASSERT_EQ(ParseTauSpec("decade", &spec), "");
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors), "");
+  EXPECT_EQ(factors, (std::vector<int64_t>{1, 2, 4, 10, 20, 40, 100, 200}));
+  ASSERT_EQ(ParseTauSpec("per-decade:3", &spec), "");
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors), "");
+  EXPECT_EQ(factors, (std::vector<int64_t>{1, 2, 5, 10, 22, 46, 100, 215}));
+  ASSERT_EQ(ParseTauSpec("0.01, 0.1,1", &spec), "");
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors), "");
+  EXPECT_EQ(factors, (std::vector<int64_t>{1, 10, 100}));
+  ASSERT_EQ(ParseTauSpec("0.015", &spec), "");
+  EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("not a whole multiple"),
+            std::string::npos);
+  ASSERT_EQ(ParseTauSpec("6", &spec), "");
+  EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("too long"), std::string::npos);
+  EXPECT_NE(ParseTauSpec("weekly", &spec).find("allowed: octave, decade, all, per-decade:K"), std::string::npos);
+  EXPECT_NE(AveragingFactors(TauSpec(), AllanEstimator::kOadev, 3, 0.01, &factors).find("too short"),
+            std::string::npos);
+  AllanEstimator estimator;
+  EXPECT_FALSE(ParseAllanEstimator("avar", &estimator));
+  EXPECT_EQ(AllanEstimatorNames(), "adev, oadev, mdev, tdev, hdev, ohdev, totdev");
+}
+
+// ---------------------------------------------------------------- IEEE 952 fit, known truth
+
+// The fit's uncertainty is honest: the truth lies within this many of its standard
+// uncertainties (3: a 0.3 % chance of a false alarm per check for a correct uncertainty).
+constexpr double kCoverageSigmas = 3.0;
+// And it is informative: the stated uncertainty is at most this fraction of the value.
+constexpr double kMaxRelativeUncertainty = 0.1;
+
+NoiseFitSummary FitRates(const std::vector<double>& y, double tau0, const char* taus = "per-decade:5") {
+  TauSpec spec;
+  EXPECT_EQ(ParseTauSpec(taus, &spec), "");
+  std::vector<int64_t> factors;
+  EXPECT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, static_cast<int64_t>(y.size()), tau0, &factors), "");
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(y, tau0, factors, options);
+  return FitNoiseModel(result.points, static_cast<int64_t>(y.size()));
+}
+
+void ExpectRecovered(const NoiseFitSummary& fit, int term, double truth) {
+  EXPECT_NEAR(fit.value[term], truth, kCoverageSigmas * fit.sigma[term])
+      << NoiseTermName(term) << ": fitted " << fit.value[term] << " +- " << fit.sigma[term] << ", truth " << truth;
+  EXPECT_LT(fit.sigma[term], kMaxRelativeUncertainty * truth) << NoiseTermName(term);
+}
+
+TEST(NoiseFitTest, WhiteNoiseGivesItsAngleRandomWalk) {
+  const double tau0 = 0.01;
+  const double arw = 2e-4;  // rad/sqrt(s): sigma of one sample is arw / sqrt(tau0)
+  const NoiseFitSummary fit = FitRates(WhiteNoise(400000, arw / std::sqrt(tau0), 11), tau0);
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  ExpectRecovered(fit, kRandomWalk, arw);
+  EXPECT_NEAR(fit.readout_random_walk / arw, 1.0, 0.02);
+}
+
+TEST(NoiseFitTest, RandomWalkGivesItsRateRandomWalk) {
+  const double tau0 = 0.1;
+  const double arw = 1e-4;  // rad/sqrt(s)
+  const double rrw = 2e-6;  // rad/s/sqrt(s): the rate's step per sample is rrw * sqrt(tau0)
+  std::vector<double> y = WhiteNoise(1000000, arw / std::sqrt(tau0), 12);
+  const std::vector<double> walk = RandomWalk(1000000, rrw * std::sqrt(tau0), 13);
+  for (size_t i = 0; i < y.size(); ++i) y[i] += walk[i];
+  const NoiseFitSummary fit = FitRates(y, tau0);
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  ExpectRecovered(fit, kRandomWalk, arw);
+  ExpectRecovered(fit, kRateRandomWalk, rrw);
+}
+
+TEST(NoiseFitTest, QuantizedAngleGivesItsQuantizationNoise) {
+  // A rate-integrating gyro that outputs angle in steps of `step`: the rate is the difference of
+  // quantized angles. Its angle error is uniform, so Q = step / sqrt(12).
+  const double tau0 = 0.01;
+  const double step = 1e-5;  // rad
+  const double rate = 0.0123456789;  // rad/s, incommensurate with the step
+  const int64_t n = 400000;
+  // An angle random walk of half a step per sample: enough to make successive quantization
+  // errors independent (their correlation is below 1e-2), small enough for the steps to show.
+  const std::vector<double> walk = WhiteNoise(n + 1, 0.5 * step, 14);
+  std::vector<double> y(n);
+  double angle = 0.0;
+  double previous = 0.0;
+  for (int64_t i = 0; i <= n; ++i) {
+    angle += rate * tau0 + walk[i];
+    const double quantized = step * std::round(angle / step);
+    if (i > 0) y[i - 1] = (quantized - previous) / tau0;
+    previous = quantized;
+  }
+  const NoiseFitSummary fit = FitRates(y, tau0);
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  ExpectRecovered(fit, kQuantization, step / std::sqrt(12.0));
+}
+
+// The reported uncertainty matches the spread over independent records: the rms of
+// (fitted - true) / uncertainty of the variance coefficients N^2 and K^2 is near 1.
+TEST(NoiseFitTest, UncertaintyMatchesTheMonteCarloSpread) {
+  // Bounds on the rms z-score over kRecords records: 1 +- 0.5 (with 24 records the rms itself
+  // scatters by about 0.15; the model of correlated taus is good to about 20 %).
+  constexpr int kRecords = 24;
+  constexpr double kMinRmsZ = 0.5;
+  constexpr double kMaxRmsZ = 1.5;
+  const double tau0 = 0.01;
+  const double arw = 1e-3;
+  const double rrw = 2e-5;
+  double sum_n = 0.0;
+  double sum_k = 0.0;
+  for (int record = 0; record < kRecords; ++record) {
+    std::vector<double> y = WhiteNoise(100000, arw / std::sqrt(tau0), 1000 + record);
+    const std::vector<double> walk = RandomWalk(100000, rrw * std::sqrt(tau0), 2000 + record);
+    for (size_t i = 0; i < y.size(); ++i) y[i] += walk[i];
+    const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+    ASSERT_TRUE(fit.fitted);
+    const double z_n = (fit.variance[kRandomWalk] - arw * arw) / fit.variance_sigma[kRandomWalk];
+    const double z_k = (fit.variance[kRateRandomWalk] - rrw * rrw) / fit.variance_sigma[kRateRandomWalk];
+    sum_n += z_n * z_n;
+    sum_k += z_k * z_k;
+  }
+  const double rms_n = std::sqrt(sum_n / kRecords);
+  const double rms_k = std::sqrt(sum_k / kRecords);
+  EXPECT_GT(rms_n, kMinRmsZ);
+  EXPECT_LT(rms_n, kMaxRmsZ);
+  EXPECT_GT(rms_k, kMinRmsZ);
+  EXPECT_LT(rms_k, kMaxRmsZ);
+}
+
+TEST(NoiseFitTest, TooFewPointsIsReportedNotFitted) {
+  AllanOptions options;
+  const AllanResult result = ComputeAllanFromRates(kNbs9, 1.0, {1, 2}, options);
+  const NoiseFitSummary fit = FitNoiseModel(result.points, 9);
+  EXPECT_FALSE(fit.fitted);
+  EXPECT_NE(fit.message.find("too few points"), std::string::npos);
+}
+
+
+// ---------------------------------------------------------------- imufit allan, end to end
+
+namespace fs = std::filesystem;
+
+class AllanCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("imufit_allan_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // Writes a samples file: time_s at `interval`, temp_c, gyro_x (white, sigma 0.01 rad/s) and
+  // accel_y (white, 0.02 m/s^2 around 9.8), `rows` rows; `time_of` may bend the time column.
+  std::string WriteSamples(const std::string& name, int rows, double interval = 0.01,
+                           const std::function<double(int)>& time_of = nullptr) {
+    const std::vector<double> gyro = WhiteNoise(rows, 0.01, 21);
+    const std::vector<double> accel = WhiteNoise(rows, 0.02, 22);
+    std::ostringstream text;
+    text << "# a comment line\ntime_s,temp_c,gyro_x,accel_y\n";
+    text.precision(17);
+    for (int i = 0; i < rows; ++i) {
+      text << (time_of ? time_of(i) : 1000.0 + i * interval) << ",25," << gyro[i] << "," << 9.8 + accel[i] << "\n";
+    }
+    const std::string path = Path(name);
+    if (name.size() > 3 && name.substr(name.size() - 3) == ".gz") {
+      gzFile file = gzopen(path.c_str(), "wb");
+      const std::string data = text.str();
+      gzwrite(file, data.data(), static_cast<unsigned>(data.size()));
+      gzclose(file);
+    } else {
+      std::ofstream(path) << text.str();
+    }
+    return path;
+  }
+
+  // Runs `imufit ARGS` (with `environment` prefixed, e.g. "PATH=/x"); returns the exit status and
+  // leaves stderr in error_.
+  int Run(const std::string& args, const std::string& environment = "") {
+    const std::string err = Path("stderr.txt");
+    const std::string command = (environment.empty() ? "" : "env " + environment + " ") + "'" IMUFIT_EXE "' " +
+                                args + " > '" + Path("stdout.txt") + "' 2> '" + err + "'";
+    const int status = std::system(command.c_str());
+    error_ = Read(err);
+    output_ = Read(Path("stdout.txt"));
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  static std::string Read(const std::string& path) {
+    std::ifstream stream(path, std::ios::binary);
+    std::stringstream text;
+    text << stream.rdbuf();
+    return text.str();
+  }
+
+  fs::path dir_;
+  std::string error_;
+  std::string output_;
+};
+
+TEST_F(AllanCliTest, WritesTheCsvOfTheLibraryAndANoiseFile) {
+  const std::string samples = WriteSamples("samples.csv", 20000);
+  const std::string csv = Path("allan.csv");
+  const std::string yaml = Path("noise.yaml");
+  ASSERT_EQ(Run("allan -s '" + samples + "' -c gyro_x,accel_y -o '" + csv + "' --noise-yaml '" + yaml + "'"), 0)
+      << error_;
+  EXPECT_NE(output_.find("angle random walk"), std::string::npos) << output_;
+  EXPECT_NE(output_.find("velocity random walk"), std::string::npos) << output_;
+
+  std::istringstream lines(Read(csv));
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "column,estimator,tau_s,terms,dev,dev_lo,dev_hi");
+  // The library on the same numbers (the file holds them exactly).
+  std::vector<int64_t> factors;
+  ASSERT_EQ(AveragingFactors(TauSpec(), AllanEstimator::kOadev, 20000, 0.01, &factors), "");
+  const AllanResult gyro = ComputeAllanFromRates(WhiteNoise(20000, 0.01, 21), 0.01, factors, AllanOptions());
+  size_t rows = 0;
+  while (std::getline(lines, line)) {
+    std::istringstream fields(line);
+    std::string column, estimator, tau, terms, dev;
+    std::getline(fields, column, ',');
+    std::getline(fields, estimator, ',');
+    std::getline(fields, tau, ',');
+    std::getline(fields, terms, ',');
+    std::getline(fields, dev, ',');
+    EXPECT_EQ(estimator, "oadev");
+    if (column == "gyro_x") {
+      ASSERT_LT(rows, gyro.points.size());
+      EXPECT_NEAR(std::stod(tau) / gyro.points[rows].tau_s, 1.0, 1e-9);
+      EXPECT_EQ(std::stoll(terms), gyro.points[rows].terms);
+      EXPECT_NEAR(std::stod(dev) / gyro.points[rows].dev, 1.0, 1e-9);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2 * factors.size());
+
+  // The noise file has one top-level key, so it merges into a calibration by appending.
+  const YAML::Node noise = YAML::LoadFile(yaml);
+  ASSERT_EQ(noise.size(), 1u);
+  const YAML::Node arw = noise["noise"]["columns"]["gyro_x"]["arw_deg_per_sqrt_hr"];
+  ASSERT_TRUE(arw.IsSequence());
+  // White gyro noise of 0.01 rad/s at 100 Hz is an ARW of 0.001 rad/sqrt(s) = 3.44 deg/sqrt(h).
+  const double arw_deg_per_sqrt_hr = 0.01 * std::sqrt(0.01) * 180.0 / 3.14159265358979323846 * 60.0;
+  EXPECT_NEAR(arw[0].as<double>(), arw_deg_per_sqrt_hr, kCoverageSigmas * arw[1].as<double>());
+  EXPECT_GT(noise["noise"]["kalibr"]["gyroscope_noise_density"].as<double>(), 0.0);
+  EXPECT_GT(noise["noise"]["kalibr"]["accelerometer_noise_density"].as<double>(), 0.0);
+  EXPECT_TRUE(noise["noise"]["columns"]["accel_y"]["bias_instability_ug"].IsSequence());
+  const YAML::Node merged = YAML::Load("format: imufit-calibration\nversion: 1\n" + Read(yaml));
+  EXPECT_EQ(merged["format"].as<std::string>(), "imufit-calibration");
+  EXPECT_TRUE(merged["noise"]["kalibr"].IsMap());
+}
+
+TEST_F(AllanCliTest, GzipInputGivesTheSameResult) {
+  const std::string plain = WriteSamples("samples.csv", 5000);
+  const std::string gz = WriteSamples("samples.csv.gz", 5000);
+  ASSERT_EQ(Run("allan -q -s '" + plain + "' -c gyro_x -e mdev -t decade -o '" + Path("a.csv") + "'"), 0) << error_;
+  ASSERT_EQ(Run("allan -q -s '" + gz + "' -c gyro_x -e mdev -t decade -o '" + Path("b.csv") + "'"), 0) << error_;
+  EXPECT_EQ(Read(Path("a.csv")), Read(Path("b.csv")));
+  EXPECT_NE(Read(Path("a.csv")).find("gyro_x,mdev,0.01,"), std::string::npos);
+}
+
+TEST_F(AllanCliTest, BadInputIsExitTwoWithALocatedMessage) {
+  const std::string samples = WriteSamples("samples.csv", 2000);
+  const std::string out = Path("out.csv");
+  const std::string common = " -o '" + out + "'";
+  // A column that does not exist: the header line (line 2, after the comment).
+  EXPECT_EQ(Run("allan -s '" + samples + "' -c gyro_q" + common), 2);
+  EXPECT_NE(error_.find(samples + ":2: no column \"gyro_q\" in the header (it has: time_s,temp_c,gyro_x,accel_y)"),
+            std::string::npos)
+      << error_;
+  // A gap: sample 1000 comes two intervals late; it sits on line 1000 + 3.
+  const std::string gap = WriteSamples("gap.csv", 2000, 0.01, [](int i) { return i < 1000 ? i * 0.01 : (i + 1) * 0.01; });
+  EXPECT_EQ(Run("allan -s '" + gap + "' -c gyro_x" + common), 2);
+  EXPECT_NE(error_.find(gap + ":1003:1: time_s: a gap in time: 10.01 s follows 9.99"), std::string::npos) << error_;
+  // ... which --gaps bridge joins knowingly.
+  EXPECT_EQ(Run("allan -s '" + gap + "' -c gyro_x --gaps bridge" + common), 0) << error_;
+  EXPECT_NE(output_.find("bridged 1 gap"), std::string::npos) << output_;
+  fs::remove(out);
+  // Jitter beyond the tolerance.
+  const std::string jitter = WriteSamples("jitter.csv", 2000, 0.01, [](int i) { return i * 0.01 + (i == 500 ? 0.002 : 0.0); });
+  EXPECT_EQ(Run("allan -s '" + jitter + "' -c gyro_x --time-tolerance 0.1" + common), 2);
+  EXPECT_NE(error_.find(jitter + ":503:1: time_s:"), std::string::npos) << error_;
+  // Time that goes backwards.
+  const std::string backwards = WriteSamples("back.csv", 100, 0.01, [](int i) { return i == 50 ? 0.3 : i * 0.01; });
+  EXPECT_EQ(Run("allan -s '" + backwards + "' -c gyro_x" + common), 2);
+  EXPECT_NE(error_.find(":53:1: time_s: 0.3 s does not increase"), std::string::npos) << error_;
+  // Too short.
+  const std::string short_file = WriteSamples("short.csv", 3);
+  EXPECT_EQ(Run("allan -s '" + short_file + "' -c gyro_x" + common), 2);
+  EXPECT_NE(error_.find(short_file + ": too short: 3 samples"), std::string::npos) << error_;
+  // Bad options, each naming what is allowed.
+  EXPECT_EQ(Run("allan -s '" + samples + "' -e avar" + common), 2);
+  EXPECT_NE(error_.find("--estimator \"avar\" is not one of: adev, oadev, mdev, tdev, hdev, ohdev, totdev"),
+            std::string::npos)
+      << error_;
+  EXPECT_EQ(Run("allan -s '" + samples + "' -t 0.015" + common), 2);
+  EXPECT_NE(error_.find("tau 0.015 s is not a whole multiple of the sample interval"), std::string::npos) << error_;
+  EXPECT_EQ(Run("allan -s '" + samples + "' -t weekly" + common), 2);
+  EXPECT_NE(error_.find("allowed: octave, decade, all, per-decade:K"), std::string::npos) << error_;
+  EXPECT_EQ(Run("allan -s '" + samples + "' --confidence 1.5" + common), 2);
+  EXPECT_NE(error_.find("confidence must lie strictly between 0 and 1"), std::string::npos) << error_;
+  // Never its own input; and nothing written by any failed run.
+  EXPECT_EQ(Run("allan -s '" + samples + "' -o '" + samples + "'"), 2);
+  EXPECT_NE(error_.find("is also an input"), std::string::npos) << error_;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(AllanCliTest, PlotsWithGnuplotOrSaysItIsMissing) {
+  const std::string samples = WriteSamples("samples.csv", 20000);
+  // Without gnuplot on PATH: exit 1, the tool named, nothing written.
+  EXPECT_EQ(Run("allan -s '" + samples + "' -o '" + Path("a.csv") + "' --plot '" + Path("a.png") + "'",
+                "PATH=" + dir_.string()),
+            1);
+  EXPECT_NE(error_.find("--plot needs gnuplot, which is not on PATH"), std::string::npos) << error_;
+  EXPECT_FALSE(fs::exists(Path("a.csv")));
+  EXPECT_EQ(Run("allan -s '" + samples + "' -o '" + Path("a.csv") + "' --plot '" + Path("a.pdf") + "'"), 2);
+  EXPECT_NE(error_.find("--plot must end in .svg or .png"), std::string::npos) << error_;
+
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) GTEST_SKIP() << "gnuplot is not installed";
+  ASSERT_EQ(Run("allan -q -s '" + samples + "' -o '" + Path("a.csv") + "' --plot '" + Path("a.png") + "'"), 0)
+      << error_;
+  EXPECT_EQ(Read(Path("a.png")).substr(0, 4), "\x89PNG");
+  ASSERT_EQ(Run("allan -q -s '" + samples + "' -o '" + Path("b.csv") + "' --plot '" + Path("a.svg") + "'"), 0)
+      << error_;
+  EXPECT_NE(Read(Path("a.svg")).find("<svg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace imufit
