@@ -24,6 +24,7 @@
 #include <stdexcept>
 
 #include "commands.h"
+#include "imufit/io/path.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/series_reader.h"
@@ -148,10 +149,6 @@ std::string FindOnPath(const std::string& program) {
     if (::access(candidate.c_str(), X_OK) == 0) return candidate;
   }
   return "";
-}
-
-bool EndsWith(const std::string& text, const std::string& suffix) {
-  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 std::string Number(double value, int digits = 4) {
@@ -318,7 +315,7 @@ std::string PlotScript(const std::string& output, const std::string& title, cons
   constexpr int kModelPoints = 160;
   std::ostringstream gp;
   gp.precision(10);
-  const bool png = EndsWith(args.plot, ".png");
+  const bool png = HasSuffix(args.plot, ".png");
   std::vector<ColumnKind> kinds;
   for (const ColumnResult& r : results) {
     if (std::find(kinds.begin(), kinds.end(), r.kind) == kinds.end()) kinds.push_back(r.kind);
@@ -547,7 +544,7 @@ int RunAllan(const AllanArguments& args) {
   }
   std::string gnuplot;
   if (!args.plot.empty()) {
-    if (!EndsWith(args.plot, ".svg") && !EndsWith(args.plot, ".png")) {
+    if (!HasSuffix(args.plot, ".svg") && !HasSuffix(args.plot, ".png")) {
       throw InputError(args.plot, "--plot must end in .svg or .png");
     }
     gnuplot = FindOnPath("gnuplot");

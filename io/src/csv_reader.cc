@@ -10,16 +10,12 @@
 #include <cstring>
 
 #include "imufit/io/error.h"
+#include "imufit/io/path.h"
 
 namespace imufit {
 namespace {
 
 constexpr size_t kBlockBytes = 4 << 20;
-
-bool EndsWith(const std::string& text, std::string_view suffix) {
-  return text.size() >= suffix.size() &&
-         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 std::string_view Trim(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
@@ -51,7 +47,7 @@ bool ParseSmallInteger(std::string_view text, double* value) {
 class CsvReader::Source {
  public:
   explicit Source(const std::string& path) : path_(path) {
-    if (EndsWith(path, ".gz")) {
+    if (IsGzipPath(path)) {
       gz_ = gzopen(path.c_str(), "rb");
       if (gz_ == nullptr) Throw();
       gzbuffer(gz_, 1 << 18);

@@ -13,16 +13,12 @@
 #include <filesystem>
 
 #include "imufit/io/error.h"
+#include "imufit/io/path.h"
 
 namespace imufit {
 namespace {
 
 constexpr size_t kFlushBytes = 1 << 20;
-
-bool EndsWith(const std::string& text, std::string_view suffix) {
-  return text.size() >= suffix.size() &&
-         text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 }  // namespace
 
@@ -44,7 +40,7 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
   const mode_t mask = ::umask(0);
   ::umask(mask);
   ::fchmod(fd_, 0666 & ~mask);
-  if (EndsWith(path_, ".gz")) {
+  if (IsGzipPath(path_)) {
     gz_ = gzdopen(fd_, "wb6");
     if (gz_ == nullptr) {
       ::close(fd_);

@@ -1,3 +1,4 @@
+#include "imufit/io/path.h"
 #include "imufit/io/series_reader.h"
 
 #include <sys/stat.h>
@@ -18,10 +19,6 @@ namespace {
 constexpr int64_t kRowsBeforeReserve = 4096;
 
 bool StartsWith(const std::string& text, const char* prefix) { return text.rfind(prefix, 0) == 0; }
-bool EndsWith(const std::string& text, const std::string& suffix) {
-  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 template <typename... Args>
 std::string Format(const char* format, Args... args) {
   char text[400];
@@ -94,7 +91,7 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
     previous_time = time;
     for (size_t c = 0; c < indices.size(); ++c) series.columns[c].push_back(csv.Number(indices[c]));
     ++rows;
-    if (rows == kRowsBeforeReserve && !EndsWith(path, ".gz")) {
+    if (rows == kRowsBeforeReserve && !IsGzipPath(path)) {
       struct stat status;
       if (::stat(path.c_str(), &status) == 0 && csv.bytes_read() > 0) {
         const double bytes_per_row = static_cast<double>(csv.bytes_read()) / static_cast<double>(rows);

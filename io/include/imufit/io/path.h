@@ -1,0 +1,19 @@
+// imufit — what a file's name says about it.
+#ifndef IMUFIT_IO_PATH_H_
+#define IMUFIT_IO_PATH_H_
+
+#include <string_view>
+
+namespace imufit {
+
+// True when `path` ends with `suffix` (".gz", ".png"); case-sensitive, as file systems are.
+inline bool HasSuffix(std::string_view path, std::string_view suffix) {
+  return path.size() >= suffix.size() && path.substr(path.size() - suffix.size()) == suffix;
+}
+
+// Files whose name ends in ".gz" are read and written gzip-compressed.
+inline bool IsGzipPath(std::string_view path) { return HasSuffix(path, ".gz"); }
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_PATH_H_
