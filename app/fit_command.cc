@@ -5,13 +5,10 @@
 
 #include "commands.h"
 #include "imufit/fit/thermal_fit.h"
-#include "imufit/fit/validation.h"
-#include "imufit/fit/windows.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
-#include "imufit/io/plan.h"
-#include "imufit/pipeline/run_windows.h"
+#include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
 namespace {
@@ -90,30 +87,6 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
   }
 }
 
-YAML::Node Diagnostics(const FitSummary& fit, const WindowStats& stats, const FitArguments& args) {
-  YAML::Node node;
-  node["plan"] = args.plan;
-  node["samples"] = args.samples;
-  node["samples_read"] = stats.samples;
-  node["windows_used"] = fit.windows_used;
-  node["windows_downweighted"] = fit.windows_downweighted;
-  node["distinct_temperatures_c"] = fit.distinct_temps_c;
-  node["iterations"] = fit.iterations;
-  node["termination"] = fit.termination;
-  node["gyro_residual_rms_radps"] = fit.gyro_rms_radps;
-  node["accel_residual_rms_mps2"] = fit.accel_rms_mps2;
-  node["gyro_reduced_chi2"] = fit.gyro_reduced_chi2;
-  node["accel_reduced_chi2"] = fit.accel_reduced_chi2;
-  node["gyro_temp_order"] = args.fit.gyro_temp_order;
-  node["accel_temp_order"] = args.fit.accel_temp_order;
-  node["g_sensitivity_fitted"] = args.fit.fit_g_sensitivity;
-  node["loss"] = RobustLossName(args.fit.loss);
-  node["gyro_bias_stability_radps"] = args.fit.gyro_bias_stability_radps;
-  node["accel_bias_stability_mps2"] = args.fit.accel_bias_stability_mps2;
-  node["bias_correlation_s"] = args.fit.bias_correlation_s;
-  return node;
-}
-
 int RunFit(FitArguments args) {
   RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples});
   std::string error;
@@ -121,25 +94,19 @@ int RunFit(FitArguments args) {
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
   args.fit.gyro_bias_stability_radps = args.gyro_bias_stability_dph / kRadToDeg / 3600.0;
   args.fit.accel_bias_stability_mps2 = args.accel_bias_stability_ug * 1e-6 * kStandardGravity;
-  if (const std::string problem = args.fit.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
-  if (const std::string problem = args.windows.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
-  if (args.check_samples.empty() != args.check_plan.empty() && args.check_samples.empty()) {
-    throw InputError("imufit fit", "--check-plan needs --check-samples");
-  }
+  FitRunOptions options;
+  options.fit = args.fit;
+  options.windows = args.windows;
+  options.validate = args.validate;
+  options.check_samples = args.check_samples;
+  options.check_plan = args.check_plan;
+  options.software = SoftwareVersion();
+  if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
 
-  const Plan plan = ReadPlan(args.plan);
-  const RunWindows run = ReadRunWindows(plan, args.samples, args.windows);
-  const std::vector<Window>& windows = run.windows;
-  const WindowStats& stats = run.stats;
-  // A held-out run is read before fitting, so that a bad file is reported before any work.
-  std::vector<Window> check_windows;
-  Plan check_plan;
-  if (!args.check_samples.empty()) {
-    check_plan = ReadPlan(args.check_plan.empty() ? args.plan : args.check_plan);
-    check_windows = ReadRunWindows(check_plan, args.check_samples, args.windows).windows;
-  }
-
-  const FitSummary fit = FitThermalModel(windows, plan.site, plan.segments, args.fit);
+  const FitRunResult result = FitRun(args.plan, args.samples, options);
+  const FitSummary& fit = result.fit;
+  const WindowStats& stats = result.run.stats;
+  const std::vector<Window>& windows = result.run.windows;
   if (fit.status == FitStatus::kUndetermined) {
     std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n", args.samples.c_str());
     for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
@@ -150,33 +117,11 @@ int RunFit(FitArguments args) {
                  args.windows.min_samples);
     return 1;
   }
-  if (!fit.IsSolutionUsable()) {
+  if (!result.calibration) {
     std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(), fit.BriefReport().c_str());
     return 1;
   }
-
-  Calibration calibration;
-  calibration.serial = plan.serial;
-  calibration.created_utc = UtcNow();
-  calibration.software = SoftwareVersion();
-  calibration.fit_temp_range_c = fit.temp_range_c;
-  calibration.model = fit.model;
-  calibration.sigma = fit.sigma;
-  calibration.extra = YAML::Node(YAML::NodeType::Map);
-  calibration.extra["fit"] = Diagnostics(fit, stats, args);
-
-  std::vector<HeldOutGroup> folds;
-  if (args.validate) folds = LeaveOneTemperatureOut(windows, plan.site, plan.segments, args.fit);
-  std::vector<ErrorStats> check_errors;
-  if (!check_windows.empty()) {
-    const std::vector<WindowError> errors = PredictWindows(fit.model, check_windows, check_plan.site, check_plan.segments);
-    check_errors = ErrorsBySegment(errors);
-    check_errors.push_back(SummariseErrors(errors));
-    calibration.extra["check"]["samples"] = args.check_samples;
-    calibration.extra["check"]["gyro_error_rms_radps"] = check_errors.back().gyro_rms_radps;
-    calibration.extra["check"]["accel_error_rms_mps2"] = check_errors.back().accel_rms_mps2;
-  }
-  WriteCalibration(args.output, calibration);
+  WriteCalibration(args.output, *result.calibration);
 
   if (args.quiet) return 0;
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
@@ -206,8 +151,8 @@ int RunFit(FitArguments args) {
   }
   if (args.validate) {
     std::printf("  leave-one-temperature-out validation:\n");
-    if (folds.empty()) std::printf("    not enough temperatures (needs at least 3 groups)\n");
-    for (const HeldOutGroup& g : folds) {
+    if (result.folds.empty()) std::printf("    not enough temperatures (needs at least 3 groups)\n");
+    for (const HeldOutGroup& g : result.folds) {
       if (!g.fitted) {
         std::printf("    without %.1f degC: not fitted (%s)\n", g.temp_c, g.why_not.c_str());
         continue;
@@ -217,7 +162,9 @@ int RunFit(FitArguments args) {
                   g.errors.accel_rms_mps2 / kStandardGravity * 1e3, g.errors.accel_max_mps2 / kStandardGravity * 1e3);
     }
   }
-  if (!check_errors.empty()) PrintErrors(("held-out run " + args.check_samples + ":").c_str(), check_errors);
+  if (!result.check_errors.empty()) {
+    PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
+  }
   std::printf("  wrote %s\n", args.output.c_str());
   return 0;
 }

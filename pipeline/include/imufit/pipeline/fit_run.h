@@ -1,0 +1,52 @@
+// imufit — fitting one unit's run from its files: what `imufit fit` does, as a library call, so
+// that batch tooling fits units through the same code path instead of shelling out.
+//
+// FitRun() reads the plan and the samples (and a held-out run, if given), fits, validates when
+// asked, and builds the calibration to write (with its `sigma` tree and a `fit:` diagnostics
+// block). It writes nothing. Bad input throws InputError; a run that does not determine the
+// model, or a fit that does not converge, is reported through `fit.status` (then `calibration`
+// is not set).
+#ifndef IMUFIT_PIPELINE_FIT_RUN_H_
+#define IMUFIT_PIPELINE_FIT_RUN_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imufit/fit/thermal_fit.h"
+#include "imufit/fit/validation.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/plan.h"
+#include "imufit/pipeline/run_windows.h"
+
+namespace imufit {
+
+struct FitRunOptions {
+  FitOptions fit;
+  WindowOptions windows;
+  // Leave each interior temperature out in turn and report the errors on it.
+  bool validate = false;
+  // A held-out run (and its plan; empty: the fitted run's plan) to report the errors on.
+  std::string check_samples;
+  std::string check_plan;
+  // Written into the calibration's `software` key, e.g. "imufit 0.1.0".
+  std::string software;
+
+  // An empty string when usable, else what is wrong.
+  std::string Validate() const;
+};
+
+struct FitRunResult {
+  Plan plan;
+  RunWindows run;
+  FitSummary fit;
+  std::vector<HeldOutGroup> folds;         // with options.validate
+  std::vector<ErrorStats> check_errors;    // per segment, then all ("segment" -1); with check_samples
+  std::optional<Calibration> calibration;  // when fit.IsSolutionUsable()
+};
+
+FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path, const FitRunOptions& options);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_PIPELINE_FIT_RUN_H_

@@ -1,0 +1,82 @@
+#include "imufit/pipeline/fit_run.h"
+
+namespace imufit {
+namespace {
+
+YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path, const std::string& samples_path,
+                       const FitOptions& options) {
+  const FitSummary& fit = result.fit;
+  YAML::Node node;
+  node["plan"] = plan_path;
+  node["samples"] = samples_path;
+  node["samples_read"] = result.run.stats.samples;
+  node["windows_used"] = fit.windows_used;
+  node["windows_downweighted"] = fit.windows_downweighted;
+  node["distinct_temperatures_c"] = fit.distinct_temps_c;
+  node["iterations"] = fit.iterations;
+  node["termination"] = fit.termination;
+  node["gyro_residual_rms_radps"] = fit.gyro_rms_radps;
+  node["accel_residual_rms_mps2"] = fit.accel_rms_mps2;
+  node["gyro_reduced_chi2"] = fit.gyro_reduced_chi2;
+  node["accel_reduced_chi2"] = fit.accel_reduced_chi2;
+  node["gyro_temp_order"] = options.gyro_temp_order;
+  node["accel_temp_order"] = options.accel_temp_order;
+  node["g_sensitivity_fitted"] = options.fit_g_sensitivity;
+  node["loss"] = RobustLossName(options.loss);
+  node["gyro_bias_stability_radps"] = options.gyro_bias_stability_radps;
+  node["accel_bias_stability_mps2"] = options.accel_bias_stability_mps2;
+  node["bias_correlation_s"] = options.bias_correlation_s;
+  return node;
+}
+
+}  // namespace
+
+std::string FitRunOptions::Validate() const {
+  if (std::string problem = fit.Validate(); !problem.empty()) return problem;
+  if (std::string problem = windows.Validate(); !problem.empty()) return problem;
+  if (check_samples.empty() && !check_plan.empty()) return "a check plan needs check samples";
+  return "";
+}
+
+FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path, const FitRunOptions& options) {
+  FitRunResult result;
+  result.plan = ReadPlan(plan_path);
+  result.run = ReadRunWindows(result.plan, samples_path, options.windows);
+  // A held-out run is read before fitting, so that a bad file is reported before any work.
+  std::vector<Window> check_windows;
+  Plan check_plan;
+  if (!options.check_samples.empty()) {
+    check_plan = ReadPlan(options.check_plan.empty() ? plan_path : options.check_plan);
+    check_windows = ReadRunWindows(check_plan, options.check_samples, options.windows).windows;
+  }
+
+  result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
+  if (!result.fit.IsSolutionUsable()) return result;
+
+  Calibration calibration;
+  calibration.serial = result.plan.serial;
+  calibration.created_utc = UtcNow();
+  calibration.software = options.software;
+  calibration.fit_temp_range_c = result.fit.temp_range_c;
+  calibration.model = result.fit.model;
+  calibration.sigma = result.fit.sigma;
+  calibration.extra = YAML::Node(YAML::NodeType::Map);
+  calibration.extra["fit"] = Diagnostics(result, plan_path, samples_path, options.fit);
+
+  if (options.validate) {
+    result.folds = LeaveOneTemperatureOut(result.run.windows, result.plan.site, result.plan.segments, options.fit);
+  }
+  if (!check_windows.empty()) {
+    const std::vector<WindowError> errors =
+        PredictWindows(result.fit.model, check_windows, check_plan.site, check_plan.segments);
+    result.check_errors = ErrorsBySegment(errors);
+    result.check_errors.push_back(SummariseErrors(errors));
+    calibration.extra["check"]["samples"] = options.check_samples;
+    calibration.extra["check"]["gyro_error_rms_radps"] = result.check_errors.back().gyro_rms_radps;
+    calibration.extra["check"]["accel_error_rms_mps2"] = result.check_errors.back().accel_rms_mps2;
+  }
+  result.calibration = std::move(calibration);
+  return result;
+}
+
+}  // namespace imufit
