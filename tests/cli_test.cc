@@ -805,6 +805,7 @@ TEST_F(CliTest, AnOutputThatIsAlsoAnInputIsRefused) {
       {"simulate", "-p", plan, "-c", calibration, "-o", calibration},
       {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", plan},
       {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", Path("new.csv")},
+      {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", (work_ / "." / "new.csv").string()},
   };
   const std::set<std::string> before = Listing();
   for (const auto& args : cases) {
