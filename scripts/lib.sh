@@ -64,8 +64,11 @@ imufit_build() {
     cat "$dir/configure.log" >&2
     imufit_die "cmake could not configure $dir"
   fi
-  # --quiet drops the progress lines; compiler messages still show. (pipefail: ninja's status.)
-  if ! ninja -C "$dir" --quiet "${targets[@]}" | { grep -v '^ninja: no work to do\.$' || true; }; then
+  # --quiet (ninja 1.11+) drops the progress lines; compiler messages still show. With pipefail
+  # the pipeline fails when ninja does.
+  local quiet=()
+  if grep -q -- '--quiet' <<<"$(ninja --help 2>&1)"; then quiet=(--quiet); fi
+  if ! ninja -C "$dir" "${quiet[@]}" "${targets[@]}" | { grep -v '^ninja: no work to do\.$' || true; }; then
     imufit_die "the build in $dir failed"
   fi
 }
