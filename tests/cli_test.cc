@@ -865,5 +865,124 @@ TEST_F(CliTest, AnOutputThatIsAlsoAnInputIsRefused) {
   }
 }
 
+// ------------------------------------------------------------------------------------------
+// imufit fit, end to end.
+
+TEST_F(CliTest, FitWritesACalibrationThatCorrectsAnotherRun) {
+  const std::string calibration = Path("calibration.yaml");
+  const RunResult fit = Run({"fit", "--plan", Fixture("plan_6pos.yaml"), "--samples", Fixture("mems_6pos_soak.csv.gz"),
+                             "-o", calibration, "--validate"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("converged"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("at 25 degC (+- 1 sigma)"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("leave-one-temperature-out validation"), std::string::npos) << fit.out;
+  const YAML::Node written = YAML::LoadFile(calibration);
+  EXPECT_EQ(written["format"].as<std::string>(), "imufit-calibration");
+  EXPECT_EQ(written["sigma"]["gyro"]["g_sensitivity"]["zz"].size(), 4u);
+  EXPECT_EQ(written["fit"]["windows_used"].as<int>(), 90);
+  EXPECT_EQ(written["fit"]["distinct_temperatures_c"].size(), 5u);
+
+  // The fitted calibration corrects the noiseless run (same unit, other temperatures) to within
+  // what the noise of the fitted run leaves: a few thousandths of a deg/s, a few tenths of a mg.
+  constexpr double kGyroToleranceRadps = 0.02 * kDegToRad;
+  constexpr double kAccelToleranceMps2 = 1e-3 * 9.80665;
+  const std::string corrected = Path("corrected.csv");
+  const RunResult apply =
+      Run({"apply", "-c", calibration, "-s", Fixture("mems_6pos_noiseless.csv.gz"), "-o", corrected, "-q"});
+  ASSERT_EQ(apply.status, 0) << apply.err;
+  const Table got = ReadTable(corrected);
+  const Table truth = ReadTable(Fixture("mems_6pos_noiseless_truth.csv.gz"));
+  ASSERT_EQ(got.rows.size(), truth.rows.size());
+  double worst_gyro = 0.0;
+  double worst_accel = 0.0;
+  for (size_t r = 0; r < got.rows.size(); ++r) {
+    for (const char* axis : {"x", "y", "z"}) {
+      const int g = got.Column(std::string("gyro_") + axis);
+      const int a = got.Column(std::string("accel_") + axis);
+      worst_gyro = std::max(worst_gyro, std::abs(std::stod(got.rows[r][g]) - std::stod(truth.rows[r][g])));
+      worst_accel = std::max(worst_accel, std::abs(std::stod(got.rows[r][a]) - std::stod(truth.rows[r][a])));
+    }
+  }
+  EXPECT_LT(worst_gyro, kGyroToleranceRadps);
+  EXPECT_LT(worst_accel, kAccelToleranceMps2);
+}
+
+TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
+  const std::string samples = Path("one_temperature.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", samples,
+                 "--temps", "25", "--rate", "10", "--dwell", "3", "-q"})
+                .status,
+            0);
+  const std::string output = Write("calibration.yaml", "precious\n");
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", output});
+  EXPECT_EQ(fit.status, 1);
+  EXPECT_NE(fit.err.find("does not determine the model"), std::string::npos) << fit.err;
+  EXPECT_NE(fit.err.find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
+                         "at least 4 needed"),
+            std::string::npos)
+      << fit.err;
+  EXPECT_EQ(ReadBytes(output), "precious\n");
+  EXPECT_EQ(Listing(), (std::set<std::string>{"one_temperature.csv", "calibration.yaml"}));
+  // The same run determines a constant model.
+  const RunResult constant = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("constant.yaml"),
+                                  "--gyro-temp-order", "0", "--accel-temp-order", "0", "-q"});
+  EXPECT_EQ(constant.status, 0) << constant.err;
+}
+
+TEST_F(CliTest, FitNamesAnAxisGravityNeverPointsAlong) {
+  // The 6-position plan without its -y face: g-sensitivity and accelerometer column y are lost.
+  std::string plan = ReadFile(Fixture("plan_6pos.yaml"));
+  YAML::Node root = YAML::Load(plan);
+  YAML::Node kept(YAML::NodeType::Sequence);
+  for (const YAML::Node& segment : root["segments"]) {
+    if (segment["up"][1].as<double>() < -0.5) continue;
+    kept.push_back(segment);
+  }
+  root["segments"] = kept;
+  YAML::Emitter emitter;
+  emitter << root;
+  const std::string plan_path = Write("plan.yaml", emitter.c_str());
+  const std::string samples = Path("run.csv");
+  ASSERT_EQ(Run({"simulate", "-p", plan_path, "-c", Fixture("mems_truth.yaml"), "-o", samples, "--temps=-40,0,40,85",
+                 "--rate", "10", "--dwell", "3", "-q"})
+                .status,
+            0);
+  const RunResult fit = Run({"fit", "-p", plan_path, "-s", samples, "-o", Path("calibration.yaml")});
+  EXPECT_EQ(fit.status, 1);
+  EXPECT_NE(fit.err.find("gyro g_sensitivity column y (xy, yy, zy) is undetermined: no positions with gravity along -y"),
+            std::string::npos)
+      << fit.err;
+  EXPECT_NE(fit.err.find("accel scale y and misalignment xy, zy are undetermined"), std::string::npos) << fit.err;
+  EXPECT_FALSE(fs::exists(Path("calibration.yaml")));
+}
+
+TEST_F(CliTest, FitRefusesBadInputWithExitTwo) {
+  // A segment id the plan does not have: located at its line and field.
+  const std::string samples = Write("samples.csv",
+                                    "time_s,temp_c,segment,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n"
+                                    "0,25,99,1,2,3,4,5,6\n");
+  RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("c.yaml")});
+  EXPECT_EQ(fit.status, 2);
+  EXPECT_NE(fit.err.find("samples.csv:2:3: segment: segment 99 is not in the plan"), std::string::npos) << fit.err;
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o", Path("c.yaml"),
+             "--loss", "tukey"});
+  EXPECT_EQ(fit.status, 2);
+  EXPECT_NE(fit.err.find("\"tukey\" is not a robust loss (none, huber, cauchy)"), std::string::npos) << fit.err;
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o", Path("c.yaml"),
+             "--gyro-temp-order", "4"});
+  EXPECT_EQ(fit.status, 2);
+  EXPECT_FALSE(fs::exists(Path("c.yaml")));
+}
+
+TEST_F(CliTest, FitReportsErrorsOnAHeldOutRun) {
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
+                             Path("calibration.yaml"), "--check-samples", Fixture("mems_6pos_ramp.csv.gz")});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("held-out run"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("    all      216"), std::string::npos) << fit.out;
+  const YAML::Node written = YAML::LoadFile(Path("calibration.yaml"));
+  EXPECT_LT(written["check"]["gyro_error_rms_radps"].as<double>(), 0.02 * kDegToRad);
+}
+
 }  // namespace
 }  // namespace imufit
