@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
@@ -161,6 +162,15 @@ TEST_F(FactoryTest, KeyFiguresAndVerdictOnTheTruthCalibration) {
   EXPECT_EQ(by_name.at("fit_temp_range_c")->margin, 0.0);
   EXPECT_NE(verdict.FailedSummary().find("|gyro_g_sensitivity_dpsg.yy|"), std::string::npos);
   EXPECT_NE(verdict.Table().find("FAIL"), std::string::npos);
+}
+
+TEST(RobustZScores, FlagsTheOneFarValue) {
+  // median 1.0, absolute deviations {0.2, 0.1, 0, 0.1, 5}: MAD 0.1; z of 6.0 = 0.6745 * 5 / 0.1.
+  const std::vector<RobustZ> z = RobustZScores({0.8, 0.9, 1.0, 1.1, 6.0});
+  EXPECT_NEAR(z[4].z, 0.6745 * 5.0 / 0.1, 1e-9);
+  EXPECT_TRUE(z[4].outlier);
+  EXPECT_FALSE(z[3].outlier);
+  EXPECT_FALSE(RobustZScores({1.0, 1.0, 1.0, 5.0})[3].outlier);  // MAD 0: no spread to judge by
 }
 
 TEST_F(FactoryTest, StoreRecordsAndAnswers) {

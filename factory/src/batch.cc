@@ -302,7 +302,13 @@ BatchResult RunBatch(const BatchOptions& options) {
     done.push_back(std::move(u));
   }
   result.units = std::move(done);
-  if (result.complete) WriteLotSummary((fs::path(options.output_dir) / "lot_summary.csv").string(), result);
+  if (result.complete) {
+    WriteLotSummary((fs::path(options.output_dir) / "lot_summary.csv").string(), result);
+    if (options.write_reports) {
+      WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(),
+                          LotReportHtml(shared.lot, result, options.fit.software));
+    }
+  }
   return result;
 }
 

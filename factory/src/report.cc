@@ -437,11 +437,106 @@ std::string UnitReportHtml(const UnitReport& r) {
 
 void WriteUnitReport(const std::string& path, const UnitReport& report) { WriteFileAtomically(path, UnitReportHtml(report)); }
 
+std::vector<RobustZ> RobustZScores(const std::vector<double>& values) {
+  std::vector<RobustZ> scores(values.size());
+  if (values.size() < 3) return scores;
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  const double m = median(values);
+  std::vector<double> deviations;
+  for (double v : values) deviations.push_back(std::abs(v - m));
+  const double mad = median(deviations);
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!(mad > 0.0)) continue;  // half the lot identical: no spread to judge by
+    scores[i].z = 0.6745 * (values[i] - m) / mad;
+    scores[i].outlier = std::abs(scores[i].z) > kOutlierRobustZ;
+  }
+  return scores;
+}
+
 std::string LotReportHtml(const std::string& lot, const BatchResult& batch, const std::string& software) {
-  (void)lot;
-  (void)batch;
-  (void)software;
-  return "";
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>Lot " << HtmlEscape(lot)
+       << "</title>\n<style>" << kStyle << "</style></head><body>\n";
+  const int units = static_cast<int>(batch.units.size());
+  html << "<h1>Lot <span data-key=\"lot\">" << HtmlEscape(lot) << "</span></h1>\n<table>\n"
+       << Row({"units", "<span data-key=\"units\">" + std::to_string(units) + "</span>"})
+       << Row({"passed", "<span class=\"PASS\" data-key=\"passed\">" + std::to_string(batch.passed) + "</span>"})
+       << Row({"failed limits", "<span class=\"FAIL\" data-key=\"failed\">" + std::to_string(batch.failed) + "</span>"})
+       << Row({"not fitted / errors", std::to_string(batch.not_fitted) + " / " + std::to_string(batch.errors)})
+       << Row({"yield", "<span data-key=\"yield\">" + Fmt("%.1f", units ? 100.0 * batch.passed / units : 0.0) + "</span> %"})
+       << Row({"written", HtmlEscape(UtcNow()) + " by " + HtmlEscape(software) + ", git " + IMUFIT_GIT_REVISION}) << "</table>\n";
+
+  html << "<h2>Units</h2>\n<table><tr><th>unit</th><th>serial</th><th>status</th><th>verdict</th><th>reason</th></tr>\n";
+  for (const UnitOutcome& u : batch.units) {
+    const std::string name = u.status == "fitted" ? "<a href=\"" + HtmlEscape(u.unit) + "/report.html\">" + HtmlEscape(u.unit) + "</a>"
+                                                  : HtmlEscape(u.unit);
+    html << "<tr data-unit=\"" << HtmlEscape(u.unit) << "\"><td>" << name << "</td><td>" << HtmlEscape(u.serial) << "</td><td>"
+         << HtmlEscape(u.status) << "</td><td class=\"" << HtmlEscape(u.verdict) << "\">" << HtmlEscape(u.verdict)
+         << "</td><td>" << HtmlEscape(u.message) << "</td></tr>\n";
+  }
+  html << "</table>\n";
+
+  // Distributions: one strip plot per key figure over the fitted units; outliers in red.
+  std::string script, outliers;
+  int plots = 0;
+  for (const std::string& name : kSummaryFigures) {
+    std::vector<double> values;
+    std::vector<const UnitOutcome*> owners;
+    std::string unit;
+    for (const UnitOutcome& u : batch.units) {
+      if (const Figure* f = FindFigure(u.figures, name)) {
+        values.push_back(f->value);
+        owners.push_back(&u);
+        unit = f->unit;
+      }
+    }
+    if (values.empty()) continue;
+    const std::vector<RobustZ> z = RobustZScores(values);
+    std::ostringstream gp;
+    gp.precision(12);
+    for (int kind = 0; kind < 2; ++kind) {
+      gp << "$s" << kind << " << EOD\n";
+      for (size_t i = 0; i < values.size(); ++i) {
+        if (z[i].outlier == (kind == 1)) gp << values[i] << " " << (i % 5) * 0.15 << "\n";
+      }
+      gp << "NaN NaN\nEOD\n";
+    }
+    for (size_t i = 0; i < values.size(); ++i) {
+      if (!z[i].outlier) continue;
+      outliers += "<tr data-outlier=\"" + HtmlEscape(owners[i]->unit) + "\" data-figure=\"" + HtmlEscape(name) + "\"><td>" +
+                  HtmlEscape(owners[i]->unit) + "</td><td>" + HtmlEscape(owners[i]->serial) + "</td><td>" + HtmlEscape(name) +
+                  "</td>" + Num(Fmt("%.6g", values[i]) + " " + HtmlEscape(unit)) + Num(Fmt("%+.1f", z[i].z)) + "</tr>\n";
+    }
+    gp << "set terminal svg size 460,150 dynamic font 'DejaVu Sans,10' background rgb 'white'\nset output '@OUT" << plots << "@'\n"
+       << "set title " << GnuplotQuote(name + " (" + unit + ")") << "\nunset ytics\nset yrange [-0.3:0.9]\nset grid xtics\n"
+       << "set offsets graph 0.05, graph 0.05, 0, 0\nunset key\n"
+       << "plot $s0 using 1:2 with points pt 7 ps 0.8 lc rgb '#1f77b4', $s1 using 1:2 with points pt 7 ps 1.2 lc rgb '#d62728'\n"
+       << "unset output\nreset\n";
+    script += gp.str();
+    ++plots;
+  }
+  html << "<h2>Outliers (robust z = 0.6745 (x - median) / MAD, |z| &gt; " << Fmt("%.1f", kOutlierRobustZ) << ")</h2>\n";
+  if (outliers.empty()) {
+    html << "<p>None.</p>\n";
+  } else {
+    html << "<table><tr><th>unit</th><th>serial</th><th>figure</th><th>value</th><th>robust z</th></tr>\n" << outliers << "</table>\n";
+  }
+  html << "<h2>Distributions of the key figures at 25 degC</h2>\n<p class=\"note\">One dot per fitted unit; red: outlier.</p>\n";
+  if (plots > 0) {
+    try {
+      html << "<div style=\"display: grid; grid-template-columns: 1fr 1fr; gap: 4px\">\n";
+      for (const std::string& svg : RunGnuplotSvg(script, plots)) html << "<div class=\"plot\">" << svg << "</div>\n";
+      html << "</div>\n";
+    } catch (const std::exception& e) {
+      html << "</div><p class=\"note\">Plots not drawn: " << HtmlEscape(e.what()) << "</p>\n";
+    }
+  }
+  html << "</body></html>\n";
+  return html.str();
 }
 
 }  // namespace imufit

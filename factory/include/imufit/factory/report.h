@@ -61,6 +61,12 @@ void WriteUnitReport(const std::string& path, const UnitReport& report);
 // outliers (robust z = 0.6745 (x - median) / MAD beyond kOutlierRobustZ), with links to the
 // units' reports.
 inline constexpr double kOutlierRobustZ = 3.5;
+struct RobustZ {
+  double z = 0.0;
+  bool outlier = false;
+};
+// Robust z-scores of `values` (all 0 and no outliers with fewer than 3 values or a zero MAD).
+std::vector<RobustZ> RobustZScores(const std::vector<double>& values);
 std::string LotReportHtml(const std::string& lot, const BatchResult& batch, const std::string& software);
 
 // Runs gnuplot on `script` (which must `set output` to each of `outputs` in turn, as given,
