@@ -135,7 +135,7 @@ std::string GnuplotQuote(const std::string& text) {
   return quoted + "\"";
 }
 
-const char* kTerminal = "set terminal svg size 760,330 dynamic font 'DejaVu Sans,11' background rgb 'white'\n";
+const char* kTerminal = "set terminal svg size 760,330 dynamic noenhanced font 'DejaVu Sans,11' background rgb 'white'\n";
 
 std::string CurvesScript(const CurveGroup& g, int output) {
   std::ostringstream gp;
@@ -511,7 +511,7 @@ std::string LotReportHtml(const std::string& lot, const BatchResult& batch, cons
                   HtmlEscape(owners[i]->unit) + "</td><td>" + HtmlEscape(owners[i]->serial) + "</td><td>" + HtmlEscape(name) +
                   "</td>" + Num(Fmt("%.6g", values[i]) + " " + HtmlEscape(unit)) + Num(Fmt("%+.1f", z[i].z)) + "</tr>\n";
     }
-    gp << "set terminal svg size 460,150 dynamic font 'DejaVu Sans,10' background rgb 'white'\nset output '@OUT" << plots << "@'\n"
+    gp << "set terminal svg size 460,150 dynamic noenhanced font 'DejaVu Sans,10' background rgb 'white'\nset output '@OUT" << plots << "@'\n"
        << "set title " << GnuplotQuote(name + " (" + unit + ")") << "\nunset ytics\nset yrange [-0.3:0.9]\nset grid xtics\n"
        << "set offsets graph 0.05, graph 0.05, 0, 0\nunset key\n"
        << "plot $s0 using 1:2 with points pt 7 ps 0.8 lc rgb '#1f77b4', $s1 using 1:2 with points pt 7 ps 1.2 lc rgb '#d62728'\n"
