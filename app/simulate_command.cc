@@ -1,5 +1,6 @@
 // imufit simulate — writes a rate-table run for a plan from a calibration used as truth.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -30,7 +31,14 @@ int RunSimulate(SimulateArguments args) {
   RefuseToOverwriteInputs(args.output, {args.plan, args.calibration});
   if (!args.truth_output.empty()) {
     RefuseToOverwriteInputs(args.truth_output, {args.plan, args.calibration});
-    if (args.truth_output == args.output) throw InputError(args.output, "--truth must differ from --output");
+    // Compare the files, not the spellings (x.csv and ./x.csv are one file).
+    std::error_code truth_error;
+    std::error_code output_error;
+    const auto truth_file = std::filesystem::weakly_canonical(args.truth_output, truth_error);
+    const auto output_file = std::filesystem::weakly_canonical(args.output, output_error);
+    if (args.truth_output == args.output || (!truth_error && !output_error && truth_file == output_file)) {
+      throw InputError(args.output, "--truth must differ from --output");
+    }
   }
   SimulationOptions& options = args.options;
   if (!args.ramp_c.empty()) {

@@ -26,9 +26,9 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Dense>
 
 #include "imufit/model/sensor_model.h"
 
@@ -86,7 +86,8 @@ struct Table {
   }
   double Number(size_t row, const std::string& name) const { return std::stod(rows[row][Column(name)]); }
   Eigen::Vector3d Vector(size_t row, const std::string& prefix) const {
-    return Eigen::Vector3d(Number(row, prefix + "_x"), Number(row, prefix + "_y"), Number(row, prefix + "_z"));
+    return Eigen::Vector3d(Number(row, prefix + "_x"), Number(row, prefix + "_y"),
+                           Number(row, prefix + "_z"));
   }
 };
 
@@ -209,7 +210,8 @@ std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> SpecTruthOfPlan(const
     Eigen::Vector3d omega = rate * up;
     if (has_latitude) {
       omega += kEarthRate * std::sin(phi) * up;
-      if (rate == 0.0 && segment["north"]) omega += kEarthRate * std::cos(phi) * vector(segment["north"]).normalized();
+      if (rate == 0.0 && segment["north"])
+        omega += kEarthRate * std::cos(phi) * vector(segment["north"]).normalized();
     }
     Eigen::Vector3d a = g * up;
     if (rate != 0.0 && segment["lever_arm_m"]) {
@@ -232,9 +234,8 @@ struct RunResult {
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("imufit_cli_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("imufit_cli_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "work");
     work_ = dir_ / "work";
@@ -292,16 +293,16 @@ class CliTest : public ::testing::Test {
 
   // Runs a noiseless simulation at 20 Hz with 1 s dwells and 0.75 s transitions (`extra` adds
   // options or overrides these) and returns the paths of {samples, truth}.
-  std::pair<std::string, std::string> SimulateNoiseless(const std::string& plan, const std::string& calibration,
+  std::pair<std::string, std::string> SimulateNoiseless(const std::string& plan,
+                                                        const std::string& calibration,
                                                         const std::string& stem,
                                                         const std::vector<std::string>& extra = {}) {
     const std::string samples = Path(stem + ".csv");
     const std::string truth = Path(stem + "_truth.csv");
-    std::vector<std::string> args = {"simulate", "--plan", plan,    "--calibration", calibration,
-                                     "-o",       samples,  "--truth", truth,          "--quiet"};
-    for (const auto& [option, value] : {std::pair<std::string, std::string>{"--rate", "20"},
-                                        {"--dwell", "1"},
-                                        {"--transition", "0.75"}}) {
+    std::vector<std::string> args = {"simulate", "--plan", plan,      "--calibration", calibration,
+                                     "-o",       samples,  "--truth", truth,           "--quiet"};
+    for (const auto& [option, value] :
+         {std::pair<std::string, std::string>{"--rate", "20"}, {"--dwell", "1"}, {"--transition", "0.75"}}) {
       if (std::find(extra.begin(), extra.end(), option) == extra.end()) {
         args.push_back(option);
         args.push_back(value);
@@ -325,7 +326,8 @@ class CliTest : public ::testing::Test {
     for (size_t i = 0; i < got.rows.size(); ++i) {
       ASSERT_EQ(got.rows[i][0], truth.rows[i][0]) << "time_s, row " << i;
       ASSERT_EQ(got.rows[i][1], truth.rows[i][1]) << "temp_c, row " << i;
-      worst_gyro = std::max(worst_gyro, (got.Vector(i, "gyro") - truth.Vector(i, "gyro")).cwiseAbs().maxCoeff());
+      worst_gyro =
+          std::max(worst_gyro, (got.Vector(i, "gyro") - truth.Vector(i, "gyro")).cwiseAbs().maxCoeff());
       worst_accel =
           std::max(worst_accel, (got.Vector(i, "accel") - truth.Vector(i, "accel")).cwiseAbs().maxCoeff());
     }
@@ -392,11 +394,35 @@ TEST_F(CliTest, BadInvocationsExitTwo) {
 
 TEST_F(CliTest, SimulateIsDeterministic) {
   const auto simulate = [&](const std::string& name, const std::string& seed) {
-    const RunResult r = Run({"simulate", "--plan", Fixture("plan_6pos.yaml"), "--calibration",
-                             Fixture("mems_truth.yaml"), "-o", Path(name), "--ramp=-40,85", "--passes", "2",
-                             "--rate", "25", "--dwell", "1", "--transition", "0.5", "--gyro-noise-density",
-                             "8.7e-5", "--accel-noise-density", "1.5e-3", "--gyro-bias-instability", "2.4e-5",
-                             "--accel-random-walk", "3e-5", "--temp-noise", "0.05", "--quantize", "--seed", seed,
+    const RunResult r = Run({"simulate",
+                             "--plan",
+                             Fixture("plan_6pos.yaml"),
+                             "--calibration",
+                             Fixture("mems_truth.yaml"),
+                             "-o",
+                             Path(name),
+                             "--ramp=-40,85",
+                             "--passes",
+                             "2",
+                             "--rate",
+                             "25",
+                             "--dwell",
+                             "1",
+                             "--transition",
+                             "0.5",
+                             "--gyro-noise-density",
+                             "8.7e-5",
+                             "--accel-noise-density",
+                             "1.5e-3",
+                             "--gyro-bias-instability",
+                             "2.4e-5",
+                             "--accel-random-walk",
+                             "3e-5",
+                             "--temp-noise",
+                             "0.05",
+                             "--quantize",
+                             "--seed",
+                             seed,
                              "--quiet"});
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.out, "");  // --quiet
@@ -429,8 +455,10 @@ TEST_F(CliTest, SimulatedTruthFollowsTheSpec) {
       }
       seen.insert(segment);
       ASSERT_TRUE(expected.count(segment)) << segment;
-      EXPECT_LE((truth.Vector(i, "gyro") - expected.at(segment).first).norm(), 1e-14) << plan << " " << segment;
-      EXPECT_LE((truth.Vector(i, "accel") - expected.at(segment).second).norm(), 1e-13) << plan << " " << segment;
+      EXPECT_LE((truth.Vector(i, "gyro") - expected.at(segment).first).norm(), 1e-14)
+          << plan << " " << segment;
+      EXPECT_LE((truth.Vector(i, "accel") - expected.at(segment).second).norm(), 1e-13)
+          << plan << " " << segment;
     }
     EXPECT_EQ(seen.size(), expected.size()) << plan;
     EXPECT_GT(transitions, 0) << plan;
@@ -449,13 +477,14 @@ TEST_F(CliTest, ApplyRecoversTheTruthOfANoiselessSimulation) {
       const auto [samples, truth] =
           SimulateNoiseless(Fixture(plan), Fixture(calibration), "run", {"--ramp=-40,85", "--passes", "2"});
       const std::string corrected = Path("corrected.csv");
-      const RunResult r = Run({"apply", "--calibration", Fixture(calibration), "--samples", samples, "-o", corrected});
+      const RunResult r =
+          Run({"apply", "--calibration", Fixture(calibration), "--samples", samples, "-o", corrected});
       ASSERT_EQ(r.status, 0) << r.err;
       EXPECT_EQ(r.err, "") << "no warning expected inside the fit range";
       ExpectRecovered(corrected, truth);
       const Table table = ReadTable(corrected);
-      EXPECT_EQ(table.header, (std::vector<std::string>{"time_s", "temp_c", "segment", "gyro_x", "gyro_y", "gyro_z",
-                                                        "accel_x", "accel_y", "accel_z"}));
+      EXPECT_EQ(table.header, (std::vector<std::string>{"time_s", "temp_c", "segment", "gyro_x", "gyro_y",
+                                                        "gyro_z", "accel_x", "accel_y", "accel_z"}));
     }
   }
 }
@@ -463,8 +492,8 @@ TEST_F(CliTest, ApplyRecoversTheTruthOfANoiselessSimulation) {
 // The bundled golden pair: fixtures/mems_6pos_noiseless.csv.gz corrected with mems_truth.yaml is
 // fixtures/mems_6pos_noiseless_truth.csv.gz.
 TEST_F(CliTest, ApplyTurnsTheNoiselessFixtureIntoItsTruth) {
-  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Fixture("mems_6pos_noiseless.csv.gz"),
-                           "-o", Path("corrected.csv.gz"), "-q"});
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s",
+                           Fixture("mems_6pos_noiseless.csv.gz"), "-o", Path("corrected.csv.gz"), "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out, "");
   ExpectRecovered(Path("corrected.csv.gz"), Fixture("mems_6pos_noiseless_truth.csv.gz"));
@@ -483,8 +512,9 @@ TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
     std::uniform_real_distribution<double> temp(-40.0, 85.0);
     std::uniform_real_distribution<double> rate(-6.0, 6.0);     // rad/s
     std::uniform_real_distribution<double> force(-30.0, 30.0);  // m/s^2
-    std::string samples = "# hand-made raw samples\r\nnote,accel_z,gyro_y,segment,temp_c,accel_x,gyro_z,time_s,gyro_x,"
-                          "accel_y\r\n";
+    std::string samples =
+        "# hand-made raw samples\r\nnote,accel_z,gyro_y,segment,temp_c,accel_x,gyro_z,time_s,gyro_x,"
+        "accel_y\r\n";
     std::string truth = "time_s,temp_c,segment,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
     constexpr int kSamples = 2000;
     for (int i = 0; i < kSamples; ++i) {
@@ -502,17 +532,17 @@ TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
       ASSERT_LE((header_gyro - gyro_m).norm(), kForwardAgreementRelative * gyro_m.norm()) << i;
       ASSERT_LE((header_accel - accel_m).norm(), kForwardAgreementRelative * accel_m.norm()) << i;
       const auto f = FormatExactly;
-      samples += "\"row " + std::to_string(i) + ", hand-made\"," + f(accel_m.z()) + "," + f(gyro_m.y()) + "," +
-                 std::to_string(segment) + "," + f(temp_c) + "," + f(accel_m.x()) + "," + f(gyro_m.z()) + "," +
-                 f(t) + "," + f(gyro_m.x()) + "," + f(accel_m.y()) + "\r\n";
+      samples += "\"row " + std::to_string(i) + ", hand-made\"," + f(accel_m.z()) + "," + f(gyro_m.y()) +
+                 "," + std::to_string(segment) + "," + f(temp_c) + "," + f(accel_m.x()) + "," +
+                 f(gyro_m.z()) + "," + f(t) + "," + f(gyro_m.x()) + "," + f(accel_m.y()) + "\r\n";
       if (i == kSamples / 2) samples += "# a comment half way\r\n";
-      truth += f(t) + "," + f(temp_c) + "," + std::to_string(segment) + "," + f(omega.x()) + "," + f(omega.y()) +
-               "," + f(omega.z()) + "," + f(a.x()) + "," + f(a.y()) + "," + f(a.z()) + "\n";
+      truth += f(t) + "," + f(temp_c) + "," + std::to_string(segment) + "," + f(omega.x()) + "," +
+               f(omega.y()) + "," + f(omega.z()) + "," + f(a.x()) + "," + f(a.y()) + "," + f(a.z()) + "\n";
     }
     const std::string samples_path = Write("raw.csv", samples);
     const std::string truth_path = Write("truth.csv", truth);
-    const RunResult r =
-        Run({"apply", "--calibration", Fixture(calibration), "--samples", samples_path, "-o", Path("out.csv")});
+    const RunResult r = Run(
+        {"apply", "--calibration", Fixture(calibration), "--samples", samples_path, "-o", Path("out.csv")});
     ASSERT_EQ(r.status, 0) << r.err;
     // Compare numerically: ExpectRecovered compares time and temperature text, which differ in
     // spelling between %.17g and the shortest round-trip form.
@@ -550,9 +580,21 @@ TEST_F(CliTest, ApplyWithoutSegmentColumnWritesNone) {
 }
 
 TEST_F(CliTest, GzipInputsAndOutputsWork) {
-  const std::vector<std::string> simulate = {"simulate", "--plan", Fixture("plan_6pos.yaml"), "--calibration",
-                                             Fixture("mems_truth.yaml"), "--rate", "20", "--dwell", "2",
-                                             "--gyro-noise-density", "1e-4", "--seed", "5", "-q", "-o"};
+  const std::vector<std::string> simulate = {"simulate",
+                                             "--plan",
+                                             Fixture("plan_6pos.yaml"),
+                                             "--calibration",
+                                             Fixture("mems_truth.yaml"),
+                                             "--rate",
+                                             "20",
+                                             "--dwell",
+                                             "2",
+                                             "--gyro-noise-density",
+                                             "1e-4",
+                                             "--seed",
+                                             "5",
+                                             "-q",
+                                             "-o"};
   const auto with = [](std::vector<std::string> args, const std::string& last) {
     args.push_back(last);
     return args;
@@ -567,7 +609,8 @@ TEST_F(CliTest, GzipInputsAndOutputsWork) {
   EXPECT_EQ(ReadFile(Path("raw.csv.gz")), ReadBytes(Path("raw.csv")));
 
   const auto apply = [&](const std::string& in, const std::string& out) {
-    const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Path(in), "-o", Path(out), "-q"});
+    const RunResult r =
+        Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Path(in), "-o", Path(out), "-q"});
     EXPECT_EQ(r.status, 0) << r.err;
   };
   apply("raw.csv", "plain_plain.csv");
@@ -642,7 +685,8 @@ const char kGoodSamples[] =
 
 const BadInput kBadInputs[] = {
     // plan
-    {"plan_malformed_number", "plan", "gravity_mps2: 9.81", "gravity_mps2: 9.8.1", 4, "\"9.8.1\" is not a number"},
+    {"plan_malformed_number", "plan", "gravity_mps2: 9.81", "gravity_mps2: 9.8.1", 4,
+     "\"9.8.1\" is not a number"},
     {"plan_unknown_key", "plan", "gravity_mps2: 9.81", "gravity: 9.81", 4, "unknown key \"gravity\""},
     {"plan_unknown_segment_key", "plan", "    rate_dps: 100\n", "    rate_dps: 100\n    speed: 3\n", 13,
      "unknown key \"speed\""},
@@ -678,10 +722,11 @@ const BadInput kBadInputs[] = {
      "y: [931.52, -0.0895, -0.00017]", 23, "4 numbers"},
     {"calibration_wrong_unit", "calibration", "unit: rad/s", "unit: deg/s", 16, "deg/s"},
     {"calibration_zero_scale", "calibration", "z: [209.97,", "z: [0,", 51, "scale c0 is zero"},
-    {"calibration_missing_group", "calibration", "  misalignment:\n    xy: [-0.00214", "  misalign:\n    xy: [-0.00214",
-     43, "accel.misalignment: missing"},  // the line where the `accel` mapping starts
-    {"calibration_reversed_range", "calibration", "fit_temp_range_c: [-40, 85]", "fit_temp_range_c: [85, -40]", 14,
-     "range"},
+    {"calibration_missing_group", "calibration", "  misalignment:\n    xy: [-0.00214",
+     "  misalign:\n    xy: [-0.00214", 43,
+     "accel.misalignment: missing"},  // the line where the `accel` mapping starts
+    {"calibration_reversed_range", "calibration", "fit_temp_range_c: [-40, 85]",
+     "fit_temp_range_c: [85, -40]", 14, "range"},
 };
 
 void PrintTo(const BadInput& input, std::ostream* os) { *os << input.what; }
@@ -705,8 +750,8 @@ TEST_P(BadInputTest, ExitsTwoWithFileAndLineAndWritesNothing) {
   // A plan is read by simulate; samples and calibrations by apply (calibrations by both).
   std::vector<std::vector<std::string>> commands;
   if (kind != "samples") {
-    commands.push_back({"simulate", "--plan", plan, "--calibration", calibration, "-o", Path("out.csv"), "--dwell",
-                        "0.1"});
+    commands.push_back(
+        {"simulate", "--plan", plan, "--calibration", calibration, "-o", Path("out.csv"), "--dwell", "0.1"});
   }
   if (kind != "plan") commands.push_back({"apply", "-c", calibration, "-s", samples, "-o", Path("out.csv")});
   const std::set<std::string> before = Listing();
@@ -755,10 +800,10 @@ TEST_F(CliTest, MissingOrEmptyInputFilesExitTwoNamingTheFile) {
 // A failing run never damages an existing output and leaves no temporary file: the error comes
 // after more than two megabytes of output were written (so part of it reached the temporary file).
 TEST_F(CliTest, AFailingRunLeavesAnExistingOutputUntouched) {
-  const auto [samples, truth] = SimulateNoiseless(Fixture("plan_24pos.yaml"), Fixture("mems_truth.yaml"), "run",
-                                                  {"--rate", "100", "--dwell", "2", "--temps=-40,85"});
+  const auto [samples, truth] = SimulateNoiseless(Fixture("plan_24pos.yaml"), Fixture("mems_truth.yaml"),
+                                                  "run", {"--rate", "100", "--dwell", "2", "--temps=-40,85"});
   std::string text = ReadBytes(samples);
-  ASSERT_GT(text.size(), 2u << 20);  // the output is about as long: beyond the 1 MiB write buffer
+  ASSERT_GT(text.size(), 2u << 20);     // the output is about as long: beyond the 1 MiB write buffer
   text += "1e9,25,1,1,2,3,4,5,oops\n";  // the last row is bad
   const std::string bad_samples = Write("bad.csv", text);
   fs::remove(samples);
@@ -780,8 +825,8 @@ TEST_F(CliTest, AFailingRunLeavesAnExistingOutputUntouched) {
   const std::string truth_out = Write("sim_truth.csv", sentinel);
   const std::string bad_calibration = Write("bad.yaml", "format: imufit-calibration\nversion: 1\ngyro: 3\n");
   const std::set<std::string> before = Listing();
-  const RunResult r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", bad_calibration, "-o", out, "--truth",
-                           truth_out});
+  const RunResult r = Run(
+      {"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", bad_calibration, "-o", out, "--truth", truth_out});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(ReadBytes(out), sentinel);
   EXPECT_EQ(ReadBytes(truth_out), sentinel);
@@ -805,6 +850,8 @@ TEST_F(CliTest, AnOutputThatIsAlsoAnInputIsRefused) {
       {"simulate", "-p", plan, "-c", calibration, "-o", calibration},
       {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", plan},
       {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth", Path("new.csv")},
+      {"simulate", "-p", plan, "-c", calibration, "-o", Path("new.csv"), "--truth",
+       (work_ / "." / "new.csv").string()},
   };
   const std::set<std::string> before = Listing();
   for (const auto& args : cases) {

@@ -16,7 +16,7 @@ int main() {
     model.gyro[(imufit::kBiasCoefficient + axis) * imufit::kPolynomialTerms] = 20.0 + axis;
     model.gyro[(imufit::kBiasCoefficient + axis) * imufit::kPolynomialTerms + 1] = 0.1;
   }
-  model.gyro[imufit::kMisalignmentCoefficient * imufit::kPolynomialTerms] = 0.003;         // xy
+  model.gyro[imufit::kMisalignmentCoefficient * imufit::kPolynomialTerms] = 0.003;          // xy
   model.accel[(imufit::kMisalignmentCoefficient + 4) * imufit::kPolynomialTerms] = -0.002;  // zx
   model.gyro[imufit::kGSensitivityCoefficient * imufit::kPolynomialTerms] = 0.05;           // xx
 

@@ -1,0 +1,74 @@
+# Shared by scripts/example.sh and scripts/test.sh (sourced, not run): installs what is missing
+# on a Debian machine and configures and builds imufit. Idempotent: a second run installs nothing
+# and rebuilds only what changed.
+# shellcheck shell=bash
+
+IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+# Everything the build, the tests and the Allan plots need, as Debian packages.
+IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
+                     libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox)
+
+imufit_say() { printf '== %s\n' "$*"; }
+imufit_die() { printf 'error: %s\n' "$*" >&2; exit 1; }
+
+# Installs the packages of IMUFIT_APT_PACKAGES that are not installed yet (apt-get update first;
+# sudo only when not root).
+imufit_install_deps() {
+  if ! command -v dpkg-query >/dev/null 2>&1; then
+    imufit_say "not a Debian system: make sure these are installed: ${IMUFIT_APT_PACKAGES[*]}"
+    return 0
+  fi
+  local missing=() package
+  for package in "${IMUFIT_APT_PACKAGES[@]}"; do
+    if [[ $(dpkg-query -W -f='${db:Status-Status}' "$package" 2>/dev/null) != installed ]]; then
+      missing+=("$package")
+    fi
+  done
+  if [[ ${#missing[@]} -eq 0 ]]; then
+    return 0
+  fi
+  local sudo=()
+  if [[ $(id -u) != 0 ]]; then
+    command -v sudo >/dev/null 2>&1 || imufit_die "need root or sudo to install: ${missing[*]}"
+    sudo=(sudo)
+  fi
+  imufit_say "installing ${missing[*]}"
+  local log
+  log=$(mktemp "${TMPDIR:-/tmp}/imufit_apt.XXXXXX")
+  if ! { "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q &&
+         "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
+           "${missing[@]}"; } >"$log" 2>&1 </dev/null; then
+    cat "$log" >&2
+    rm -f "$log"
+    imufit_die "apt-get could not install ${missing[*]}"
+  fi
+  rm -f "$log"
+}
+
+# imufit_build DIR [TARGET...] [-- CMAKE_ARGS...]: configures DIR (Ninja, Release unless the
+# arguments say otherwise) and builds the targets (all when none). Quiet unless something fails.
+imufit_build() {
+  local dir=$1
+  shift
+  local targets=() cmake_args=()
+  while [[ $# -gt 0 && $1 != -- ]]; do targets+=("$1"); shift; done
+  [[ $# -gt 0 ]] && shift
+  cmake_args=("$@")
+  if command -v ccache >/dev/null 2>&1; then
+    cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  fi
+  mkdir -p "$dir"
+  if ! cmake -S "$IMUFIT_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${cmake_args[@]}" \
+       >"$dir/configure.log" 2>&1; then
+    cat "$dir/configure.log" >&2
+    imufit_die "cmake could not configure $dir"
+  fi
+  # --quiet (ninja 1.11+) drops the progress lines; compiler messages still show. With pipefail
+  # the pipeline fails when ninja does.
+  local quiet=()
+  if grep -q -- '--quiet' <<<"$(ninja --help 2>&1)"; then quiet=(--quiet); fi
+  if ! ninja -C "$dir" "${quiet[@]}" "${targets[@]}" | { grep -v '^ninja: no work to do\.$' || true; }; then
+    imufit_die "the build in $dir failed"
+  fi
+}

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The whole test suite, from a fresh Debian machine: installs what is missing, then builds and runs
+# every test with ctest twice: in a Release build (build-release/) and in a build with
+# AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/, -DIMUFIT_SANITIZE=ON).
+# Exits non-zero on the first failure. This is what CI runs (.ci/run).
+#
+#   bash scripts/test.sh
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+
+jobs=$(nproc 2>/dev/null || echo 2)
+# A sanitizer finding is an error: stop at the first one, with a stack.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+
+run_suite() {  # run_suite NAME DIR
+  imufit_say "$1: running the tests"
+  (cd "$2" && ctest --output-on-failure --timeout 900 -j "$jobs")
+}
+
+imufit_install_deps
+
+imufit_say "Release build (build-release/)"
+imufit_build "$IMUFIT_ROOT/build-release"
+run_suite Release "$IMUFIT_ROOT/build-release"
+
+imufit_say "AddressSanitizer + UndefinedBehaviorSanitizer build (build-sanitize/)"
+imufit_build "$IMUFIT_ROOT/build-sanitize" -- -DIMUFIT_SANITIZE=ON -DIMUFIT_BUILD_BENCH=OFF
+run_suite "ASan+UBSan" "$IMUFIT_ROOT/build-sanitize"
