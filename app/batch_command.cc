@@ -25,15 +25,16 @@ void ShowProgress(const BatchProgress& p, bool terminal) {
   const double rate = p.elapsed_s > 0.0 && fitted > 0 ? fitted / p.elapsed_s : 0.0;
   const double left_s = rate > 0.0 ? (p.total - p.done) / rate : 0.0;
   const UnitOutcome& u = *p.last;
-  const std::string outcome = u.skipped ? "unchanged, skipped" : u.status + (u.verdict.empty() ? "" : " " + u.verdict);
+  const std::string outcome =
+      u.skipped ? "unchanged, skipped" : u.status + (u.verdict.empty() ? "" : " " + u.verdict);
   if (terminal) {
     std::fprintf(stderr, "\r\033[K[%d/%d] %.2f units/s, %.0f s left; %s: %s", p.done, p.total, rate, left_s,
                  u.unit.c_str(), outcome.c_str());
     if (p.done == p.total) std::fprintf(stderr, "\n");
   } else {
-    std::fprintf(stderr, "imufit batch: [%d/%d] %s: %s%s%s (%.1f s; %.2f units/s, %.0f s left)\n", p.done, p.total,
-                 u.unit.c_str(), outcome.c_str(), u.message.empty() ? "" : ": ", u.message.c_str(), u.seconds, rate,
-                 left_s);
+    std::fprintf(stderr, "imufit batch: [%d/%d] %s: %s%s%s (%.1f s; %.2f units/s, %.0f s left)\n", p.done,
+                 p.total, u.unit.c_str(), outcome.c_str(), u.message.empty() ? "" : ": ", u.message.c_str(),
+                 u.seconds, rate, left_s);
   }
   std::fflush(stderr);
 }
@@ -47,17 +48,21 @@ int RunBatchCommand(BatchArguments args) {
   options.write_reports = !args.no_report;
   const BatchResult result = RunBatch(options);
   if (!args.quiet) {
-    std::printf("imufit batch: %zu units: %d passed, %d failed limits, %d not fitted, %d errors; %d unchanged and skipped\n",
-                result.units.size(), result.passed, result.failed, result.not_fitted, result.errors, result.skipped);
+    std::printf(
+        "imufit batch: %zu units: %d passed, %d failed limits, %d not fitted, %d errors; %d unchanged and "
+        "skipped\n",
+        result.units.size(), result.passed, result.failed, result.not_fitted, result.errors, result.skipped);
     for (const UnitOutcome& u : result.units) {
       if (u.verdict == "PASS" || (u.verdict.empty() && u.status == "fitted")) continue;
-      std::printf("  %s (%s): %s%s%s\n", u.unit.c_str(), u.serial.c_str(), u.verdict.empty() ? u.status.c_str() : u.verdict.c_str(),
-                  u.message.empty() ? "" : ": ", u.message.c_str());
+      std::printf("  %s (%s): %s%s%s\n", u.unit.c_str(), u.serial.c_str(),
+                  u.verdict.empty() ? u.status.c_str() : u.verdict.c_str(), u.message.empty() ? "" : ": ",
+                  u.message.c_str());
     }
     if (result.complete) std::printf("  wrote %s/lot_summary.csv\n", options.output_dir.c_str());
   }
   if (!result.complete) {
-    std::fprintf(stderr, "imufit batch: stopped after --max-units %d; run again to finish the lot\n", options.max_units);
+    std::fprintf(stderr, "imufit batch: stopped after --max-units %d; run again to finish the lot\n",
+                 options.max_units);
     return 1;
   }
   return result.failed + result.not_fitted + result.errors > 0 ? kExitFailedLimits : 0;
@@ -70,9 +75,11 @@ CommandRunner AddBatchCommand(CLI::App* root) {
   BatchOptions& b = args->batch;
   CLI::App* command = root->add_subcommand(
       "batch",
-      "Fit every unit of a lot: each folder of UNITS_DIR is a unit (plan.yaml and samples.csv[.gz], or samples "
+      "Fit every unit of a lot: each folder of UNITS_DIR is a unit (plan.yaml and samples.csv[.gz], or "
+      "samples "
       "only with --plan). Writes OUT_DIR/<unit>/calibration.yaml, report.html and manifest.yaml, and "
-      "OUT_DIR/lot_summary.csv; a re-run skips units whose inputs and software are unchanged. Exit 0 every unit "
+      "OUT_DIR/lot_summary.csv; a re-run skips units whose inputs and software are unchanged. Exit 0 every "
+      "unit "
       "passed, 3 some unit failed its limits or could not be fitted, 1 stopped early, 2 bad invocation.");
   command->add_option("units_dir", b.units_dir, "folder of unit folders")->required();
   command->add_option("--output,-o", b.output_dir, "output folder")->required();
@@ -81,8 +88,9 @@ CommandRunner AddBatchCommand(CLI::App* root) {
   command->add_option("--store", b.store_path, "results store (SQLite) to record every fit in");
   command->add_option("--lot", b.lot, "the lot's name in the store (default: the units folder's name)");
   command->add_option("--jobs,-j", b.jobs, "units fitted in parallel (0: all cores)")->capture_default_str();
-  command->add_option("--max-units", b.max_units,
-                      "stop after fitting this many units (0: all); a later run resumes the lot")
+  command
+      ->add_option("--max-units", b.max_units,
+                   "stop after fitting this many units (0: all); a later run resumes the lot")
       ->capture_default_str();
   command->add_flag("--no-report", args->no_report, "write no report.html per unit");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");

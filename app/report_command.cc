@@ -23,16 +23,19 @@ struct ReportArguments {
 
 int RunReport(const ReportArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.plan, args.samples, args.limits});
-  if (const std::string problem = args.windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
+  if (const std::string problem = args.windows.Validate(); !problem.empty())
+    throw InputError("imufit report", problem);
   const Calibration calibration = ReadCalibration(args.calibration);
   std::optional<Verdict> verdict;
   if (!args.limits.empty()) verdict = EvaluateLimits(ReadLimits(args.limits), calibration);
   const Plan plan = ReadPlan(args.plan);
   RunWindows run = ReadRunWindows(plan, args.samples, args.windows);
-  const UnitReport report = MakeUnitReport(
-      calibration, plan, std::move(run),
-      {{"calibration", args.calibration, ""}, {"plan", args.plan, ""}, {"samples", args.samples, ""}, {"limits", args.limits, ""}},
-      verdict);
+  const UnitReport report = MakeUnitReport(calibration, plan, std::move(run),
+                                           {{"calibration", args.calibration, ""},
+                                            {"plan", args.plan, ""},
+                                            {"samples", args.samples, ""},
+                                            {"limits", args.limits, ""}},
+                                           verdict);
   WriteUnitReport(args.output, report);
   std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
               verdict ? (verdict->pass ? " (acceptance PASS)" : " (acceptance FAIL)") : "");
@@ -45,7 +48,8 @@ CommandRunner AddReportCommand(CLI::App* root) {
   auto args = std::make_shared<ReportArguments>();
   CLI::App* command = root->add_subcommand(
       "report",
-      "Write a unit's calibration certificate (one self-contained HTML file) from its calibration and the run it "
+      "Write a unit's calibration certificate (one self-contained HTML file) from its calibration and the "
+      "run it "
       "was fitted to; with --limits, the acceptance verdict too (exit 3 when it fails).");
   command->add_option("--calibration,-c", args->calibration, "calibration YAML")->required();
   command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();

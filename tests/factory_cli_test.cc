@@ -75,9 +75,12 @@ std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& text)
     std::string cell;
     bool quoted = false;
     for (char c : l) {
-      if (c == '"') quoted = !quoted;
-      else if (c == ',' && !quoted) cells.push_back(std::move(cell)), cell.clear();
-      else cell += c;
+      if (c == '"')
+        quoted = !quoted;
+      else if (c == ',' && !quoted)
+        cells.push_back(std::move(cell)), cell.clear();
+      else
+        cell += c;
     }
     cells.push_back(cell);
     return cells;
@@ -98,7 +101,8 @@ std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& text)
 
 // The value of data-value on the element with data-figure="name" in a report.
 std::string ReportFigure(const std::string& html, const std::string& name) {
-  const std::regex pattern("data-figure=\"" + std::regex_replace(name, std::regex("\\."), "\\.") + "\" data-value=\"([^\"]+)\"");
+  const std::regex pattern("data-figure=\"" + std::regex_replace(name, std::regex("\\."), "\\.") +
+                           "\" data-value=\"([^\"]+)\"");
   std::smatch match;
   return std::regex_search(html, match, pattern) ? match[1].str() : "<none>";
 }
@@ -153,15 +157,33 @@ class FactoryCliTest : public ::testing::Test {
 
   // Simulates a unit's run with a fixed seed and a little white noise.
   void Simulate(const std::string& plan, const std::string& truth, const std::string& samples, int seed) {
-    const RunResult r = Run({"simulate", "--plan", plan, "--calibration", truth, "-o", samples, "--rate", "10", "--dwell",
-                             "3", "--temps", "-20,5,30,60", "--gyro-noise-density", "2e-4", "--accel-noise-density",
-                             "2e-3", "--seed", std::to_string(seed), "-q"});
+    const RunResult r = Run({"simulate",
+                             "--plan",
+                             plan,
+                             "--calibration",
+                             truth,
+                             "-o",
+                             samples,
+                             "--rate",
+                             "10",
+                             "--dwell",
+                             "3",
+                             "--temps",
+                             "-20,5,30,60",
+                             "--gyro-noise-density",
+                             "2e-4",
+                             "--accel-noise-density",
+                             "2e-3",
+                             "--seed",
+                             std::to_string(seed),
+                             "-q"});
     ASSERT_EQ(r.status, 0) << r.err;
   }
 
   std::string UnitPlan(const std::string& unit, const std::string& serial) {
     std::string plan = ReadBytes(kFixtures + "/plan_6pos.yaml");
-    plan = std::regex_replace(plan, std::regex("format: imufit-plan\n"), "format: imufit-plan\nserial: " + serial + "\n");
+    plan = std::regex_replace(plan, std::regex("format: imufit-plan\n"),
+                              "format: imufit-plan\nserial: " + serial + "\n");
     return Write("units/" + unit + "/plan.yaml", plan);
   }
 
@@ -172,7 +194,8 @@ class FactoryCliTest : public ::testing::Test {
     bad_truth = std::regex_replace(bad_truth, std::regex("xx: \\[0\\.0483,"), "xx: [0.15,");
     ASSERT_NE(bad_truth, ReadBytes(truth));
     const std::string bad_truth_path = Write("bad_truth.yaml", bad_truth);
-    for (const char* unit : {"unit-01", "unit-02", "unit-03", "unit-04", "unit-05"}) fs::create_directories(dir_ / "units" / unit);
+    for (const char* unit : {"unit-01", "unit-02", "unit-03", "unit-04", "unit-05"})
+      fs::create_directories(dir_ / "units" / unit);
     Simulate(UnitPlan("unit-01", "SN-01"), truth, Path("units/unit-01/samples.csv.gz"), 1);
     Simulate(UnitPlan("unit-02", "SN-02"), truth, Path("units/unit-02/samples.csv.gz"), 2);
     Simulate(kFixtures + "/plan_6pos.yaml", truth, Path("units/unit-03/samples.csv.gz"), 3);
@@ -186,8 +209,9 @@ class FactoryCliTest : public ::testing::Test {
   }
 
   std::vector<std::string> BatchArgs(const std::string& out) const {
-    return {"batch", Path("units"), "--limits", Path("limits.yaml"), "-o", Path(out), "--plan",
-            kFixtures + "/plan_6pos.yaml", "--store", Path("store.db"), "--lot", "LOT-A"};
+    return {"batch",   Path("units"),    "--limits", Path("limits.yaml"),
+            "-o",      Path(out),        "--plan",   kFixtures + "/plan_6pos.yaml",
+            "--store", Path("store.db"), "--lot",    "LOT-A"};
   }
 
   std::map<std::string, std::map<std::string, std::string>> Summary(const std::string& out) const {
@@ -204,7 +228,9 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   args.insert(args.end(), {"--jobs", "2"});
   RunResult r = Run(args);
   ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;  // one unit failed, one could not be read
-  EXPECT_NE(r.out.find("5 units: 3 passed, 1 failed limits, 0 not fitted, 1 errors; 0 unchanged"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("5 units: 3 passed, 1 failed limits, 0 not fitted, 1 errors; 0 unchanged"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.err.find("[5/5]"), std::string::npos) << r.err;  // progress, plain lines when not a terminal
 
   auto summary = Summary("out");
@@ -225,22 +251,28 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   // The lot page: yield, and the g-sensitivity of unit-04 flagged as an outlier of the lot.
   const std::string lot = ReadBytes(dir_ / "out" / "lot.html");
   EXPECT_NE(lot.find("data-key=\"yield\">60.0<"), std::string::npos);
-  EXPECT_NE(lot.find("data-outlier=\"unit-04\" data-figure=\"gyro_g_sensitivity_dpsg.xx\""), std::string::npos);
+  EXPECT_NE(lot.find("data-outlier=\"unit-04\" data-figure=\"gyro_g_sensitivity_dpsg.xx\""),
+            std::string::npos);
   for (const char* unit : {"unit-01", "unit-02", "unit-03"}) {
-    EXPECT_EQ(lot.find("data-outlier=\"" + std::string(unit) + "\" data-figure=\"gyro_g_sensitivity_dpsg.xx\""),
-              std::string::npos);
+    EXPECT_EQ(
+        lot.find("data-outlier=\"" + std::string(unit) + "\" data-figure=\"gyro_g_sensitivity_dpsg.xx\""),
+        std::string::npos);
   }
 
   // The certificate: key values read back out of the HTML agree with the lot summary and inputs.
   const std::string report = ReadBytes(dir_ / "out" / "unit-04" / "report.html");
-  EXPECT_EQ(ReportFigure(report, "gyro_g_sensitivity_dpsg.xx"), summary["unit-04"]["gyro_g_sensitivity_dpsg.xx"]);
+  EXPECT_EQ(ReportFigure(report, "gyro_g_sensitivity_dpsg.xx"),
+            summary["unit-04"]["gyro_g_sensitivity_dpsg.xx"]);
   EXPECT_EQ(ReportFigure(report, "gyro_bias_dps.x"), summary["unit-04"]["gyro_bias_dps.x"]);
   EXPECT_NE(report.find("data-key=\"serial\">SN-04<"), std::string::npos);
   EXPECT_NE(report.find("data-key=\"verdict\">FAIL<"), std::string::npos);
-  EXPECT_NE(report.find("data-criterion=\"|gyro_g_sensitivity_dpsg.xx|\" data-pass=\"0\""), std::string::npos);
-  EXPECT_NE(report.find("data-sha256=\"samples\">" + Sha256OfFile(Path("units/unit-04/samples.csv.gz")) + "<"),
+  EXPECT_NE(report.find("data-criterion=\"|gyro_g_sensitivity_dpsg.xx|\" data-pass=\"0\""),
             std::string::npos);
-  EXPECT_NE(report.find("data-sha256=\"limits\">" + Sha256OfFile(Path("limits.yaml")) + "<"), std::string::npos);
+  EXPECT_NE(
+      report.find("data-sha256=\"samples\">" + Sha256OfFile(Path("units/unit-04/samples.csv.gz")) + "<"),
+      std::string::npos);
+  EXPECT_NE(report.find("data-sha256=\"limits\">" + Sha256OfFile(Path("limits.yaml")) + "<"),
+            std::string::npos);
   EXPECT_NE(report.find("<svg"), std::string::npos);
   EXPECT_EQ(report.find("http://"), report.find("http://www.w3.org"));  // no link out but SVG namespaces
 
@@ -273,7 +305,8 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
 
   // A unit's samples change: that unit alone is fitted again.
-  Simulate(Path("units/unit-02/plan.yaml"), kFixtures + "/mems_truth.yaml", Path("units/unit-02/samples.csv.gz"), 22);
+  Simulate(Path("units/unit-02/plan.yaml"), kFixtures + "/mems_truth.yaml",
+           Path("units/unit-02/samples.csv.gz"), 22);
   r = Run(BatchArgs("out"));
   EXPECT_NE(r.out.find("4 unchanged and skipped"), std::string::npos) << r.out;
   EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-02", "--csv"}).out).size(), 2u);
@@ -289,7 +322,8 @@ TEST_F(FactoryCliTest, InterruptedBatchResumesWithoutLoss) {
   EXPECT_EQ(r.status, kExitNotDone) << r.out << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out" / "lot_summary.csv"));
   int manifests = 0;
-  for (const auto& unit : fs::directory_iterator(dir_ / "out")) manifests += fs::exists(unit.path() / "manifest.yaml");
+  for (const auto& unit : fs::directory_iterator(dir_ / "out"))
+    manifests += fs::exists(unit.path() / "manifest.yaml");
   EXPECT_EQ(manifests, 1);
   // A kill between the store and the manifest: the unit is redone, never lost.
   r = Run(BatchArgs("out"));
@@ -310,8 +344,9 @@ TEST_F(FactoryCliTest, InterruptedBatchResumesWithoutLoss) {
 
 TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
   const std::string plan = Path("units/unit-01/plan.yaml");
-  RunResult r = Run({"fit", "-p", plan, "-s", Path("units/unit-01/samples.csv.gz"), "-o", Path("cal1.yaml"), "--limits",
-                     Path("limits.yaml"), "--report", Path("unit1.html"), "--store", Path("fit.db")});
+  RunResult r =
+      Run({"fit", "-p", plan, "-s", Path("units/unit-01/samples.csv.gz"), "-o", Path("cal1.yaml"), "--limits",
+           Path("limits.yaml"), "--report", Path("unit1.html"), "--store", Path("fit.db")});
   EXPECT_EQ(r.status, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("acceptance MEMS-A acceptance: PASS"), std::string::npos) << r.out;
   EXPECT_NE(ReadBytes(Path("unit1.html")).find("data-key=\"verdict\">PASS<"), std::string::npos);
@@ -330,13 +365,17 @@ TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
   EXPECT_EQ(r.status, kExitFailedLimits) << r.err;
   const std::string report = ReadBytes(Path("unit4.html"));
   EXPECT_NE(report.find("data-key=\"verdict\">FAIL<"), std::string::npos);
-  EXPECT_NE(report.find("data-sha256=\"calibration\">" + Sha256OfFile(Path("cal4.yaml")) + "<"), std::string::npos);
+  EXPECT_NE(report.find("data-sha256=\"calibration\">" + Sha256OfFile(Path("cal4.yaml")) + "<"),
+            std::string::npos);
 
   // A bad limits file: exit 2 with its location, before any work, nothing written.
-  const std::string bad = Write("bad_limits.yaml", std::string(kLimits) + "  - {quantity: gyro_bias_dps, max_abs: 0}\n");
-  r = Run({"fit", "-p", plan, "-s", Path("units/unit-01/samples.csv.gz"), "-o", Path("cal_bad.yaml"), "--limits", bad});
+  const std::string bad =
+      Write("bad_limits.yaml", std::string(kLimits) + "  - {quantity: gyro_bias_dps, max_abs: 0}\n");
+  r = Run({"fit", "-p", plan, "-s", Path("units/unit-01/samples.csv.gz"), "-o", Path("cal_bad.yaml"),
+           "--limits", bad});
   EXPECT_EQ(r.status, kExitBadInput);
-  EXPECT_NE(r.err.find("bad_limits.yaml:12:40: criteria[6].max_abs: \"0\" must be greater than 0"), std::string::npos)
+  EXPECT_NE(r.err.find("bad_limits.yaml:12:40: criteria[6].max_abs: \"0\" must be greater than 0"),
+            std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(Path("cal_bad.yaml")));
   r = Run(std::vector<std::string>{"batch", Path("units"), "--limits", bad, "-o", Path("out_bad")});

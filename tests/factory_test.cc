@@ -54,7 +54,8 @@ TEST(Sha256, FipsVectors) {
   EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   EXPECT_EQ(Sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
             "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
-  EXPECT_EQ(Sha256Hex(std::string(1000000, 'a')), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  EXPECT_EQ(Sha256Hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
   EXPECT_EQ(Sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
 }
 
@@ -105,15 +106,21 @@ struct BadLimits {
 TEST_F(FactoryTest, BadLimitsAreLocatedInputErrors) {
   const std::string head = "format: imufit-limits\nversion: 1\ncriteria:\n";
   const std::vector<BadLimits> cases = {
-      {head + "  - {quantity: gyro_bias_dps, max_abs: 1, colour: red}\n", ":4:43: criteria[0]: unknown key \"colour\""},
-      {head + "  - {quantity: gyro_bias_dpx, max_abs: 1}\n", ":4:16: criteria[0].quantity: unknown quantity \"gyro_bias_dpx\""},
-      {head + "  - {quantity: gyro_bias_dps, max_abs: -1}\n", ":4:40: criteria[0].max_abs: \"-1\" must be greater than 0"},
-      {head + "  - {quantity: gyro_bias_dps, max_abs: abc}\n", "criteria[0].max_abs: \"abc\" is not a number"},
-      {head + "  - {quantity: gyro_bias_dps, axes: [x, q], max_abs: 1}\n", "criteria[0].axes[1]: unknown axis \"q\""},
+      {head + "  - {quantity: gyro_bias_dps, max_abs: 1, colour: red}\n",
+       ":4:43: criteria[0]: unknown key \"colour\""},
+      {head + "  - {quantity: gyro_bias_dpx, max_abs: 1}\n",
+       ":4:16: criteria[0].quantity: unknown quantity \"gyro_bias_dpx\""},
+      {head + "  - {quantity: gyro_bias_dps, max_abs: -1}\n",
+       ":4:40: criteria[0].max_abs: \"-1\" must be greater than 0"},
+      {head + "  - {quantity: gyro_bias_dps, max_abs: abc}\n",
+       "criteria[0].max_abs: \"abc\" is not a number"},
+      {head + "  - {quantity: gyro_bias_dps, axes: [x, q], max_abs: 1}\n",
+       "criteria[0].axes[1]: unknown axis \"q\""},
       {head + "  - {quantity: gyro_scale_error_ppm, max_abs: 1}\n", "needs nominal.gyro_scale"},
       {head + "  - {quantity: fit_temp_range_c, covers: [60, -20]}\n", "expected [lo, hi] with lo < hi"},
       {head + "  - {quantity: gyro_residual_rms_dps, statistic: sigma, max_abs: 1}\n", "has no 1-sigma"},
-      {"format: imufit-plan\nversion: 1\ncriteria: []\n", ":1:9: format: \"imufit-plan\" is not \"imufit-limits\""},
+      {"format: imufit-plan\nversion: 1\ncriteria: []\n",
+       ":1:9: format: \"imufit-plan\" is not \"imufit-limits\""},
       {"format: imufit-limits\nversion: 2\ncriteria: []\n", ":2:10: version: version 2 is not supported"},
       {"format: imufit-limits\nversion: 1\ncriteria: []\n", "no criteria"},
       {"format: imufit-limits\nversion: 1\ncriteria: [\n", "YAML syntax"},
@@ -125,7 +132,8 @@ TEST_F(FactoryTest, BadLimitsAreLocatedInputErrors) {
       ADD_FAILURE() << "accepted:\n" << c.text;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what() << "\nexpected: " << c.message;
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos)
+          << e.what() << "\nexpected: " << c.message;
     }
   }
 }
@@ -222,9 +230,12 @@ TEST_F(FactoryTest, StoreRefusesANewerSchemaAndForeignFiles) {
     ResultsStore store(path);
     ADD_FAILURE() << "opened a version 99 store";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("schema version 99 is not supported"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("schema version 99 is not supported"), std::string::npos)
+        << e.what();
   }
-  EXPECT_THROW(ResultsStore(Write("text.db", "this is not a database, just some text long enough to matter\n")), InputError);
+  EXPECT_THROW(
+      ResultsStore(Write("text.db", "this is not a database, just some text long enough to matter\n")),
+      InputError);
 }
 
 }  // namespace

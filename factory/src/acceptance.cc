@@ -38,34 +38,44 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
   const double* gyro_sigma = calibration.sigma ? calibration.sigma->gyro.data() : nullptr;
   const double* accel_sigma = calibration.sigma ? calibration.sigma->accel.data() : nullptr;
   std::vector<Figure> figures;
-  const auto add = [&](std::string quantity, std::string sensor, int coefficient, const char* unit, double factor,
-                       const double* params, const double* sigma) {
+  const auto add = [&](std::string quantity, std::string sensor, int coefficient, const char* unit,
+                       double factor, const double* params, const double* sigma) {
     const CoefficientName& n = kCoefficientNames[coefficient];
     figures.push_back({quantity + "." + n.axis, sensor + "." + n.group + "." + n.axis, unit,
-                       Term0(params, coefficient) * factor, sigma ? Term0(sigma, coefficient) * std::abs(factor) : -1.0});
+                       Term0(params, coefficient) * factor,
+                       sigma ? Term0(sigma, coefficient) * std::abs(factor) : -1.0});
   };
   for (int i = 0; i < 3; ++i) {
-    add("gyro_bias_dps", "gyro", kBiasCoefficient + i, "deg/s", kRadToDeg / Term0(gyro, kScaleCoefficient + i), gyro,
-        gyro_sigma);
+    add("gyro_bias_dps", "gyro", kBiasCoefficient + i, "deg/s",
+        kRadToDeg / Term0(gyro, kScaleCoefficient + i), gyro, gyro_sigma);
   }
   for (int i = 0; i < 3; ++i) {
     add("accel_bias_mg", "accel", kBiasCoefficient + i, "mg",
         1e3 / (Term0(accel, kScaleCoefficient + i) * kStandardGravityMps2), accel, accel_sigma);
   }
-  for (int i = 0; i < 3; ++i) add("gyro_scale_per_dps", "gyro", kScaleCoefficient + i, "raw/(deg/s)", 1.0 / kRadToDeg, gyro, gyro_sigma);
-  for (int i = 0; i < 3; ++i) add("accel_scale_per_g", "accel", kScaleCoefficient + i, "raw/g", kStandardGravityMps2, accel, accel_sigma);
-  for (int m = 0; m < 6; ++m) add("gyro_misalignment_mrad", "gyro", kMisalignmentCoefficient + m, "mrad", 1e3, gyro, gyro_sigma);
-  for (int m = 0; m < 6; ++m) add("accel_misalignment_mrad", "accel", kMisalignmentCoefficient + m, "mrad", 1e3, accel, accel_sigma);
+  for (int i = 0; i < 3; ++i)
+    add("gyro_scale_per_dps", "gyro", kScaleCoefficient + i, "raw/(deg/s)", 1.0 / kRadToDeg, gyro,
+        gyro_sigma);
+  for (int i = 0; i < 3; ++i)
+    add("accel_scale_per_g", "accel", kScaleCoefficient + i, "raw/g", kStandardGravityMps2, accel,
+        accel_sigma);
+  for (int m = 0; m < 6; ++m)
+    add("gyro_misalignment_mrad", "gyro", kMisalignmentCoefficient + m, "mrad", 1e3, gyro, gyro_sigma);
+  for (int m = 0; m < 6; ++m)
+    add("accel_misalignment_mrad", "accel", kMisalignmentCoefficient + m, "mrad", 1e3, accel, accel_sigma);
   for (int h = 0; h < 9; ++h) {
     add("gyro_g_sensitivity_dpsg", "gyro", kGSensitivityCoefficient + h, "deg/s/g",
         kRadToDeg * kStandardGravityMps2 / Term0(gyro, kScaleCoefficient + h / 3), gyro, gyro_sigma);
   }
   bool found = false;
   const double gyro_rms = FitNumber(calibration, "gyro_residual_rms_radps", &found);
-  if (found) figures.push_back({"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", gyro_rms * kRadToDeg, -1.0});
+  if (found)
+    figures.push_back(
+        {"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", gyro_rms * kRadToDeg, -1.0});
   const double accel_rms = FitNumber(calibration, "accel_residual_rms_mps2", &found);
   if (found) {
-    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg", accel_rms / kStandardGravityMps2 * 1e3, -1.0});
+    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg",
+                       accel_rms / kStandardGravityMps2 * 1e3, -1.0});
   }
   return figures;
 }
@@ -95,14 +105,17 @@ std::string Verdict::FailedSummary() const {
 std::string Verdict::Table() const {
   std::string text;
   char line[256];
-  std::snprintf(line, sizeof line, "  acceptance%s%s: %s (%d of %zu criteria failed)\n", limits_name.empty() ? "" : " ",
-                limits_name.c_str(), pass ? "PASS" : "FAIL", Failed(), criteria.size());
+  std::snprintf(line, sizeof line, "  acceptance%s%s: %s (%d of %zu criteria failed)\n",
+                limits_name.empty() ? "" : " ", limits_name.c_str(), pass ? "PASS" : "FAIL", Failed(),
+                criteria.size());
   text += line;
-  std::snprintf(line, sizeof line, "    %-36s %14s %16s %14s  %s\n", "criterion", "measured", "limit", "margin", "verdict");
+  std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", "criterion", "measured", "limit",
+                "margin", "verdict");
   text += line;
   for (const CriterionResult& c : criteria) {
-    std::snprintf(line, sizeof line, "    %-36s %14s %16s %14s  %s\n", c.name.c_str(), c.measured_text.c_str(),
-                  c.limit_text.c_str(), (Number(c.margin) + " " + c.unit).c_str(), c.pass ? "PASS" : "FAIL");
+    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", c.name.c_str(),
+                  c.measured_text.c_str(), c.limit_text.c_str(), (Number(c.margin) + " " + c.unit).c_str(),
+                  c.pass ? "PASS" : "FAIL");
     text += line;
   }
   return text;
@@ -144,7 +157,8 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration) {
         const bool gyro = name.rfind("gyro", 0) == 0;
         const std::string axis = name.substr(name.rfind('.') + 1);
         const Figure* scale = FindFigure(figures, std::string(gyro ? "gyro" : "accel") + ".scale." + axis);
-        const double nominal = gyro ? limits.nominal_gyro_scale / kRadToDeg : limits.nominal_accel_scale * kStandardGravityMps2;
+        const double nominal =
+            gyro ? limits.nominal_gyro_scale / kRadToDeg : limits.nominal_accel_scale * kStandardGravityMps2;
         const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
         r.measured = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
         found = !sigma || scale->sigma >= 0.0;

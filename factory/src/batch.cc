@@ -18,11 +18,20 @@
 
 namespace imufit {
 
-const std::vector<std::string> kSummaryFigures = {
-    "gyro_bias_dps.x",         "gyro_bias_dps.y",          "gyro_bias_dps.z",          "accel_bias_mg.x",
-    "accel_bias_mg.y",         "accel_bias_mg.z",          "gyro_scale_per_dps.x",     "gyro_scale_per_dps.y",
-    "gyro_scale_per_dps.z",    "gyro_g_sensitivity_dpsg.xx", "gyro_g_sensitivity_dpsg.yy",
-    "gyro_g_sensitivity_dpsg.zz", "gyro_residual_rms_dps", "accel_residual_rms_mg"};
+const std::vector<std::string> kSummaryFigures = {"gyro_bias_dps.x",
+                                                  "gyro_bias_dps.y",
+                                                  "gyro_bias_dps.z",
+                                                  "accel_bias_mg.x",
+                                                  "accel_bias_mg.y",
+                                                  "accel_bias_mg.z",
+                                                  "gyro_scale_per_dps.x",
+                                                  "gyro_scale_per_dps.y",
+                                                  "gyro_scale_per_dps.z",
+                                                  "gyro_g_sensitivity_dpsg.xx",
+                                                  "gyro_g_sensitivity_dpsg.yy",
+                                                  "gyro_g_sensitivity_dpsg.zz",
+                                                  "gyro_residual_rms_dps",
+                                                  "accel_residual_rms_mg"};
 
 namespace {
 
@@ -40,7 +49,8 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
   if (!fs::exists(path)) return std::nullopt;
   try {
     const YAML::Node node = YAML::LoadFile(path);
-    if (node["format"].as<std::string>() != kManifestFormat || node["version"].as<int>() != 1) return std::nullopt;
+    if (node["format"].as<std::string>() != kManifestFormat || node["version"].as<int>() != 1)
+      return std::nullopt;
     Manifest m;
     std::string* fields[] = {&m.software, &m.plan_sha256, &m.samples_sha256, &m.limits_sha256,
                              &m.serial,   &m.status,      &m.verdict,        &m.message};
@@ -57,14 +67,20 @@ void WriteManifest(const std::string& path, const Manifest& m) {
   YAML::Emitter out;
   out << YAML::BeginMap << YAML::Key << "format" << YAML::Value << kManifestFormat << YAML::Key << "version"
       << YAML::Value << 1;
-  const std::pair<const char*, const std::string*> fields[] = {
-      {"software", &m.software}, {"plan_sha256", &m.plan_sha256}, {"samples_sha256", &m.samples_sha256},
-      {"limits_sha256", &m.limits_sha256}, {"serial", &m.serial}, {"status", &m.status},
-      {"verdict", &m.verdict}, {"message", &m.message}};
-  for (const auto& [key, value] : fields) out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
+  const std::pair<const char*, const std::string*> fields[] = {{"software", &m.software},
+                                                               {"plan_sha256", &m.plan_sha256},
+                                                               {"samples_sha256", &m.samples_sha256},
+                                                               {"limits_sha256", &m.limits_sha256},
+                                                               {"serial", &m.serial},
+                                                               {"status", &m.status},
+                                                               {"verdict", &m.verdict},
+                                                               {"message", &m.message}};
+  for (const auto& [key, value] : fields)
+    out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
   out << YAML::EndMap;
-  WriteFileAtomically(path, std::string("# imufit batch: this unit's inputs and outcome; delete to redo it\n") +
-                                out.c_str() + "\n");
+  WriteFileAtomically(
+      path, std::string("# imufit batch: this unit's inputs and outcome; delete to redo it\n") + out.c_str() +
+                "\n");
 }
 
 std::string Join(const std::vector<std::string>& parts, const char* separator) {
@@ -109,19 +125,29 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     if (!fs::exists(samples)) throw InputError(unit_dir.string(), "no samples.csv or samples.csv.gz");
     std::string plan = (unit_dir / "plan.yaml").string();
     if (!fs::exists(plan)) {
-      if (options.shared_plan.empty()) throw InputError(unit_dir.string(), "no plan.yaml and no shared --plan");
+      if (options.shared_plan.empty())
+        throw InputError(unit_dir.string(), "no plan.yaml and no shared --plan");
       plan = options.shared_plan;
     }
     outcome.plan_path = plan;
     outcome.samples_path = samples;
     outcome.plan_sha256 = Sha256OfFile(plan);
     outcome.samples_sha256 = Sha256OfFile(samples);
-    manifest = {options.fit.software, outcome.plan_sha256, outcome.samples_sha256, shared.limits_sha256, "", "", "", ""};
+    manifest = {options.fit.software,
+                outcome.plan_sha256,
+                outcome.samples_sha256,
+                shared.limits_sha256,
+                "",
+                "",
+                "",
+                ""};
 
     // Unchanged since a finished run: take its outcome, redo nothing.
     if (const std::optional<Manifest> previous = ReadManifest(manifest_path);
-        previous && previous->software == manifest.software && previous->plan_sha256 == manifest.plan_sha256 &&
-        previous->samples_sha256 == manifest.samples_sha256 && previous->limits_sha256 == manifest.limits_sha256 &&
+        previous && previous->software == manifest.software &&
+        previous->plan_sha256 == manifest.plan_sha256 &&
+        previous->samples_sha256 == manifest.samples_sha256 &&
+        previous->limits_sha256 == manifest.limits_sha256 &&
         (previous->status != "fitted" || fs::exists(calibration_path))) {
       outcome.skipped = true;
       outcome.serial = previous->serial;
@@ -233,7 +259,8 @@ std::string BatchOptions::Validate() const {
 }
 
 BatchResult RunBatch(const BatchOptions& options) {
-  if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit batch", problem);
+  if (const std::string problem = options.Validate(); !problem.empty())
+    throw InputError("imufit batch", problem);
   if (!fs::is_directory(options.units_dir)) throw InputError(options.units_dir, "not a folder");
   Shared shared;
   shared.options = &options;
@@ -244,9 +271,12 @@ BatchResult RunBatch(const BatchOptions& options) {
   if (!options.shared_plan.empty()) ReadPlan(options.shared_plan);  // a bad shared plan is the lot's error
   std::error_code error;
   fs::create_directories(options.output_dir, error);
-  if (!fs::is_directory(options.output_dir)) throw InputError(options.output_dir, "cannot create the output folder");
-  shared.lot = options.lot.empty() ? fs::path(options.units_dir).lexically_normal().filename().string() : options.lot;
-  if (shared.lot.empty()) shared.lot = fs::path(options.units_dir).lexically_normal().parent_path().filename().string();
+  if (!fs::is_directory(options.output_dir))
+    throw InputError(options.output_dir, "cannot create the output folder");
+  shared.lot =
+      options.lot.empty() ? fs::path(options.units_dir).lexically_normal().filename().string() : options.lot;
+  if (shared.lot.empty())
+    shared.lot = fs::path(options.units_dir).lexically_normal().parent_path().filename().string();
   if (!options.store_path.empty()) shared.store = std::make_unique<ResultsStore>(options.store_path);
 
   std::vector<fs::path> units;
@@ -281,7 +311,8 @@ BatchResult RunBatch(const BatchOptions& options) {
       if (options.progress) options.progress(progress);
     }
   };
-  int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int jobs =
+      options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   jobs = std::min<int>(jobs, std::max<size_t>(units.size(), 1));
   std::vector<std::thread> threads;
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);

@@ -27,7 +27,8 @@ namespace fs = std::filesystem;
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kCurvePoints = 61;  // temperatures at which the coefficient curves are drawn
-const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f"};
+const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
+                               "#8c564b", "#e377c2", "#17becf", "#7f7f7f"};
 
 std::string Fmt(const char* format, double value) {
   char text[64];
@@ -90,32 +91,37 @@ std::vector<CurveGroup> CoefficientCurves(const Calibration& cal) {
     }
     groups.push_back(std::move(g));
   };
-  const auto scale_at = [&](bool gyro, int axis, double dt) { return Coefficient(cal, gyro, kScaleCoefficient + axis).At(dt); };
-  group("Gyro bias", "deg/s", true, kBiasCoefficient, 3, [&](const Cubic& c, int i, double dt, double* v, double* s) {
-    const double k = kRadToDeg / scale_at(true, i, dt);
-    *v = c.At(dt) * k;
-    *s = c.SigmaAt(dt, 0) * std::abs(k);
-  });
+  const auto scale_at = [&](bool gyro, int axis, double dt) {
+    return Coefficient(cal, gyro, kScaleCoefficient + axis).At(dt);
+  };
+  group("Gyro bias", "deg/s", true, kBiasCoefficient, 3,
+        [&](const Cubic& c, int i, double dt, double* v, double* s) {
+          const double k = kRadToDeg / scale_at(true, i, dt);
+          *v = c.At(dt) * k;
+          *s = c.SigmaAt(dt, 0) * std::abs(k);
+        });
   group("Gyro scale factor change from 25 degC", "ppm", true, kScaleCoefficient, 3,
         [&](const Cubic& c, int, double dt, double* v, double* s) {
           *v = (c.At(dt) / c.c[0] - 1.0) * 1e6;
           *s = c.SigmaAt(dt, 1) / std::abs(c.c[0]) * 1e6;
         });
-  group("Gyro misalignment", "mrad", true, kMisalignmentCoefficient, 6, [&](const Cubic& c, int, double dt, double* v, double* s) {
-    *v = c.At(dt) * 1e3;
-    *s = c.SigmaAt(dt, 0) * 1e3;
-  });
+  group("Gyro misalignment", "mrad", true, kMisalignmentCoefficient, 6,
+        [&](const Cubic& c, int, double dt, double* v, double* s) {
+          *v = c.At(dt) * 1e3;
+          *s = c.SigmaAt(dt, 0) * 1e3;
+        });
   group("Gyro g-sensitivity", "deg/s/g", true, kGSensitivityCoefficient, 9,
         [&](const Cubic& c, int i, double dt, double* v, double* s) {
           const double k = kRadToDeg * kStandardGravityMps2 / scale_at(true, i / 3, dt);
           *v = c.At(dt) * k;
           *s = c.SigmaAt(dt, 0) * std::abs(k);
         });
-  group("Accelerometer bias", "mg", false, kBiasCoefficient, 3, [&](const Cubic& c, int i, double dt, double* v, double* s) {
-    const double k = 1e3 / (scale_at(false, i, dt) * kStandardGravityMps2);
-    *v = c.At(dt) * k;
-    *s = c.SigmaAt(dt, 0) * std::abs(k);
-  });
+  group("Accelerometer bias", "mg", false, kBiasCoefficient, 3,
+        [&](const Cubic& c, int i, double dt, double* v, double* s) {
+          const double k = 1e3 / (scale_at(false, i, dt) * kStandardGravityMps2);
+          *v = c.At(dt) * k;
+          *s = c.SigmaAt(dt, 0) * std::abs(k);
+        });
   group("Accelerometer scale factor change from 25 degC", "ppm", false, kScaleCoefficient, 3,
         [&](const Cubic& c, int, double dt, double* v, double* s) {
           *v = (c.At(dt) / c.c[0] - 1.0) * 1e6;
@@ -135,14 +141,16 @@ std::string GnuplotQuote(const std::string& text) {
   return quoted + "\"";
 }
 
-const char* kTerminal = "set terminal svg size 760,330 dynamic noenhanced font 'DejaVu Sans,11' background rgb 'white'\n";
+const char* kTerminal =
+    "set terminal svg size 760,330 dynamic noenhanced font 'DejaVu Sans,11' background rgb 'white'\n";
 
 std::string CurvesScript(const CurveGroup& g, int output) {
   std::ostringstream gp;
   gp.precision(10);
   for (size_t n = 0; n < g.curves.size(); ++n) {
     gp << "$c" << n << " << EOD\n";
-    for (const auto& p : g.curves[n]) gp << p[0] << " " << p[1] << " " << p[1] - p[2] << " " << p[1] + p[2] << "\n";
+    for (const auto& p : g.curves[n])
+      gp << p[0] << " " << p[1] << " " << p[1] - p[2] << " " << p[1] + p[2] << "\n";
     gp << "EOD\n";
   }
   gp << kTerminal << "set output '@OUT" << output << "@'\n";
@@ -167,14 +175,17 @@ std::string ResidualScript(const std::vector<WindowError>& errors, const Plan& p
     for (const WindowError& e : errors) {
       const TableSegment* segment = plan.Find(e.segment);
       if ((segment && segment->IsStatic()) != (kind == 0)) continue;
-      gp << e.temp_c << " " << (gyro ? e.gyro_radps.norm() * kRadToDeg : e.accel_mps2.norm() / kStandardGravityMps2 * 1e3)
+      gp << e.temp_c << " "
+         << (gyro ? e.gyro_radps.norm() * kRadToDeg : e.accel_mps2.norm() / kStandardGravityMps2 * 1e3)
          << "\n";
     }
     gp << "0 NaN\nEOD\n";
   }
   gp << kTerminal << "set output '@OUT" << output << "@'\n";
-  gp << "set title " << GnuplotQuote(std::string(gyro ? "Gyro" : "Accelerometer") +
-                                     " error after correction, per window (|corrected - true|)") << "\n";
+  gp << "set title "
+     << GnuplotQuote(std::string(gyro ? "Gyro" : "Accelerometer") +
+                     " error after correction, per window (|corrected - true|)")
+     << "\n";
   gp << "set xlabel 'temperature, degC'\nset ylabel " << GnuplotQuote(gyro ? "deg/s" : "mg") << "\n";
   gp << "set grid\nset key outside right top\n";
   gp << "plot $r0 using 1:2 with points pt 7 ps 0.5 lc rgb '#1f77b4' title 'static positions', "
@@ -212,12 +223,13 @@ std::string Plots(const std::vector<std::string>& svgs, const std::string& failu
 }
 
 std::string VerdictHtml(const Verdict& verdict) {
-  std::string html = "<table><tr><th>criterion</th><th>measured</th><th>limit</th><th>margin</th><th>verdict</th></tr>\n";
+  std::string html =
+      "<table><tr><th>criterion</th><th>measured</th><th>limit</th><th>margin</th><th>verdict</th></tr>\n";
   for (const CriterionResult& c : verdict.criteria) {
-    html += "<tr data-criterion=\"" + HtmlEscape(c.name) + "\" data-pass=\"" + (c.pass ? "1" : "0") + "\"><td>" +
-            HtmlEscape(c.name) + "</td>" + Num(HtmlEscape(c.measured_text)) + Num(HtmlEscape(c.limit_text)) +
-            Num(Fmt("%.4g", c.margin) + " " + HtmlEscape(c.unit)) + "<td class=\"" + (c.pass ? "PASS" : "FAIL") + "\">" +
-            (c.pass ? "PASS" : "FAIL") + "</td></tr>\n";
+    html += "<tr data-criterion=\"" + HtmlEscape(c.name) + "\" data-pass=\"" + (c.pass ? "1" : "0") +
+            "\"><td>" + HtmlEscape(c.name) + "</td>" + Num(HtmlEscape(c.measured_text)) +
+            Num(HtmlEscape(c.limit_text)) + Num(Fmt("%.4g", c.margin) + " " + HtmlEscape(c.unit)) +
+            "<td class=\"" + (c.pass ? "PASS" : "FAIL") + "\">" + (c.pass ? "PASS" : "FAIL") + "</td></tr>\n";
   }
   return html + "</table>\n";
 }
@@ -228,11 +240,20 @@ std::string HtmlEscape(const std::string& text) {
   std::string escaped;
   for (char c : text) {
     switch (c) {
-      case '&': escaped += "&amp;"; break;
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '"': escaped += "&quot;"; break;
-      default: escaped += c;
+      case '&':
+        escaped += "&amp;";
+        break;
+      case '<':
+        escaped += "&lt;";
+        break;
+      case '>':
+        escaped += "&gt;";
+        break;
+      case '"':
+        escaped += "&quot;";
+        break;
+      default:
+        escaped += c;
     }
   }
   return escaped;
@@ -240,7 +261,8 @@ std::string HtmlEscape(const std::string& text) {
 
 std::vector<std::string> RunGnuplotSvg(const std::string& script, int outputs) {
   std::string folder = (fs::temp_directory_path() / "imufit-plot-XXXXXX").string();
-  if (::mkdtemp(folder.data()) == nullptr) throw std::runtime_error("cannot create a temporary folder for gnuplot");
+  if (::mkdtemp(folder.data()) == nullptr)
+    throw std::runtime_error("cannot create a temporary folder for gnuplot");
   std::string text = script;
   for (int i = 0; i < outputs; ++i) {
     const std::string mark = "@OUT" + std::to_string(i) + "@";
@@ -299,11 +321,12 @@ UnitReport MakeUnitReport(const Calibration& calibration, const Plan& plan, RunW
 
 UnitReport MakeUnitReport(const UnitOutcome& unit, const std::string& limits_path) {
   const FitRunResult& fit = *unit.fit;
-  UnitReport report = MakeUnitReport(*fit.calibration, fit.plan, fit.run,
-                                     {{"plan", unit.plan_path, unit.plan_sha256},
-                                      {"samples", unit.samples_path, unit.samples_sha256},
-                                      {"limits", limits_path, ""}},
-                                     unit.verdict.empty() ? std::nullopt : std::optional<Verdict>(unit.verdict_detail));
+  UnitReport report =
+      MakeUnitReport(*fit.calibration, fit.plan, fit.run,
+                     {{"plan", unit.plan_path, unit.plan_sha256},
+                      {"samples", unit.samples_path, unit.samples_sha256},
+                      {"limits", limits_path, ""}},
+                     unit.verdict.empty() ? std::nullopt : std::optional<Verdict>(unit.verdict_detail));
   report.calibration.serial = unit.serial;
   report.unit = unit.unit;
   report.folds = fit.folds;
@@ -316,7 +339,8 @@ std::string UnitReportHtml(const UnitReport& r) {
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>Calibration certificate "
        << HtmlEscape(serial) << "</title>\n<style>" << kStyle << "</style></head><body>\n";
-  html << "<h1>IMU calibration certificate &mdash; <span data-key=\"serial\">" << HtmlEscape(serial) << "</span></h1>\n";
+  html << "<h1>IMU calibration certificate &mdash; <span data-key=\"serial\">" << HtmlEscape(serial)
+       << "</span></h1>\n";
   if (r.verdict) {
     const char* v = r.verdict->pass ? "PASS" : "FAIL";
     html << "<p><span class=\"badge " << v << "\" data-key=\"verdict\">" << v << "</span> "
@@ -325,14 +349,17 @@ std::string UnitReportHtml(const UnitReport& r) {
   }
   html << "<table>\n" << Row({"unit serial", HtmlEscape(serial)});
   if (!r.unit.empty()) html << Row({"unit folder", HtmlEscape(r.unit)});
-  html << Row({"calibrated (UTC)", HtmlEscape(cal.created_utc)}) << Row({"report written (UTC)", HtmlEscape(r.created_utc)})
+  html << Row({"calibrated (UTC)", HtmlEscape(cal.created_utc)})
+       << Row({"report written (UTC)", HtmlEscape(r.created_utc)})
        << Row({"software", "<span data-key=\"software\">" + HtmlEscape(cal.software) + "</span>"})
-       << Row({"software of this report", HtmlEscape(r.software) + ", git " + HtmlEscape(r.git_revision)}) << "</table>\n";
+       << Row({"software of this report", HtmlEscape(r.software) + ", git " + HtmlEscape(r.git_revision)})
+       << "</table>\n";
 
   html << "<h2>Input files</h2>\n<table><tr><th>role</th><th>file</th><th>SHA-256</th></tr>\n";
   for (const ReportInput& in : r.inputs) {
-    html << "<tr><td>" << HtmlEscape(in.role) << "</td><td>" << HtmlEscape(in.path) << "</td><td class=\"hash\" data-sha256=\""
-         << HtmlEscape(in.role) << "\">" << in.sha256 << "</td></tr>\n";
+    html << "<tr><td>" << HtmlEscape(in.role) << "</td><td>" << HtmlEscape(in.path)
+         << "</td><td class=\"hash\" data-sha256=\"" << HtmlEscape(in.role) << "\">" << in.sha256
+         << "</td></tr>\n";
   }
   html << "</table>\n";
 
@@ -349,34 +376,40 @@ std::string UnitReportHtml(const UnitReport& r) {
   for (const Window& w : r.run.windows) temps.insert(std::lround(w.temp_c));
   html << "<h2>Plan and run</h2>\n<table>\n"
        << Row({"plan", HtmlEscape(r.plan.path)})
-       << Row({"segments", std::to_string(r.plan.segments.size()) + " (" + std::to_string(statics) + " static, " +
-                               std::to_string(r.plan.segments.size() - statics) + " rate; |rate| " + rates + " deg/s)"})
+       << Row({"segments", std::to_string(r.plan.segments.size()) + " (" + std::to_string(statics) +
+                               " static, " + std::to_string(r.plan.segments.size() - statics) +
+                               " rate; |rate| " + rates + " deg/s)"})
        << Row({"local gravity", Fmt("%.6g m/s&sup2;", r.plan.site.gravity_mps2)})
-       << Row({"latitude", r.plan.site.latitude_rad ? Fmt("%.4f deg", *r.plan.site.latitude_rad * kRadToDeg) : "not given"})
+       << Row({"latitude", r.plan.site.latitude_rad ? Fmt("%.4f deg", *r.plan.site.latitude_rad * kRadToDeg)
+                                                    : "not given"})
        << Row({"samples read", std::to_string(r.run.stats.samples)})
        << Row({"windows", std::to_string(r.run.windows.size())})
-       << Row({"temperature range covered",
-               "<span data-key=\"temp_range_c\">" + Fmt("%.1f", cal.fit_temp_range_c[0]) + " .. " +
-                   Fmt("%.1f", cal.fit_temp_range_c[1]) + "</span> degC"})
+       << Row({"temperature range covered", "<span data-key=\"temp_range_c\">" +
+                                                Fmt("%.1f", cal.fit_temp_range_c[0]) + " .. " +
+                                                Fmt("%.1f", cal.fit_temp_range_c[1]) + "</span> degC"})
        << "</table>\n";
 
   if (r.verdict) html << "<h2>Acceptance</h2>\n" << VerdictHtml(*r.verdict);
 
-  html << "<h2>Coefficients at 25 degC (&plusmn; 1 sigma)</h2>\n<table><tr><th>coefficient</th><th>value</th><th>1-sigma</th><th>unit</th></tr>\n";
+  html << "<h2>Coefficients at 25 degC (&plusmn; 1 "
+          "sigma)</h2>\n<table><tr><th>coefficient</th><th>value</th><th>1-sigma</th><th>unit</th></tr>\n";
   for (const Figure& f : KeyFigures(cal)) {
     html << "<tr><td>" << HtmlEscape(f.name) << "</td><td class=\"num\" data-figure=\"" << HtmlEscape(f.name)
          << "\" data-value=\"" << FormatDouble(f.value) << "\">" << Fmt("%+.6g", f.value) << "</td>"
-         << Num(f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "&ndash;") << "<td>" << HtmlEscape(f.unit) << "</td></tr>\n";
+         << Num(f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "&ndash;") << "<td>" << HtmlEscape(f.unit)
+         << "</td></tr>\n";
   }
   html << "</table>\n";
 
   // Plots: every coefficient group, then the residuals (one gnuplot run).
   const std::vector<CurveGroup> groups = CoefficientCurves(cal);
-  const std::vector<WindowError> errors = PredictWindows(cal.model, r.run.windows, r.plan.site, r.plan.segments);
+  const std::vector<WindowError> errors =
+      PredictWindows(cal.model, r.run.windows, r.plan.site, r.plan.segments);
   std::string script;
   for (size_t g = 0; g < groups.size(); ++g) script += CurvesScript(groups[g], static_cast<int>(g));
   const int gyro_plot = static_cast<int>(groups.size());
-  script += ResidualScript(errors, r.plan, true, gyro_plot) + ResidualScript(errors, r.plan, false, gyro_plot + 1);
+  script +=
+      ResidualScript(errors, r.plan, true, gyro_plot) + ResidualScript(errors, r.plan, false, gyro_plot + 1);
   std::vector<std::string> svgs;
   std::string failure;
   try {
@@ -390,13 +423,15 @@ std::string UnitReportHtml(const UnitReport& r) {
     return part;
   };
   html << "<h2>Coefficients against temperature</h2>\n"
-       << "<p class=\"note\">Bands: 1-sigma from each term's own sigma (correlations between terms not drawn).</p>\n"
+       << "<p class=\"note\">Bands: 1-sigma from each term's own sigma (correlations between terms not "
+          "drawn).</p>\n"
        << Plots(slice(0, groups.size()), failure);
 
   html << "<h2>Residuals after correction</h2>\n" << Plots(slice(groups.size(), groups.size() + 2), "");
   std::vector<ErrorStats> stats = ErrorsBySegment(errors);
   stats.push_back(SummariseErrors(errors));
-  html << "<table><tr><th>segment</th><th>up</th><th>rate, deg/s</th><th>windows</th><th>gyro RMS, deg/s</th><th>gyro max, deg/s</th>"
+  html << "<table><tr><th>segment</th><th>up</th><th>rate, deg/s</th><th>windows</th><th>gyro RMS, "
+          "deg/s</th><th>gyro max, deg/s</th>"
           "<th>accel RMS, mg</th><th>accel max, mg</th></tr>\n";
   for (const ErrorStats& s : stats) {
     const TableSegment* seg = s.segment < 0 ? nullptr : r.plan.Find(s.segment);
@@ -415,27 +450,32 @@ std::string UnitReportHtml(const UnitReport& r) {
   if (r.folds.empty()) {
     html << "<p class=\"note\">Not run (imufit fit --validate runs it).</p>\n";
   } else {
-    html << "<table><tr><th>held-out temperature, degC</th><th>windows</th><th>gyro RMS, deg/s</th><th>gyro max, deg/s</th>"
+    html << "<table><tr><th>held-out temperature, degC</th><th>windows</th><th>gyro RMS, deg/s</th><th>gyro "
+            "max, deg/s</th>"
             "<th>accel RMS, mg</th><th>accel max, mg</th></tr>\n";
     for (const HeldOutGroup& g : r.folds) {
       if (!g.fitted) {
-        html << "<tr><td>" << Fmt("%.1f", g.temp_c) << "</td><td colspan=\"5\">not fitted: " << HtmlEscape(g.why_not)
-             << "</td></tr>\n";
+        html << "<tr><td>" << Fmt("%.1f", g.temp_c)
+             << "</td><td colspan=\"5\">not fitted: " << HtmlEscape(g.why_not) << "</td></tr>\n";
         continue;
       }
       html << "<tr><td>" << Fmt("%.1f", g.temp_c) << "</td>" << Num(std::to_string(g.errors.windows))
-           << Num(Fmt("%.5f", g.errors.gyro_rms_radps * kRadToDeg)) << Num(Fmt("%.5f", g.errors.gyro_max_radps * kRadToDeg))
+           << Num(Fmt("%.5f", g.errors.gyro_rms_radps * kRadToDeg))
+           << Num(Fmt("%.5f", g.errors.gyro_max_radps * kRadToDeg))
            << Num(Fmt("%.4f", g.errors.accel_rms_mps2 / kStandardGravityMps2 * 1e3))
            << Num(Fmt("%.4f", g.errors.accel_max_mps2 / kStandardGravityMps2 * 1e3)) << "</tr>\n";
     }
     html << "</table>\n";
   }
-  html << "<p class=\"note\">Units: deg/s and mg at 25 degC; 1 g = 9.80665 m/s&sup2;. Coefficient model and file "
+  html << "<p class=\"note\">Units: deg/s and mg at 25 degC; 1 g = 9.80665 m/s&sup2;. Coefficient model and "
+          "file "
           "format: SPEC.md; conversions: docs/factory.md.</p>\n</body></html>\n";
   return html.str();
 }
 
-void WriteUnitReport(const std::string& path, const UnitReport& report) { WriteFileAtomically(path, UnitReportHtml(report)); }
+void WriteUnitReport(const std::string& path, const UnitReport& report) {
+  WriteFileAtomically(path, UnitReportHtml(report));
+}
 
 std::vector<RobustZ> RobustZScores(const std::vector<double>& values) {
   std::vector<RobustZ> scores(values.size());
@@ -464,19 +504,28 @@ std::string LotReportHtml(const std::string& lot, const BatchResult& batch, cons
   const int units = static_cast<int>(batch.units.size());
   html << "<h1>Lot <span data-key=\"lot\">" << HtmlEscape(lot) << "</span></h1>\n<table>\n"
        << Row({"units", "<span data-key=\"units\">" + std::to_string(units) + "</span>"})
-       << Row({"passed", "<span class=\"PASS\" data-key=\"passed\">" + std::to_string(batch.passed) + "</span>"})
-       << Row({"failed limits", "<span class=\"FAIL\" data-key=\"failed\">" + std::to_string(batch.failed) + "</span>"})
-       << Row({"not fitted / errors", std::to_string(batch.not_fitted) + " / " + std::to_string(batch.errors)})
-       << Row({"yield", "<span data-key=\"yield\">" + Fmt("%.1f", units ? 100.0 * batch.passed / units : 0.0) + "</span> %"})
-       << Row({"written", HtmlEscape(UtcNow()) + " by " + HtmlEscape(software) + ", git " + IMUFIT_GIT_REVISION}) << "</table>\n";
+       << Row({"passed",
+               "<span class=\"PASS\" data-key=\"passed\">" + std::to_string(batch.passed) + "</span>"})
+       << Row({"failed limits",
+               "<span class=\"FAIL\" data-key=\"failed\">" + std::to_string(batch.failed) + "</span>"})
+       << Row({"not fitted / errors",
+               std::to_string(batch.not_fitted) + " / " + std::to_string(batch.errors)})
+       << Row({"yield", "<span data-key=\"yield\">" +
+                            Fmt("%.1f", units ? 100.0 * batch.passed / units : 0.0) + "</span> %"})
+       << Row({"written",
+               HtmlEscape(UtcNow()) + " by " + HtmlEscape(software) + ", git " + IMUFIT_GIT_REVISION})
+       << "</table>\n";
 
-  html << "<h2>Units</h2>\n<table><tr><th>unit</th><th>serial</th><th>status</th><th>verdict</th><th>reason</th></tr>\n";
+  html << "<h2>Units</h2>\n<table><tr><th>unit</th><th>serial</th><th>status</th><th>verdict</th><th>reason</"
+          "th></tr>\n";
   for (const UnitOutcome& u : batch.units) {
-    const std::string name = u.status == "fitted" ? "<a href=\"" + HtmlEscape(u.unit) + "/report.html\">" + HtmlEscape(u.unit) + "</a>"
+    const std::string name = u.status == "fitted" ? "<a href=\"" + HtmlEscape(u.unit) + "/report.html\">" +
+                                                        HtmlEscape(u.unit) + "</a>"
                                                   : HtmlEscape(u.unit);
-    html << "<tr data-unit=\"" << HtmlEscape(u.unit) << "\"><td>" << name << "</td><td>" << HtmlEscape(u.serial) << "</td><td>"
-         << HtmlEscape(u.status) << "</td><td class=\"" << HtmlEscape(u.verdict) << "\">" << HtmlEscape(u.verdict)
-         << "</td><td>" << HtmlEscape(u.message) << "</td></tr>\n";
+    html << "<tr data-unit=\"" << HtmlEscape(u.unit) << "\"><td>" << name << "</td><td>"
+         << HtmlEscape(u.serial) << "</td><td>" << HtmlEscape(u.status) << "</td><td class=\""
+         << HtmlEscape(u.verdict) << "\">" << HtmlEscape(u.verdict) << "</td><td>" << HtmlEscape(u.message)
+         << "</td></tr>\n";
   }
   html << "</table>\n";
 
@@ -507,29 +556,39 @@ std::string LotReportHtml(const std::string& lot, const BatchResult& batch, cons
     }
     for (size_t i = 0; i < values.size(); ++i) {
       if (!z[i].outlier) continue;
-      outliers += "<tr data-outlier=\"" + HtmlEscape(owners[i]->unit) + "\" data-figure=\"" + HtmlEscape(name) + "\"><td>" +
-                  HtmlEscape(owners[i]->unit) + "</td><td>" + HtmlEscape(owners[i]->serial) + "</td><td>" + HtmlEscape(name) +
-                  "</td>" + Num(Fmt("%.6g", values[i]) + " " + HtmlEscape(unit)) + Num(Fmt("%+.1f", z[i].z)) + "</tr>\n";
+      outliers += "<tr data-outlier=\"" + HtmlEscape(owners[i]->unit) + "\" data-figure=\"" +
+                  HtmlEscape(name) + "\"><td>" + HtmlEscape(owners[i]->unit) + "</td><td>" +
+                  HtmlEscape(owners[i]->serial) + "</td><td>" + HtmlEscape(name) + "</td>" +
+                  Num(Fmt("%.6g", values[i]) + " " + HtmlEscape(unit)) + Num(Fmt("%+.1f", z[i].z)) +
+                  "</tr>\n";
     }
-    gp << "set terminal svg size 460,150 dynamic noenhanced font 'DejaVu Sans,10' background rgb 'white'\nset output '@OUT" << plots << "@'\n"
-       << "set title " << GnuplotQuote(name + " (" + unit + ")") << "\nunset ytics\nset yrange [-0.3:0.9]\nset grid xtics\n"
+    gp << "set terminal svg size 460,150 dynamic noenhanced font 'DejaVu Sans,10' background rgb "
+          "'white'\nset output '@OUT"
+       << plots << "@'\n"
+       << "set title " << GnuplotQuote(name + " (" + unit + ")")
+       << "\nunset ytics\nset yrange [-0.3:0.9]\nset grid xtics\n"
        << "set offsets graph 0.05, graph 0.05, 0, 0\nunset key\n"
-       << "plot $s0 using 1:2 with points pt 7 ps 0.8 lc rgb '#1f77b4', $s1 using 1:2 with points pt 7 ps 1.2 lc rgb '#d62728'\n"
+       << "plot $s0 using 1:2 with points pt 7 ps 0.8 lc rgb '#1f77b4', $s1 using 1:2 with points pt 7 ps "
+          "1.2 lc rgb '#d62728'\n"
        << "unset output\nreset\n";
     script += gp.str();
     ++plots;
   }
-  html << "<h2>Outliers (robust z = 0.6745 (x - median) / MAD, |z| &gt; " << Fmt("%.1f", kOutlierRobustZ) << ")</h2>\n";
+  html << "<h2>Outliers (robust z = 0.6745 (x - median) / MAD, |z| &gt; " << Fmt("%.1f", kOutlierRobustZ)
+       << ")</h2>\n";
   if (outliers.empty()) {
     html << "<p>None.</p>\n";
   } else {
-    html << "<table><tr><th>unit</th><th>serial</th><th>figure</th><th>value</th><th>robust z</th></tr>\n" << outliers << "</table>\n";
+    html << "<table><tr><th>unit</th><th>serial</th><th>figure</th><th>value</th><th>robust z</th></tr>\n"
+         << outliers << "</table>\n";
   }
-  html << "<h2>Distributions of the key figures at 25 degC</h2>\n<p class=\"note\">One dot per fitted unit; red: outlier.</p>\n";
+  html << "<h2>Distributions of the key figures at 25 degC</h2>\n<p class=\"note\">One dot per fitted unit; "
+          "red: outlier.</p>\n";
   if (plots > 0) {
     try {
       html << "<div style=\"display: grid; grid-template-columns: 1fr 1fr; gap: 4px\">\n";
-      for (const std::string& svg : RunGnuplotSvg(script, plots)) html << "<div class=\"plot\">" << svg << "</div>\n";
+      for (const std::string& svg : RunGnuplotSvg(script, plots))
+        html << "<div class=\"plot\">" << svg << "</div>\n";
       html << "</div>\n";
     } catch (const std::exception& e) {
       html << "</div><p class=\"note\">Plots not drawn: " << HtmlEscape(e.what()) << "</p>\n";

@@ -64,6 +64,17 @@ ResultsStore::ResultsStore(const std::string& path) : path_(path) {
     db_ = nullptr;
     throw InputError(path, "cannot open the results store: " + message);
   }
+  try {
+    Open();
+  } catch (...) {
+    sqlite3_close(db_);  // the destructor does not run for a constructor that throws
+    db_ = nullptr;
+    throw;
+  }
+}
+
+void ResultsStore::Open() {
+  const std::string& path = path_;
   sqlite3_busy_timeout(db_, 10000);
   Execute("PRAGMA journal_mode = WAL");
   Execute("PRAGMA synchronous = NORMAL");  // durable across a process crash; WAL keeps it consistent
@@ -84,7 +95,8 @@ ResultsStore::ResultsStore(const std::string& path) : path_(path) {
   if (found > kStoreSchemaVersion || found < 1) {
     Execute("ROLLBACK");
     throw InputError(path, "results store schema version " + std::to_string(found) +
-                               " is not supported (this imufit writes version " + std::to_string(kStoreSchemaVersion) + ")");
+                               " is not supported (this imufit writes version " +
+                               std::to_string(kStoreSchemaVersion) + ")");
   }
   Execute("COMMIT");
 }
@@ -116,14 +128,16 @@ int64_t ResultsStore::Record(const StoredFit& fit) {
                      "limits_sha256, status, verdict, message, calibration_yaml) "
                      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)");
     if (!insert.ok()) Fail("preparing the insert");
-    const std::string* texts[] = {&fit.serial,         &fit.unit,           &fit.lot,    &fit.time_utc,
-                                  &fit.software,       &fit.plan_sha256,    &fit.samples_sha256,
-                                  &fit.limits_sha256,  &fit.status,         &fit.verdict,
-                                  &fit.message,        &fit.calibration_yaml};
+    const std::string* texts[] = {&fit.serial,         &fit.unit,          &fit.lot,
+                                  &fit.time_utc,       &fit.software,      &fit.plan_sha256,
+                                  &fit.samples_sha256, &fit.limits_sha256, &fit.status,
+                                  &fit.verdict,        &fit.message,       &fit.calibration_yaml};
     for (int i = 0; i < 12; ++i) insert.Bind(i + 1, *texts[i]);
     if (insert.Step() != SQLITE_DONE) Fail("recording the fit");
     id = sqlite3_last_insert_rowid(db_);
-    Statement figure(db_, "INSERT INTO figures (fit_id, name, coefficient, unit, value, sigma) VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+    Statement figure(db_,
+                     "INSERT INTO figures (fit_id, name, coefficient, unit, value, sigma) VALUES (?1, ?2, "
+                     "?3, ?4, ?5, ?6)");
     if (!figure.ok()) Fail("preparing the insert");
     for (const Figure& f : fit.figures) {
       figure.Bind(1, id);
@@ -142,26 +156,29 @@ int64_t ResultsStore::Record(const StoredFit& fit) {
 
 std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
   std::vector<StoredFit> fits;
-  Statement query(db_,
-                  "SELECT id, serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, limits_sha256, "
-                  "status, verdict, message, calibration_yaml FROM fits WHERE serial = ?1 ORDER BY time_utc, id");
+  Statement query(
+      db_,
+      "SELECT id, serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, limits_sha256, "
+      "status, verdict, message, calibration_yaml FROM fits WHERE serial = ?1 ORDER BY time_utc, id");
   if (!query.ok()) Fail("querying fits");
   query.Bind(1, serial);
   while (query.Step() == SQLITE_ROW) {
     StoredFit f;
     f.id = query.Integer(0);
-    std::string* texts[] = {&f.serial,        &f.unit,          &f.lot,     &f.time_utc,        &f.software,
-                            &f.plan_sha256,   &f.samples_sha256, &f.limits_sha256, &f.status, &f.verdict,
-                            &f.message,       &f.calibration_yaml};
+    std::string* texts[] = {
+        &f.serial,         &f.unit,          &f.lot,    &f.time_utc, &f.software, &f.plan_sha256,
+        &f.samples_sha256, &f.limits_sha256, &f.status, &f.verdict,  &f.message,  &f.calibration_yaml};
     for (int i = 0; i < 12; ++i) *texts[i] = query.Text(i + 1);
     fits.push_back(std::move(f));
   }
   for (StoredFit& f : fits) {
-    Statement figures(db_, "SELECT name, coefficient, unit, value, sigma FROM figures WHERE fit_id = ?1 ORDER BY rowid");
+    Statement figures(
+        db_, "SELECT name, coefficient, unit, value, sigma FROM figures WHERE fit_id = ?1 ORDER BY rowid");
     if (!figures.ok()) Fail("querying figures");
     figures.Bind(1, f.id);
     while (figures.Step() == SQLITE_ROW) {
-      f.figures.push_back({figures.Text(0), figures.Text(1), figures.Text(2), figures.Double(3), figures.Double(4)});
+      f.figures.push_back(
+          {figures.Text(0), figures.Text(1), figures.Text(2), figures.Double(3), figures.Double(4)});
     }
   }
   return fits;
@@ -169,10 +186,11 @@ std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
 
 std::vector<LotYield> ResultsStore::Yield(const std::string& lot) {
   // Each unit of a lot counts once, by its latest fit (a unit refitted after a fix counts as fixed).
-  Statement query(db_,
-                  "SELECT lot, count(*), sum(verdict = 'PASS'), sum(verdict = 'FAIL'), sum(status != 'fitted') "
-                  "FROM fits f WHERE id = (SELECT max(id) FROM fits g WHERE g.lot = f.lot AND g.unit = f.unit) "
-                  "AND lot != '' AND (?1 = '' OR lot = ?1) GROUP BY lot ORDER BY min(time_utc), lot");
+  Statement query(
+      db_,
+      "SELECT lot, count(*), sum(verdict = 'PASS'), sum(verdict = 'FAIL'), sum(status != 'fitted') "
+      "FROM fits f WHERE id = (SELECT max(id) FROM fits g WHERE g.lot = f.lot AND g.unit = f.unit) "
+      "AND lot != '' AND (?1 = '' OR lot = ?1) GROUP BY lot ORDER BY min(time_utc), lot");
   if (!query.ok()) Fail("querying the yield");
   query.Bind(1, lot);
   std::vector<LotYield> yields;
@@ -184,15 +202,18 @@ std::vector<LotYield> ResultsStore::Yield(const std::string& lot) {
 }
 
 std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std::string& serial) {
-  Statement query(db_,
-                  "SELECT f.time_utc, f.serial, f.lot, g.value, g.sigma, g.unit FROM figures g JOIN fits f ON f.id = g.fit_id "
-                  "WHERE (g.name = ?1 OR g.coefficient = ?1) AND (?2 = '' OR f.serial = ?2) ORDER BY f.time_utc, f.id");
+  Statement query(
+      db_,
+      "SELECT f.time_utc, f.serial, f.lot, g.value, g.sigma, g.unit FROM figures g JOIN fits f ON f.id = "
+      "g.fit_id "
+      "WHERE (g.name = ?1 OR g.coefficient = ?1) AND (?2 = '' OR f.serial = ?2) ORDER BY f.time_utc, f.id");
   if (!query.ok()) Fail("querying the trend");
   query.Bind(1, figure);
   query.Bind(2, serial);
   std::vector<TrendPoint> points;
   while (query.Step() == SQLITE_ROW) {
-    points.push_back({query.Text(0), query.Text(1), query.Text(2), query.Double(3), query.Double(4), query.Text(5)});
+    points.push_back(
+        {query.Text(0), query.Text(1), query.Text(2), query.Double(3), query.Double(4), query.Text(5)});
   }
   return points;
 }

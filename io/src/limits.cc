@@ -77,7 +77,8 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
   }
 
   if (criterion.kind == LimitKind::kCoverage) {
-    if (entry.Has("max_abs")) entry["max_abs"].Fail(criterion.quantity + " takes `covers: [lo, hi]`, not max_abs");
+    if (entry.Has("max_abs"))
+      entry["max_abs"].Fail(criterion.quantity + " takes `covers: [lo, hi]`, not max_abs");
     const yaml::Located covers = entry["covers"];
     const std::vector<double> range = covers.Doubles(2);
     if (!(range[0] < range[1])) covers.Fail("expected [lo, hi] with lo < hi");
@@ -106,7 +107,8 @@ Limits ReadLimits(const std::string& path) {
     if (nominal.Has("accel_scale")) limits.nominal_accel_scale = PositiveNumber(nominal["accel_scale"]);
   }
   const yaml::Located criteria = root["criteria"];
-  for (size_t i = 0; i < criteria.Size(); ++i) limits.criteria.push_back(ReadCriterion(criteria.At(i), limits));
+  for (size_t i = 0; i < criteria.Size(); ++i)
+    limits.criteria.push_back(ReadCriterion(criteria.At(i), limits));
   if (limits.criteria.empty()) criteria.Fail("no criteria: a limits file must check something");
   return limits;
 }

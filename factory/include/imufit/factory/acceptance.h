@@ -25,7 +25,7 @@ struct Figure {
   std::string coefficient;  // the calibration's path, e.g. "gyro.bias.x"; "fit.gyro_residual_rms"
   std::string unit;         // "deg/s", "mg", ...
   double value = 0.0;
-  double sigma = -1.0;      // 1-sigma; < 0 when the calibration has none
+  double sigma = -1.0;  // 1-sigma; < 0 when the calibration has none
 };
 
 // Every coefficient at 25 degC and the residual RMS values, in a fixed order.
@@ -34,11 +34,11 @@ std::vector<Figure> KeyFigures(const Calibration& calibration);
 const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name);
 
 struct CriterionResult {
-  std::string name;      // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"
+  std::string name;  // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"
   std::string unit;
   double measured = 0.0;  // for coverage: the margin's side that binds
   double limit = 0.0;
-  double margin = 0.0;    // limit - |measured| (coverage: degC to spare at the tighter end); >= 0 passes
+  double margin = 0.0;  // limit - |measured| (coverage: degC to spare at the tighter end); >= 0 passes
   std::string measured_text;
   std::string limit_text;
   bool pass = false;

@@ -25,11 +25,11 @@ namespace imufit {
 
 // One unit's outcome.
 struct UnitOutcome {
-  std::string unit;    // the folder name
-  std::string serial;  // the plan's serial, else the unit folder name
-  std::string status;  // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
-  std::string verdict; // "PASS", "FAIL", "" (not fitted, or no limits)
-  std::string message; // the failed criteria, or why it was not fitted
+  std::string unit;     // the folder name
+  std::string serial;   // the plan's serial, else the unit folder name
+  std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
+  std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
+  std::string message;  // the failed criteria, or why it was not fitted
   std::vector<Figure> figures;
   std::string plan_path;
   std::string samples_path;
@@ -43,7 +43,7 @@ struct UnitOutcome {
 };
 
 struct BatchProgress {
-  int done = 0;     // units finished (skipped ones included)
+  int done = 0;  // units finished (skipped ones included)
   int skipped = 0;
   int total = 0;
   double elapsed_s = 0.0;

@@ -77,6 +77,7 @@ class ResultsStore {
   std::vector<TrendPoint> Trend(const std::string& figure, const std::string& serial);
 
  private:
+  void Open();  // pragmas, schema, version check
   void Execute(const std::string& sql);
   [[noreturn]] void Fail(const std::string& what);
 

@@ -33,10 +33,10 @@ enum class LimitKind {
 };
 
 struct LimitQuantity {
-  const char* name;   // as written in the file, unit in the name
+  const char* name;  // as written in the file, unit in the name
   LimitKind kind;
-  const char* axes;   // space-separated axis names of a coefficient quantity, "" otherwise
-  const char* unit;   // for tables: "deg/s", "ppm", ...
+  const char* axes;  // space-separated axis names of a coefficient quantity, "" otherwise
+  const char* unit;  // for tables: "deg/s", "ppm", ...
 };
 
 inline constexpr LimitQuantity kLimitQuantities[] = {
@@ -57,12 +57,12 @@ inline constexpr LimitQuantity kLimitQuantities[] = {
 enum class LimitStatistic { kValue, kSigma };
 
 struct LimitCriterion {
-  std::string quantity;           // a kLimitQuantities name
+  std::string quantity;  // a kLimitQuantities name
   LimitKind kind = LimitKind::kCoefficient;
   std::string unit;
   std::vector<std::string> axes;  // the axes checked (all of the quantity's when not given)
   LimitStatistic statistic = LimitStatistic::kValue;
-  double max_abs = 0.0;           // kCoefficient, kFigure: the limit, > 0
+  double max_abs = 0.0;                      // kCoefficient, kFigure: the limit, > 0
   std::array<double, 2> covers_c{0.0, 0.0};  // kCoverage: lo < hi
 };
 
