@@ -181,6 +181,27 @@ TEST(RobustZScores, FlagsTheOneFarValue) {
   EXPECT_FALSE(RobustZScores({1.0, 1.0, 1.0, 5.0})[3].outlier);  // MAD 0: no spread to judge by
 }
 
+TEST_F(FactoryTest, NoiseLimitsUseTheNoiseBlockWhenPresent) {
+  const std::string limits_path = Write("limits.yaml",
+                                        "format: imufit-limits\nversion: 1\ncriteria:\n"
+                                        "  - {quantity: gyro_arw_deg_per_sqrt_hr, max_abs: 0.2, axes: [x]}\n"
+                                        "  - {quantity: gyro_bias_instability_dph, max_abs: 0.5, axes: [x]}\n");
+  Calibration calibration = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  // Without a noise block the criteria cannot pass.
+  Verdict verdict = EvaluateLimits(ReadLimits(limits_path), calibration);
+  EXPECT_FALSE(verdict.criteria[0].pass);
+  EXPECT_EQ(verdict.criteria[0].measured_text, "not in calibration");
+  // With one (the layout imufit allan --noise-yaml writes, docs/allan.md).
+  calibration.extra["noise"] = YAML::Load(
+      "{format: imufit-noise, version: 1, columns: {gyro_x: {arw_deg_per_sqrt_hr: [0.1498, 0.0002], "
+      "bias_instability_deg_per_hr: [0.94, 0.67]}}}");
+  verdict = EvaluateLimits(ReadLimits(limits_path), calibration);
+  EXPECT_TRUE(verdict.criteria[0].pass);
+  EXPECT_EQ(verdict.criteria[0].measured, 0.1498);
+  EXPECT_FALSE(verdict.criteria[1].pass);  // 0.94 deg/h > 0.5 deg/h
+  EXPECT_EQ(FindFigure(KeyFigures(calibration), "noise.gyro_x.arw_deg_per_sqrt_hr")->sigma, 0.0002);
+}
+
 TEST_F(FactoryTest, StoreRecordsAndAnswers) {
   const std::string path = (dir_ / "store.db").string();
   const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <utility>
 
 namespace imufit {
 namespace {
@@ -27,6 +29,18 @@ double FitNumber(const Calibration& calibration, const char* key, bool* found) {
     return value;
   } catch (const YAML::Exception&) {
     return 0.0;
+  }
+}
+
+// [value, 1-sigma] of noise.columns.gyro_<axis>.<key>, when there.
+std::optional<std::array<double, 2>> NoiseFigure(const Calibration& calibration, const char* axis, const char* key) {
+  if (!calibration.extra || !calibration.extra.IsMap()) return std::nullopt;
+  try {
+    const YAML::Node node = calibration.extra["noise"]["columns"][std::string("gyro_") + axis][key];
+    if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
+    return std::array<double, 2>{node[0].as<double>(), node[1].as<double>()};
+  } catch (const YAML::Exception&) {
+    return std::nullopt;
   }
 }
 
@@ -66,6 +80,24 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
   for (int h = 0; h < 9; ++h) {
     add("gyro_g_sensitivity_dpsg", "gyro", kGSensitivityCoefficient + h, "deg/s/g",
         kRadToDeg * kStandardGravityMps2 / Term0(gyro, kScaleCoefficient + h / 3), gyro, gyro_sigma);
+  }
+  // Noise figures, when the calibration carries a `noise:` block (imufit allan --noise-yaml,
+  // docs/allan.md): [value, 1-sigma] per gyro column.
+  const char* axes[] = {"x", "y", "z"};
+  struct NoiseKey {
+    const char* name;
+    const char* key;
+    const char* unit;
+  };
+  const NoiseKey noise_keys[] = {{"gyro_arw_deg_per_sqrt_hr", "arw_deg_per_sqrt_hr", "deg/sqrt(h)"},
+                                 {"gyro_bias_instability_dph", "bias_instability_deg_per_hr", "deg/h"}};
+  for (const auto& [name, key, unit] : noise_keys) {
+    for (const char* axis : axes) {
+      if (const std::optional<std::array<double, 2>> pair = NoiseFigure(calibration, axis, key)) {
+        figures.push_back({std::string(name) + "." + axis, std::string("noise.gyro_") + axis + "." + key,
+                           unit, (*pair)[0], (*pair)[1]});
+      }
+    }
   }
   bool found = false;
   const double gyro_rms = FitNumber(calibration, "gyro_residual_rms_radps", &found);
