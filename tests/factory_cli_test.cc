@@ -127,24 +127,26 @@ class FactoryCliTest : public ::testing::Test {
     return Path(name);
   }
 
-  RunResult Run(const std::vector<std::string>& args) const {
+  RunResult Run(const std::vector<std::string>& args) const { return RunProgram(IMUFIT_EXE, args); }
+
+  RunResult RunProgram(const std::string& program, const std::vector<std::string>& args) const {
     const std::string out_path = Path("stdout.txt"), err_path = Path("stderr.txt");
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<std::string> storage = {IMUFIT_EXE};
+    std::vector<std::string> storage = {program};
     storage.insert(storage.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& a : storage) argv.push_back(a.data());
     argv.push_back(nullptr);
     pid_t pid = 0;
     RunResult result;
-    const int spawned = posix_spawn(&pid, IMUFIT_EXE, &actions, nullptr, argv.data(), environ);
+    const int spawned = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     if (spawned != 0) {
-      ADD_FAILURE() << "cannot run " << IMUFIT_EXE << ": " << std::strerror(spawned);
+      ADD_FAILURE() << "cannot run " << program << ": " << std::strerror(spawned);
       return result;
     }
     int status = 0;
@@ -274,7 +276,10 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   EXPECT_NE(report.find("data-sha256=\"limits\">" + Sha256OfFile(Path("limits.yaml")) + "<"),
             std::string::npos);
   EXPECT_NE(report.find("<svg"), std::string::npos);
-  EXPECT_EQ(report.find("http://"), report.find("http://www.w3.org"));  // no link out but SVG namespaces
+  // Self-contained: nothing loaded from elsewhere (the only URLs are SVG namespace names).
+  EXPECT_EQ(report.find(" src="), std::string::npos);
+  EXPECT_EQ(report.find("<link"), std::string::npos);
+  EXPECT_EQ(report.find("<script"), std::string::npos);
 
   // The store: one row per unit of the lot, with the verdicts; the yield.
   r = Run({"history", Path("store.db"), "--lot", "--csv"});
@@ -383,6 +388,34 @@ TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
   r = Run({"history", Path("fit.db"), "--serial", "NO-SUCH-SERIAL"});
   EXPECT_EQ(r.status, kExitBadInput);
   EXPECT_NE(r.err.find("no calibrations of serial"), std::string::npos) << r.err;
+}
+
+// The certificate as a browser draws it: headless Chromium renders it to a PNG of the page's width.
+TEST_F(FactoryCliTest, ChromiumRendersTheCertificate) {
+  const std::string chromium = "/usr/bin/chromium";
+  if (!fs::exists(chromium) || !fs::exists("/usr/bin/timeout")) GTEST_SKIP() << "no " << chromium;
+  RunResult r =
+      Run({"fit", "-p", Path("units/unit-04/plan.yaml"), "-s", Path("units/unit-04/samples.csv.gz"), "-o",
+           Path("cal4.yaml"), "--limits", Path("limits.yaml"), "--report", Path("unit4.html"), "-q"});
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.err;
+  const std::string png = Path("unit4.png");
+  r = RunProgram("/usr/bin/timeout",
+                 {"120", chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                  "--user-data-dir=" + Path("chromium-profile"), "--screenshot=" + png,
+                  "--window-size=1000,3000", "file://" + Path("unit4.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string image = ReadBytes(png);
+  ASSERT_GT(image.size(), 24u);
+  ASSERT_EQ(image.substr(1, 3), "PNG");
+  const auto be32 = [&](size_t at) {
+    return (static_cast<unsigned char>(image[at]) << 24) | (static_cast<unsigned char>(image[at + 1]) << 16) |
+           (static_cast<unsigned char>(image[at + 2]) << 8) | static_cast<unsigned char>(image[at + 3]);
+  };
+  EXPECT_EQ(be32(16), 1000u);  // IHDR width
+  EXPECT_EQ(be32(20), 3000u);  // IHDR height
+  // A page of tables and plots compresses to far more than a blank page (a few kB).
+  constexpr size_t kMinimumDrawnPngBytes = 100000;
+  EXPECT_GT(image.size(), kMinimumDrawnPngBytes);
 }
 
 }  // namespace

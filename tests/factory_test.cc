@@ -182,10 +182,11 @@ TEST(RobustZScores, FlagsTheOneFarValue) {
 }
 
 TEST_F(FactoryTest, NoiseLimitsUseTheNoiseBlockWhenPresent) {
-  const std::string limits_path = Write("limits.yaml",
-                                        "format: imufit-limits\nversion: 1\ncriteria:\n"
-                                        "  - {quantity: gyro_arw_deg_per_sqrt_hr, max_abs: 0.2, axes: [x]}\n"
-                                        "  - {quantity: gyro_bias_instability_dph, max_abs: 0.5, axes: [x]}\n");
+  const std::string limits_path =
+      Write("limits.yaml",
+            "format: imufit-limits\nversion: 1\ncriteria:\n"
+            "  - {quantity: gyro_arw_deg_per_sqrt_hr, max_abs: 0.2, axes: [x]}\n"
+            "  - {quantity: gyro_bias_instability_dph, max_abs: 0.5, axes: [x]}\n");
   Calibration calibration = ReadCalibration(kFixtures + "/mems_truth.yaml");
   // Without a noise block the criteria cannot pass.
   Verdict verdict = EvaluateLimits(ReadLimits(limits_path), calibration);

@@ -33,7 +33,8 @@ double FitNumber(const Calibration& calibration, const char* key, bool* found) {
 }
 
 // [value, 1-sigma] of noise.columns.gyro_<axis>.<key>, when there.
-std::optional<std::array<double, 2>> NoiseFigure(const Calibration& calibration, const char* axis, const char* key) {
+std::optional<std::array<double, 2>> NoiseFigure(const Calibration& calibration, const char* axis,
+                                                 const char* key) {
   if (!calibration.extra || !calibration.extra.IsMap()) return std::nullopt;
   try {
     const YAML::Node node = calibration.extra["noise"]["columns"][std::string("gyro_") + axis][key];
