@@ -8,6 +8,7 @@
 // The program is run as a user runs it (IMUFIT_EXE); outputs are read back from the files.
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -330,11 +331,26 @@ TEST_F(FactoryCliTest, InterruptedBatchResumesWithoutLoss) {
   for (const auto& unit : fs::directory_iterator(dir_ / "out"))
     manifests += fs::exists(unit.path() / "manifest.yaml");
   EXPECT_EQ(manifests, 1);
-  // A kill between the store and the manifest: the unit is redone, never lost.
+  // What a kill leaves behind: a temporary file of an output never committed; and, while another
+  // batch holds the output folder, a second one is refused.
+  fs::create_directories(dir_ / "out" / "unit-02");
+  const fs::path leftover = dir_ / "out" / "unit-02" / ".calibration.yaml.tmp-AbC123";
+  std::ofstream(leftover) << "half a calibration";
+  {
+    const int fd = ::open((dir_ / "out" / ".imufit-batch.lock").c_str(), O_RDWR | O_CREAT, 0644);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    r = Run(BatchArgs("out"));
+    EXPECT_EQ(r.status, kExitBadInput);
+    EXPECT_NE(r.err.find("another imufit batch is writing to this folder"), std::string::npos) << r.err;
+    ::close(fd);
+  }
+  // Resumed: the finished unit is skipped, the others are done, the leftover is gone.
   r = Run(BatchArgs("out"));
   EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
   EXPECT_NE(r.out.find("1 unchanged and skipped"), std::string::npos) << r.out;
   EXPECT_EQ(Summary("out").size(), kUnits);
+  EXPECT_FALSE(fs::exists(leftover));
+  // A kill between the store and the manifest: the unit is redone, never lost.
   fs::remove(dir_ / "out" / "unit-02" / "manifest.yaml");
   r = Run(BatchArgs("out"));
   EXPECT_NE(r.out.find("4 unchanged and skipped"), std::string::npos) << r.out;

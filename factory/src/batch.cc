@@ -1,5 +1,9 @@
 #include "imufit/factory/batch.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -83,6 +87,36 @@ void WriteManifest(const std::string& path, const Manifest& m) {
                 "\n");
 }
 
+// Temporary files of outputs a killed run never committed (OutputFile's ".NAME.tmp-XXXXXX").
+void RemoveLeftovers(const fs::path& folder) {
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() > 1 && name[0] == '.' && name.find(".tmp-") != std::string::npos)
+      fs::remove(entry.path(), error);
+  }
+}
+
+// Holds an exclusive lock on OUT_DIR/.imufit-batch.lock: two batches never write one folder.
+class FolderLock {
+ public:
+  explicit FolderLock(const std::string& folder) {
+    const std::string path = (fs::path(folder) / ".imufit-batch.lock").string();
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw InputError(path, "cannot create the lock file");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw InputError(folder, "another imufit batch is writing to this folder");
+    }
+  }
+  ~FolderLock() { ::close(fd_); }
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 std::string Join(const std::vector<std::string>& parts, const char* separator) {
   std::string text;
   for (const std::string& p : parts) text += (text.empty() ? "" : separator) + p;
@@ -159,6 +193,7 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     }
 
     fs::create_directories(out_dir);
+    RemoveLeftovers(out_dir);
     FitRunResult result = FitRun(plan, samples, options.fit);
     if (!result.plan.serial.empty()) outcome.serial = result.plan.serial;
     if (result.fit.status == FitStatus::kUndetermined) {
@@ -271,8 +306,10 @@ BatchResult RunBatch(const BatchOptions& options) {
   if (!options.shared_plan.empty()) ReadPlan(options.shared_plan);  // a bad shared plan is the lot's error
   std::error_code error;
   fs::create_directories(options.output_dir, error);
-  if (!fs::is_directory(options.output_dir))
+  if (!fs::is_directory(options.output_dir)) {
     throw InputError(options.output_dir, "cannot create the output folder");
+  }
+  const FolderLock lock(options.output_dir);
   shared.lot =
       options.lot.empty() ? fs::path(options.units_dir).lexically_normal().filename().string() : options.lot;
   if (shared.lot.empty())
@@ -281,7 +318,8 @@ BatchResult RunBatch(const BatchOptions& options) {
 
   std::vector<fs::path> units;
   for (const fs::directory_entry& entry : fs::directory_iterator(options.units_dir)) {
-    if (entry.is_directory()) units.push_back(entry.path());
+    if (entry.is_directory() && entry.path().filename().string()[0] != '.')
+      units.push_back(entry.path());  // not .git and the like
   }
   std::sort(units.begin(), units.end());
 
