@@ -93,6 +93,8 @@ CommandRunner AddBatchCommand(CLI::App* root) {
                    "stop after fitting this many units (0: all); a later run resumes the lot")
       ->capture_default_str();
   command->add_flag("--no-report", args->no_report, "write no report.html per unit");
+  command->add_flag("--validate", b.fit.validate,
+                    "leave each interior temperature out in turn, refit, and put the errors in the reports");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunBatchCommand(*args); };
 }

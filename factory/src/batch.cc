@@ -241,7 +241,15 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     row.calibration_yaml = calibration_yaml;
     row.figures = outcome.figures;
     std::lock_guard<std::mutex> lock(shared.store_mutex);
-    shared.store->Record(row);
+    try {
+      shared.store->Record(row);
+    } catch (const std::exception& e) {
+      // Not recorded: no manifest either, so that the next run does the unit again.
+      outcome.status = "error";
+      outcome.verdict.clear();
+      outcome.message = std::string("not recorded in the results store: ") + e.what();
+      return outcome;
+    }
   }
   if (!outcome.plan_sha256.empty()) {
     manifest.serial = outcome.serial;
