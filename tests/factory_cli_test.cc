@@ -7,11 +7,13 @@
 //   unit-05           a corrupt samples file (a number "1.2.3" in the middle)
 // The program is run as a user runs it (IMUFIT_EXE); outputs are read back from the files.
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -361,6 +363,45 @@ TEST_F(FactoryCliTest, InterruptedBatchResumesWithoutLoss) {
   auto yields = ReadCsv(Run({"history", Path("store.db"), "--lot", "LOT-A", "--csv"}).out);
   ASSERT_EQ(yields.size(), 1u);
   EXPECT_EQ(yields[0]["units"], "5");
+}
+
+// The real thing: the batch is killed (SIGKILL, no clean-up) as soon as its first unit is finished.
+TEST_F(FactoryCliTest, KilledBatchResumesWithoutLoss) {
+  std::vector<std::string> storage = {IMUFIT_EXE};
+  for (const std::string& a : BatchArgs("out")) storage.push_back(a);
+  storage.insert(storage.end(), {"--jobs", "1", "-q"});
+  std::vector<char*> argv;
+  for (std::string& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, IMUFIT_EXE, nullptr, nullptr, argv.data(), environ), 0);
+  const fs::path first = dir_ / "out" / "unit-01" / "manifest.yaml";
+  constexpr int kPollLimit = 60000;  // x 1 ms
+  for (int i = 0; i < kPollLimit && !fs::exists(first); ++i) ::usleep(1000);
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(fs::exists(first));
+
+  const RunResult r = Run(BatchArgs("out"));
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  std::printf("resumed after the kill: %s", r.out.substr(0, r.out.find('\n') + 1).c_str());
+  auto summary = Summary("out");
+  ASSERT_EQ(summary.size(), kUnits);
+  EXPECT_EQ(summary["unit-04"]["verdict"], "FAIL");
+  EXPECT_EQ(summary["unit-05"]["status"], "error");
+  for (const char* serial : {"SN-01", "SN-02", "SN-04"}) {
+    const size_t rows = ReadCsv(Run({"history", Path("store.db"), "--serial", serial, "--csv"}).out).size();
+    EXPECT_GE(rows, 1u) << serial;  // twice for a unit killed between its store row and its manifest
+    EXPECT_LE(rows, 2u) << serial;
+  }
+  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
+  for (const auto& unit : fs::directory_iterator(dir_ / "out")) {
+    if (!unit.is_directory()) continue;
+    for (const auto& file : fs::directory_iterator(unit.path())) {
+      EXPECT_EQ(file.path().filename().string().find(".tmp-"), std::string::npos) << file.path();
+    }
+  }
 }
 
 TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
