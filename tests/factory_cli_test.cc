@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -445,6 +446,30 @@ TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
   r = Run({"history", Path("fit.db"), "--serial", "NO-SUCH-SERIAL"});
   EXPECT_EQ(r.status, kExitBadInput);
   EXPECT_NE(r.err.find("no calibrations of serial"), std::string::npos) << r.err;
+}
+
+// A run with a long static stretch gets the Allan deviation and the ARW in its certificate.
+TEST_F(FactoryCliTest, ReportShowsTheGyroNoiseOfALongStaticStretch) {
+  const std::string plan = Write("static_plan.yaml",
+                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+                                 "  - {id: 1, up: [0, 0, 1]}\n");
+  constexpr double kGyroNoiseDensity = 2e-4;  // rad/s/sqrt(Hz)
+  const RunResult sim = Run({"simulate", "--plan", plan, "--calibration", kFixtures + "/mems_truth.yaml",
+                             "-o", Path("static.csv"), "--rate", "10", "--dwell", "120", "--temps", "25",
+                             "--gyro-noise-density", "2e-4", "--seed", "9", "-q"});
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const RunResult r = Run({"report", "-c", kFixtures + "/mems_truth.yaml", "-p", plan, "-s",
+                           Path("static.csv"), "-o", Path("static.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string report = ReadBytes(Path("static.html"));
+  // ARW = noise density in deg/sqrt(h); 1200 samples fix it to a few percent (relative, per axis).
+  constexpr double kArwRelativeTolerance = 0.15;
+  const double expected_arw = kGyroNoiseDensity * 180.0 / M_PI * 60.0;
+  for (const char* axis : {"x", "y", "z"}) {
+    const std::string value = ReportFigure(report, std::string("gyro_arw_deg_per_sqrt_hr.") + axis);
+    ASSERT_NE(value, "<none>") << axis;
+    EXPECT_NEAR(std::stod(value), expected_arw, expected_arw * kArwRelativeTolerance) << axis;
+  }
 }
 
 // The certificate as a browser draws it: headless Chromium renders it to a PNG of the page's width.

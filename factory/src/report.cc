@@ -16,7 +16,10 @@
 #include <sstream>
 
 #include "imufit/io/output_file.h"
+#include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
+#include "imufit/noise/allan.h"
+#include "imufit/noise/noise_model.h"
 
 extern char** environ;
 
@@ -27,6 +30,10 @@ namespace fs = std::filesystem;
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kCurvePoints = 61;  // temperatures at which the coefficient curves are drawn
+// The Allan section needs a static stretch of at least this long (else it says why not).
+constexpr double kMinAllanStretchS = 60.0;
+constexpr int kNoiseTermRandomWalk = 1;       // N, rad/s * sqrt(s)  (noise_model.h: Q, N, B, K, R)
+constexpr int kNoiseTermBiasInstability = 2;  // B, rad/s
 const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
                                "#8c564b", "#e377c2", "#17becf", "#7f7f7f"};
 
@@ -232,6 +239,88 @@ std::string VerdictHtml(const Verdict& verdict) {
             "<td class=\"" + (c.pass ? "PASS" : "FAIL") + "\">" + (c.pass ? "PASS" : "FAIL") + "</td></tr>\n";
   }
   return html + "</table>\n";
+}
+
+// The Allan deviation of the gyro over the longest static stretch of the run (raw counts over the
+// 25 degC scale factor: rad/s), with the IEEE 952 fit's ARW and bias instability.
+std::string AllanSection(const UnitReport& r, const std::string& samples_path) {
+  std::string html = "<h2>Gyro noise (Allan deviation, longest static stretch)</h2>\n";
+  SamplesReader reader(samples_path, true);
+  std::vector<Sample> best, current;
+  Sample sample;
+  const auto close_stretch = [&] {
+    if (current.size() > best.size()) best.swap(current);
+    current.clear();
+  };
+  while (reader.Next(&sample)) {
+    const TableSegment* segment = r.plan.Find(sample.segment);
+    if (segment == nullptr || !segment->IsStatic() ||
+        (!current.empty() && current.back().segment != sample.segment)) {
+      close_stretch();
+    }
+    if (segment != nullptr && segment->IsStatic()) current.push_back(sample);
+  }
+  close_stretch();
+  const double duration_s = best.size() > 1 ? best.back().time_s - best.front().time_s : 0.0;
+  if (duration_s < kMinAllanStretchS) {
+    return html + "<p class=\"note\">Not drawn: the longest static stretch is " + Fmt("%.1f", duration_s) +
+           " s; at least " + Fmt("%.0f", kMinAllanStretchS) +
+           " s are needed (imufit allan on a long static log).</p>\n";
+  }
+  const double tau0_s = duration_s / (best.size() - 1);
+  std::vector<int64_t> factors;
+  AveragingFactors(TauSpec(), AllanEstimator::kOadev, static_cast<int64_t>(best.size()), tau0_s, &factors);
+  AllanOptions options;
+  options.threads = 1;
+  std::ostringstream gp;
+  gp.precision(10);
+  std::string table =
+      "<table><tr><th>axis</th><th>ARW, deg/&radic;h</th><th>bias instability, "
+      "deg/h</th><th>points</th></tr>\n";
+  const char* axes = "xyz";
+  for (int axis = 0; axis < 3; ++axis) {
+    const double scale = Coefficient(r.calibration, true, kScaleCoefficient + axis).c[0];
+    std::vector<double> rates;
+    for (const Sample& s : best) rates.push_back(s.gyro(axis) / scale);
+    const AllanResult allan = ComputeAllanFromRates(std::move(rates), tau0_s, factors, options);
+    const NoiseFitSummary fit = FitNoiseModel(allan.points, allan.n_samples);
+    gp << "$a" << axis << " << EOD\n";
+    for (const AllanPoint& p : allan.points) gp << p.tau_s << " " << p.dev * kRadToDeg * 3600.0 << "\n";
+    gp << "EOD\n";
+    const std::string name = std::string("gyro_") + axes[axis];
+    if (fit.fitted) {
+      const double arw = fit.value[kNoiseTermRandomWalk] * kRadToDeg * 60.0;
+      const double arw_sigma = fit.sigma[kNoiseTermRandomWalk] * kRadToDeg * 60.0;
+      const double bi = fit.value[kNoiseTermBiasInstability] * kRadToDeg * 3600.0;
+      const double bi_sigma = fit.sigma[kNoiseTermBiasInstability] * kRadToDeg * 3600.0;
+      table += "<tr><td>" + name + "</td><td class=\"num\" data-figure=\"gyro_arw_deg_per_sqrt_hr." +
+               axes[axis] + "\" data-value=\"" + FormatDouble(arw) + "\">" + Fmt("%.4g", arw) + " &plusmn; " +
+               Fmt("%.2g", arw_sigma) + "</td>" +
+               Num(Fmt("%.4g", bi) + " &plusmn; " + Fmt("%.2g", bi_sigma)) +
+               Num(std::to_string(fit.points_used)) + "</tr>\n";
+    } else {
+      table += "<tr><td>" + name + "</td><td colspan=\"3\">not fitted: " + HtmlEscape(fit.message) +
+               "</td></tr>\n";
+    }
+  }
+  table += "</table>\n";
+  gp << kTerminal
+     << "set output '@OUT0@'\nset logscale xy\nset format y '%g'\nset grid xtics ytics mxtics mytics\n"
+     << "set title "
+     << GnuplotQuote("Gyro overlapping Allan deviation, segment " + std::to_string(best.front().segment) +
+                     Fmt(", %.0f s", duration_s) + Fmt(" at %.1f degC", best.front().temp_c))
+     << "\nset xlabel 'tau, s'\nset ylabel 'deg/h'\nset key outside right top\nplot ";
+  for (int axis = 0; axis < 3; ++axis) {
+    gp << (axis ? ", " : "") << "$a" << axis << " using 1:2 with linespoints pt 7 ps 0.6 lw 2 lc rgb '"
+       << kColors[axis] << "' title '" << axes[axis] << "'";
+  }
+  gp << "\nunset output\nreset\n";
+  try {
+    html += Plots(RunGnuplotSvg(gp.str(), 1), "");
+  } catch (const std::exception& e) {
+    html += Plots({}, e.what());
+  }
+  return html + table;
 }
 
 }  // namespace
@@ -445,6 +534,15 @@ std::string UnitReportHtml(const UnitReport& r) {
          << Num(Fmt("%.4f", s.accel_max_mps2 / kStandardGravityMps2 * 1e3)) << "</tr>\n";
   }
   html << "</table>\n";
+
+  for (const ReportInput& in : r.inputs) {
+    if (in.role != "samples") continue;
+    try {
+      html << AllanSection(r, in.path);
+    } catch (const std::exception& e) {
+      html << "<p class=\"note\">Allan deviation not computed: " << HtmlEscape(e.what()) << "</p>\n";
+    }
+  }
 
   html << "<h2>Validation (leave one temperature out)</h2>\n";
   if (r.folds.empty()) {

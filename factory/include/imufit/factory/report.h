@@ -5,7 +5,8 @@
 // the plan summary and the temperature range covered, every coefficient at 25 degC with 1-sigma
 // in familiar units (acceptance.h gives the conversions), each coefficient group against
 // temperature with a 1-sigma band, the residuals of the calibration per plan segment and
-// temperature, the leave-one-temperature-out validation errors (when run), and the acceptance
+// temperature, the gyro Allan deviation with ARW and bias instability over the longest static
+// stretch (at least 60 s), the leave-one-temperature-out validation errors (when run), and the acceptance
 // verdict criterion by criterion. Key numbers carry machine-readable attributes
 // (data-figure="gyro_bias_dps.x" data-value="..."), so tests and tools can read them back.
 //
