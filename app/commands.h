@@ -1,7 +1,7 @@
 // imufit — the subcommands of the `imufit` program. Each Add*Command registers its options on
 // `root` and returns the function that runs it once the command line has been parsed; that
 // function returns the exit status of SPEC.md section 4 (0 done, 1 could not be done, 2 bad
-// input) and lets InputError escape to main(), which prints it and returns 2.
+// input; 3 done but failed acceptance limits) and lets InputError escape to main(), which prints it and returns 2.
 #ifndef IMUFIT_APP_COMMANDS_H_
 #define IMUFIT_APP_COMMANDS_H_
 
@@ -18,6 +18,13 @@ CommandRunner AddApplyCommand(CLI::App* root);
 CommandRunner AddFitCommand(CLI::App* root);
 CommandRunner AddSimulateCommand(CLI::App* root);
 CommandRunner AddAllanCommand(CLI::App* root);
+CommandRunner AddBatchCommand(CLI::App* root);
+CommandRunner AddHistoryCommand(CLI::App* root);
+CommandRunner AddReportCommand(CLI::App* root);
+
+// Exit status 3 (an addition to SPEC.md section 4, docs/factory.md): the job was done, but a unit
+// failed its acceptance limits (or, in a batch, could not be fitted).
+inline constexpr int kExitFailedLimits = 3;
 
 // "imufit 0.1.0 (git abc123)" — the software string written into calibration files.
 std::string SoftwareVersion();

@@ -2,12 +2,18 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "commands.h"
+#include "imufit/factory/acceptance.h"
+#include "imufit/factory/report.h"
+#include "imufit/factory/store.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
+#include "imufit/io/sha256.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
@@ -26,6 +32,9 @@ struct FitArguments {
   bool no_g_sensitivity = false;
   bool validate = false;
   bool quiet = false;
+  std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
+  std::string report;  // certificate HTML to write
+  std::string store;   // results store to record the fit in
   double gyro_bias_stability_dph = 0.0;
   double accel_bias_stability_ug = 0.0;
   FitOptions fit;
@@ -87,8 +96,58 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
   }
 }
 
+// --limits, --report, --store: the factory additions, after the calibration is written.
+// Returns the exit status: 0, or kExitFailedLimits.
+int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result) {
+  const Calibration& calibration = *result.calibration;
+  std::optional<Verdict> verdict;
+  if (limits) {
+    verdict = EvaluateLimits(*limits, calibration);
+    if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
+  }
+  std::string plan_sha256, samples_sha256;
+  if (!args.report.empty() || !args.store.empty()) {
+    plan_sha256 = Sha256OfFile(args.plan);
+    samples_sha256 = Sha256OfFile(args.samples);
+  }
+  if (!args.report.empty()) {
+    UnitReport report = MakeUnitReport(calibration, result.plan, result.run,
+                                       {{"plan", args.plan, plan_sha256},
+                                        {"samples", args.samples, samples_sha256},
+                                        {"limits", args.limits, ""}},
+                                       verdict);
+    report.folds = result.folds;
+    WriteUnitReport(args.report, report);
+    if (!args.quiet) std::printf("  wrote %s\n", args.report.c_str());
+  }
+  if (!args.store.empty()) {
+    StoredFit row;
+    row.serial = calibration.serial.empty() ? args.samples : calibration.serial;
+    row.unit = args.samples;
+    row.time_utc = calibration.created_utc;
+    row.software = calibration.software;
+    row.plan_sha256 = plan_sha256;
+    row.samples_sha256 = samples_sha256;
+    row.limits_sha256 = args.limits.empty() ? "" : Sha256OfFile(args.limits);
+    row.status = "fitted";
+    row.verdict = verdict ? (verdict->pass ? "PASS" : "FAIL") : "";
+    row.message = verdict ? verdict->FailedSummary() : "";
+    row.calibration_yaml = CalibrationToYaml(calibration);
+    row.figures = KeyFigures(calibration);
+    ResultsStore(args.store).Record(row);
+    if (!args.quiet) std::printf("  recorded in %s\n", args.store.c_str());
+  }
+  return verdict && !verdict->pass ? kExitFailedLimits : 0;
+}
+
 int RunFit(FitArguments args) {
-  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples});
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits});
+  if (!args.report.empty()) {
+    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits, args.output});
+  }
+  // A bad limits file is reported before any work.
+  std::optional<Limits> limits;
+  if (!args.limits.empty()) limits = ReadLimits(args.limits);
   std::string error;
   if (!ParseRobustLoss(args.loss, &args.fit.loss, &error)) throw InputError("--loss", error);
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
@@ -123,7 +182,7 @@ int RunFit(FitArguments args) {
   }
   WriteCalibration(args.output, *result.calibration);
 
-  if (args.quiet) return 0;
+  if (args.quiet) return FinishFactory(args, limits, result);
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
   std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
@@ -166,7 +225,7 @@ int RunFit(FitArguments args) {
     PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
   }
   std::printf("  wrote %s\n", args.output.c_str());
-  return 0;
+  return FinishFactory(args, limits, result);
 }
 
 }  // namespace
@@ -219,6 +278,10 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--check-samples", args->check_samples, "a held-out run to report the calibration's errors on");
   command->add_option("--check-plan", args->check_plan, "the plan of --check-samples (default: --plan)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  command->add_option("--limits,-l", args->limits,
+                      "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
+  command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
+  command->add_option("--store", args->store, "record the fit in this results store (SQLite; created when missing)");
   return [args] { return RunFit(*args); };
 }
 

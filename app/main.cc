@@ -21,8 +21,8 @@ int main(int argc, char** argv) {
       "imufit: thermal calibration of inertial measurement units.\n"
       "Fits gyro and accelerometer biases, scale factors, misalignments, gyro g-sensitivity and\n"
       "their cubic temperature dependence from rate-table runs, applies calibrations, simulates\n"
-      "runs and characterises noise. Exit status: 0 done, 1 the job could not be done, 2 bad\n"
-      "invocation or bad input.",
+      "runs and characterises noise; runs factory batches with acceptance limits. Exit status: 0 done,\n"
+      "1 the job could not be done, 2 bad invocation or bad input, 3 done but acceptance limits failed.",
       "imufit"};
   app.set_version_flag("--version", std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
   app.require_subcommand(1);
@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   add(imufit::AddApplyCommand(&app));
   add(imufit::AddSimulateCommand(&app));
   add(imufit::AddAllanCommand(&app));
+  add(imufit::AddBatchCommand(&app));
+  add(imufit::AddHistoryCommand(&app));
+  add(imufit::AddReportCommand(&app));
 
   try {
     app.parse(argc, argv);

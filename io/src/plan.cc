@@ -34,14 +34,7 @@ Plan ReadPlan(const std::string& path) {
   const yaml::Located root{&path, root_node, ""};
   if (!root_node.IsMap()) throw InputError(path, "not an imufit plan (expected a YAML mapping)");
   root.RejectUnknownKeys({"format", "version", "gravity_mps2", "latitude_deg", "serial", "segments"});
-  if (root["format"].String() != "imufit-plan") {
-    root["format"].Fail(QuoteForMessage(root["format"].String()) + " is not \"imufit-plan\"");
-  }
-  const long version = root["version"].Integer();
-  if (version < 1 || version > kPlanFormatVersion) {
-    root["version"].Fail("version " + std::to_string(version) + " is not supported (this imufit reads version " +
-                         std::to_string(kPlanFormatVersion) + ")");
-  }
+  root.RequireFormat("imufit-plan", kPlanFormatVersion);
   Plan plan;
   plan.path = path;
   plan.site.gravity_mps2 = root["gravity_mps2"].Double();

@@ -112,4 +112,16 @@ std::vector<double> Located::Doubles(size_t count) const {
   return values;
 }
 
+long Located::RequireFormat(const std::string& format, long max_version) const {
+  if ((*this)["format"].String() != format) {
+    (*this)["format"].Fail(QuoteForMessage((*this)["format"].String()) + " is not \"" + format + "\"");
+  }
+  const long version = (*this)["version"].Integer();
+  if (version < 1 || version > max_version) {
+    (*this)["version"].Fail("version " + std::to_string(version) + " is not supported (this imufit reads version " +
+                            std::to_string(max_version) + ")");
+  }
+  return version;
+}
+
 }  // namespace imufit::yaml

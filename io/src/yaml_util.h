@@ -31,6 +31,8 @@ struct Located {
   long Integer() const;
   std::string String() const;
   std::vector<double> Doubles(size_t count) const;  // a sequence of exactly `count` numbers
+  // Checks the `format` and `version` keys of a versioned imufit file; returns the version.
+  long RequireFormat(const std::string& format, long max_version) const;
 };
 
 }  // namespace imufit::yaml

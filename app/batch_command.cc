@@ -1,0 +1,102 @@
+// imufit batch — fits every unit of a lot, judges it against acceptance limits, writes each unit's
+// calibration (and report) and the lot summary, records every fit in the results store.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "imufit/factory/batch.h"
+#include "imufit/io/error.h"
+
+namespace imufit {
+namespace {
+
+struct BatchArguments {
+  BatchOptions batch;
+  bool no_report = false;
+  bool quiet = false;
+};
+
+// Units done, rate and time left: one updating line on a terminal, plain lines otherwise.
+void ShowProgress(const BatchProgress& p, bool terminal) {
+  const int fitted = p.done - p.skipped;
+  const double rate = p.elapsed_s > 0.0 && fitted > 0 ? fitted / p.elapsed_s : 0.0;
+  const double left_s = rate > 0.0 ? (p.total - p.done) / rate : 0.0;
+  const UnitOutcome& u = *p.last;
+  const std::string outcome =
+      u.skipped ? "unchanged, skipped" : u.status + (u.verdict.empty() ? "" : " " + u.verdict);
+  if (terminal) {
+    std::fprintf(stderr, "\r\033[K[%d/%d] %.2f units/s, %.0f s left; %s: %s", p.done, p.total, rate, left_s,
+                 u.unit.c_str(), outcome.c_str());
+    if (p.done == p.total) std::fprintf(stderr, "\n");
+  } else {
+    std::fprintf(stderr, "imufit batch: [%d/%d] %s: %s%s%s (%.1f s; %.2f units/s, %.0f s left)\n", p.done,
+                 p.total, u.unit.c_str(), outcome.c_str(), u.message.empty() ? "" : ": ", u.message.c_str(),
+                 u.seconds, rate, left_s);
+  }
+  std::fflush(stderr);
+}
+
+int RunBatchCommand(BatchArguments args) {
+  BatchOptions& options = args.batch;
+  options.fit.software = SoftwareVersion();
+  options.fit.fit.num_threads = 1;  // parallel over units instead
+  const bool terminal = isatty(STDERR_FILENO) != 0;
+  if (!args.quiet) options.progress = [terminal](const BatchProgress& p) { ShowProgress(p, terminal); };
+  options.write_reports = !args.no_report;
+  const BatchResult result = RunBatch(options);
+  if (!args.quiet) {
+    std::printf(
+        "imufit batch: %zu units: %d passed, %d failed limits, %d not fitted, %d errors; %d unchanged and "
+        "skipped\n",
+        result.units.size(), result.passed, result.failed, result.not_fitted, result.errors, result.skipped);
+    for (const UnitOutcome& u : result.units) {
+      if (u.verdict == "PASS" || (u.verdict.empty() && u.status == "fitted")) continue;
+      std::printf("  %s (%s): %s%s%s\n", u.unit.c_str(), u.serial.c_str(),
+                  u.verdict.empty() ? u.status.c_str() : u.verdict.c_str(), u.message.empty() ? "" : ": ",
+                  u.message.c_str());
+    }
+    if (result.complete) std::printf("  wrote %s/lot_summary.csv\n", options.output_dir.c_str());
+  }
+  if (!result.complete) {
+    std::fprintf(stderr, "imufit batch: stopped after --max-units %d; run again to finish the lot\n",
+                 options.max_units);
+    return 1;
+  }
+  return result.failed + result.not_fitted + result.errors > 0 ? kExitFailedLimits : 0;
+}
+
+}  // namespace
+
+CommandRunner AddBatchCommand(CLI::App* root) {
+  auto args = std::make_shared<BatchArguments>();
+  BatchOptions& b = args->batch;
+  CLI::App* command = root->add_subcommand(
+      "batch",
+      "Fit every unit of a lot: each folder of UNITS_DIR is a unit (plan.yaml and samples.csv[.gz], or "
+      "samples "
+      "only with --plan). Writes OUT_DIR/<unit>/calibration.yaml, report.html and manifest.yaml, and "
+      "OUT_DIR/lot_summary.csv; a re-run skips units whose inputs and software are unchanged. Exit 0 every "
+      "unit "
+      "passed, 3 some unit failed its limits or could not be fitted, 1 stopped early, 2 bad invocation.");
+  command->add_option("units_dir", b.units_dir, "folder of unit folders")->required();
+  command->add_option("--output,-o", b.output_dir, "output folder")->required();
+  command->add_option("--limits,-l", b.limits_path, "acceptance limits YAML (format imufit-limits)");
+  command->add_option("--plan,-p", b.shared_plan, "plan for units without their own plan.yaml");
+  command->add_option("--store", b.store_path, "results store (SQLite) to record every fit in");
+  command->add_option("--lot", b.lot, "the lot's name in the store (default: the units folder's name)");
+  command->add_option("--jobs,-j", b.jobs, "units fitted in parallel (0: all cores)")->capture_default_str();
+  command
+      ->add_option("--max-units", b.max_units,
+                   "stop after fitting this many units (0: all); a later run resumes the lot")
+      ->capture_default_str();
+  command->add_flag("--no-report", args->no_report, "write no report.html per unit");
+  command->add_flag("--validate", b.fit.validate,
+                    "leave each interior temperature out in turn, refit, and put the errors in the reports");
+  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  return [args] { return RunBatchCommand(*args); };
+}
+
+}  // namespace imufit

@@ -1,0 +1,88 @@
+// imufit — a batch: every unit of a lot fitted, judged and recorded (`imufit batch`).
+//
+// UNITS_DIR holds one folder per unit: plan.yaml + samples.csv (or samples.csv.gz), or samples
+// only when a shared plan is given. Units are fitted in parallel (a pool of `jobs` threads, one
+// unit each, one solver thread per unit); a unit's failure never stops the others. For each unit
+// OUT_DIR/<unit>/ receives, each file atomically and in this order: calibration.yaml (when
+// fitted), report.html (with write_reports), then manifest.yaml last. The manifest
+// holds the SHA-256 of the unit's inputs (plan, samples, limits) and the software version;
+// a re-run skips a unit whose manifest matches, so a batch killed half way and run again redoes
+// only the units that had not finished. The lot summary OUT_DIR/lot_summary.csv is written at the
+// end from every unit's outcome (fitted now or before).
+#ifndef IMUFIT_FACTORY_BATCH_H_
+#define IMUFIT_FACTORY_BATCH_H_
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imufit/factory/acceptance.h"
+#include "imufit/io/limits.h"
+#include "imufit/pipeline/fit_run.h"
+
+namespace imufit {
+
+// One unit's outcome.
+struct UnitOutcome {
+  std::string unit;     // the folder name
+  std::string serial;   // the plan's serial, else the unit folder name
+  std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
+  std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
+  std::string message;  // the failed criteria, or why it was not fitted
+  std::vector<Figure> figures;
+  std::string plan_path;
+  std::string samples_path;
+  std::string plan_sha256;
+  std::string samples_sha256;
+  bool skipped = false;  // unchanged since a previous run: nothing redone
+  double seconds = 0.0;
+  // The fit's result and the calibration (not filled for skipped units).
+  std::optional<FitRunResult> fit;
+  Verdict verdict_detail;
+};
+
+struct BatchProgress {
+  int done = 0;  // units finished (skipped ones included)
+  int skipped = 0;
+  int total = 0;
+  double elapsed_s = 0.0;
+  const UnitOutcome* last = nullptr;  // the unit that just finished
+};
+
+struct BatchOptions {
+  std::string units_dir;
+  std::string output_dir;
+  std::string limits_path;  // empty: no verdicts
+  std::string shared_plan;  // used by units without their own plan.yaml
+  std::string store_path;   // empty: no results store
+  std::string lot;          // the lot's name in the store; empty: the units folder's name
+  // Worker threads; 0: all cores.
+  int jobs = 0;
+  // Stop after this many units have been fitted in this run (0: no limit) — for tests of resuming.
+  int max_units = 0;
+  FitRunOptions fit;
+  // Write OUT_DIR/<unit>/report.html for each fitted unit and OUT_DIR/lot.html (report.h).
+  bool write_reports = true;
+  // Called under a lock after each unit finishes (from whichever thread finished it).
+  std::function<void(const BatchProgress&)> progress;
+
+  std::string Validate() const;
+};
+
+struct BatchResult {
+  std::vector<UnitOutcome> units;  // in folder-name order
+  int passed = 0, failed = 0, not_fitted = 0, errors = 0, skipped = 0;
+  bool complete = true;  // false when max_units stopped the batch early
+};
+
+// Throws InputError for a bad units folder, output folder, limits file or store; never for one
+// unit's bad input (that unit's status is "error").
+BatchResult RunBatch(const BatchOptions& options);
+
+// The unit's key figures in the lot summary, in column order.
+extern const std::vector<std::string> kSummaryFigures;
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FACTORY_BATCH_H_

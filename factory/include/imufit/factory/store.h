@@ -1,0 +1,90 @@
+// imufit — the results store: every fit of a unit recorded in an embedded SQLite database.
+//
+// Schema (version kStoreSchemaVersion, docs/factory.md):
+//   schema_version(version)                       one row
+//   fits(id, serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, limits_sha256,
+//        status, verdict, message, calibration_yaml)
+//   figures(fit_id -> fits.id, name, coefficient, unit, value, sigma)   the key figures at 25 degC
+// The database runs in WAL mode; Record() writes one fit and its figures in one transaction, so a
+// crash loses at most the fit being written and never leaves half a fit. Errors (the file cannot
+// be opened, is not an imufit store, has a newer schema) are InputErrors naming the file.
+#ifndef IMUFIT_FACTORY_STORE_H_
+#define IMUFIT_FACTORY_STORE_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "imufit/factory/acceptance.h"
+
+struct sqlite3;
+
+namespace imufit {
+
+inline constexpr int kStoreSchemaVersion = 1;
+
+struct StoredFit {
+  int64_t id = 0;
+  std::string serial;
+  std::string unit;  // the unit folder of a batch, or the samples file of `imufit fit`
+  std::string lot;   // the batch's lot name; empty for a single fit
+  std::string time_utc;
+  std::string software;
+  std::string plan_sha256;
+  std::string samples_sha256;
+  std::string limits_sha256;  // empty without limits
+  std::string status;         // "fitted", "not-fitted" (the run does not determine the model), "error"
+  std::string verdict;        // "PASS", "FAIL", "" (no limits, or not fitted)
+  std::string message;        // failed criteria, or why it was not fitted
+  std::string calibration_yaml;
+  std::vector<Figure> figures;
+};
+
+struct LotYield {
+  std::string lot;
+  int units = 0;  // distinct units, each counted by its latest fit
+  int passed = 0;
+  int failed = 0;
+  int not_fitted = 0;  // not-fitted or error
+};
+
+struct TrendPoint {
+  std::string time_utc;
+  std::string serial;
+  std::string lot;
+  double value = 0.0;
+  double sigma = -1.0;
+  std::string unit;
+};
+
+class ResultsStore {
+ public:
+  // Opens the database at `path`, creating it (and its schema) when it does not exist.
+  explicit ResultsStore(const std::string& path);
+  ~ResultsStore();
+  ResultsStore(const ResultsStore&) = delete;
+  ResultsStore& operator=(const ResultsStore&) = delete;
+
+  // Records one fit in one transaction; returns its id.
+  int64_t Record(const StoredFit& fit);
+
+  // Every fit of a serial, oldest first, with figures.
+  std::vector<StoredFit> BySerial(const std::string& serial);
+  // Yield per lot (one lot when `lot` is not empty), by each unit's latest fit in the lot.
+  std::vector<LotYield> Yield(const std::string& lot);
+  // One key figure (a Figure name such as "gyro_bias_dps.x" or coefficient path "gyro.bias.x")
+  // over time, oldest first; optionally of one serial.
+  std::vector<TrendPoint> Trend(const std::string& figure, const std::string& serial);
+
+ private:
+  void Open();  // pragmas, schema, version check
+  void Execute(const std::string& sql);
+  [[noreturn]] void Fail(const std::string& what);
+
+  std::string path_;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FACTORY_STORE_H_

@@ -1,0 +1,219 @@
+#include "imufit/factory/acceptance.h"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <utility>
+
+namespace imufit {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+std::string Number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+double Term0(const double* params, int coefficient) { return params[coefficient * kPolynomialTerms]; }
+
+double FitNumber(const Calibration& calibration, const char* key, bool* found) {
+  *found = false;
+  if (!calibration.extra || !calibration.extra.IsMap() || !calibration.extra["fit"]) return 0.0;
+  const YAML::Node node = calibration.extra["fit"][key];
+  if (!node || !node.IsScalar()) return 0.0;
+  try {
+    const double value = node.as<double>();
+    *found = value >= 0.0;
+    return value;
+  } catch (const YAML::Exception&) {
+    return 0.0;
+  }
+}
+
+// [value, 1-sigma] of noise.columns.gyro_<axis>.<key>, when there.
+std::optional<std::array<double, 2>> NoiseFigure(const Calibration& calibration, const char* axis,
+                                                 const char* key) {
+  if (!calibration.extra || !calibration.extra.IsMap()) return std::nullopt;
+  try {
+    const YAML::Node node = calibration.extra["noise"]["columns"][std::string("gyro_") + axis][key];
+    if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
+    return std::array<double, 2>{node[0].as<double>(), node[1].as<double>()};
+  } catch (const YAML::Exception&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+std::vector<Figure> KeyFigures(const Calibration& calibration) {
+  const double* gyro = calibration.model.gyro.data();
+  const double* accel = calibration.model.accel.data();
+  const double* gyro_sigma = calibration.sigma ? calibration.sigma->gyro.data() : nullptr;
+  const double* accel_sigma = calibration.sigma ? calibration.sigma->accel.data() : nullptr;
+  std::vector<Figure> figures;
+  const auto add = [&](std::string quantity, std::string sensor, int coefficient, const char* unit,
+                       double factor, const double* params, const double* sigma) {
+    const CoefficientName& n = kCoefficientNames[coefficient];
+    figures.push_back({quantity + "." + n.axis, sensor + "." + n.group + "." + n.axis, unit,
+                       Term0(params, coefficient) * factor,
+                       sigma ? Term0(sigma, coefficient) * std::abs(factor) : -1.0});
+  };
+  for (int i = 0; i < 3; ++i) {
+    add("gyro_bias_dps", "gyro", kBiasCoefficient + i, "deg/s",
+        kRadToDeg / Term0(gyro, kScaleCoefficient + i), gyro, gyro_sigma);
+  }
+  for (int i = 0; i < 3; ++i) {
+    add("accel_bias_mg", "accel", kBiasCoefficient + i, "mg",
+        1e3 / (Term0(accel, kScaleCoefficient + i) * kStandardGravityMps2), accel, accel_sigma);
+  }
+  for (int i = 0; i < 3; ++i)
+    add("gyro_scale_per_dps", "gyro", kScaleCoefficient + i, "raw/(deg/s)", 1.0 / kRadToDeg, gyro,
+        gyro_sigma);
+  for (int i = 0; i < 3; ++i)
+    add("accel_scale_per_g", "accel", kScaleCoefficient + i, "raw/g", kStandardGravityMps2, accel,
+        accel_sigma);
+  for (int m = 0; m < 6; ++m)
+    add("gyro_misalignment_mrad", "gyro", kMisalignmentCoefficient + m, "mrad", 1e3, gyro, gyro_sigma);
+  for (int m = 0; m < 6; ++m)
+    add("accel_misalignment_mrad", "accel", kMisalignmentCoefficient + m, "mrad", 1e3, accel, accel_sigma);
+  for (int h = 0; h < 9; ++h) {
+    add("gyro_g_sensitivity_dpsg", "gyro", kGSensitivityCoefficient + h, "deg/s/g",
+        kRadToDeg * kStandardGravityMps2 / Term0(gyro, kScaleCoefficient + h / 3), gyro, gyro_sigma);
+  }
+  // Noise figures, when the calibration carries a `noise:` block (imufit allan --noise-yaml,
+  // docs/allan.md): [value, 1-sigma] per gyro column.
+  const char* axes[] = {"x", "y", "z"};
+  struct NoiseKey {
+    const char* name;
+    const char* key;
+    const char* unit;
+  };
+  const NoiseKey noise_keys[] = {{"gyro_arw_deg_per_sqrt_hr", "arw_deg_per_sqrt_hr", "deg/sqrt(h)"},
+                                 {"gyro_bias_instability_dph", "bias_instability_deg_per_hr", "deg/h"}};
+  for (const auto& [name, key, unit] : noise_keys) {
+    for (const char* axis : axes) {
+      if (const std::optional<std::array<double, 2>> pair = NoiseFigure(calibration, axis, key)) {
+        figures.push_back({std::string(name) + "." + axis, std::string("noise.gyro_") + axis + "." + key,
+                           unit, (*pair)[0], (*pair)[1]});
+      }
+    }
+  }
+  bool found = false;
+  const double gyro_rms = FitNumber(calibration, "gyro_residual_rms_radps", &found);
+  if (found)
+    figures.push_back(
+        {"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", gyro_rms * kRadToDeg, -1.0});
+  const double accel_rms = FitNumber(calibration, "accel_residual_rms_mps2", &found);
+  if (found) {
+    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg",
+                       accel_rms / kStandardGravityMps2 * 1e3, -1.0});
+  }
+  return figures;
+}
+
+const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name) {
+  for (const Figure& f : figures) {
+    if (f.name == name || f.coefficient == name) return &f;
+  }
+  return nullptr;
+}
+
+int Verdict::Failed() const {
+  int failed = 0;
+  for (const CriterionResult& c : criteria) failed += c.pass ? 0 : 1;
+  return failed;
+}
+
+std::string Verdict::FailedSummary() const {
+  std::string text;
+  for (const CriterionResult& c : criteria) {
+    if (c.pass) continue;
+    text += (text.empty() ? "" : "; ") + c.name + " " + c.measured_text + " (limit " + c.limit_text + ")";
+  }
+  return text;
+}
+
+std::string Verdict::Table() const {
+  std::string text;
+  char line[256];
+  std::snprintf(line, sizeof line, "  acceptance%s%s: %s (%d of %zu criteria failed)\n",
+                limits_name.empty() ? "" : " ", limits_name.c_str(), pass ? "PASS" : "FAIL", Failed(),
+                criteria.size());
+  text += line;
+  std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", "criterion", "measured", "limit",
+                "margin", "verdict");
+  text += line;
+  for (const CriterionResult& c : criteria) {
+    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", c.name.c_str(),
+                  c.measured_text.c_str(), c.limit_text.c_str(), (Number(c.margin) + " " + c.unit).c_str(),
+                  c.pass ? "PASS" : "FAIL");
+    text += line;
+  }
+  return text;
+}
+
+Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration) {
+  Verdict verdict;
+  verdict.limits_name = limits.name;
+  const std::vector<Figure> figures = KeyFigures(calibration);
+  for (const LimitCriterion& criterion : limits.criteria) {
+    const bool sigma = criterion.statistic == LimitStatistic::kSigma;
+    if (criterion.kind == LimitKind::kCoverage) {
+      CriterionResult r;
+      r.name = criterion.quantity;
+      r.unit = criterion.unit;
+      const auto& range = calibration.fit_temp_range_c;
+      r.margin = std::min(criterion.covers_c[0] - range[0], range[1] - criterion.covers_c[1]);
+      r.measured = r.margin;
+      r.limit = 0.0;
+      r.measured_text = Number(range[0]) + ".." + Number(range[1]) + " degC";
+      r.limit_text = "covers " + Number(criterion.covers_c[0]) + ".." + Number(criterion.covers_c[1]);
+      r.pass = r.margin >= 0.0;
+      verdict.criteria.push_back(r);
+      continue;
+    }
+    std::vector<std::string> names;
+    if (criterion.axes.empty()) names.push_back(criterion.quantity);
+    for (const std::string& axis : criterion.axes) names.push_back(criterion.quantity + "." + axis);
+    for (const std::string& name : names) {
+      CriterionResult r;
+      r.name = sigma ? "sigma(" + name + ")" : criterion.kind == LimitKind::kFigure ? name : "|" + name + "|";
+      r.unit = criterion.unit;
+      r.limit = criterion.max_abs;
+      r.limit_text = "< " + Number(criterion.max_abs) + " " + criterion.unit;
+      // Scale errors are relative to the nominal scale the limits file gives.
+      const size_t error_at = name.find("_scale_error_");
+      bool found = true;
+      if (error_at != std::string::npos) {
+        const bool gyro = name.rfind("gyro", 0) == 0;
+        const std::string axis = name.substr(name.rfind('.') + 1);
+        const Figure* scale = FindFigure(figures, std::string(gyro ? "gyro" : "accel") + ".scale." + axis);
+        const double nominal =
+            gyro ? limits.nominal_gyro_scale / kRadToDeg : limits.nominal_accel_scale * kStandardGravityMps2;
+        const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
+        r.measured = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
+        found = !sigma || scale->sigma >= 0.0;
+      } else {
+        const Figure* figure = FindFigure(figures, name);
+        found = figure != nullptr && (!sigma || figure->sigma >= 0.0);
+        if (found) r.measured = sigma ? figure->sigma : figure->value;
+      }
+      if (!found) {
+        r.measured_text = "not in calibration";
+        r.margin = -r.limit;
+        r.pass = false;
+      } else {
+        r.measured_text = Number(r.measured) + " " + criterion.unit;
+        r.margin = r.limit - std::abs(r.measured);
+        r.pass = r.margin > 0.0;
+      }
+      verdict.criteria.push_back(r);
+    }
+  }
+  for (const CriterionResult& c : verdict.criteria) verdict.pass = verdict.pass && c.pass;
+  return verdict;
+}
+
+}  // namespace imufit

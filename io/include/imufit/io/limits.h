@@ -1,0 +1,84 @@
+// imufit — the acceptance limits file (docs/factory.md): what a unit must meet to pass.
+//
+//   format: imufit-limits
+//   version: 1
+//   name: "MEMS-A acceptance, rev B"       # optional, printed with the verdict
+//   nominal:                                # needed by the *_scale_error_* quantities
+//     gyro_scale: 939.65                    #   raw per rad/s
+//     accel_scale: 208.838                  #   raw per m/s^2
+//   criteria:
+//     - {quantity: gyro_bias_dps, max_abs: 0.5}                  # every axis
+//     - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.05, axes: [xx, yy, zz]}
+//     - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}   # the 1-sigma, not the value
+//     - {quantity: fit_temp_range_c, covers: [-20, 60]}
+//
+// Quantities are the 25 degC values of coefficients in familiar units (kLimitQuantities), fit
+// residual RMS values, and the fitted temperature range. The reader checks every name, axis and
+// number and throws InputError at file:line:column; evaluation is imufit::factory's.
+#ifndef IMUFIT_IO_LIMITS_H_
+#define IMUFIT_IO_LIMITS_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace imufit {
+
+inline constexpr int kLimitsFormatVersion = 1;
+
+enum class LimitKind {
+  kCoefficient,  // a 25 degC coefficient value per axis: |value| (or its 1-sigma) < max_abs
+  kFigure,       // one number without axes (residual RMS): value < max_abs
+  kCoverage,     // fit_temp_range_c must cover [lo, hi]
+};
+
+struct LimitQuantity {
+  const char* name;  // as written in the file, unit in the name
+  LimitKind kind;
+  const char* axes;  // space-separated axis names of a coefficient quantity, "" otherwise
+  const char* unit;  // for tables: "deg/s", "ppm", ...
+};
+
+inline constexpr LimitQuantity kLimitQuantities[] = {
+    {"gyro_bias_dps", LimitKind::kCoefficient, "x y z", "deg/s"},
+    {"accel_bias_mg", LimitKind::kCoefficient, "x y z", "mg"},
+    {"gyro_scale_error_ppm", LimitKind::kCoefficient, "x y z", "ppm"},
+    {"gyro_scale_error_pct", LimitKind::kCoefficient, "x y z", "%"},
+    {"accel_scale_error_ppm", LimitKind::kCoefficient, "x y z", "ppm"},
+    {"accel_scale_error_pct", LimitKind::kCoefficient, "x y z", "%"},
+    {"gyro_misalignment_mrad", LimitKind::kCoefficient, "xy xz yx yz zx zy", "mrad"},
+    {"accel_misalignment_mrad", LimitKind::kCoefficient, "xy xz yx yz zx zy", "mrad"},
+    {"gyro_g_sensitivity_dpsg", LimitKind::kCoefficient, "xx xy xz yx yy yz zx zy zz", "deg/s/g"},
+    {"gyro_residual_rms_dps", LimitKind::kFigure, "", "deg/s"},
+    {"accel_residual_rms_mg", LimitKind::kFigure, "", "mg"},
+    {"fit_temp_range_c", LimitKind::kCoverage, "", "degC"},
+    // From a `noise:` block in the calibration (imufit allan --noise-yaml appended to it).
+    {"gyro_arw_deg_per_sqrt_hr", LimitKind::kCoefficient, "x y z", "deg/sqrt(h)"},
+    {"gyro_bias_instability_dph", LimitKind::kCoefficient, "x y z", "deg/h"},
+};
+
+enum class LimitStatistic { kValue, kSigma };
+
+struct LimitCriterion {
+  std::string quantity;  // a kLimitQuantities name
+  LimitKind kind = LimitKind::kCoefficient;
+  std::string unit;
+  std::vector<std::string> axes;  // the axes checked (all of the quantity's when not given)
+  LimitStatistic statistic = LimitStatistic::kValue;
+  double max_abs = 0.0;                      // kCoefficient, kFigure: the limit, > 0
+  std::array<double, 2> covers_c{0.0, 0.0};  // kCoverage: lo < hi
+};
+
+struct Limits {
+  std::string path;
+  std::string name;
+  double nominal_gyro_scale = 0.0;   // raw per rad/s; 0: not given
+  double nominal_accel_scale = 0.0;  // raw per m/s^2; 0: not given
+  std::vector<LimitCriterion> criteria;
+};
+
+Limits ReadLimits(const std::string& path);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_LIMITS_H_

@@ -1,0 +1,38 @@
+// imufit — SHA-256 (FIPS 180-4), for the input hashes of certificates, batch manifests and the
+// results store. Implemented here rather than taken from a crypto library so that io/ needs
+// nothing beyond yaml-cpp and zlib; tests/io_test.cc checks it against the FIPS 180-2 vectors.
+#ifndef IMUFIT_IO_SHA256_H_
+#define IMUFIT_IO_SHA256_H_
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace imufit {
+
+// Incremental SHA-256: Update() any number of times, then HexDigest() once.
+class Sha256 {
+ public:
+  Sha256();
+  void Update(std::string_view data);
+  // The digest as 64 lowercase hex digits. Finishes the hash: call once.
+  std::string HexDigest();
+
+ private:
+  void Block(const unsigned char* block);
+
+  std::array<uint32_t, 8> state_;
+  std::array<unsigned char, 64> buffer_{};
+  size_t buffered_ = 0;
+  uint64_t length_bytes_ = 0;
+};
+
+std::string Sha256Hex(std::string_view data);
+// The hash of a file's bytes as they are on disk (a .gz file is hashed compressed). Throws
+// InputError naming the file when it cannot be read.
+std::string Sha256OfFile(const std::string& path);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_IO_SHA256_H_

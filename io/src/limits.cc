@@ -1,0 +1,116 @@
+#include "imufit/io/limits.h"
+
+#include <sstream>
+
+#include "imufit/io/error.h"
+#include "yaml_util.h"
+
+namespace imufit {
+namespace {
+
+std::vector<std::string> Words(const char* text) {
+  std::istringstream stream(text);
+  std::vector<std::string> words;
+  for (std::string word; stream >> word;) words.push_back(word);
+  return words;
+}
+
+const LimitQuantity* FindQuantity(const std::string& name) {
+  for (const LimitQuantity& q : kLimitQuantities) {
+    if (name == q.name) return &q;
+  }
+  return nullptr;
+}
+
+double PositiveNumber(const yaml::Located& value) {
+  const double number = value.Double();
+  if (!(number > 0.0)) value.Fail(QuoteForMessage(value.String()) + " must be greater than 0");
+  return number;
+}
+
+LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
+  entry.RejectUnknownKeys({"quantity", "axes", "statistic", "max_abs", "covers"});
+  LimitCriterion criterion;
+  const yaml::Located quantity = entry["quantity"];
+  criterion.quantity = quantity.String();
+  const LimitQuantity* known = FindQuantity(criterion.quantity);
+  if (known == nullptr) {
+    std::string list;
+    for (const LimitQuantity& q : kLimitQuantities) list += (list.empty() ? "" : ", ") + std::string(q.name);
+    quantity.Fail("unknown quantity " + QuoteForMessage(criterion.quantity) + " (known: " + list + ")");
+  }
+  criterion.kind = known->kind;
+  criterion.unit = known->unit;
+  const std::vector<std::string> all_axes = Words(known->axes);
+  if (criterion.quantity.find("_scale_error_") != std::string::npos) {
+    const bool gyro = criterion.quantity.rfind("gyro", 0) == 0;
+    if ((gyro ? limits.nominal_gyro_scale : limits.nominal_accel_scale) == 0.0) {
+      quantity.Fail(std::string("needs nominal.") + (gyro ? "gyro_scale" : "accel_scale") +
+                    " (raw per rad/s or per m/s^2) in the limits file");
+    }
+  }
+
+  if (entry.Has("axes")) {
+    const yaml::Located axes = entry["axes"];
+    if (all_axes.empty()) axes.Fail(criterion.quantity + " has no axes");
+    for (size_t i = 0; i < axes.Size(); ++i) {
+      const std::string axis = axes.At(i).String();
+      bool valid = false;
+      for (const std::string& a : all_axes) valid = valid || a == axis;
+      if (!valid) axes.At(i).Fail("unknown axis " + QuoteForMessage(axis) + " (known: " + known->axes + ")");
+      criterion.axes.push_back(axis);
+    }
+    if (criterion.axes.empty()) axes.Fail("an empty list of axes checks nothing");
+  } else {
+    criterion.axes = all_axes;
+  }
+
+  if (entry.Has("statistic")) {
+    const yaml::Located statistic = entry["statistic"];
+    const std::string text = statistic.String();
+    if (text == "sigma") {
+      if (criterion.kind != LimitKind::kCoefficient) statistic.Fail(criterion.quantity + " has no 1-sigma");
+      criterion.statistic = LimitStatistic::kSigma;
+    } else if (text != "value") {
+      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: value, sigma)");
+    }
+  }
+
+  if (criterion.kind == LimitKind::kCoverage) {
+    if (entry.Has("max_abs"))
+      entry["max_abs"].Fail(criterion.quantity + " takes `covers: [lo, hi]`, not max_abs");
+    const yaml::Located covers = entry["covers"];
+    const std::vector<double> range = covers.Doubles(2);
+    if (!(range[0] < range[1])) covers.Fail("expected [lo, hi] with lo < hi");
+    criterion.covers_c = {range[0], range[1]};
+  } else {
+    if (entry.Has("covers")) entry["covers"].Fail("only fit_temp_range_c takes `covers`");
+    criterion.max_abs = PositiveNumber(entry["max_abs"]);
+  }
+  return criterion;
+}
+
+}  // namespace
+
+Limits ReadLimits(const std::string& path) {
+  const YAML::Node root_node = yaml::LoadFile(path);
+  const yaml::Located root{&path, root_node, ""};
+  root.RejectUnknownKeys({"format", "version", "name", "nominal", "criteria"});
+  root.RequireFormat("imufit-limits", kLimitsFormatVersion);
+  Limits limits;
+  limits.path = path;
+  if (root.Has("name")) limits.name = root["name"].String();
+  if (root.Has("nominal")) {
+    const yaml::Located nominal = root["nominal"];
+    nominal.RejectUnknownKeys({"gyro_scale", "accel_scale"});
+    if (nominal.Has("gyro_scale")) limits.nominal_gyro_scale = PositiveNumber(nominal["gyro_scale"]);
+    if (nominal.Has("accel_scale")) limits.nominal_accel_scale = PositiveNumber(nominal["accel_scale"]);
+  }
+  const yaml::Located criteria = root["criteria"];
+  for (size_t i = 0; i < criteria.Size(); ++i)
+    limits.criteria.push_back(ReadCriterion(criteria.At(i), limits));
+  if (limits.criteria.empty()) criteria.Fail("no criteria: a limits file must check something");
+  return limits;
+}
+
+}  // namespace imufit

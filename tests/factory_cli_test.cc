@@ -1,0 +1,504 @@
+// End-to-end tests of the factory commands (`imufit batch`, `imufit history`, `imufit report`,
+// `imufit fit --limits/--report/--store`) on a simulated lot of five small units made with
+// `imufit simulate` from fixtures/mems_truth.yaml (10 Hz, 3 s dwells, 4 temperatures):
+//   unit-01, unit-02  good units with their own plan (serials SN-01, SN-02)
+//   unit-03           a good unit with samples only: fitted with the shared --plan
+//   unit-04           g-sensitivity xx of 0.089 deg/s/g, outside the 0.05 deg/s/g limit (SN-04)
+//   unit-05           a corrupt samples file (a number "1.2.3" in the middle)
+// The program is run as a user runs it (IMUFIT_EXE); outputs are read back from the files.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "imufit/io/sha256.h"
+
+extern char** environ;
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kFixtures = IMUFIT_FIXTURES_DIR;
+// The exit statuses of SPEC.md section 4 and the factory addition (docs/factory.md).
+constexpr int kExitBadInput = 2;
+constexpr int kExitNotDone = 1;
+constexpr int kExitFailedLimits = 3;
+constexpr int kUnits = 5;
+
+constexpr const char* kLimits = R"(format: imufit-limits
+version: 1
+name: MEMS-A acceptance
+nominal: {gyro_scale: 939.65, accel_scale: 208.838}
+criteria:
+  - {quantity: gyro_bias_dps, max_abs: 5}
+  - {quantity: gyro_scale_error_pct, max_abs: 2}
+  - {quantity: gyro_misalignment_mrad, max_abs: 10}
+  - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.05}
+  - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}
+  - {quantity: fit_temp_range_c, covers: [-20, 60]}
+)";
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::stringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+struct RunResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+// A CSV split into rows of cells (no quoted commas in the cells the tests read).
+std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& text) {
+  std::vector<std::map<std::string, std::string>> rows;
+  std::istringstream lines(text);
+  std::string line;
+  std::vector<std::string> header;
+  const auto split = [](const std::string& l) {
+    std::vector<std::string> cells;
+    std::string cell;
+    bool quoted = false;
+    for (char c : l) {
+      if (c == '"')
+        quoted = !quoted;
+      else if (c == ',' && !quoted)
+        cells.push_back(std::move(cell)), cell.clear();
+      else
+        cell += c;
+    }
+    cells.push_back(cell);
+    return cells;
+  };
+  while (std::getline(lines, line)) {
+    if (line.empty()) continue;
+    if (header.empty()) {
+      header = split(line);
+      continue;
+    }
+    const std::vector<std::string> cells = split(line);
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The value of data-value on the element with data-figure="name" in a report.
+std::string ReportFigure(const std::string& html, const std::string& name) {
+  const std::regex pattern("data-figure=\"" + std::regex_replace(name, std::regex("\\."), "\\.") +
+                           "\" data-value=\"([^\"]+)\"");
+  std::smatch match;
+  return std::regex_search(html, match, pattern) ? match[1].str() : "<none>";
+}
+
+class FactoryCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("imufit_factory_cli_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "units");
+    Write("limits.yaml", kLimits);
+    MakeLot();
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string Write(const std::string& name, const std::string& text) const {
+    std::ofstream(Path(name), std::ios::binary) << text;
+    return Path(name);
+  }
+
+  RunResult Run(const std::vector<std::string>& args) const { return RunProgram(IMUFIT_EXE, args); }
+
+  RunResult RunProgram(const std::string& program, const std::vector<std::string>& args) const {
+    const std::string out_path = Path("stdout.txt"), err_path = Path("stderr.txt");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<std::string> storage = {program};
+    storage.insert(storage.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : storage) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    RunResult result;
+    const int spawned = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (spawned != 0) {
+      ADD_FAILURE() << "cannot run " << program << ": " << std::strerror(spawned);
+      return result;
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = ReadBytes(out_path);
+    result.err = ReadBytes(err_path);
+    return result;
+  }
+
+  // Simulates a unit's run with a fixed seed and a little white noise.
+  void Simulate(const std::string& plan, const std::string& truth, const std::string& samples, int seed) {
+    const RunResult r = Run({"simulate",
+                             "--plan",
+                             plan,
+                             "--calibration",
+                             truth,
+                             "-o",
+                             samples,
+                             "--rate",
+                             "10",
+                             "--dwell",
+                             "3",
+                             "--temps",
+                             "-20,5,30,60",
+                             "--gyro-noise-density",
+                             "2e-4",
+                             "--accel-noise-density",
+                             "2e-3",
+                             "--seed",
+                             std::to_string(seed),
+                             "-q"});
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+
+  std::string UnitPlan(const std::string& unit, const std::string& serial) {
+    std::string plan = ReadBytes(kFixtures + "/plan_6pos.yaml");
+    plan = std::regex_replace(plan, std::regex("format: imufit-plan\n"),
+                              "format: imufit-plan\nserial: " + serial + "\n");
+    return Write("units/" + unit + "/plan.yaml", plan);
+  }
+
+  void MakeLot() {
+    const std::string truth = kFixtures + "/mems_truth.yaml";
+    // A unit whose gyro g-sensitivity xx is 0.15 counts per m/s^2: 0.089 deg/s/g at 25 degC.
+    std::string bad_truth = ReadBytes(truth);
+    bad_truth = std::regex_replace(bad_truth, std::regex("xx: \\[0\\.0483,"), "xx: [0.15,");
+    ASSERT_NE(bad_truth, ReadBytes(truth));
+    const std::string bad_truth_path = Write("bad_truth.yaml", bad_truth);
+    for (const char* unit : {"unit-01", "unit-02", "unit-03", "unit-04", "unit-05"})
+      fs::create_directories(dir_ / "units" / unit);
+    Simulate(UnitPlan("unit-01", "SN-01"), truth, Path("units/unit-01/samples.csv.gz"), 1);
+    Simulate(UnitPlan("unit-02", "SN-02"), truth, Path("units/unit-02/samples.csv.gz"), 2);
+    Simulate(kFixtures + "/plan_6pos.yaml", truth, Path("units/unit-03/samples.csv.gz"), 3);
+    Simulate(UnitPlan("unit-04", "SN-04"), bad_truth_path, Path("units/unit-04/samples.csv.gz"), 4);
+    Simulate(UnitPlan("unit-05", "SN-05"), truth, Path("units/unit-05/samples.csv"), 5);
+    std::string samples = ReadBytes(Path("units/unit-05/samples.csv"));
+    const size_t line = samples.find('\n', samples.size() / 2) + 1;
+    const size_t comma = samples.find(',', line);
+    samples.replace(line, comma - line, "1.2.3");
+    Write("units/unit-05/samples.csv", samples);
+  }
+
+  std::vector<std::string> BatchArgs(const std::string& out) const {
+    return {"batch",   Path("units"),    "--limits", Path("limits.yaml"),
+            "-o",      Path(out),        "--plan",   kFixtures + "/plan_6pos.yaml",
+            "--store", Path("store.db"), "--lot",    "LOT-A"};
+  }
+
+  std::map<std::string, std::map<std::string, std::string>> Summary(const std::string& out) const {
+    std::map<std::string, std::map<std::string, std::string>> by_unit;
+    for (const auto& row : ReadCsv(ReadBytes(dir_ / out / "lot_summary.csv"))) by_unit[row.at("unit")] = row;
+    return by_unit;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
+  std::vector<std::string> args = BatchArgs("out");
+  args.insert(args.end(), {"--jobs", "2"});
+  RunResult r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;  // one unit failed, one could not be read
+  EXPECT_NE(r.out.find("5 units: 3 passed, 1 failed limits, 0 not fitted, 1 errors; 0 unchanged"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.err.find("[5/5]"), std::string::npos) << r.err;  // progress, plain lines when not a terminal
+
+  auto summary = Summary("out");
+  ASSERT_EQ(summary.size(), kUnits);
+  EXPECT_EQ(summary["unit-01"]["serial"], "SN-01");
+  EXPECT_EQ(summary["unit-01"]["verdict"], "PASS");
+  EXPECT_EQ(summary["unit-03"]["serial"], "unit-03");  // shared plan without a serial: the folder name
+  EXPECT_EQ(summary["unit-03"]["verdict"], "PASS");
+  EXPECT_EQ(summary["unit-04"]["status"], "fitted");
+  EXPECT_EQ(summary["unit-04"]["verdict"], "FAIL");
+  EXPECT_NE(summary["unit-04"]["message"].find("|gyro_g_sensitivity_dpsg.xx|"), std::string::npos);
+  EXPECT_GT(std::stod(summary["unit-04"]["gyro_g_sensitivity_dpsg.xx"]), 0.05);
+  EXPECT_EQ(summary["unit-05"]["status"], "error");
+  EXPECT_NE(summary["unit-05"]["message"].find("samples.csv:"), std::string::npos);
+  EXPECT_NE(summary["unit-05"]["message"].find("1.2.3 is not a number"), std::string::npos)
+      << summary["unit-05"]["message"];
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "unit-05" / "calibration.yaml"));
+  // The lot page: yield, and the g-sensitivity of unit-04 flagged as an outlier of the lot.
+  const std::string lot = ReadBytes(dir_ / "out" / "lot.html");
+  EXPECT_NE(lot.find("data-key=\"yield\">60.0<"), std::string::npos);
+  EXPECT_NE(lot.find("data-outlier=\"unit-04\" data-figure=\"gyro_g_sensitivity_dpsg.xx\""),
+            std::string::npos);
+  for (const char* unit : {"unit-01", "unit-02", "unit-03"}) {
+    EXPECT_EQ(
+        lot.find("data-outlier=\"" + std::string(unit) + "\" data-figure=\"gyro_g_sensitivity_dpsg.xx\""),
+        std::string::npos);
+  }
+
+  // The certificate: key values read back out of the HTML agree with the lot summary and inputs.
+  const std::string report = ReadBytes(dir_ / "out" / "unit-04" / "report.html");
+  EXPECT_EQ(ReportFigure(report, "gyro_g_sensitivity_dpsg.xx"),
+            summary["unit-04"]["gyro_g_sensitivity_dpsg.xx"]);
+  EXPECT_EQ(ReportFigure(report, "gyro_bias_dps.x"), summary["unit-04"]["gyro_bias_dps.x"]);
+  EXPECT_NE(report.find("data-key=\"serial\">SN-04<"), std::string::npos);
+  EXPECT_NE(report.find("data-key=\"verdict\">FAIL<"), std::string::npos);
+  EXPECT_NE(report.find("data-criterion=\"|gyro_g_sensitivity_dpsg.xx|\" data-pass=\"0\""),
+            std::string::npos);
+  EXPECT_NE(
+      report.find("data-sha256=\"samples\">" + Sha256OfFile(Path("units/unit-04/samples.csv.gz")) + "<"),
+      std::string::npos);
+  EXPECT_NE(report.find("data-sha256=\"limits\">" + Sha256OfFile(Path("limits.yaml")) + "<"),
+            std::string::npos);
+  EXPECT_NE(report.find("<svg"), std::string::npos);
+  // Self-contained: nothing loaded from elsewhere (the only URLs are SVG namespace names).
+  EXPECT_EQ(report.find(" src="), std::string::npos);
+  EXPECT_EQ(report.find("<link"), std::string::npos);
+  EXPECT_EQ(report.find("<script"), std::string::npos);
+
+  // The store: one row per unit of the lot, with the verdicts; the yield.
+  r = Run({"history", Path("store.db"), "--lot", "--csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto yields = ReadCsv(r.out);
+  ASSERT_EQ(yields.size(), 1u);
+  EXPECT_EQ(yields[0]["lot"], "LOT-A");
+  EXPECT_EQ(yields[0]["units"], "5");
+  EXPECT_EQ(yields[0]["passed"], "3");
+  EXPECT_EQ(yields[0]["failed"], "1");
+  r = Run({"history", Path("store.db"), "--serial", "SN-04", "--csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto fits = ReadCsv(r.out);
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_EQ(fits[0]["verdict"], "FAIL");
+  EXPECT_EQ(fits[0]["samples_sha256"], Sha256OfFile(Path("units/unit-04/samples.csv.gz")));
+  EXPECT_EQ(fits[0]["gyro_g_sensitivity_dpsg.xx"], summary["unit-04"]["gyro_g_sensitivity_dpsg.xx"]);
+  r = Run({"history", Path("store.db"), "--trend", "gyro.bias.x", "--csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(ReadCsv(r.out).size(), 4u);  // the four fitted units
+
+  // Again: nothing changed, nothing redone, same summary, no new rows.
+  const std::string first_summary = ReadBytes(dir_ / "out" / "lot_summary.csv");
+  r = Run(BatchArgs("out"));
+  EXPECT_EQ(r.status, kExitFailedLimits);
+  EXPECT_NE(r.out.find("5 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadBytes(dir_ / "out" / "lot_summary.csv"), first_summary);
+  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
+
+  // A unit's samples change: that unit alone is fitted again.
+  Simulate(Path("units/unit-02/plan.yaml"), kFixtures + "/mems_truth.yaml",
+           Path("units/unit-02/samples.csv.gz"), 22);
+  r = Run(BatchArgs("out"));
+  EXPECT_NE(r.out.find("4 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-02", "--csv"}).out).size(), 2u);
+  EXPECT_NE(Summary("out")["unit-02"]["gyro_bias_dps.x"], summary["unit-02"]["gyro_bias_dps.x"]);
+}
+
+TEST_F(FactoryCliTest, InterruptedBatchResumesWithoutLoss) {
+  // Stopped after the first unit (as a kill would stop it): that unit is finished and recorded,
+  // no lot summary yet.
+  std::vector<std::string> args = BatchArgs("out");
+  args.insert(args.end(), {"--max-units", "1", "--jobs", "1"});
+  RunResult r = Run(args);
+  EXPECT_EQ(r.status, kExitNotDone) << r.out << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "lot_summary.csv"));
+  int manifests = 0;
+  for (const auto& unit : fs::directory_iterator(dir_ / "out"))
+    manifests += fs::exists(unit.path() / "manifest.yaml");
+  EXPECT_EQ(manifests, 1);
+  // What a kill leaves behind: a temporary file of an output never committed; and, while another
+  // batch holds the output folder, a second one is refused.
+  fs::create_directories(dir_ / "out" / "unit-02");
+  const fs::path leftover = dir_ / "out" / "unit-02" / ".calibration.yaml.tmp-AbC123";
+  std::ofstream(leftover) << "half a calibration";
+  {
+    const int fd = ::open((dir_ / "out" / ".imufit-batch.lock").c_str(), O_RDWR | O_CREAT, 0644);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    r = Run(BatchArgs("out"));
+    EXPECT_EQ(r.status, kExitBadInput);
+    EXPECT_NE(r.err.find("another imufit batch is writing to this folder"), std::string::npos) << r.err;
+    ::close(fd);
+  }
+  // Resumed: the finished unit is skipped, the others are done, the leftover is gone.
+  r = Run(BatchArgs("out"));
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_NE(r.out.find("1 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(Summary("out").size(), kUnits);
+  EXPECT_FALSE(fs::exists(leftover));
+  // A kill between the store and the manifest: the unit is redone, never lost.
+  fs::remove(dir_ / "out" / "unit-02" / "manifest.yaml");
+  r = Run(BatchArgs("out"));
+  EXPECT_NE(r.out.find("4 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(Summary("out").size(), kUnits);
+  // Every unit is in the store; unit-01 once, unit-02 twice (its redo).
+  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
+  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-02", "--csv"}).out).size(), 2u);
+  auto yields = ReadCsv(Run({"history", Path("store.db"), "--lot", "LOT-A", "--csv"}).out);
+  ASSERT_EQ(yields.size(), 1u);
+  EXPECT_EQ(yields[0]["units"], "5");
+}
+
+// The real thing: the batch is killed (SIGKILL, no clean-up) as soon as its first unit is finished.
+TEST_F(FactoryCliTest, KilledBatchResumesWithoutLoss) {
+  std::vector<std::string> storage = {IMUFIT_EXE};
+  for (const std::string& a : BatchArgs("out")) storage.push_back(a);
+  storage.insert(storage.end(), {"--jobs", "1", "-q"});
+  std::vector<char*> argv;
+  for (std::string& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, IMUFIT_EXE, nullptr, nullptr, argv.data(), environ), 0);
+  const fs::path first = dir_ / "out" / "unit-01" / "manifest.yaml";
+  constexpr int kPollLimit = 60000;  // x 1 ms
+  for (int i = 0; i < kPollLimit && !fs::exists(first); ++i) ::usleep(1000);
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(fs::exists(first));
+
+  const RunResult r = Run(BatchArgs("out"));
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  std::printf("resumed after the kill: %s", r.out.substr(0, r.out.find('\n') + 1).c_str());
+  auto summary = Summary("out");
+  ASSERT_EQ(summary.size(), kUnits);
+  EXPECT_EQ(summary["unit-04"]["verdict"], "FAIL");
+  EXPECT_EQ(summary["unit-05"]["status"], "error");
+  for (const char* serial : {"SN-01", "SN-02", "SN-04"}) {
+    const size_t rows = ReadCsv(Run({"history", Path("store.db"), "--serial", serial, "--csv"}).out).size();
+    EXPECT_GE(rows, 1u) << serial;  // twice for a unit killed between its store row and its manifest
+    EXPECT_LE(rows, 2u) << serial;
+  }
+  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
+  for (const auto& unit : fs::directory_iterator(dir_ / "out")) {
+    if (!unit.is_directory()) continue;
+    for (const auto& file : fs::directory_iterator(unit.path())) {
+      EXPECT_EQ(file.path().filename().string().find(".tmp-"), std::string::npos) << file.path();
+    }
+  }
+}
+
+TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
+  const std::string plan = Path("units/unit-01/plan.yaml");
+  RunResult r =
+      Run({"fit", "-p", plan, "-s", Path("units/unit-01/samples.csv.gz"), "-o", Path("cal1.yaml"), "--limits",
+           Path("limits.yaml"), "--report", Path("unit1.html"), "--store", Path("fit.db")});
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("acceptance MEMS-A acceptance: PASS"), std::string::npos) << r.out;
+  EXPECT_NE(ReadBytes(Path("unit1.html")).find("data-key=\"verdict\">PASS<"), std::string::npos);
+  EXPECT_EQ(ReadCsv(Run({"history", Path("fit.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
+
+  // Fitted but out of limits: the calibration is written, the exit status says so.
+  r = Run({"fit", "-p", Path("units/unit-04/plan.yaml"), "-s", Path("units/unit-04/samples.csv.gz"), "-o",
+           Path("cal4.yaml"), "--limits", Path("limits.yaml"), "-q"});
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.err;
+  EXPECT_TRUE(fs::exists(Path("cal4.yaml")));
+  EXPECT_NE(r.out.find("|gyro_g_sensitivity_dpsg.xx|"), std::string::npos) << r.out;
+
+  // imufit report from the calibration and its run gives the same figures.
+  r = Run({"report", "-c", Path("cal4.yaml"), "-p", Path("units/unit-04/plan.yaml"), "-s",
+           Path("units/unit-04/samples.csv.gz"), "--limits", Path("limits.yaml"), "-o", Path("unit4.html")});
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.err;
+  const std::string report = ReadBytes(Path("unit4.html"));
+  EXPECT_NE(report.find("data-key=\"verdict\">FAIL<"), std::string::npos);
+  EXPECT_NE(report.find("data-sha256=\"calibration\">" + Sha256OfFile(Path("cal4.yaml")) + "<"),
+            std::string::npos);
+
+  // A bad limits file: exit 2 with its location, before any work, nothing written.
+  const std::string bad =
+      Write("bad_limits.yaml", std::string(kLimits) + "  - {quantity: gyro_bias_dps, max_abs: 0}\n");
+  r = Run({"fit", "-p", plan, "-s", Path("units/unit-01/samples.csv.gz"), "-o", Path("cal_bad.yaml"),
+           "--limits", bad});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("bad_limits.yaml:12:40: criteria[6].max_abs: \"0\" must be greater than 0"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("cal_bad.yaml")));
+  r = Run(std::vector<std::string>{"batch", Path("units"), "--limits", bad, "-o", Path("out_bad")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  r = Run({"history", Path("fit.db"), "--serial", "NO-SUCH-SERIAL"});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("no calibrations of serial"), std::string::npos) << r.err;
+}
+
+// A run with a long static stretch gets the Allan deviation and the ARW in its certificate.
+TEST_F(FactoryCliTest, ReportShowsTheGyroNoiseOfALongStaticStretch) {
+  const std::string plan = Write("static_plan.yaml",
+                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+                                 "  - {id: 1, up: [0, 0, 1]}\n");
+  constexpr double kGyroNoiseDensity = 2e-4;  // rad/s/sqrt(Hz)
+  const RunResult sim = Run({"simulate", "--plan", plan, "--calibration", kFixtures + "/mems_truth.yaml",
+                             "-o", Path("static.csv"), "--rate", "10", "--dwell", "120", "--temps", "25",
+                             "--gyro-noise-density", "2e-4", "--seed", "9", "-q"});
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const RunResult r = Run({"report", "-c", kFixtures + "/mems_truth.yaml", "-p", plan, "-s",
+                           Path("static.csv"), "-o", Path("static.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string report = ReadBytes(Path("static.html"));
+  // ARW = noise density in deg/sqrt(h); 1200 samples fix it to a few percent (relative, per axis).
+  constexpr double kArwRelativeTolerance = 0.15;
+  const double expected_arw = kGyroNoiseDensity * 180.0 / M_PI * 60.0;
+  for (const char* axis : {"x", "y", "z"}) {
+    const std::string value = ReportFigure(report, std::string("gyro_arw_deg_per_sqrt_hr.") + axis);
+    ASSERT_NE(value, "<none>") << axis;
+    EXPECT_NEAR(std::stod(value), expected_arw, expected_arw * kArwRelativeTolerance) << axis;
+  }
+}
+
+// The certificate as a browser draws it: headless Chromium renders it to a PNG of the page's width.
+TEST_F(FactoryCliTest, ChromiumRendersTheCertificate) {
+  const std::string chromium = "/usr/bin/chromium";
+  if (!fs::exists(chromium) || !fs::exists("/usr/bin/timeout")) GTEST_SKIP() << "no " << chromium;
+  RunResult r =
+      Run({"fit", "-p", Path("units/unit-04/plan.yaml"), "-s", Path("units/unit-04/samples.csv.gz"), "-o",
+           Path("cal4.yaml"), "--limits", Path("limits.yaml"), "--report", Path("unit4.html"), "-q"});
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.err;
+  const std::string png = Path("unit4.png");
+  r = RunProgram("/usr/bin/timeout",
+                 {"120", chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                  "--user-data-dir=" + Path("chromium-profile"), "--screenshot=" + png,
+                  "--window-size=1000,3000", "file://" + Path("unit4.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string image = ReadBytes(png);
+  ASSERT_GT(image.size(), 24u);
+  ASSERT_EQ(image.substr(1, 3), "PNG");
+  const auto be32 = [&](size_t at) {
+    return (static_cast<unsigned char>(image[at]) << 24) | (static_cast<unsigned char>(image[at + 1]) << 16) |
+           (static_cast<unsigned char>(image[at + 2]) << 8) | static_cast<unsigned char>(image[at + 3]);
+  };
+  EXPECT_EQ(be32(16), 1000u);  // IHDR width
+  EXPECT_EQ(be32(20), 3000u);  // IHDR height
+  // A page of tables and plots compresses to far more than a blank page (a few kB).
+  constexpr size_t kMinimumDrawnPngBytes = 100000;
+  EXPECT_GT(image.size(), kMinimumDrawnPngBytes);
+}
+
+}  // namespace
+}  // namespace imufit

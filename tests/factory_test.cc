@@ -1,0 +1,264 @@
+// Tests of imufit::factory (and the io pieces it brought): SHA-256 against the FIPS 180-2
+// vectors, the limits file reader and its located errors, the acceptance verdict on a known
+// calibration, and the results store (records, queries, schema version).
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "imufit/factory/acceptance.h"
+#include "imufit/factory/report.h"
+#include "imufit/factory/store.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/error.h"
+#include "imufit/io/limits.h"
+#include "imufit/io/sha256.h"
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Relative tolerance of a unit conversion recomputed here by hand (same arithmetic, other order).
+constexpr double kConversionRelative = 1e-12;
+
+const std::string kFixtures = IMUFIT_FIXTURES_DIR;
+
+class FactoryTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("imufit_factory_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  std::string Write(const std::string& name, const std::string& text) const {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+  fs::path dir_;
+};
+
+TEST(Sha256, FipsVectors) {
+  // FIPS 180-2 appendix B.1, B.2, B.3, and the empty message.
+  EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(Sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(Sha256Hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  EXPECT_EQ(Sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+}
+
+TEST(Sha256, IncrementalEqualsOneShotAtEveryPaddingBoundary) {
+  std::string message;
+  for (int n = 0; n < 200; ++n) {
+    Sha256 pieces;
+    for (size_t at = 0; at < message.size(); at += 7) pieces.Update(std::string_view(message).substr(at, 7));
+    EXPECT_EQ(pieces.HexDigest(), Sha256Hex(message)) << n << " bytes";
+    message += static_cast<char>('a' + n % 26);
+  }
+}
+
+TEST_F(FactoryTest, Sha256OfFileAndMissingFile) {
+  EXPECT_EQ(Sha256OfFile(Write("abc.txt", "abc")), Sha256Hex("abc"));
+  EXPECT_THROW(Sha256OfFile((dir_ / "missing").string()), InputError);
+}
+
+constexpr const char* kLimits = R"(format: imufit-limits
+version: 1
+name: test limits
+nominal: {gyro_scale: 939.65, accel_scale: 208.838}
+criteria:
+  - {quantity: gyro_bias_dps, max_abs: 5}
+  - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.03, axes: [xx, yy]}
+  - {quantity: gyro_scale_error_ppm, max_abs: 20000}
+  - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}
+  - {quantity: fit_temp_range_c, covers: [-40, 85]}
+)";
+
+TEST_F(FactoryTest, ReadsLimits) {
+  const Limits limits = ReadLimits(Write("limits.yaml", kLimits));
+  EXPECT_EQ(limits.name, "test limits");
+  EXPECT_EQ(limits.nominal_gyro_scale, 939.65);
+  ASSERT_EQ(limits.criteria.size(), 5u);
+  EXPECT_EQ(limits.criteria[0].axes, (std::vector<std::string>{"x", "y", "z"}));
+  EXPECT_EQ(limits.criteria[1].axes, (std::vector<std::string>{"xx", "yy"}));
+  EXPECT_EQ(limits.criteria[3].statistic, LimitStatistic::kSigma);
+  EXPECT_EQ(limits.criteria[4].kind, LimitKind::kCoverage);
+  EXPECT_EQ(limits.criteria[4].covers_c[1], 85.0);
+}
+
+struct BadLimits {
+  std::string text;
+  std::string message;  // what the error must say, including its location
+};
+
+TEST_F(FactoryTest, BadLimitsAreLocatedInputErrors) {
+  const std::string head = "format: imufit-limits\nversion: 1\ncriteria:\n";
+  const std::vector<BadLimits> cases = {
+      {head + "  - {quantity: gyro_bias_dps, max_abs: 1, colour: red}\n",
+       ":4:43: criteria[0]: unknown key \"colour\""},
+      {head + "  - {quantity: gyro_bias_dpx, max_abs: 1}\n",
+       ":4:16: criteria[0].quantity: unknown quantity \"gyro_bias_dpx\""},
+      {head + "  - {quantity: gyro_bias_dps, max_abs: -1}\n",
+       ":4:40: criteria[0].max_abs: \"-1\" must be greater than 0"},
+      {head + "  - {quantity: gyro_bias_dps, max_abs: abc}\n",
+       "criteria[0].max_abs: \"abc\" is not a number"},
+      {head + "  - {quantity: gyro_bias_dps, axes: [x, q], max_abs: 1}\n",
+       "criteria[0].axes[1]: unknown axis \"q\""},
+      {head + "  - {quantity: gyro_scale_error_ppm, max_abs: 1}\n", "needs nominal.gyro_scale"},
+      {head + "  - {quantity: fit_temp_range_c, covers: [60, -20]}\n", "expected [lo, hi] with lo < hi"},
+      {head + "  - {quantity: gyro_residual_rms_dps, statistic: sigma, max_abs: 1}\n", "has no 1-sigma"},
+      {"format: imufit-plan\nversion: 1\ncriteria: []\n",
+       ":1:9: format: \"imufit-plan\" is not \"imufit-limits\""},
+      {"format: imufit-limits\nversion: 2\ncriteria: []\n", ":2:10: version: version 2 is not supported"},
+      {"format: imufit-limits\nversion: 1\ncriteria: []\n", "no criteria"},
+      {"format: imufit-limits\nversion: 1\ncriteria: [\n", "YAML syntax"},
+  };
+  for (const BadLimits& c : cases) {
+    const std::string path = Write("bad.yaml", c.text);
+    try {
+      ReadLimits(path);
+      ADD_FAILURE() << "accepted:\n" << c.text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos)
+          << e.what() << "\nexpected: " << c.message;
+    }
+  }
+}
+
+TEST_F(FactoryTest, KeyFiguresAndVerdictOnTheTruthCalibration) {
+  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  const std::vector<Figure> figures = KeyFigures(truth);
+  // By hand from fixtures/mems_truth.yaml: V_x / S_x in deg/s, H_xx / S_x in deg/s/g.
+  const Figure* bias = FindFigure(figures, "gyro.bias.x");
+  ASSERT_NE(bias, nullptr);
+  EXPECT_EQ(bias->name, "gyro_bias_dps.x");
+  EXPECT_NEAR(bias->value, 23.4 / 948.31 * 180.0 / M_PI, 23.4 / 948.31 * 180.0 / M_PI * kConversionRelative);
+  const double g_sensitivity_xx = 0.0483 / 948.31 * 180.0 / M_PI * 9.80665;
+  EXPECT_NEAR(FindFigure(figures, "gyro_g_sensitivity_dpsg.xx")->value, g_sensitivity_xx,
+              g_sensitivity_xx * kConversionRelative);
+
+  const Verdict verdict = EvaluateLimits(ReadLimits(Write("limits.yaml", kLimits)), truth);
+  EXPECT_FALSE(verdict.pass);
+  std::map<std::string, const CriterionResult*> by_name;
+  for (const CriterionResult& c : verdict.criteria) by_name[c.name] = &c;
+  ASSERT_EQ(verdict.criteria.size(), 3u + 2u + 3u + 3u + 1u);
+  EXPECT_TRUE(by_name.at("|gyro_bias_dps.x|")->pass);
+  // xx is 0.0286 deg/s/g (inside 0.03), yy is -0.0333 deg/s/g (outside).
+  const CriterionResult& xx = *by_name.at("|gyro_g_sensitivity_dpsg.xx|");
+  EXPECT_TRUE(xx.pass);
+  EXPECT_NEAR(xx.margin, 0.03 - g_sensitivity_xx, 1e-15);
+  EXPECT_FALSE(by_name.at("|gyro_g_sensitivity_dpsg.yy|")->pass);
+  EXPECT_NEAR(by_name.at("|gyro_scale_error_ppm.x|")->measured, (948.31 / 939.65 - 1.0) * 1e6, 1e-6);
+  // The truth file has no sigma tree: a sigma criterion cannot pass.
+  EXPECT_FALSE(by_name.at("sigma(gyro_bias_dps.x)")->pass);
+  EXPECT_EQ(by_name.at("sigma(gyro_bias_dps.x)")->measured_text, "not in calibration");
+  // The truth claims -40..85 degC: exactly covered, margin 0.
+  EXPECT_TRUE(by_name.at("fit_temp_range_c")->pass);
+  EXPECT_EQ(by_name.at("fit_temp_range_c")->margin, 0.0);
+  EXPECT_NE(verdict.FailedSummary().find("|gyro_g_sensitivity_dpsg.yy|"), std::string::npos);
+  EXPECT_NE(verdict.Table().find("FAIL"), std::string::npos);
+}
+
+TEST(RobustZScores, FlagsTheOneFarValue) {
+  // median 1.0, absolute deviations {0.2, 0.1, 0, 0.1, 5}: MAD 0.1; z of 6.0 = 0.6745 * 5 / 0.1.
+  const std::vector<RobustZ> z = RobustZScores({0.8, 0.9, 1.0, 1.1, 6.0});
+  EXPECT_NEAR(z[4].z, 0.6745 * 5.0 / 0.1, 1e-9);
+  EXPECT_TRUE(z[4].outlier);
+  EXPECT_FALSE(z[3].outlier);
+  EXPECT_FALSE(RobustZScores({1.0, 1.0, 1.0, 5.0})[3].outlier);  // MAD 0: no spread to judge by
+}
+
+TEST_F(FactoryTest, NoiseLimitsUseTheNoiseBlockWhenPresent) {
+  const std::string limits_path =
+      Write("limits.yaml",
+            "format: imufit-limits\nversion: 1\ncriteria:\n"
+            "  - {quantity: gyro_arw_deg_per_sqrt_hr, max_abs: 0.2, axes: [x]}\n"
+            "  - {quantity: gyro_bias_instability_dph, max_abs: 0.5, axes: [x]}\n");
+  Calibration calibration = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  // Without a noise block the criteria cannot pass.
+  Verdict verdict = EvaluateLimits(ReadLimits(limits_path), calibration);
+  EXPECT_FALSE(verdict.criteria[0].pass);
+  EXPECT_EQ(verdict.criteria[0].measured_text, "not in calibration");
+  // With one (the layout imufit allan --noise-yaml writes, docs/allan.md).
+  calibration.extra["noise"] = YAML::Load(
+      "{format: imufit-noise, version: 1, columns: {gyro_x: {arw_deg_per_sqrt_hr: [0.1498, 0.0002], "
+      "bias_instability_deg_per_hr: [0.94, 0.67]}}}");
+  verdict = EvaluateLimits(ReadLimits(limits_path), calibration);
+  EXPECT_TRUE(verdict.criteria[0].pass);
+  EXPECT_EQ(verdict.criteria[0].measured, 0.1498);
+  EXPECT_FALSE(verdict.criteria[1].pass);  // 0.94 deg/h > 0.5 deg/h
+  EXPECT_EQ(FindFigure(KeyFigures(calibration), "noise.gyro_x.arw_deg_per_sqrt_hr")->sigma, 0.0002);
+}
+
+TEST_F(FactoryTest, StoreRecordsAndAnswers) {
+  const std::string path = (dir_ / "store.db").string();
+  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  {
+    ResultsStore store(path);
+    for (int i = 0; i < 3; ++i) {
+      StoredFit fit;
+      fit.serial = i == 2 ? "SN2" : "SN1";
+      fit.unit = "u" + std::to_string(i);
+      fit.lot = i == 0 ? "lot-a" : "lot-b";
+      fit.time_utc = "2026-11-22T07:0" + std::to_string(i) + ":00Z";
+      fit.software = "imufit test";
+      fit.status = "fitted";
+      fit.verdict = i == 1 ? "FAIL" : "PASS";
+      fit.calibration_yaml = CalibrationToYaml(truth);
+      fit.figures = KeyFigures(truth);
+      fit.figures[0].value += i;
+      EXPECT_GT(store.Record(fit), 0);
+    }
+  }
+  ResultsStore store(path);  // reopened: the rows are there
+  const std::vector<StoredFit> fits = store.BySerial("SN1");
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[1].verdict, "FAIL");
+  EXPECT_EQ(fits[1].calibration_yaml, CalibrationToYaml(truth));
+  EXPECT_EQ(fits[1].figures.size(), KeyFigures(truth).size());
+  const std::vector<LotYield> yields = store.Yield("");
+  ASSERT_EQ(yields.size(), 2u);
+  EXPECT_EQ(yields[1].lot, "lot-b");
+  EXPECT_EQ(yields[1].units, 2);
+  EXPECT_EQ(yields[1].passed, 1);
+  EXPECT_EQ(yields[1].failed, 1);
+  const std::vector<TrendPoint> trend = store.Trend("gyro.bias.x", "");
+  ASSERT_EQ(trend.size(), 3u);
+  EXPECT_EQ(trend[2].value - trend[0].value, 2.0);
+  EXPECT_EQ(store.Trend("gyro_bias_dps.x", "SN2").size(), 1u);
+}
+
+TEST_F(FactoryTest, StoreRefusesANewerSchemaAndForeignFiles) {
+  const std::string path = (dir_ / "store.db").string();
+  { ResultsStore store(path); }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE schema_version SET version = 99", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+  try {
+    ResultsStore store(path);
+    ADD_FAILURE() << "opened a version 99 store";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("schema version 99 is not supported"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(
+      ResultsStore(Write("text.db", "this is not a database, just some text long enough to matter\n")),
+      InputError);
+}
+
+}  // namespace
+}  // namespace imufit
