@@ -57,6 +57,8 @@ imufit_build() {
   cmake_args=("$@")
   if command -v ccache >/dev/null 2>&1; then
     cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    # Paths below the checkout count as relative, so another clone (CI's) reuses the cache.
+    export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$IMUFIT_ROOT}
   fi
   mkdir -p "$dir"
   if ! cmake -S "$IMUFIT_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${cmake_args[@]}" \
