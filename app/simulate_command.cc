@@ -102,11 +102,11 @@ CommandRunner AddSimulateCommand(CLI::App* root) {
                                    "soak temperatures, degC, comma-separated: one pass through the plan at each")
                    ->delimiter(',')
                    ->default_str("25");
-  command->add_option("--ramp", args->ramp_c, "a linear temperature ramp FROM,TO in degC across --passes passes")
-      ->delimiter(',')
-      ->expected(2)
-      ->excludes(soak);
-  command->add_option("--passes", o.passes, "passes through the plan during a ramp")->capture_default_str();
+  auto* ramp = command->add_option("--ramp", args->ramp_c, "a linear temperature ramp FROM,TO in degC across --passes passes")
+                   ->delimiter(',')
+                   ->expected(2)
+                   ->excludes(soak);
+  command->add_option("--passes", o.passes, "passes through the plan during a ramp")->capture_default_str()->needs(ramp);
   command->add_option("--dwell", o.dwell_s, "seconds in each segment")->capture_default_str();
   command->add_option("--transition", o.transition_s, "seconds the table moves between segments (segment -1)")
       ->capture_default_str();

@@ -137,8 +137,12 @@ TEST(Windows, OccurrencesTrimmingAndTemperatureSpans) {
   EXPECT_NEAR(windows[0].gyro_mean.x(), 0.5, 1e-15);  // i = 4..19: eight odd values of 16
   EXPECT_NEAR(windows[0].gyro_std.x(), std::sqrt(0.25 * 16.0 / 15.0), 1e-15);
   EXPECT_EQ(windows[0].gyro_std.y(), 0.0);
+  EXPECT_EQ(windows[0].min_temp_c, 25.0);
+  EXPECT_EQ(windows[0].max_temp_c, 25.0);
+  EXPECT_NEAR(windows[1].min_temp_c, 20.4, 1e-12);  // the ramp's first kept sample
   for (size_t w = 1; w < windows.size(); ++w) {
     EXPECT_EQ(windows[w].occurrence, 1);
+    EXPECT_LE(windows[w].max_temp_c - windows[w].min_temp_c, 1.0 + 1e-12);
     EXPECT_LE(windows[w].samples, 11);  // a 1 degC span at 0.1 degC per sample
   }
 }

@@ -39,6 +39,9 @@ struct FixtureCase {
   double bias_correlation_s;
 };
 
+// gtest prints the case by name, not as bytes.
+void PrintTo(const FixtureCase& c, std::ostream* os) { *os << c.name; }
+
 std::string Fixture(const std::string& name) { return std::string(IMUFIT_FIXTURES_DIR) + "/" + name; }
 
 class FixtureRegression : public ::testing::TestWithParam<FixtureCase> {};

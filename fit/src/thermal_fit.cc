@@ -313,7 +313,11 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   TemperatureBasis basis;
   if (!temps.empty()) {
     const auto [lo, hi] = std::minmax_element(temps.begin(), temps.end());
-    summary.temp_range_c = {*lo, *hi};
+    summary.temp_range_c = {windows.front().min_temp_c, windows.front().max_temp_c};
+    for (const Window& w : windows) {
+      summary.temp_range_c[0] = std::min(summary.temp_range_c[0], w.min_temp_c);
+      summary.temp_range_c[1] = std::max(summary.temp_range_c[1], w.max_temp_c);
+    }
     basis.center_c = 0.5 * (*lo + *hi);
     basis.half_range_c = std::max(0.5 * (*hi - *lo), 1.0);
   }

@@ -58,6 +58,7 @@ void WindowBuilder::Add(const Sample& sample) {
     start_s_ = sample.time_s;
     window_first_temp_c_ = sample.temp_c;
     temp_mean_ = 0.0;
+    temp_min_ = temp_max_ = sample.temp_c;
     mean_.setZero();
     m2_.setZero();
   }
@@ -65,6 +66,8 @@ void WindowBuilder::Add(const Sample& sample) {
   end_s_ = sample.time_s;
   const double inv_n = 1.0 / static_cast<double>(n_);
   temp_mean_ += (sample.temp_c - temp_mean_) * inv_n;
+  temp_min_ = std::min(temp_min_, sample.temp_c);
+  temp_max_ = std::max(temp_max_, sample.temp_c);
   Eigen::Matrix<double, 6, 1> value;
   value << sample.gyro, sample.accel;
   const Eigen::Matrix<double, 6, 1> delta = value - mean_;
@@ -86,6 +89,8 @@ void WindowBuilder::Close() {
   window.start_s = start_s_;
   window.end_s = end_s_;
   window.temp_c = temp_mean_;
+  window.min_temp_c = temp_min_;
+  window.max_temp_c = temp_max_;
   const Eigen::Matrix<double, 6, 1> std_dev = (m2_ / static_cast<double>(n_ - 1)).cwiseSqrt();
   window.gyro_mean = mean_.head<3>();
   window.accel_mean = mean_.tail<3>();

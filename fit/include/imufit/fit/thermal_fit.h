@@ -110,7 +110,8 @@ struct FitSummary {
   int windows_downweighted = 0;
   // What the data do not determine, one readable finding each, with what would determine it.
   std::vector<std::string> undetermined;
-  // Distinct temperatures of the run (cluster centres), degC, and the range it covers.
+  // Distinct temperatures of the run (cluster centres), degC, and the range of the readings
+  // in its windows (the calibration's fit_temp_range_c).
   std::vector<double> distinct_temps_c;
   std::array<double, 2> temp_range_c{0.0, 0.0};
   // Residual RMS over windows and axes, SI, unweighted.

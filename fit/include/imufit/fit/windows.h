@@ -44,6 +44,8 @@ struct Window {
   double start_s = 0.0;
   double end_s = 0.0;
   double temp_c = 0.0;     // mean temperature reading
+  double min_temp_c = 0.0;  // extremes of the readings in the window
+  double max_temp_c = 0.0;
   Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyro_std = Eigen::Vector3d::Zero();   // sample standard deviation
@@ -89,6 +91,8 @@ class WindowBuilder {
   double start_s_ = 0.0;
   double end_s_ = 0.0;
   double temp_mean_ = 0.0;
+  double temp_min_ = 0.0;
+  double temp_max_ = 0.0;
   Eigen::Matrix<double, 6, 1> mean_ = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> m2_ = Eigen::Matrix<double, 6, 1>::Zero();
 };
