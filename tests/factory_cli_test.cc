@@ -280,6 +280,19 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   EXPECT_NE(report.find("data-sha256=\"limits\">" + Sha256OfFile(Path("limits.yaml")) + "<"),
             std::string::npos);
   EXPECT_NE(report.find("<svg"), std::string::npos);
+  // Residuals before (25 degC scale only) and after correction: the calibration must have fixed
+  // something. The "all" row's cells: windows, gyro RMS before, after, max, accel before, after, max.
+  const size_t all_row = report.find("data-key=\"residual_all\"");
+  ASSERT_NE(all_row, std::string::npos);
+  std::vector<double> cells;
+  for (size_t at = report.find("<td class=\"num\">", all_row); at < report.find("</tr>", all_row);
+       at = report.find("<td class=\"num\">", at + 1)) {
+    const std::string text = report.substr(at + 16, report.find('<', at + 16) - at - 16);
+    if (!text.empty()) cells.push_back(std::stod(text));
+  }
+  ASSERT_EQ(cells.size(), 7u);
+  EXPECT_GT(cells[1], 10.0 * cells[2]);  // gyro RMS before > 10 x after
+  EXPECT_GT(cells[4], 10.0 * cells[5]);  // accel
   // Self-contained: nothing loaded from elsewhere (the only URLs are SVG namespace names).
   EXPECT_EQ(report.find(" src="), std::string::npos);
   EXPECT_EQ(report.find("<link"), std::string::npos);

@@ -516,20 +516,38 @@ std::string UnitReportHtml(const UnitReport& r) {
           "drawn).</p>\n"
        << Plots(slice(0, groups.size()), failure);
 
-  html << "<h2>Residuals after correction</h2>\n" << Plots(slice(groups.size(), groups.size() + 2), "");
+  html << "<h2>Residuals before and after correction</h2>\n" << Plots(slice(groups.size(), groups.size() + 2), "");
+  // Before correction: the raw outputs divided by the unit's own 25 degC scale factors only (no
+  // bias, misalignment, g-sensitivity or temperature dependence), i.e. what the calibration fixes.
+  SensorModel scale_only = SensorModel::Identity();
+  for (int axis = 0; axis < 3; ++axis) {
+    const int c0 = (kScaleCoefficient + axis) * kPolynomialTerms;
+    scale_only.gyro[c0] = cal.model.gyro[c0];
+    scale_only.accel[c0] = cal.model.accel[c0];
+  }
   std::vector<ErrorStats> stats = ErrorsBySegment(errors);
   stats.push_back(SummariseErrors(errors));
-  html << "<table><tr><th>segment</th><th>up</th><th>rate, deg/s</th><th>windows</th><th>gyro RMS, "
-          "deg/s</th><th>gyro max, deg/s</th>"
-          "<th>accel RMS, mg</th><th>accel max, mg</th></tr>\n";
-  for (const ErrorStats& s : stats) {
+  const std::vector<WindowError> errors_before =
+      PredictWindows(scale_only, r.run.windows, r.plan.site, r.plan.segments);
+  std::vector<ErrorStats> before = ErrorsBySegment(errors_before);
+  before.push_back(SummariseErrors(errors_before));
+  html << "<p class=\"note\">Per window, |corrected - true|; <em>before</em>: the raw outputs divided by the "
+          "unit's 25 degC scale factors only.</p>\n"
+          "<table><tr><th>segment</th><th>up</th><th>rate, deg/s</th><th>windows</th>"
+          "<th>gyro RMS before, deg/s</th><th>gyro RMS, deg/s</th><th>gyro max, deg/s</th>"
+          "<th>accel RMS before, mg</th><th>accel RMS, mg</th><th>accel max, mg</th></tr>\n";
+  for (size_t i = 0; i < stats.size(); ++i) {
+    const ErrorStats& s = stats[i];
+    const ErrorStats& b = before[i];  // the same segments, in the same order
     const TableSegment* seg = s.segment < 0 ? nullptr : r.plan.Find(s.segment);
     std::string up = "";
     if (seg) up = Fmt("[%g,", seg->up.x()) + Fmt(" %g,", seg->up.y()) + Fmt(" %g]", seg->up.z());
     html << "<tr" << (s.segment < 0 ? " data-key=\"residual_all\"" : "") << "><td>"
          << (s.segment < 0 ? "all" : std::to_string(s.segment)) << "</td><td>" << up << "</td>"
          << Num(seg ? Fmt("%g", seg->rate_radps * kRadToDeg) : "") << Num(std::to_string(s.windows))
-         << Num(Fmt("%.5f", s.gyro_rms_radps * kRadToDeg)) << Num(Fmt("%.5f", s.gyro_max_radps * kRadToDeg))
+         << Num(Fmt("%.4f", b.gyro_rms_radps * kRadToDeg)) << Num(Fmt("%.5f", s.gyro_rms_radps * kRadToDeg))
+         << Num(Fmt("%.5f", s.gyro_max_radps * kRadToDeg))
+         << Num(Fmt("%.3f", b.accel_rms_mps2 / kStandardGravityMps2 * 1e3))
          << Num(Fmt("%.4f", s.accel_rms_mps2 / kStandardGravityMps2 * 1e3))
          << Num(Fmt("%.4f", s.accel_max_mps2 / kStandardGravityMps2 * 1e3)) << "</tr>\n";
   }
