@@ -8,9 +8,6 @@
 // own output and truth, and on samples this file computes with its own forward model written
 // from SPEC.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
 // neither the simulator nor imufit's reader and model are checked only against themselves.
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -31,13 +28,15 @@
 #include <Eigen/Dense>
 
 #include "imufit/model/sensor_model.h"
-
-extern char** environ;
+#include "run_program.h"
 
 namespace imufit {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ReadBytes;
+using testing::RunProgram;
+using testing::RunResult;
 
 // Worst-case absolute error of a recovered rate (rad/s) or specific force (m/s^2).
 constexpr double kRecoveryToleranceSi = 1e-9;
@@ -62,14 +61,6 @@ std::string ReadFile(const std::string& path) {
   while ((n = gzread(file, block, sizeof block)) > 0) text.append(block, n);
   gzclose(file);
   return text;
-}
-
-// Reads a file's bytes as they are on disk.
-std::string ReadBytes(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::stringstream text;
-  text << stream.rdbuf();
-  return text.str();
 }
 
 // A CSV file split into its header and rows ('#' lines skipped), for checking outputs.
@@ -225,12 +216,6 @@ std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> SpecTruthOfPlan(const
 
 // ------------------------------------------------------------------------------------------
 
-struct RunResult {
-  int status = -1;  // exit status, or 128 + signal
-  std::string out;
-  std::string err;
-};
-
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -256,32 +241,7 @@ class CliTest : public ::testing::Test {
 
   // Runs imufit with `args`, stdin from /dev/null, and captures its output.
   RunResult Run(const std::vector<std::string>& args) const {
-    const std::string out_path = (dir_ / "stdout.txt").string();
-    const std::string err_path = (dir_ / "stderr.txt").string();
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<std::string> argv_storage = {IMUFIT_EXE};
-    argv_storage.insert(argv_storage.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& arg : argv_storage) argv.push_back(arg.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    RunResult result;
-    const int spawned = posix_spawn(&pid, IMUFIT_EXE, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (spawned != 0) {
-      ADD_FAILURE() << "cannot run " << IMUFIT_EXE << ": " << std::strerror(spawned);
-      return result;
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    result.out = ReadBytes(out_path);
-    result.err = ReadBytes(err_path);
-    return result;
+    return RunProgram(IMUFIT_EXE, args, (dir_ / "stdout.txt").string(), (dir_ / "stderr.txt").string());
   }
 
   // The names in the work folder.

@@ -27,13 +27,13 @@
 #include <gtest/gtest.h>
 
 #include "imufit/io/sha256.h"
-
-extern char** environ;
+#include "run_program.h"
 
 namespace imufit {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::RunResult;
 
 const std::string kFixtures = IMUFIT_FIXTURES_DIR;
 // The exit statuses of SPEC.md section 4 and the factory addition (docs/factory.md).
@@ -55,18 +55,7 @@ criteria:
   - {quantity: fit_temp_range_c, covers: [-20, 60]}
 )";
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::stringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-struct RunResult {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+std::string ReadBytes(const fs::path& path) { return testing::ReadBytes(path.string()); }
 
 // A CSV split into rows of cells (no quoted commas in the cells the tests read).
 std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& text) {
@@ -134,31 +123,7 @@ class FactoryCliTest : public ::testing::Test {
   RunResult Run(const std::vector<std::string>& args) const { return RunProgram(IMUFIT_EXE, args); }
 
   RunResult RunProgram(const std::string& program, const std::vector<std::string>& args) const {
-    const std::string out_path = Path("stdout.txt"), err_path = Path("stderr.txt");
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<std::string> storage = {program};
-    storage.insert(storage.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : storage) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    RunResult result;
-    const int spawned = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (spawned != 0) {
-      ADD_FAILURE() << "cannot run " << program << ": " << std::strerror(spawned);
-      return result;
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    result.out = ReadBytes(out_path);
-    result.err = ReadBytes(err_path);
-    return result;
+    return testing::RunProgram(program, args, Path("stdout.txt"), Path("stderr.txt"));
   }
 
   // Simulates a unit's run with a fixed seed and a little white noise.
