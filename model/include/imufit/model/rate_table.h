@@ -21,13 +21,23 @@ namespace imufit {
 inline constexpr double kEarthRateRadps = 7.292115e-5;
 
 // One segment of a rate-table plan, in SI units (io/ converts the plan file's deg/s).
+//
+// Three kinds of segment: static (rate 0, no angle); a constant rate about the rotation axis
+// (rate_radps != 0); a turn through a known angle about the rotation axis (angle_rad set: hand
+// rotations, position-mode tables, indexing heads; the rate during the turn is not known, only
+// its integral). The rotation axis is `axis` when given (two- and three-axis tables, turns about
+// a horizontal axis), else `up` (a single-axis table turns about the vertical).
 struct TableSegment {
   int id = 0;
-  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // unit vector, body axes
-  double rate_radps = 0.0;                        // table rate about `up`, right-hand rule
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // unit vector, body axes (at the start of a turn)
+  double rate_radps = 0.0;                        // rate about RotationAxis(), right-hand rule
+  std::optional<double> angle_rad;                // turn through this angle about RotationAxis()
+  std::optional<Eigen::Vector3d> axis;            // unit, body axes; absent: the axis is `up`
   std::optional<Eigen::Vector3d> north;           // unit, horizontal, body axes; static only
   std::optional<Eigen::Vector3d> lever_arm_m;     // sensor position from the table axis
-  bool IsStatic() const { return rate_radps == 0.0; }
+  bool IsStatic() const { return rate_radps == 0.0 && !angle_rad; }
+  bool IsTurn() const { return angle_rad.has_value(); }
+  const Eigen::Vector3d& RotationAxis() const { return axis ? *axis : up; }
 };
 
 // The site of the run: local gravity and, optionally, latitude.
