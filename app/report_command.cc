@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "imufit/factory/certificate.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
@@ -29,14 +30,17 @@ int RunReport(const ReportArguments& args) {
   std::optional<Verdict> verdict;
   if (!args.limits.empty()) verdict = EvaluateLimits(ReadLimits(args.limits), calibration);
   const Plan plan = ReadPlan(args.plan);
-  RunWindows run = ReadRunWindows(plan, args.samples, args.windows);
-  const UnitReport report = MakeUnitReport(calibration, plan, std::move(run),
-                                           {{"calibration", args.calibration, ""},
-                                            {"plan", args.plan, ""},
-                                            {"samples", args.samples, ""},
-                                            {"limits", args.limits, ""}},
-                                           verdict);
-  WriteUnitReport(args.output, report);
+  CertificateSources sources;
+  sources.calibration = calibration;
+  sources.plan = plan;
+  sources.run = ReadRunWindows(plan, args.samples, args.windows);
+  sources.windows = args.windows;
+  sources.verdict = verdict;
+  sources.inputs = {{"calibration", args.calibration, ""},
+                    {"plan", args.plan, ""},
+                    {"samples", args.samples, ""},
+                    {"limits", args.limits, ""}};
+  WriteCertificate(args.output, MakeCertificate(sources));
   std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
               verdict ? (verdict->pass ? " (acceptance PASS)" : " (acceptance FAIL)") : "");
   return verdict && !verdict->pass ? kExitFailedLimits : 0;

@@ -14,9 +14,11 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/factory/certificate.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/error.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 
@@ -212,7 +214,8 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     }
     outcome.fit = std::move(result);
     if (outcome.status == "fitted" && options.write_reports) {
-      WriteUnitReport((out_dir / "report.html").string(), MakeUnitReport(outcome, options.limits_path));
+      WriteCertificate((out_dir / "report.html").string(),
+                       MakeCertificate(outcome, options.limits_path, options.fit.windows));
     }
   } catch (const InputError& e) {
     outcome.status = "error";
@@ -382,8 +385,10 @@ BatchResult RunBatch(const BatchOptions& options) {
   if (result.complete) {
     WriteLotSummary((fs::path(options.output_dir) / "lot_summary.csv").string(), result);
     if (options.write_reports) {
+      std::optional<Limits> limits;
+      if (!options.limits_path.empty()) limits = ReadLimits(options.limits_path);
       WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(),
-                          LotReportHtml(shared.lot, result, options.fit.software));
+                          LotPageHtml(MakeLotSummary(shared.lot, result, options.fit.software, limits)));
     }
   }
   return result;
