@@ -34,6 +34,7 @@ struct FitArguments {
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
   std::string report;  // certificate HTML to write
   std::string store;   // results store to record the fit in
+  std::string serial;  // the unit's serial; empty: the plan's
   double gyro_bias_stability_dph = 0.0;
   double accel_bias_stability_ug = 0.0;
   FitOptions fit;
@@ -93,16 +94,12 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 // Returns the exit status: 0, or kExitFailedLimits.
 int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result) {
   const Calibration& calibration = *result.calibration;
-  std::optional<Verdict> verdict;
-  if (limits) {
-    verdict = EvaluateLimits(*limits, calibration);
-    if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
-  }
   std::string plan_sha256, samples_sha256;
   if (!args.report.empty() || !args.store.empty()) {
     plan_sha256 = Sha256OfFile(args.plan);
     samples_sha256 = Sha256OfFile(args.samples);
   }
+  std::optional<Certificate> certificate;
   if (!args.report.empty()) {
     CertificateSources sources;
     sources.calibration = calibration;
@@ -110,12 +107,20 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
     sources.run = result.run;
     sources.windows = args.windows;
     sources.folds = result.folds;
-    sources.verdict = verdict;
+    sources.limits = limits;  // judged with the noise the certificate measures
     sources.inputs = {{"calibration", args.output, ""},
                       {"plan", args.plan, plan_sha256},
                       {"samples", args.samples, samples_sha256},
                       {"limits", args.limits, ""}};
-    WriteCertificate(args.report, MakeCertificate(sources));
+    certificate = MakeCertificate(sources);
+  }
+  std::optional<Verdict> verdict;
+  if (limits) {
+    verdict = certificate ? *certificate->verdict : EvaluateLimits(*limits, calibration);
+    if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
+  }
+  if (certificate) {
+    WriteCertificate(args.report, *certificate);
     if (!args.quiet) std::printf("  wrote %s\n", args.report.c_str());
   }
   if (!args.store.empty()) {
@@ -158,6 +163,7 @@ int RunFit(FitArguments args) {
   options.check_samples = args.check_samples;
   options.check_plan = args.check_plan;
   options.software = SoftwareVersion();
+  options.serial = args.serial;
   if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
 
   const FitRunResult result = FitRun(args.plan, args.samples, options);
@@ -278,6 +284,7 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   command->add_option("--limits,-l", args->limits,
                       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
+  command->add_option("--serial", args->serial, "the unit's serial (default: the plan's serial)");
   command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
   command->add_option("--store", args->store, "record the fit in this results store (SQLite; created when missing)");
   return [args] { return RunFit(*args); };

@@ -74,6 +74,8 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
   if (found)
     figures.push_back(
         {"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(gyro_rms), -1.0});
+  const double missing = FitNumber(calibration, "missing_segments", &found);
+  if (found) figures.push_back({"coverage", "fit.missing_segments", "segments missing", missing, -1.0});
   const double accel_rms = FitNumber(calibration, "accel_residual_rms_mps2", &found);
   if (found) {
     figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(accel_rms), -1.0});

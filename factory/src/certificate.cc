@@ -344,7 +344,6 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   CoverageWarnings(sources.plan, sources.run, &c.warnings);
   c.run = SummariseRun(cal, sources.plan, sources.run);
   c.settings = Settings(cal, sources.windows);
-  c.verdict = sources.verdict;
 
   for (const Figure& f : KeyFigures(cal)) {
     c.figures.push_back(
@@ -368,6 +367,8 @@ Certificate MakeCertificate(const CertificateSources& sources) {
       c.noise.why_not = e.what();
     }
   }
+  c.verdict = sources.verdict;
+  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, MeasuredFigures(c));
   for (const HeldOutGroup& g : sources.folds) {
     ValidationRow row;
     row.temp_c = g.temp_c;
@@ -383,7 +384,43 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   return c;
 }
 
+std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
+  std::vector<Figure> figures;
+  for (const NoiseAxis& a : certificate.noise.axes) {
+    if (!a.fitted) continue;
+    if (a.arw_resolved) {
+      figures.push_back({"gyro_arw_deg_per_sqrt_hr." + a.axis, "certificate.gyro_" + a.axis + ".arw",
+                         "deg/sqrt(h)", a.arw_deg_per_sqrt_hr, a.arw_sigma});
+    }
+    if (a.bias_instability_resolved) {
+      figures.push_back({"gyro_bias_instability_dph." + a.axis,
+                         "certificate.gyro_" + a.axis + ".bias_instability", "deg/h", a.bias_instability_dph,
+                         a.bias_instability_sigma});
+    }
+  }
+  return figures;
+}
+
+std::vector<std::string> InputMismatches(const Calibration& calibration, const std::string& plan_path,
+                                         const std::string& samples_path) {
+  std::vector<std::string> mismatches;
+  const auto check = [&](const char* key, const char* role, const std::string& path) {
+    const std::string recorded = FitText(calibration, key);
+    if (recorded.empty() || path.empty()) return;
+    const std::string actual = Sha256OfFile(path);
+    if (actual != recorded) {
+      mismatches.push_back(std::string("the calibration was fitted to a ") + role + " with SHA-256 " +
+                           recorded.substr(0, 16) + "..., not " + path + " (" + actual.substr(0, 16) +
+                           "...)");
+    }
+  };
+  check("plan_sha256", "plan", plan_path);
+  check("samples_sha256", "samples file", samples_path);
+  return mismatches;
+}
+
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
+                            const std::optional<Limits>& limits, const std::string& calibration_path,
                             const WindowOptions& windows) {
   const FitRunResult& fit = *unit.fit;
   CertificateSources sources;
@@ -395,7 +432,9 @@ Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_p
   sources.windows = windows;
   sources.folds = fit.folds;
   if (!unit.verdict.empty()) sources.verdict = unit.verdict_detail;
-  sources.inputs = {{"plan", unit.plan_path, unit.plan_sha256},
+  sources.limits = limits;
+  sources.inputs = {{"calibration", calibration_path, ""},
+                    {"plan", unit.plan_path, unit.plan_sha256},
                     {"samples", unit.samples_path, unit.samples_sha256},
                     {"limits", limits_path, ""}};
   return MakeCertificate(sources);

@@ -43,9 +43,12 @@ struct CertificateSources {
   Calibration calibration;
   Plan plan;
   RunWindows run;
-  WindowOptions windows;              // how the run was cut into windows (trim, ...)
-  std::vector<HeldOutGroup> folds;    // empty when validation was not run
-  std::optional<Verdict> verdict;     // with limits
+  WindowOptions windows;            // how the run was cut into windows (trim, ...)
+  std::vector<HeldOutGroup> folds;  // empty when validation was not run
+  std::optional<Verdict> verdict;   // judged by the caller; replaced when `limits` is given
+  // Acceptance limits: judged here, with the ARW and bias instability this certificate measures
+  // taking the place of a `noise:` block's.
+  std::optional<Limits> limits;
   std::vector<ReportInput> inputs;    // files to hash and list
   std::vector<std::string> warnings;  // from the caller (e.g. a mismatch the user allowed)
 };
@@ -171,7 +174,16 @@ struct Certificate {
 Certificate MakeCertificate(const CertificateSources& sources);
 // From a batch unit just fitted (its FitRunResult is in unit.fit).
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
+                            const std::optional<Limits>& limits, const std::string& calibration_path,
                             const WindowOptions& windows = WindowOptions());
+
+// The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
+std::vector<Figure> MeasuredFigures(const Certificate& certificate);
+
+// Where a calibration says it was fitted to other files than the ones given (SHA-256 in its `fit:`
+// block): one message per mismatch, empty when they belong together or the calibration does not say.
+std::vector<std::string> InputMismatches(const Calibration& calibration, const std::string& plan_path,
+                                         const std::string& samples_path);
 
 // ---------------------------------------------------------------- the lot page
 
