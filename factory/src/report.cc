@@ -113,7 +113,7 @@ PlotFigure CoefficientFigure(const CoefficientGroup& g) {
   if (g.grid) {
     figure.rows = figure.cols = 3;
     figure.width_px = 760;
-    figure.height_px = 520;
+    figure.height_px = 400;
     figure.title = g.title + " (" + g.unit + ") against temperature, degC; 1-sigma band";
     for (const CoefficientCurve& c : g.curves) {
       Plot plot;
@@ -125,7 +125,7 @@ PlotFigure CoefficientFigure(const CoefficientGroup& g) {
     return figure;
   }
   figure.width_px = 480;
-  figure.height_px = 280;
+  figure.height_px = 240;
   Plot plot = Panel(g.title + ", 1-sigma band", "temperature, degC", g.unit);
   for (size_t i = 0; i < g.curves.size(); ++i) panel(g.curves[i], static_cast<int>(i), &plot);
   figure.panels.push_back(plot);
