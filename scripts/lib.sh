@@ -7,7 +7,7 @@ IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # Everything the build, the tests and the Allan plots need, as Debian packages.
 IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
-                     libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev)
+                     libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev chromium poppler-utils)
 
 imufit_say() { printf '== %s\n' "$*"; }
 imufit_die() { printf 'error: %s\n' "$*" >&2; exit 1; }

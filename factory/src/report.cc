@@ -33,7 +33,7 @@ thead { display: table-header-group; } tr { break-inside: avoid; page-break-insi
 .badge { display: inline-block; padding: 3px 14px; font-size: 18px; border: 2px solid; border-radius: 4px; }
 .plot svg { width: 100%; height: auto; } .plot { break-inside: avoid; page-break-inside: avoid; }
 .plots2 { display: grid; grid-template-columns: 1fr 1fr; gap: 2px 10px; }
-.cols { display: grid; grid-template-columns: 1fr 1fr; gap: 12px; } .cols > div { break-inside: avoid; }
+.cols { display: grid; grid-template-columns: 1fr 1fr; gap: 12px; } .cols > div { break-inside: avoid; } .cols table { width: 100%; }
 .keep { break-inside: avoid; page-break-inside: avoid; }
 .warn { background: #fff4d6; border: 1px solid #e0b000; padding: 4px 8px; margin: 6px 0; }
 .note { color: #555; font-size: 11px; }
@@ -331,16 +331,12 @@ void Acceptance(Html* h, const Verdict& verdict) {
   h->Close("tbody").Close("table");
 }
 
-void KeyFigures(Html* h, const Certificate& c) {
-  h->Element("h2", "Coefficients at 25 degC");
-  h->Element("p",
-             "1-sigma from the fit's covariance; U is the expanded uncertainty at k = 2 (about 95 % for a "
-             "normal distribution).",
-             {{"class", "note"}});
+void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
   h->Open("table").Open("thead");
   Row(h, {"coefficient", "value", "1-sigma", "U (k = 2)", "unit"}, "th");
   h->Close("thead").Open("tbody");
-  for (const KeyFigureRow& f : c.figures) {
+  for (const KeyFigureRow& f : figures) {
+    if ((f.name.rfind("gyro", 0) == 0) != gyro) continue;
     h->Open("tr").Element("td", f.name);
     Num(h, Fmt("%+.6g", f.value), {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
     Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
@@ -348,6 +344,20 @@ void KeyFigures(Html* h, const Certificate& c) {
     h->Element("td", f.unit).Close("tr");
   }
   h->Close("tbody").Close("table");
+}
+
+void KeyFigures(Html* h, const Certificate& c) {
+  h->Element("h2", "Coefficients at 25 degC");
+  h->Element("p",
+             "1-sigma from the fit's covariance; U is the expanded uncertainty at k = 2 (about 95 % for a "
+             "normal distribution).",
+             {{"class", "note"}});
+  h->Open("div", {{"class", "cols"}});
+  h->Open("div");
+  FigureTable(h, c.figures, true);
+  h->Close("div").Open("div");
+  FigureTable(h, c.figures, false);
+  h->Close("div").Close("div");
 }
 
 void ResidualTable(Html* h, const Certificate& c) {
@@ -476,7 +486,6 @@ std::string CertificateHtml(const Certificate& c) {
   KeyFigures(&h, c);
 
   const size_t groups = c.curves.size();
-  h.Open("div", {{"class", "page-break"}}).Close("div");
   h.Element("h2", "Coefficients against temperature");
   h.Element("p",
             "Lines: the fitted polynomial; bands: 1-sigma from each term's own sigma (correlations between "
