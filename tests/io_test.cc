@@ -1,6 +1,12 @@
 // Tests of io/: every file format read and written per SPEC.md, and every error located.
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -8,6 +14,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
@@ -503,6 +510,179 @@ TEST_F(IoTest, AUtf8ByteOrderMarkIsSkippedAndUtf16IsNamed) {
   EXPECT_EQ(csv.Number(csv.RequireColumn("time_s")), 1.0);
   const InputError e = Catch([&] { CsvReader utf16(Write("utf16.csv", std::string("\xFF\xFEt\0i\0", 6))); });
   EXPECT_NE(e.message().find("UTF-16"), std::string::npos) << e.what();
+}
+
+TEST_F(IoTest, SilentGarbageInYamlIsRefused) {
+  struct Case {
+    std::string from, to, expect;
+  };
+  const Case cases[] = {
+      {"latitude_deg: 30.27", "latitude_deg: 30.27\nlatitude_deg: 10", "\"latitude_deg\" appears twice"},
+      {"rate_dps: -300", "rate_dps: -300\n    rate_dps: 300", "\"rate_dps\" appears twice"},
+      {"serial: SN0001", "serial: SN0001\n---\nserial: other", "a second YAML document"},
+      {"gravity_mps2: 9.79285", "gravity_mps2: \"9.79285\"", "quoted text"},
+      {"id: 7", "id: '7'", "quoted text"},
+      {"rate_dps: -300", "rate_dps: !!str -300", "quoted text"},
+      {"rate_dps: -300", "rate_dps: +-300", "\"+-300\" is not a number"},
+      {"up: [1, 0, 0]", "up: [1e200, 1e200, 0]", "length must lie between"},
+      {"up: [1, 0, 0]", "up: [1e-200, 0, 0]", "length must lie between"},
+      {"gravity_mps2: 9.79285", "gravity_mps2: 1e308", "between 9.7 and 9.9"},
+      {"gravity_mps2: 9.79285", "gravity_mps2: 0.001", "between 9.7 and 9.9"},
+  };
+  for (const Case& c : cases) {
+    std::string text = kPlan;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    const InputError e = Catch([&] { ReadPlan(Write("bad.yaml", text)); });
+    EXPECT_NE(e.message().find(c.expect), std::string::npos) << c.to << ": " << e.what();
+    EXPECT_GT(e.line(), 0) << c.to << ": " << e.what();
+  }
+  // A limits file whose duplicate key would have let a unit pass.
+  const std::string limits = Write("limits.yaml",
+                                   "format: imufit-limits\nversion: 1\ncriteria:\n"
+                                   "  - {quantity: gyro_bias_dps, max_abs: 0.01, max_abs: 1000}\n");
+  const InputError e = Catch([&] { ReadLimits(limits); });
+  EXPECT_NE(e.message().find("\"max_abs\" appears twice"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), 4);
+  // Limits: file size and nesting are bounded.
+  const InputError big = Catch([&] { ReadLimits("/dev/zero"); });
+  EXPECT_NE(big.message().find("larger than 16 MiB"), std::string::npos) << big.what();
+  const InputError deep = Catch(
+      [&] { ReadLimits(Write("deep.yaml", "criteria: " + std::string(100, '[') + std::string(100, ']'))); });
+  EXPECT_NE(deep.message().find("nested deeper than 64"), std::string::npos) << deep.what();
+}
+
+TEST_F(IoTest, ManyUnknownCalibrationKeysAreKeptInLinearTime) {
+  // 30000 unknown keys: a quadratic copy takes many seconds (minutes at 10^5); linear, a fraction.
+  std::string text = CalibrationToYaml(ExampleCalibration());
+  for (int i = 0; i < 30000; ++i) text += "k" + std::to_string(i) + ": " + std::to_string(i) + "\n";
+  const Calibration read = ReadCalibration(Write("many.yaml", text));
+  EXPECT_EQ(read.extra.size(), 30001u);  // with `fit`
+  EXPECT_EQ(read.extra["k29999"].as<int>(), 29999);
+}
+
+TEST_F(IoTest, CalibrationsThatCannotCorrectAreRefusedOnRead) {
+  const Calibration good = ExampleCalibration();
+  const auto error_of = [&](const std::function<void(Calibration*)>& change) {
+    Calibration bad = good;
+    change(&bad);
+    return Catch([&] { ReadCalibration(Write("bad.yaml", CalibrationToYaml(bad))); }).message();
+  };
+  const int sx = kScaleCoefficient * kPolynomialTerms;  // gyro scale x, c0
+  // A scale that crosses zero at 60 degC inside [-40, 85]: 1 - (T - 25) / 35.
+  std::string e = error_of([&](Calibration* c) {
+    c->model.gyro[sx] = 1.0;
+    c->model.gyro[sx + 1] = -1.0 / 35.0;
+    c->model.gyro[sx + 2] = c->model.gyro[sx + 3] = 0.0;
+  });
+  EXPECT_NE(e.find("gyro.scale.x: the scale factor changes sign"), std::string::npos) << e;
+  // A cubic that dips to 1e-6 of its peak between the ends (double root at 50 degC).
+  e = error_of([&](Calibration* c) {
+    const int sy = sx + kPolynomialTerms;
+    c->model.accel[sy] = 625.0 + 1e-4;  // (x - 25)^2 = x^2 - 50 x + 625, x = T - 25
+    c->model.accel[sy + 1] = -50.0;
+    c->model.accel[sy + 2] = 1.0;
+    c->model.accel[sy + 3] = 0.0;
+  });
+  EXPECT_NE(e.find("accel.scale.y: the scale factor comes near zero"), std::string::npos) << e;
+  // A denormal scale; a singular M (xy = yx = 1 makes two rows equal).
+  e = error_of([&](Calibration* c) {
+    c->model.gyro[sx] = 1e-310;
+    c->model.gyro[sx + 1] = c->model.gyro[sx + 2] = c->model.gyro[sx + 3] = 0.0;
+  });
+  EXPECT_NE(e.find("comes near zero"), std::string::npos) << e;
+  e = error_of([&](Calibration* c) {
+    c->model.accel[kMisalignmentCoefficient * kPolynomialTerms] = 1.0;        // xy
+    c->model.accel[(kMisalignmentCoefficient + 2) * kPolynomialTerms] = 1.0;  // yx
+  });
+  EXPECT_NE(e.find("accel.misalignment: M is nearly singular"), std::string::npos) << e;
+  // The example itself, and a scale that crosses zero only outside the fit range, are fine.
+  ReadCalibration(Write("good.yaml", CalibrationToYaml(good)));
+  Calibration outside = good;
+  outside.model.gyro[sx] = 1.0;
+  outside.model.gyro[sx + 1] = -1.0 / 100.0;  // zero at 125 degC
+  outside.model.gyro[sx + 2] = outside.model.gyro[sx + 3] = 0.0;
+  ReadCalibration(Write("outside.yaml", CalibrationToYaml(outside)));
+}
+
+TEST_F(IoTest, OutputsRefuseLinksFifosDevicesAndReadOnlyFiles) {
+  const std::string target = Write("target.csv", "the user's file\n");
+  const std::string link = (dir_ / "link.csv").string();
+  fs::create_symlink(target, link);
+  const std::string fifo = (dir_ / "fifo.csv").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  const std::string read_only = Write("read_only.csv", "locked\n");
+  fs::permissions(read_only, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  struct Case {
+    std::string path, expect;
+  };
+  for (const Case& c : {Case{link, "is a symbolic link"}, Case{fifo, "is a FIFO, not a regular file"},
+                        Case{read_only, "is read-only"}, Case{dir_.string() + "/", "not a file name"}}) {
+    const InputError e = Catch([&] { WriteFileAtomically(c.path, "new\n"); });
+    EXPECT_NE(e.message().find(c.expect), std::string::npos) << c.path << ": " << e.what();
+  }
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(Read(target), "the user's file\n");
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_EQ(Read(read_only), "locked\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 4)
+      << "temporary left behind";
+  // A link that appears while the output is written is not replaced either.
+  const std::string late = (dir_ / "late.csv").string();
+  OutputFile file(late);
+  file.Write("x\n");
+  fs::create_symlink(target, late);
+  EXPECT_NE(Catch([&] { file.Commit(); }).message().find("symbolic link"), std::string::npos);
+  EXPECT_EQ(Read(target), "the user's file\n");
+}
+
+TEST_F(IoTest, AnOutputTransactionWritesAllOrNothing) {
+  const std::string first = Write("first.yaml", "old first\n");
+  const std::string second = (dir_ / "second.html").string();
+  {
+    OutputTransaction outputs;
+    WriteFileAtomically(first, "new first\n");
+    EXPECT_EQ(Read(first), "old first\n") << "renamed before the transaction commits";
+    // The second output fails (its folder does not exist): the first must not change.
+    EXPECT_THROW(WriteFileAtomically((dir_ / "missing" / "x.html").string(), "y"), InputError);
+  }
+  EXPECT_EQ(Read(first), "old first\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1)
+      << "temporary left behind";
+  {
+    OutputTransaction outputs;
+    WriteFileAtomically(first, "new first\n");
+    WriteFileAtomically(second, "new second\n");
+    EXPECT_FALSE(fs::exists(second));
+    outputs.Commit();
+  }
+  EXPECT_EQ(Read(first), "new first\n");
+  EXPECT_EQ(Read(second), "new second\n");
+  // Outside a transaction, Commit() renames at once again.
+  WriteFileAtomically(second, "third\n");
+  EXPECT_EQ(Read(second), "third\n");
+}
+
+TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
+  for (const int signal_number : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string path = (dir_ / ("out" + std::to_string(signal_number) + ".csv.gz")).string();
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      InstallOutputCleanupOnSignals();
+      OutputFile file(path);
+      file.Write(std::string(3 << 20, 'x'));  // past the first flush
+      OutputTransaction outputs;
+      WriteFileAtomically(path + ".other", "pending in a transaction\n");
+      ::raise(signal_number);
+      ::_exit(0);  // not reached
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the child should die of the signal, as without the handler";
+    EXPECT_EQ(WTERMSIG(status), signal_number);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 0)
+        << "temporary file left behind after signal " << signal_number;
+  }
 }
 
 }  // namespace
