@@ -262,9 +262,9 @@ void WriteNoiseYaml(const std::string& path, const AllanArguments& args, const U
          << YamlNumber(fit.readout_rate_random_walk * k.engineer_per_si) << "\n";
   }
   const bool has_gyro = std::any_of(results.begin(), results.end(),
-                                    [](const ColumnResult& r) { return r.kind == ColumnKind::kGyro; });
+                                    [](const ColumnResult& r) { return r.kind == ColumnKind::kGyro && r.fit.fitted; });
   const bool has_accel = std::any_of(results.begin(), results.end(),
-                                     [](const ColumnResult& r) { return r.kind == ColumnKind::kAccel; });
+                                     [](const ColumnResult& r) { return r.kind == ColumnKind::kAccel && r.fit.fitted; });
   if (has_gyro || has_accel) {
     yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor\n";
     if (has_gyro) {

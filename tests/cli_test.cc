@@ -830,8 +830,8 @@ TEST_F(CliTest, AnOutputThatIsAlsoAnInputIsRefused) {
 
 TEST_F(CliTest, FitWritesACalibrationThatCorrectsAnotherRun) {
   const std::string calibration = Path("calibration.yaml");
-  const RunResult fit = Run({"fit", "--plan", Fixture("plan_6pos.yaml"), "--samples", Fixture("mems_6pos_soak.csv.gz"),
-                             "-o", calibration, "--validate"});
+  const RunResult fit = Run({"fit", "--plan", Fixture("plan_6pos.yaml"), "--samples",
+                             Fixture("mems_6pos_soak.csv.gz"), "-o", calibration, "--validate"});
   ASSERT_EQ(fit.status, 0) << fit.err;
   EXPECT_NE(fit.out.find("converged"), std::string::npos) << fit.out;
   EXPECT_NE(fit.out.find("at 25 degC (+- 1 sigma)"), std::string::npos) << fit.out;
@@ -877,15 +877,17 @@ TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
   const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", output});
   EXPECT_EQ(fit.status, 1);
   EXPECT_NE(fit.err.find("does not determine the model"), std::string::npos) << fit.err;
-  EXPECT_NE(fit.err.find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
-                         "at least 4 needed"),
-            std::string::npos)
+  EXPECT_NE(
+      fit.err.find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
+                   "at least 4 needed"),
+      std::string::npos)
       << fit.err;
   EXPECT_EQ(ReadBytes(output), "precious\n");
   EXPECT_EQ(Listing(), (std::set<std::string>{"one_temperature.csv", "calibration.yaml"}));
   // The same run determines a constant model.
-  const RunResult constant = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("constant.yaml"),
-                                  "--gyro-temp-order", "0", "--accel-temp-order", "0", "-q"});
+  const RunResult constant =
+      Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("constant.yaml"),
+           "--gyro-temp-order", "0", "--accel-temp-order", "0", "-q"});
   EXPECT_EQ(constant.status, 0) << constant.err;
 }
 
@@ -903,16 +905,19 @@ TEST_F(CliTest, FitNamesAnAxisGravityNeverPointsAlong) {
   emitter << root;
   const std::string plan_path = Write("plan.yaml", emitter.c_str());
   const std::string samples = Path("run.csv");
-  ASSERT_EQ(Run({"simulate", "-p", plan_path, "-c", Fixture("mems_truth.yaml"), "-o", samples, "--temps=-40,0,40,85",
-                 "--rate", "10", "--dwell", "3", "-q"})
+  ASSERT_EQ(Run({"simulate", "-p", plan_path, "-c", Fixture("mems_truth.yaml"), "-o", samples,
+                 "--temps=-40,0,40,85", "--rate", "10", "--dwell", "3", "-q"})
                 .status,
             0);
   const RunResult fit = Run({"fit", "-p", plan_path, "-s", samples, "-o", Path("calibration.yaml")});
   EXPECT_EQ(fit.status, 1);
-  EXPECT_NE(fit.err.find("gyro g_sensitivity column y (xy, yy, zy) is undetermined: no positions with gravity along -y"),
-            std::string::npos)
+  EXPECT_NE(
+      fit.err.find(
+          "gyro g_sensitivity column y (xy, yy, zy) is undetermined: no positions with gravity along -y"),
+      std::string::npos)
       << fit.err;
-  EXPECT_NE(fit.err.find("accel scale y and misalignment xy, zy are undetermined"), std::string::npos) << fit.err;
+  EXPECT_NE(fit.err.find("accel scale y and misalignment xy, zy are undetermined"), std::string::npos)
+      << fit.err;
   EXPECT_FALSE(fs::exists(Path("calibration.yaml")));
 }
 
@@ -923,25 +928,139 @@ TEST_F(CliTest, FitRefusesBadInputWithExitTwo) {
                                     "0,25,99,1,2,3,4,5,6\n");
   RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("c.yaml")});
   EXPECT_EQ(fit.status, 2);
-  EXPECT_NE(fit.err.find("samples.csv:2:3: segment: segment 99 is not in the plan"), std::string::npos) << fit.err;
-  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o", Path("c.yaml"),
-             "--loss", "tukey"});
+  EXPECT_NE(fit.err.find("samples.csv:2:3: segment: segment 99 is not in the plan"), std::string::npos)
+      << fit.err;
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
+             Path("c.yaml"), "--loss", "tukey"});
   EXPECT_EQ(fit.status, 2);
-  EXPECT_NE(fit.err.find("\"tukey\" is not a robust loss (none, huber, cauchy)"), std::string::npos) << fit.err;
-  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o", Path("c.yaml"),
-             "--gyro-temp-order", "4"});
+  EXPECT_NE(fit.err.find("\"tukey\" is not a robust loss (none, huber, cauchy)"), std::string::npos)
+      << fit.err;
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
+             Path("c.yaml"), "--gyro-temp-order", "4"});
   EXPECT_EQ(fit.status, 2);
   EXPECT_FALSE(fs::exists(Path("c.yaml")));
 }
 
 TEST_F(CliTest, FitReportsErrorsOnAHeldOutRun) {
-  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
-                             Path("calibration.yaml"), "--check-samples", Fixture("mems_6pos_ramp.csv.gz")});
+  const RunResult fit =
+      Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
+           Path("calibration.yaml"), "--check-samples", Fixture("mems_6pos_ramp.csv.gz")});
   ASSERT_EQ(fit.status, 0) << fit.err;
   EXPECT_NE(fit.out.find("held-out run"), std::string::npos) << fit.out;
   EXPECT_NE(fit.out.find("    all      216"), std::string::npos) << fit.out;
   const YAML::Node written = YAML::LoadFile(Path("calibration.yaml"));
   EXPECT_LT(written["check"]["gyro_error_rms_radps"].as<double>(), 0.02 * kDegToRad);
+}
+
+// ------------------------------------------------------------------------------------------
+// Inputs as they really arrive: exit 2, one located line, nothing written, nothing damaged.
+
+TEST_F(CliTest, ATruncatedGzipRunIsRefusedNotReadAsComplete) {
+  const std::string whole = ReadBytes(Fixture("mems_6pos_noiseless.csv.gz"));
+  for (const auto& [name, bytes] :
+       {std::pair<std::string, std::string>{"cut.csv.gz", whole.substr(0, whole.size() - 8)},
+        {"garbage.csv.gz", whole + "junk"}}) {
+    const std::string samples = Write(name, bytes);
+    const RunResult r =
+        Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+    EXPECT_EQ(r.status, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name + ": " + (name == "cut.csv.gz" ? "truncated gzip stream" : "trailing garbage")),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(Path("out.csv")));
+  }
+}
+
+TEST_F(CliTest, MultiOutputCommandsWriteAllOrNothing) {
+  const std::string calibration = Write("calibration.yaml", "precious\n");
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"),
+                             "-o", calibration, "--report", Path("missing/report.html"), "-q"});
+  EXPECT_EQ(fit.status, 2) << fit.err;
+  EXPECT_NE(fit.err.find("missing/report.html: cannot create"), std::string::npos) << fit.err;
+  EXPECT_EQ(ReadBytes(calibration), "precious\n")
+      << "the calibration was replaced although the report failed";
+  EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml"}));
+
+  std::string rows = "time_s,gyro_x\n";
+  for (int i = 0; i < 2000; ++i)
+    rows += std::to_string(i * 0.01) + "," + std::to_string((i * 7919 % 101) * 1e-3) + "\n";
+  const std::string samples = Write("rates.csv", rows);
+  const RunResult allan =
+      Run({"allan", "-s", samples, "-o", Path("adev.csv"), "--noise-yaml", Path("missing/noise.yaml"), "-q"});
+  EXPECT_EQ(allan.status, 2) << allan.err;
+  EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml", "rates.csv"})) << "adev.csv written alone";
+}
+
+TEST_F(CliTest, OutputsNeverReplaceALinkOrSpecialFile) {
+  const std::string target = Write("target.csv", "the user's file\n");
+  const std::string link = Path("link.csv");
+  fs::create_symlink(target, link);
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s",
+                           Fixture("mems_6pos_noiseless.csv.gz"), "-o", link, "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("link.csv: is a symbolic link"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(ReadBytes(target), "the user's file\n");
+  EXPECT_EQ(Listing(), (std::set<std::string>{"target.csv", "link.csv"}));
+}
+
+TEST_F(CliTest, NoCommandWritesANonFiniteNumber) {
+  // apply: an absurd temperature overflows the polynomials.
+  const std::string header = "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
+  const std::string samples = Write("hot.csv", header + "0,25,1,2,3,4,5,6\n0.1,1e300,1,2,3,4,5,6\n");
+  RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("hot.csv:3:2: temp_c: the correction at 1e+300 degC is not a finite number"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // apply: a calibration whose scale crosses zero inside its fit range is refused on read.
+  YAML::Node calibration = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  calibration["gyro"]["scale"]["y"][1] =
+      -calibration["gyro"]["scale"]["y"][0].as<double>() / 30.0;  // 0 at 55 degC
+  YAML::Emitter emitter;
+  emitter << calibration;
+  r = Run({"apply", "-c", Write("bad.yaml", emitter.c_str()), "-s", Fixture("mems_6pos_noiseless.csv.gz"),
+           "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("gyro.scale.y: the scale factor changes sign"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // simulate: a temperature that is not a number.
+  r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o",
+           Path("sim.csv"), "--temps", "25,nan", "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("temperatures must be numbers"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("sim.csv")));
+  // allan: a constant column gives zero deviations with zero-width intervals and says why there is
+  // no noise fit.
+  std::string rows = "time_s,gyro_x\n";
+  for (int i = 0; i < 2000; ++i) rows += std::to_string(i * 0.01) + ",0.5\n";
+  r = Run(
+      {"allan", "-s", Write("stuck.csv", rows), "-o", Path("adev.csv"), "--noise-yaml", Path("noise.yaml")});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("the column is constant"), std::string::npos) << r.out;
+  for (const char* output : {"adev.csv", "noise.yaml"}) {
+    const std::string text = ReadBytes(Path(output));
+    EXPECT_FALSE(text.empty()) << output;
+    EXPECT_EQ(text.find("nan"), std::string::npos) << output << ":\n" << text;
+    EXPECT_EQ(text.find("inf"), std::string::npos) << output << ":\n" << text;
+  }
+}
+
+TEST_F(CliTest, HostileInputGivesOneBoundedEscapedLine) {
+  const std::string samples =
+      Write("evil.csv", "time_s,temp_c,\x1b]0;owned\x07" + std::string(3000, 'x') + "\n1,2,3\n");
+  const RunResult r =
+      Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\x07'), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_LT(r.err.size(), 600u) << r.err;
+  const RunResult zero =
+      Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", "/dev/zero", "-o", Path("out.csv")});
+  EXPECT_EQ(zero.status, 2) << zero.err;
+  EXPECT_NE(zero.err.find("/dev/zero:1: line longer than"), std::string::npos) << zero.err;
 }
 
 }  // namespace
