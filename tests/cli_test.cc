@@ -830,8 +830,8 @@ TEST_F(CliTest, AnOutputThatIsAlsoAnInputIsRefused) {
 
 TEST_F(CliTest, FitWritesACalibrationThatCorrectsAnotherRun) {
   const std::string calibration = Path("calibration.yaml");
-  const RunResult fit = Run({"fit", "--plan", Fixture("plan_6pos.yaml"), "--samples",
-                             Fixture("mems_6pos_soak.csv.gz"), "-o", calibration, "--validate"});
+  const RunResult fit = Run({"fit", "--plan", Fixture("plan_6pos.yaml"), "--samples", Fixture("mems_6pos_soak.csv.gz"),
+                             "-o", calibration, "--validate"});
   ASSERT_EQ(fit.status, 0) << fit.err;
   EXPECT_NE(fit.out.find("converged"), std::string::npos) << fit.out;
   EXPECT_NE(fit.out.find("at 25 degC (+- 1 sigma)"), std::string::npos) << fit.out;
@@ -877,17 +877,15 @@ TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
   const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", output});
   EXPECT_EQ(fit.status, 1);
   EXPECT_NE(fit.err.find("does not determine the model"), std::string::npos) << fit.err;
-  EXPECT_NE(
-      fit.err.find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
-                   "at least 4 needed"),
-      std::string::npos)
+  EXPECT_NE(fit.err.find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
+                         "at least 4 needed"),
+            std::string::npos)
       << fit.err;
   EXPECT_EQ(ReadBytes(output), "precious\n");
   EXPECT_EQ(Listing(), (std::set<std::string>{"one_temperature.csv", "calibration.yaml"}));
   // The same run determines a constant model.
-  const RunResult constant =
-      Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("constant.yaml"),
-           "--gyro-temp-order", "0", "--accel-temp-order", "0", "-q"});
+  const RunResult constant = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("constant.yaml"),
+                                  "--gyro-temp-order", "0", "--accel-temp-order", "0", "-q"});
   EXPECT_EQ(constant.status, 0) << constant.err;
 }
 
@@ -905,19 +903,16 @@ TEST_F(CliTest, FitNamesAnAxisGravityNeverPointsAlong) {
   emitter << root;
   const std::string plan_path = Write("plan.yaml", emitter.c_str());
   const std::string samples = Path("run.csv");
-  ASSERT_EQ(Run({"simulate", "-p", plan_path, "-c", Fixture("mems_truth.yaml"), "-o", samples,
-                 "--temps=-40,0,40,85", "--rate", "10", "--dwell", "3", "-q"})
+  ASSERT_EQ(Run({"simulate", "-p", plan_path, "-c", Fixture("mems_truth.yaml"), "-o", samples, "--temps=-40,0,40,85",
+                 "--rate", "10", "--dwell", "3", "-q"})
                 .status,
             0);
   const RunResult fit = Run({"fit", "-p", plan_path, "-s", samples, "-o", Path("calibration.yaml")});
   EXPECT_EQ(fit.status, 1);
-  EXPECT_NE(
-      fit.err.find(
-          "gyro g_sensitivity column y (xy, yy, zy) is undetermined: no positions with gravity along -y"),
-      std::string::npos)
+  EXPECT_NE(fit.err.find("gyro g_sensitivity column y (xy, yy, zy) is undetermined: no positions with gravity along -y"),
+            std::string::npos)
       << fit.err;
-  EXPECT_NE(fit.err.find("accel scale y and misalignment xy, zy are undetermined"), std::string::npos)
-      << fit.err;
+  EXPECT_NE(fit.err.find("accel scale y and misalignment xy, zy are undetermined"), std::string::npos) << fit.err;
   EXPECT_FALSE(fs::exists(Path("calibration.yaml")));
 }
 
@@ -928,23 +923,20 @@ TEST_F(CliTest, FitRefusesBadInputWithExitTwo) {
                                     "0,25,99,1,2,3,4,5,6\n");
   RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", Path("c.yaml")});
   EXPECT_EQ(fit.status, 2);
-  EXPECT_NE(fit.err.find("samples.csv:2:3: segment: segment 99 is not in the plan"), std::string::npos)
-      << fit.err;
-  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
-             Path("c.yaml"), "--loss", "tukey"});
+  EXPECT_NE(fit.err.find("samples.csv:2:3: segment: segment 99 is not in the plan"), std::string::npos) << fit.err;
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o", Path("c.yaml"),
+             "--loss", "tukey"});
   EXPECT_EQ(fit.status, 2);
-  EXPECT_NE(fit.err.find("\"tukey\" is not a robust loss (none, huber, cauchy)"), std::string::npos)
-      << fit.err;
-  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
-             Path("c.yaml"), "--gyro-temp-order", "4"});
+  EXPECT_NE(fit.err.find("\"tukey\" is not a robust loss (none, huber, cauchy)"), std::string::npos) << fit.err;
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o", Path("c.yaml"),
+             "--gyro-temp-order", "4"});
   EXPECT_EQ(fit.status, 2);
   EXPECT_FALSE(fs::exists(Path("c.yaml")));
 }
 
 TEST_F(CliTest, FitReportsErrorsOnAHeldOutRun) {
-  const RunResult fit =
-      Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
-           Path("calibration.yaml"), "--check-samples", Fixture("mems_6pos_ramp.csv.gz")});
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"), "-o",
+                             Path("calibration.yaml"), "--check-samples", Fixture("mems_6pos_ramp.csv.gz")});
   ASSERT_EQ(fit.status, 0) << fit.err;
   EXPECT_NE(fit.out.find("held-out run"), std::string::npos) << fit.out;
   EXPECT_NE(fit.out.find("    all      216"), std::string::npos) << fit.out;
