@@ -312,8 +312,7 @@ TEST_F(IoTest, SamplesErrorsNameLineFieldAndText) {
     });
   };
   InputError e = error_of("0,25,1,1,2,3,4,5,6\n0.1,25,1,1,1.2.3,3,4,5,6\n");
-  EXPECT_STREQ(e.what(),
-               (dir_ / "samples.csv").string().append(":3:5: gyro_y: \"1.2.3\" is not a number").c_str());
+  EXPECT_STREQ(e.what(), (dir_ / "samples.csv").string().append(":3:5: gyro_y: \"1.2.3\" is not a number").c_str());
   e = error_of("0,25,1,1,2,3,4,5,6\n0,25,1,1,2,3,4,5,6\n");
   EXPECT_EQ(e.line(), 3);
   EXPECT_EQ(e.column(), 1);
@@ -326,8 +325,7 @@ TEST_F(IoTest, SamplesErrorsNameLineFieldAndText) {
   EXPECT_NE(e.message().find("segment: \"1.5\" is not an integer"), std::string::npos) << e.what();
   e = error_of("0,nan,1,1,2,3,4,5,6\n");
   EXPECT_NE(e.message().find("not a finite number"), std::string::npos) << e.what();
-  const std::string no_segment =
-      Write("n.csv", "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
+  const std::string no_segment = Write("n.csv", "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
   e = Catch([&] { SamplesReader reader(no_segment, true); });
   EXPECT_NE(e.message().find("no column \"segment\""), std::string::npos) << e.what();
   SamplesReader without(no_segment, false);
@@ -380,8 +378,7 @@ TEST_F(IoTest, AnUncommittedOutputLeavesTheOldFileIntact) {
     // no Commit(): as when an error is thrown half way
   }
   EXPECT_EQ(Read(path), "keep me\n");
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1)
-      << "temporary left behind";
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "temporary left behind";
   {
     OutputFile file(path);
     file.Write("new\n");
