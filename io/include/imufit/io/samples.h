@@ -1,4 +1,4 @@
-// imufit — samples files (SPEC.md section 2): what the unit said, sample by sample.
+// imufit — samples files (docs/spec.md section 2): what the unit said, sample by sample.
 //
 // Columns, by name and in any order: time_s (s, strictly increasing), temp_c (degC), segment
 // (plan segment id, -1 or empty while the table moves), gyro_x..z (raw B), accel_x..z (raw A).
