@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "imufit/fit/segmentation.h"
 #include "imufit/io/error.h"
 
 namespace imufit {
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   add(imufit::AddBatchCommand(&app));
   add(imufit::AddHistoryCommand(&app));
   add(imufit::AddReportCommand(&app));
+  add(imufit::AddSegmentCommand(&app));
 
   try {
     app.parse(argc, argv);
@@ -54,6 +56,9 @@ int main(int argc, char** argv) {
   } catch (const imufit::InputError& e) {
     std::fprintf(stderr, "imufit: %s\n", e.what());
     return 2;
+  } catch (const imufit::PlanMismatchError& e) {  // well-formed files that disagree: exit 1
+    std::fprintf(stderr, "imufit: %s; nothing written\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "imufit: error: %s\n", e.what());
     return 1;
