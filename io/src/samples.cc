@@ -16,7 +16,12 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, std::option
     : csv_(std::move(path)) {
   time_column_ = csv_.RequireColumn("time_s");
   if (!temp_c) {
-    temp_column_ = csv_.RequireColumn("temp_c");
+    try {
+      temp_column_ = csv_.RequireColumn("temp_c");
+    } catch (const InputError& e) {
+      throw InputError(e.file(), e.line(), e.column(),
+                       e.message() + "; for a run without a thermometer give its temperature (--temp-c)");
+    }
   } else if (csv_.FindColumn("temp_c")) {
     throw InputError(csv_.path(), "has a temp_c column: a fixed temperature (--temp-c) is only for samples "
                                   "without one (leave it out to use the readings)");
