@@ -1,5 +1,5 @@
 // imufit allan — Allan deviation (and relatives) of columns of a samples file, their confidence
-// intervals, the IEEE 952 noise terms, a noise YAML file and a plot (SPEC.md section 4, issue 4).
+// intervals, the IEEE 952 noise terms, a noise YAML file and a plot (docs/spec.md section 4, issue 4).
 //
 // Units: the columns are taken as SI rates (a corrected samples file: gyro rad/s, accel m/s^2).
 // Engineer units are converted here, once, on output:

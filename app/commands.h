@@ -1,6 +1,6 @@
 // imufit — the subcommands of the `imufit` program. Each Add*Command registers its options on
 // `root` and returns the function that runs it once the command line has been parsed; that
-// function returns the exit status of SPEC.md section 4 (0 done, 1 could not be done, 2 bad
+// function returns the exit status of docs/spec.md section 4 (0 done, 1 could not be done, 2 bad
 // input; 3 done but failed acceptance limits) and lets InputError escape to main(), which prints it and returns 2.
 #ifndef IMUFIT_APP_COMMANDS_H_
 #define IMUFIT_APP_COMMANDS_H_
@@ -42,7 +42,7 @@ void AddTempOption(CLI::App* command, SamplesInputArguments* args);
 // --segment-window, --min-steady, --direction-tolerance, --rate-tolerance.
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
 
-// Exit status 3 (an addition to SPEC.md section 4, docs/factory.md): the job was done, but a unit
+// Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).
 inline constexpr int kExitFailedLimits = 3;
 

@@ -1,4 +1,4 @@
-// imufit fit — fits the thermal model of SPEC.md section 1 to a rate-table run.
+// imufit fit — fits the thermal model of docs/spec.md section 1 to a rate-table run.
 #include <cmath>
 #include <cstdio>
 #include <memory>

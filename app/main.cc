@@ -1,5 +1,5 @@
 // imufit — the command. Thin: parse the command line, call the libraries, print, and return
-// the exit status of SPEC.md section 4.
+// the exit status of docs/spec.md section 4.
 #include <cstdio>
 #include <exception>
 #include <utility>

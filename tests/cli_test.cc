@@ -1,4 +1,4 @@
-// End-to-end tests of the `imufit` command (SPEC.md section 4): the built program (IMUFIT_EXE) is
+// End-to-end tests of the `imufit` command (docs/spec.md section 4): the built program (IMUFIT_EXE) is
 // run on fixtures (IMUFIT_FIXTURES_DIR) and on files written into a fresh temporary folder per
 // test, never the working directory.
 //
@@ -6,7 +6,7 @@
 // `imufit apply` with that calibration, gives back the true rate and specific force of every
 // sample, transitions included, to kRecoveryToleranceSi. It is done twice: on `imufit simulate`'s
 // own output and truth, and on samples this file computes with its own forward model written
-// from SPEC.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
+// from docs/spec.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
 // neither the simulator nor imufit's reader and model are checked only against themselves.
 #include <unistd.h>
 #include <zlib.h>
@@ -43,7 +43,7 @@ constexpr double kRecoveryToleranceSi = 1e-9;
 // Worst-case relative difference between two forward models that do the same arithmetic in a
 // different order.
 constexpr double kForwardAgreementRelative = 1e-12;
-// Earth's rotation rate, rad/s, as SPEC.md section 2 states it.
+// Earth's rotation rate, rad/s, as docs/spec.md section 2 states it.
 constexpr double kEarthRate = 7.292115e-5;
 constexpr double kDegToRad = M_PI / 180.0;
 
@@ -113,7 +113,7 @@ std::string FormatExactly(double value) {
 }
 
 // ------------------------------------------------------------------------------------------
-// A forward model written from SPEC.md section 1, independent of imufit's reader and model:
+// A forward model written from docs/spec.md section 1, independent of imufit's reader and model:
 //   B = diag(S_g) inv(M_g) omega + V_g + H a,   A = diag(S_a) inv(M_a) a + V_a,
 // every coefficient c0 + c1 dT + c2 dT^2 + c3 dT^3 with dT = T - reference_temp_c.
 class SpecForwardModel {
@@ -185,7 +185,7 @@ class SpecForwardModel {
   YAML::Node accel_;
 };
 
-// The truth of a plan's dwell segments, written from SPEC.md section 2 (rad/s, m/s^2, body).
+// The truth of a plan's dwell segments, written from docs/spec.md section 2 (rad/s, m/s^2, body).
 std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> SpecTruthOfPlan(const std::string& plan_path) {
   const YAML::Node plan = YAML::LoadFile(plan_path);
   const auto vector = [](const YAML::Node& v) {
@@ -398,7 +398,7 @@ TEST_F(CliTest, SimulateIsDeterministic) {
   EXPECT_NE(a.substr(a.find("time_s")), c.substr(c.find("time_s")));
 }
 
-// The truth that `imufit simulate --truth` writes for dwell samples is the truth SPEC.md section 2
+// The truth that `imufit simulate --truth` writes for dwell samples is the truth docs/spec.md section 2
 // defines (Earth rate with and without `north`, centripetal term of the lever arm).
 TEST_F(CliTest, SimulatedTruthFollowsTheSpec) {
   for (const char* plan : {"plan_6pos.yaml", "plan_24pos.yaml"}) {
@@ -460,7 +460,7 @@ TEST_F(CliTest, ApplyTurnsTheNoiselessFixtureIntoItsTruth) {
 }
 
 // The same acceptance check without imufit's simulator: raw samples computed here from chosen
-// truths with the forward model of SPEC.md (SpecForwardModel), at random temperatures in
+// truths with the forward model of docs/spec.md (SpecForwardModel), at random temperatures in
 // -40..85 degC, written as a CSV with the columns in another order, an extra column, comments
 // and CRLF line ends.
 TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
@@ -485,7 +485,7 @@ TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
       const Eigen::Vector3d a(force(engine), force(engine), force(engine));
       const Eigen::Vector3d gyro_m = spec.Gyro(temp_c, omega, a);
       const Eigen::Vector3d accel_m = spec.Accel(temp_c, a);
-      // The model header's forward form agrees with SPEC.md's.
+      // The model header's forward form agrees with docs/spec.md's.
       Eigen::Vector3d header_gyro;
       Eigen::Vector3d header_accel;
       header_model.Forward(temp_c, omega, a, &header_gyro, &header_accel);

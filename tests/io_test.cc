@@ -1,4 +1,4 @@
-// Tests of io/: every file format read and written per SPEC.md, and every error located.
+// Tests of io/: every file format read and written per docs/spec.md, and every error located.
 #include <filesystem>
 #include <fstream>
 #include <sstream>

@@ -10,7 +10,7 @@ namespace imufit {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
-// `north` may be this far from perpendicular to `up` (SPEC.md: 1 degree).
+// `north` may be this far from perpendicular to `up` (docs/spec.md: 1 degree).
 constexpr double kNorthToleranceRad = 1.0 * kDegToRad;
 
 Eigen::Vector3d ReadDirection(const yaml::Located& value) {

@@ -1,7 +1,7 @@
 // imufit — a rate-table run simulated from a known calibration (`imufit simulate`).
 //
 // For each sample the simulator knows the truth (omega_true in rad/s, a_true in m/s^2, body
-// frame, SPEC.md section 2), adds the sensor's noise in SI units at the body frame, and turns
+// frame, docs/spec.md section 2), adds the sensor's noise in SI units at the body frame, and turns
 // the result into raw outputs with the forward form of the shared model:
 //
 //   B = diag(S_g) inv(M_g) (omega_true + n_g + b_g) + V_g + H a_true

@@ -2,7 +2,7 @@
 //
 // Streams `samples_path` row by row through the shared model (SensorModel::Correct: the
 // accelerometer first, then the gyro with the corrected specific force of the same row) and
-// writes the corrected layout of SPEC.md (time_s, temp_c, segment if the input had it, gyro in
+// writes the corrected layout of docs/spec.md (time_s, temp_c, segment if the input had it, gyro in
 // rad/s, accel in m/s^2) to `output_path`, atomically.
 #ifndef IMUFIT_IO_CORRECT_FILE_H_
 #define IMUFIT_IO_CORRECT_FILE_H_

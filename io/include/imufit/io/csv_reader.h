@@ -1,4 +1,4 @@
-// imufit — a streaming reader for the CSV files of SPEC.md (plain or gzip-compressed).
+// imufit — a streaming reader for the CSV files of docs/spec.md (plain or gzip-compressed).
 //
 // The first line that is neither empty nor a comment (starting with '#') is the header; columns
 // are found by name, in any order; columns nobody asks for are never parsed. Rows are read in

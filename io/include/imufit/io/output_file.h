@@ -1,4 +1,4 @@
-// imufit — output files that are written whole or not at all (SPEC.md section 4).
+// imufit — output files that are written whole or not at all (docs/spec.md section 4).
 //
 // An OutputFile writes into a temporary file in the destination's folder and renames it over the
 // destination only in Commit(), after a flush and an fsync. If Commit() is never reached (an

@@ -1,4 +1,4 @@
-// imufit — samples files (SPEC.md section 2): what the unit said, sample by sample.
+// imufit — samples files (docs/spec.md section 2): what the unit said, sample by sample.
 //
 // Columns, by name and in any order: time_s (s, strictly increasing; the intervals may vary),
 // temp_c (degC; may be absent when the caller gives one temperature for the whole run), segment

@@ -1,4 +1,4 @@
-// imufit — the truth of a rate-table segment (SPEC.md section 2), in the body frame, SI units.
+// imufit — the truth of a rate-table segment (docs/spec.md section 2), in the body frame, SI units.
 //
 //   omega_true = rate * up + Omega_E sin(phi) up            (+ Omega_E cos(phi) north, static)
 //   a_true     = g up - rate^2 (r - up (r . up))            (centripetal, rate segments with r)
