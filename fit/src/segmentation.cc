@@ -233,6 +233,7 @@ bool Matcher::Run() {
       const std::string where = "at t = " + Seconds(piece.start_s) + " .. " + Seconds(piece.end_s) + " s: ";
       if (piece.kind == PieceKind::kMotion || (piece.kind == PieceKind::kSteadyGyro && !turning)) {
         found = expected.IsTurn() && TurnFits(p, expected, pass, &hint);
+        if (found) gravity_now = UpAfter(expected);
         continue;  // else the table moving between segments
       }
       if (!turning) {  // a rest
@@ -247,9 +248,13 @@ bool Matcher::Run() {
           found = true;
           continue;
         }
-        if ((gravity_now && AngleDeg(gravity, *gravity_now) <= tol) ||
-            (!expected.IsStatic() && error <= tol)) {
-          gyro_rest = piece.gyro_mean;  // settling, or waiting before the next segment
+        if (gravity_now && AngleDeg(gravity, *gravity_now) <= tol) {
+          gyro_rest = piece.gyro_mean;  // settling after a move
+          continue;
+        }
+        if (!expected.IsStatic() && error <= tol) {
+          gyro_rest = piece.gyro_mean;  // waiting in position for the next rate or turn
+          gravity_now = expected.up;
           continue;
         }
         return Fail(&piece, where + "a rest with gravity along body " + Vec(gravity) + " (raw accel " +
