@@ -224,6 +224,14 @@ bool Matcher::Run() {
     const TableSegment& expected = segments_[j];
     const std::string wanted = DescribeSegment(expected, pass);
     std::string hint;
+    const TableSegment& before = segments_[(j + segments_.size() - 1) % segments_.size()];
+    if (segments_.size() > 1 && expected.IsStatic() && before.IsStatic() &&
+        AngleDeg(before.up, expected.up) <= tol) {
+      hint =
+          "; segment " + std::to_string(expected.id) + " follows segment " + std::to_string(before.id) +
+          " in the same position: without labels they are told apart only by a move between them (the table "
+          "turning about the vertical), and the log shows none";
+    }
     bool found = false;
     size_t p = k;
     for (; p < pieces.size() && !found; ++p) {
@@ -530,20 +538,29 @@ Segmentation MatchPlan(const DetectedRun& run, const std::vector<TableSegment>& 
   const RunFacts facts = Facts(run, segments);
   std::optional<Matcher> best_match;
   std::optional<Matcher> furthest;
+  std::optional<Matcher> as_read;  // the raw axes unflipped
   for (const Eigen::Vector3d& accel_signs : SignPatterns(true)) {
     for (const Eigen::Vector3d& gyro_signs : SignPatterns(facts.plan_uses_gyro_signs)) {
       Matcher matcher(run, segments, options, facts, accel_signs, gyro_signs);
       if (matcher.Run()) {
         if (!best_match || matcher.residual_deg() < best_match->residual_deg()) best_match.emplace(matcher);
-      } else if (!furthest || matcher.reached_s() > furthest->reached_s()) {
-        furthest.emplace(matcher);
+        continue;
       }
+      if (!furthest || matcher.reached_s() > furthest->reached_s()) furthest.emplace(matcher);
+      if (accel_signs == Eigen::Vector3d::Ones() && gyro_signs == Eigen::Vector3d::Ones())
+        as_read.emplace(matcher);
     }
   }
   if (best_match) return best_match->result();
-  throw PlanMismatchError(furthest->problem() + " (raw axis signs tried: accel " +
-                          Vec(furthest->result().accel_signs, "%+.0f") + ", gyro " +
-                          Vec(furthest->result().gyro_signs, "%+.0f") + ")");
+  // The furthest a sign pattern got is the likeliest place; a flipped axis can also hide a missing
+  // segment for a while, so the first disagreement with the axes as read is named too.
+  std::string message = furthest->problem() + " (raw axis signs: accel " +
+                        Vec(furthest->result().accel_signs, "%+.0f") + ", gyro " +
+                        Vec(furthest->result().gyro_signs, "%+.0f") + ")";
+  if (as_read && as_read->reached_s() != furthest->reached_s()) {
+    message += "; with the raw axes as they are: " + as_read->problem();
+  }
+  throw PlanMismatchError(message);
 }
 
 int Labeller::Label(double time_s) {
