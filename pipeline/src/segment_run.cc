@@ -1,12 +1,26 @@
 #include "imufit/pipeline/segment_run.h"
 
+#include <cmath>
+
+#include "imufit/io/csv_reader.h"
 #include "imufit/io/samples.h"
 
 namespace imufit {
+namespace {
+
+// Finding segments needs no temperature: a file without temp_c (and no fixed temperature) is read
+// with NaN in its place, and written without the column.
+std::optional<double> TempToRead(const std::string& samples_path, const SamplesInput& input) {
+  if (input.temp_c) return input.temp_c;
+  if (CsvReader(samples_path).FindColumn("temp_c")) return std::nullopt;
+  return std::nan("");
+}
+
+}  // namespace
 
 Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path,
                                 const SamplesInput& input) {
-  SamplesReader reader(samples_path, /*require_segment=*/false, input.temp_c);
+  SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
   MotionDetector detector(input.segmentation);
   Sample sample;
   while (reader.Next(&sample)) detector.Add(sample);
@@ -20,7 +34,7 @@ Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_pat
 
 LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
                                         const std::string& output_path, const SamplesInput& input) {
-  SamplesReader reader(samples_path, /*require_segment=*/false, input.temp_c);
+  SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
   SamplesWriter writer(output_path, SampleColumns{true, reader.has_temp() || input.temp_c.has_value()});
   LabelledFileReport report;
   report.input_had_segment = reader.has_segment();
