@@ -197,6 +197,53 @@ TEST_F(IoTest, PlanIsReadAndConvertedToSi) {
   EXPECT_EQ(*plan.segments[1].lever_arm_m, Eigen::Vector3d(0, 0.02, 0));
   EXPECT_EQ(plan.Find(7), &plan.segments[1]);
   EXPECT_EQ(plan.Find(2), nullptr);
+  EXPECT_EQ(plan.segments[1].RotationAxis(), plan.segments[1].up);
+}
+
+TEST_F(IoTest, PlanReadsTurnsAndRateAxes) {
+  std::string text = kPlan;
+  text +=
+      "  - {id: 8, up: [0, 0, 1], angle_deg: -360, axis: [2, 0, 0]}\n"
+      "  - {id: 9, up: [0, 0, 1], angle_deg: 90}\n"
+      "  - {id: 10, up: [0, 0, 1], rate_dps: 60, axis: [0, 3, 4], lever_arm_m: [0.01, 0, 0]}\n";
+  const Plan plan = ReadPlan(Write("plan.yaml", text));
+  ASSERT_EQ(plan.segments.size(), 5u);
+  const TableSegment& turn = plan.segments[2];
+  EXPECT_TRUE(turn.IsTurn());
+  EXPECT_FALSE(turn.IsStatic());
+  EXPECT_NEAR(*turn.angle_rad, -2.0 * M_PI, 1e-15);
+  EXPECT_EQ(turn.rate_radps, 0.0);
+  EXPECT_EQ(turn.RotationAxis(), Eigen::Vector3d(1, 0, 0));
+  EXPECT_TRUE(plan.segments[3].IsTurn());
+  EXPECT_EQ(plan.segments[3].RotationAxis(), Eigen::Vector3d(0, 0, 1));  // no axis: up
+  const TableSegment& tilted = plan.segments[4];
+  EXPECT_FALSE(tilted.IsTurn());
+  EXPECT_NEAR(tilted.rate_radps, 60.0 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR((tilted.RotationAxis() - Eigen::Vector3d(0, 0.6, 0.8)).norm(), 0.0, 1e-15);
+}
+
+TEST_F(IoTest, InvalidTurnsAndAxesAreRefusedWithLocation) {
+  struct Case {
+    std::string segment, expect;
+  };
+  const Case cases[] = {
+      {"{id: 8, up: [0, 0, 1], angle_deg: 360, rate_dps: 30}", "has no rate_dps"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 0}", "cannot be 0"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: x}", "\"x\" is not a number"},
+      {"{id: 8, up: [0, 0, 1], axis: [1, 0, 0]}", "a static segment has none"},
+      {"{id: 8, up: [0, 0, 1], rate_dps: 0, axis: [1, 0, 0]}", "a static segment has none"},
+      {"{id: 8, up: [0, 0, 1], rate_dps: 10, axis: [0, 0, 0]}", "zero vector"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 90, axis: [1, 0]}", "exactly 3 numbers"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 90, lever_arm_m: [0, 0.01, 0]}", "cannot take a lever arm"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 90, north: [1, 0, 0]}", "static segments only"},
+      {"{id: 8, up: [0, 0, 1], rate_dps: 10, north: [1, 0, 0]}", "static segments only"},
+  };
+  for (const Case& c : cases) {
+    const std::string text = std::string(kPlan) + "  - " + c.segment + "\n";
+    const InputError e = Catch([&] { ReadPlan(Write("bad.yaml", text)); });
+    EXPECT_NE(e.message().find(c.expect), std::string::npos) << c.segment << ": " << e.what();
+    EXPECT_EQ(e.line(), 15) << c.segment << ": " << e.what();
+  }
 }
 
 TEST_F(IoTest, InvalidPlansAreRefusedWithLocation) {

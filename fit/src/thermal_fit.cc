@@ -39,16 +39,16 @@ struct SensorProblem {
   int coefficients = 0;
   int order = 3;
   bool with_g_sensitivity = false;
-  std::vector<double> p0;    // start, fit basis
-  std::vector<double> step;  // scale of each parameter
-  std::vector<double> q;     // the solver's variables
-  std::vector<int> held;     // parameters held at zero (p0 = 0 there)
+  std::vector<double> p0;              // start, fit basis
+  std::vector<double> step;            // scale of each parameter
+  std::vector<double> q;               // the solver's variables
+  std::vector<int> held;               // parameters held at zero (p0 = 0 there)
   std::vector<Eigen::Vector3d> sigma;  // per window, SI
   std::vector<ceres::ResidualBlockId> blocks;
   ceres::LossFunctionWrapper* loss = nullptr;  // owned by the problem
-  Eigen::MatrixXd jacobian;  // of the normalised residuals in q, free parameters only
-  std::vector<int> free;     // jacobian column -> parameter
-  double loss_threshold = 0.0;  // normalised residual norm where the robust loss starts
+  Eigen::MatrixXd jacobian;                    // of the normalised residuals in q, free parameters only
+  std::vector<int> free;                       // jacobian column -> parameter
+  double loss_threshold = 0.0;                 // normalised residual norm where the robust loss starts
   std::vector<double> Parameters() const {
     std::vector<double> p(parameters);
     for (int i = 0; i < parameters; ++i) p[i] = p0[i] + step[i] * q[i];
@@ -65,7 +65,9 @@ double Median(std::vector<double> values) {
 }
 
 // What a window's sensor responds to: (truth, specific force) for its rows.
-const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) { return gyro ? w.truth.omega_radps : w.truth.a_mps2; }
+const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) {
+  return gyro ? w.truth.omega_radps : w.truth.a_mps2;
+}
 const Eigen::Vector3d& RawFor(const FitWindow& w, bool gyro) {
   return gyro ? w.window->gyro_mean : w.window->accel_mean;
 }
@@ -100,8 +102,14 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
       rhs(r) = weight * RawFor(w, gyro)(i);
     }
     const Eigen::VectorXd column_norm = design.colwise().norm().transpose().cwiseMax(1e-300);
-    const Eigen::VectorXd solution =
-        design.array().rowwise().operator/(column_norm.transpose().array()).matrix().completeOrthogonalDecomposition().solve(rhs).cwiseQuotient(column_norm);
+    const Eigen::VectorXd solution = design.array()
+                                         .rowwise()
+                                         .
+                                         operator/(column_norm.transpose().array())
+                                         .matrix()
+                                         .completeOrthogonalDecomposition()
+                                         .solve(rhs)
+                                         .cwiseQuotient(column_norm);
     for (int k = 0; k < terms; ++k) {
       for (int j = 0; j < 3; ++j) K(3 * i + j, k) = solution(j * terms + k);
       V(i, k) = solution(3 * terms + k);
@@ -120,7 +128,8 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
   Eigen::MatrixXd vandermonde(kStartNodes, terms);
   Eigen::MatrixXd values(kStartNodes, 9);  // S x, y, z, M xy xz yx yz zx zy
   for (int node = 0; node < kStartNodes; ++node) {
-    const double x = 0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(M_PI * (node + 0.5) / kStartNodes);
+    const double x =
+        0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(M_PI * (node + 0.5) / kStartNodes);
     Eigen::Matrix3d k_at;
     for (int e = 0; e < 9; ++e) {
       const Eigen::Vector4d c = K.row(e).transpose();
@@ -139,13 +148,16 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
   const Eigen::MatrixXd fitted = vandermonde.colPivHouseholderQr().solve(values);  // terms x 9
 
   sensor->p0.assign(sensor->parameters, 0.0);
-  const auto set = [&](int coefficient, int k, double value) { sensor->p0[coefficient * kPolynomialTerms + k] = value; };
+  const auto set = [&](int coefficient, int k, double value) {
+    sensor->p0[coefficient * kPolynomialTerms + k] = value;
+  };
   for (int k = 0; k < terms; ++k) {
     for (int i = 0; i < 3; ++i) {
       set(kBiasCoefficient + i, k, V(i, k));
       set(kScaleCoefficient + i, k, fitted(k, i));
     }
-    for (int m_index = 0; m_index < 6; ++m_index) set(kMisalignmentCoefficient + m_index, k, fitted(k, 3 + m_index));
+    for (int m_index = 0; m_index < 6; ++m_index)
+      set(kMisalignmentCoefficient + m_index, k, fitted(k, 3 + m_index));
     if (sensor->with_g_sensitivity) {
       for (int h = 0; h < 9; ++h) set(kGSensitivityCoefficient + h, k, H(h, k));
     }
@@ -158,11 +170,16 @@ void SetSteps(SensorProblem* sensor) {
   sensor->step.assign(sensor->parameters, 1.0);
   for (int c = 0; c < sensor->coefficients; ++c) {
     double step = 1e-3;
-    const int row = c < kMisalignmentCoefficient ? (c % 3) : c >= kGSensitivityCoefficient ? (c - kGSensitivityCoefficient) / 3 : 0;
+    const int row = c < kMisalignmentCoefficient    ? (c % 3)
+                    : c >= kGSensitivityCoefficient ? (c - kGSensitivityCoefficient) / 3
+                                                    : 0;
     const double scale = std::abs(sensor->p0[(kScaleCoefficient + row) * kPolynomialTerms]);
-    if (c < kMisalignmentCoefficient) step = 1e-3 * scale;               // bias, scale
-    else if (c >= kGSensitivityCoefficient) step = 1e-4 * scale;         // g-sensitivity
-    for (int k = 0; k < kPolynomialTerms; ++k) sensor->step[c * kPolynomialTerms + k] = step > 0.0 ? step : 1e-3;
+    if (c < kMisalignmentCoefficient)
+      step = 1e-3 * scale;  // bias, scale
+    else if (c >= kGSensitivityCoefficient)
+      step = 1e-4 * scale;  // g-sensitivity
+    for (int k = 0; k < kPolynomialTerms; ++k)
+      sensor->step[c * kPolynomialTerms + k] = step > 0.0 ? step : 1e-3;
   }
 }
 
@@ -170,7 +187,8 @@ void SetSteps(SensorProblem* sensor) {
 void SetSigmas(const std::vector<FitWindow>& windows, bool gyro, SensorProblem* sensor) {
   sensor->sigma.assign(windows.size(), Eigen::Vector3d::Ones());
   for (int axis = 0; axis < 3; ++axis) {
-    const double scale = std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
+    const double scale =
+        std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
     std::vector<double> values;
     for (size_t w = 0; w < windows.size(); ++w) {
       sensor->sigma[w](axis) = RawSigmaFor(windows[w], gyro)(axis) / (scale > 0.0 ? scale : 1.0);
@@ -188,7 +206,10 @@ std::string ParameterName(const SensorProblem& sensor, int parameter) {
   const CoefficientName& name = kCoefficientNames[parameter / kPolynomialTerms];
   const int k = parameter % kPolynomialTerms;
   return std::string(sensor.name) + " " + name.group + " " + name.axis +
-         (k == 0 ? "" : k == 1 ? " (linear term)" : k == 2 ? " (quadratic term)" : " (cubic term)");
+         (k == 0   ? ""
+          : k == 1 ? " (linear term)"
+          : k == 2 ? " (quadratic term)"
+                   : " (cubic term)");
 }
 
 // Blocks of windows within which a slowly wandering bias is taken as constant: a new block starts
@@ -219,7 +240,8 @@ std::vector<int> TimeBlocks(const std::vector<FitWindow>& windows, double correl
 // polynomial, so the residuals do not show it. By linear response, an offset b on axis a of the
 // windows of block k moves the estimate by dq = C J^T dr with dr = b / sigma_w on those rows,
 // C = (J^T J)^-1 (`unscaled_covariance`); the blocks and axes add up independently.
-Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor, const Eigen::MatrixXd& unscaled_covariance,
+Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor,
+                                        const Eigen::MatrixXd& unscaled_covariance,
                                         const std::vector<int>& time_blocks, double stability) {
   const int blocks = time_blocks.empty() ? 0 : *std::max_element(time_blocks.begin(), time_blocks.end()) + 1;
   const int n = static_cast<int>(sensor.free.size());
@@ -251,9 +273,12 @@ Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor, const Eigen
 
 std::string RobustLossName(RobustLoss loss) {
   switch (loss) {
-    case RobustLoss::kNone: return "none";
-    case RobustLoss::kHuber: return "huber";
-    case RobustLoss::kCauchy: return "cauchy";
+    case RobustLoss::kNone:
+      return "none";
+    case RobustLoss::kHuber:
+      return "huber";
+    case RobustLoss::kCauchy:
+      return "cauchy";
   }
   return "?";
 }
@@ -323,11 +348,24 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   }
   std::vector<FitWindow> fit_windows;
   for (const Window& w : windows) {
-    const auto segment = std::find_if(segments.begin(), segments.end(), [&](const TableSegment& s) { return s.id == w.segment; });
+    const auto segment = std::find_if(segments.begin(), segments.end(),
+                                      [&](const TableSegment& s) { return s.id == w.segment; });
     assert(segment != segments.end() && "every window's segment must be in the plan");
     fit_windows.push_back(FitWindow{&w, TruthOf(site, *segment), basis.Argument(w.temp_c)});
   }
   summary.windows_used = static_cast<int>(fit_windows.size());
+  for (const TableSegment& segment : segments) {
+    // The plan reader knows these kinds; the fit learns them next (issue 9).
+    if (segment.IsTurn() || (segment.axis && std::abs(segment.axis->dot(segment.up)) < 1.0 - 1e-12)) {
+      summary.undetermined.push_back("segment " + std::to_string(segment.id) +
+                                     ": turns (angle_deg) and rate axes apart from up are not fitted yet");
+    }
+  }
+  if (!summary.undetermined.empty()) {
+    summary.status = FitStatus::kUndetermined;
+    summary.termination = "the run does not determine the model";
+    return summary;
+  }
 
   summary.undetermined = internal::CheckCoverage(fit_windows, site.gravity_mps2, options);
   if (!summary.undetermined.empty()) {
@@ -349,17 +387,18 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   accel.order = options.accel_temp_order;
   for (SensorProblem* sensor : {&gyro, &accel}) {
     const bool is_gyro = sensor == &gyro;
-    SetSigmas(fit_windows, is_gyro, sensor);   // raw units until the start is known
+    SetSigmas(fit_windows, is_gyro, sensor);  // raw units until the start is known
     LinearStart(fit_windows, is_gyro, sensor);
     if (!options.closed_form_start) {
       // Keep only the nominal scale factors: the solver must find everything else itself.
       for (int i = 0; i < sensor->parameters; ++i) {
         const int c = i / kPolynomialTerms;
-        const bool nominal_scale = c >= kScaleCoefficient && c < kMisalignmentCoefficient && i % kPolynomialTerms == 0;
+        const bool nominal_scale =
+            c >= kScaleCoefficient && c < kMisalignmentCoefficient && i % kPolynomialTerms == 0;
         if (!nominal_scale) sensor->p0[i] = 0.0;
       }
     }
-    SetSigmas(fit_windows, is_gyro, sensor);   // now in SI
+    SetSigmas(fit_windows, is_gyro, sensor);  // now in SI
     SetSteps(sensor);
     sensor->q.assign(sensor->parameters, 0.0);
     for (int c = 0; c < sensor->coefficients; ++c) {
@@ -435,8 +474,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   summary.termination = solver_summary.message;
   if (solver_summary.termination_type != ceres::CONVERGENCE) {
     summary.status = FitStatus::kNotConverged;
-    summary.termination = std::string(ceres::TerminationTypeToString(solver_summary.termination_type)) + ": " +
-                          solver_summary.message;
+    summary.termination = std::string(ceres::TerminationTypeToString(solver_summary.termination_type)) +
+                          ": " + solver_summary.message;
     return summary;
   }
 
@@ -514,8 +553,9 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     (is_gyro ? summary.gyro_rms_radps : summary.accel_rms_mps2) = rms;
     (is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2) = reduced_chi2;
   }
-  summary.windows_downweighted = static_cast<int>(
-      std::count_if(summary.residuals.begin(), summary.residuals.end(), [](const WindowResidual& r) { return r.downweighted; }));
+  summary.windows_downweighted =
+      static_cast<int>(std::count_if(summary.residuals.begin(), summary.residuals.end(),
+                                     [](const WindowResidual& r) { return r.downweighted; }));
 
   // Covariance of q, to p (times step), scaled by the reduced chi-square, to powers of dT.
   ceres::Covariance::Options covariance_options;
@@ -523,8 +563,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   covariance_options.num_threads = options.num_threads;
   covariance_options.apply_loss_function = true;
   ceres::Covariance covariance(covariance_options);
-  const std::vector<std::pair<const double*, const double*>> covariance_blocks = {{gyro.q.data(), gyro.q.data()},
-                                                                                  {accel.q.data(), accel.q.data()}};
+  const std::vector<std::pair<const double*, const double*>> covariance_blocks = {
+      {gyro.q.data(), gyro.q.data()}, {accel.q.data(), accel.q.data()}};
   const bool have_covariance = covariance.Compute(covariance_blocks, &problem);
   const std::vector<int> time_blocks = TimeBlocks(fit_windows, options.bias_correlation_s);
   const Eigen::Matrix4d to_reference = RebaseTemperaturePolynomial(basis, TemperatureBasis::Reference());
@@ -535,7 +575,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     const std::vector<double> p = sensor->Parameters();
     Eigen::MatrixXd cov_q = Eigen::MatrixXd::Zero(sensor->parameters, sensor->parameters);
     if (have_covariance) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> block(sensor->parameters, sensor->parameters);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> block(sensor->parameters,
+                                                                                   sensor->parameters);
       covariance.GetCovarianceBlock(sensor->q.data(), sensor->q.data(), block.data());
       cov_q = block;
     }
@@ -561,7 +602,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     }
   }
   if (!have_covariance) {
-    summary.undetermined.push_back("the covariance could not be computed (the problem is numerically rank deficient)");
+    summary.undetermined.push_back(
+        "the covariance could not be computed (the problem is numerically rank deficient)");
     summary.status = FitStatus::kUndetermined;
     summary.termination = "the run does not determine the model";
     return summary;
@@ -585,7 +627,8 @@ std::string FitSummary::BriefReport() const {
       break;
   }
   std::snprintf(text, sizeof text,
-                "converged in %d iterations; residual RMS gyro %.3g deg/s, accel %.3g mg; %d windows (%d down-weighted) "
+                "converged in %d iterations; residual RMS gyro %.3g deg/s, accel %.3g mg; %d windows (%d "
+                "down-weighted) "
                 "over %zu temperatures",
                 iterations, gyro_rms_radps * kRadToDeg, accel_rms_mps2 / 9.80665 * 1e3, windows_used,
                 windows_downweighted, distinct_temps_c.size());

@@ -51,7 +51,7 @@ Plan ReadPlan(const std::string& path) {
   std::set<int> ids;
   for (size_t i = 0; i < segments.Size(); ++i) {
     const yaml::Located entry = segments.At(i);
-    entry.RejectUnknownKeys({"id", "up", "rate_dps", "north", "lever_arm_m"});
+    entry.RejectUnknownKeys({"id", "up", "rate_dps", "angle_deg", "axis", "north", "lever_arm_m"});
     TableSegment segment;
     const long id = entry["id"].Integer();
     if (id < 0 || id > 1000000000L) entry["id"].Fail("an id is an integer >= 0");
@@ -59,7 +59,35 @@ Plan ReadPlan(const std::string& path) {
     if (!ids.insert(segment.id).second) entry["id"].Fail("id " + std::to_string(id) + " repeats");
     segment.up = ReadDirection(entry["up"]).normalized();
     if (entry.Has("rate_dps")) segment.rate_radps = entry["rate_dps"].Double() * kDegToRad;
+    if (entry.Has("angle_deg")) {
+      if (entry.Has("rate_dps")) {
+        entry["angle_deg"].Fail(
+            "a turn through a known angle (angle_deg) has no rate_dps: give one or the other");
+      }
+      const double angle_deg = entry["angle_deg"].Double();
+      if (angle_deg == 0.0)
+        entry["angle_deg"].Fail("a turn's angle cannot be 0 (a static segment omits angle_deg)");
+      segment.angle_rad = angle_deg * kDegToRad;
+    }
+    if (entry.Has("axis")) {
+      if (segment.IsStatic()) {
+        entry["axis"].Fail(
+            "axis is the rotation axis of a rate_dps or angle_deg segment; a static segment has none");
+      }
+      segment.axis = ReadDirection(entry["axis"]).normalized();
+    }
+    if (entry.Has("lever_arm_m") && segment.IsTurn()) {
+      entry["lever_arm_m"].Fail(
+          "a turn (angle_deg) cannot take a lever arm: its centripetal force depends on the rate profile, "
+          "which "
+          "the plan does not give");
+    }
     if (entry.Has("north")) {
+      if (!segment.IsStatic()) {
+        entry["north"].Fail(
+            "north is for static segments only (in a rate or turn segment the horizontal Earth "
+            "rate turns with the table)");
+      }
       const Eigen::Vector3d north = ReadDirection(entry["north"]).normalized();
       if (std::abs(north.dot(segment.up)) > std::sin(kNorthToleranceRad)) {
         entry["north"].Fail("north is not horizontal: it is " +
