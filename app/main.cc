@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "imufit/fit/segmentation.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
   add(imufit::AddBatchCommand(&app));
   add(imufit::AddHistoryCommand(&app));
   add(imufit::AddReportCommand(&app));
+  add(imufit::AddSegmentCommand(&app));
 
   // Outputs are written to temporary files and renamed when complete; a stopped run removes them.
   imufit::InstallOutputCleanupOnSignals();
@@ -60,6 +62,9 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "imufit: error: out of memory\n");
+    return 1;
+  } catch (const imufit::PlanMismatchError& e) {  // well-formed files that disagree: exit 1
+    std::fprintf(stderr, "imufit: %s; nothing written\n", e.what());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "imufit: error: %s\n", e.what());

@@ -1055,5 +1055,137 @@ TEST_F(CliTest, HostileInputGivesOneBoundedEscapedLine) {
   EXPECT_NE(zero.err.find("/dev/zero:1: line longer than"), std::string::npos) << zero.err;
 }
 
+// ------------------------------------------------------------------------------ unlabelled logs
+
+// `imufit segment` labels a simulated log written without its segment column (jittered times) as the
+// simulator's truth does: most samples of every dwell get their segment, none a wrong one.
+TEST_F(CliTest, SegmentLabelsAnUnlabelledLogAsTheTruthDoes) {
+  const std::string raw = Path("raw.csv");
+  const std::string truth = Path("truth.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", raw, "--truth",
+                 truth, "--temps=-20,60", "--rate", "50", "--dwell", "5", "--transition", "1", "--gyro-noise-density",
+                 "8.7e-5", "--accel-noise-density", "1.5e-3", "--quantize", "--no-segment-column", "--time-jitter-s",
+                 "0.005", "-q"})
+                .status,
+            0);
+  EXPECT_EQ(ReadTable(raw).header,
+            (std::vector<std::string>{"time_s", "temp_c", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"}));
+  const std::string labelled = Path("labelled.csv");
+  const RunResult r = Run({"segment", "--plan", Fixture("plan_6pos.yaml"), "--samples", raw, "-o", labelled});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("36 segments found in 2 passes"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("segment  pass  kind"), std::string::npos) << r.out;
+  const Table got = ReadTable(labelled);
+  const Table want = ReadTable(truth);
+  ASSERT_EQ(got.rows.size(), want.rows.size());
+  long long truly_labelled = 0;
+  long long correct = 0;
+  long long wrong = 0;
+  for (size_t i = 0; i < got.rows.size(); ++i) {
+    ASSERT_EQ(got.rows[i][got.Column("time_s")], want.rows[i][want.Column("time_s")]);
+    const int label = std::stoi(got.rows[i][got.Column("segment")]);
+    const int true_label = std::stoi(want.rows[i][want.Column("segment")]);
+    truly_labelled += true_label >= 0;
+    correct += label >= 0 && label == true_label;
+    wrong += label >= 0 && label != true_label;
+  }
+  EXPECT_GE(static_cast<double>(correct) / truly_labelled, 0.7);
+  EXPECT_EQ(wrong, 0);
+  // The labelled log fits like any labelled run.
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", labelled, "-o", Path("cal.yaml"),
+                             "--gyro-temp-order", "1", "--accel-temp-order", "1", "--no-g-sensitivity", "-q"});
+  EXPECT_EQ(fit.status, 0) << fit.err;
+}
+
+TEST_F(CliTest, SegmentRefusesALogThatDisagreesWithThePlanWithExitOne) {
+  const std::string raw = Path("raw.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", raw, "--rate",
+                 "50", "--dwell", "5", "--transition", "1", "--no-segment-column", "-q"})
+                .status,
+            0);
+  // The plan without its +x face (12 .. 17 s in the log): an extra rest in the log.
+  YAML::Node root = YAML::Load(ReadFile(Fixture("plan_6pos.yaml")));
+  YAML::Node kept(YAML::NodeType::Sequence);
+  for (const YAML::Node& segment : root["segments"]) {
+    if (segment["id"].as<int>() != 3) kept.push_back(segment);
+  }
+  root["segments"] = kept;
+  YAML::Emitter emitter;
+  emitter << root;
+  const std::string plan = Write("plan.yaml", emitter.c_str());
+  const std::string output = Write("labelled.csv", "precious\n");
+  for (const char* command : {"segment", "fit"}) {
+    const RunResult r = Run({command, "-p", plan, "-s", raw, "-o", output});
+    EXPECT_EQ(r.status, 1) << command << ": " << r.err;
+    EXPECT_NE(r.err.find("raw.csv: the log does not match the plan " + plan + ": at t = "), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("with the raw axes as they are: at t = 12."), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("nothing written"), std::string::npos) << r.err;
+    EXPECT_EQ(ReadBytes(output), "precious\n");
+  }
+  EXPECT_EQ(Listing(), (std::set<std::string>{"raw.csv", "plan.yaml", "labelled.csv"}));
+}
+
+// A lab log without a thermometer and without labels: --temp-c in segment, fit and apply.
+TEST_F(CliTest, ALogWithoutTemperatureOrLabelsCalibratesWithTempC) {
+  const std::string raw = Path("raw.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", raw, "--temps",
+                 "21", "--rate", "50", "--dwell", "5", "--transition", "1", "--gyro-noise-density", "8.7e-5",
+                 "--accel-noise-density", "1.5e-3", "--quantize", "--no-segment-column", "--no-temp-column", "-q"})
+                .status,
+            0);
+  EXPECT_EQ(ReadTable(raw).header,
+            (std::vector<std::string>{"time_s", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"}));
+  const std::string plan = Fixture("plan_6pos.yaml");
+  const std::string cal = Path("cal.yaml");
+  RunResult r = Run({"fit", "-p", plan, "-s", raw, "-o", cal});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no column \"temp_c\""), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--temp-c"), std::string::npos) << r.err;
+  r = Run({"fit", "-p", plan, "-s", raw, "-o", cal, "--temp-c", "21", "--gyro-temp-order", "3"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("use --gyro-temp-order 0 --accel-temp-order 0"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(cal));
+  r = Run({"fit", "-p", plan, "-s", raw, "-o", cal, "--temp-c", "21"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("no temp_c column, every sample at 21 degC (--temp-c): temperature orders 0"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("no segment column: 18 segments found in 1 pass"), std::string::npos) << r.out;
+  const YAML::Node written = YAML::LoadFile(cal);
+  EXPECT_EQ(written["fit"]["gyro_temp_order"].as<int>(), 0);
+  EXPECT_EQ(written["fit_temp_range_c"][0].as<double>(), 21.0);
+
+  // A file that has temp_c is refused with --temp-c (no reading is silently replaced).
+  const std::string with_temp = Write("with_temp.csv",
+                                      "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n"
+                                      "0,25,1,2,3,4,5,6\n");
+  r = Run({"apply", "-c", cal, "-s", with_temp, "-o", Path("x.csv"), "--temp-c", "21"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("has a temp_c column"), std::string::npos) << r.err;
+  r = Run({"apply", "-c", cal, "-s", raw, "-o", Path("x.csv")});
+  EXPECT_EQ(r.status, 2);
+  r = Run({"apply", "-c", cal, "-s", raw, "-o", Path("corrected.csv"), "--temp-c", "21", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table corrected = ReadTable(Path("corrected.csv"));
+  ASSERT_FALSE(corrected.rows.empty());
+  EXPECT_EQ(corrected.Number(0, "temp_c"), 21.0);
+  EXPECT_NEAR(corrected.Vector(0, "accel").norm(), 9.81274, 0.05);  // at rest, +z up
+
+  // segment keeps the file's columns: temp_c only when given.
+  ASSERT_EQ(Run({"segment", "-p", plan, "-s", raw, "-o", Path("a.csv"), "-q"}).status, 0);
+  EXPECT_EQ(ReadTable(Path("a.csv")).header.size(), 8u);
+  ASSERT_EQ(Run({"segment", "-p", plan, "-s", raw, "-o", Path("b.csv"), "--temp-c", "21", "-q"}).status, 0);
+  EXPECT_EQ(ReadTable(Path("b.csv")).header,
+            (std::vector<std::string>{"time_s", "temp_c", "segment", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y",
+                                      "accel_z"}));
+}
+
+TEST_F(CliTest, SimulateJitterMustKeepTimesIncreasing) {
+  const RunResult r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o",
+                           Path("x.csv"), "--rate", "50", "--time-jitter-s", "0.01"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("time jitter"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace imufit

@@ -130,6 +130,9 @@ std::string SimulationOptions::Validate() const {
                    gyro_bias_instability, accel_bias_instability, temp_noise_c}) {
     if (!(v >= 0.0)) return "noise figures cannot be negative";
   }
+  if (!(time_jitter_s >= 0.0 && time_jitter_s < 0.5 / rate_hz)) {
+    return "the time jitter must lie in [0, half the sample interval)";
+  }
   return "";
 }
 
@@ -172,11 +175,17 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
   std::vector<SegmentTruth> dwell_truth;
   for (const TableSegment& segment : segments) dwell_truth.push_back(TruthOf(site, segment));
 
+  // A separate generator for the jitter (seeded from the seed), so that jitter moves only the times.
+  std::mt19937_64 jitter_engine(options.seed ^ 0x6a09e667f3bcc909ULL);
   long long k = 0;
   Sample raw;
   for (const Phase& phase : phases) {
     for (long long j = 0; j < phase.samples; ++j, ++k) {
       raw.time_s = options.start_time_s + static_cast<double>(k) * dt;
+      if (options.time_jitter_s > 0.0) {
+        const double u = static_cast<double>(jitter_engine() >> 11) * 0x1.0p-53;  // [0, 1)
+        raw.time_s += options.time_jitter_s * (2.0 * u - 1.0);
+      }
       if (options.ramp) {
         const double progress = total > 1 ? static_cast<double>(k) / static_cast<double>(total - 1) : 0.0;
         raw.temp_c = options.ramp_from_c + (options.ramp_to_c - options.ramp_from_c) * progress;

@@ -8,8 +8,8 @@
 namespace imufit {
 
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path) {
-  SamplesReader reader(samples_path, /*require_segment=*/false);
+                                     const std::string& output_path, std::optional<double> temp_c) {
+  SamplesReader reader(samples_path, /*require_segment=*/false, temp_c);
   SamplesWriter writer(output_path, reader.has_segment());
   CorrectFileReport report;
   Sample raw;

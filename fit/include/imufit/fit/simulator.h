@@ -55,6 +55,10 @@ struct SimulationOptions {
   double bias_correlation_s = 100.0;
   double temp_noise_c = 0.0;  // white noise of the temperature reading, degC
   bool quantize = false;      // round raw outputs to integer counts
+  // Time stamps jitter: each time_s is off its nominal k / rate_hz by a uniform deviate in
+  // [-time_jitter_s, +time_jitter_s] (less than half the sample interval, so times still increase).
+  // The deviates come from their own generator: the samples' values are those of the run without jitter.
+  double time_jitter_s = 0.0;
   std::uint64_t seed = 1;
 
   // An empty string when the options are usable, else what is wrong.
