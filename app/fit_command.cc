@@ -101,7 +101,8 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 
 // --limits, --report, --store: the factory additions, after the calibration is written.
 // Returns the exit status: 0, or kExitFailedLimits.
-int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result) {
+int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result,
+                  OutputTransaction* outputs) {
   const Calibration& calibration = *result.calibration;
   std::optional<Verdict> verdict;
   if (limits) {
@@ -121,8 +122,10 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
                                        verdict);
     report.folds = result.folds;
     WriteUnitReport(args.report, report);
-    if (!args.quiet) std::printf("  wrote %s\n", args.report.c_str());
   }
+  outputs->Commit();  // the calibration and the report together, or neither
+  if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
+  if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
   if (!args.store.empty()) {
     StoredFit row;
     row.serial = calibration.serial.empty() ? args.samples : calibration.serial;
@@ -205,9 +208,10 @@ int RunFit(FitArguments args) {
     std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(), fit.BriefReport().c_str());
     return 1;
   }
+  OutputTransaction outputs;
   WriteCalibration(args.output, *result.calibration);
 
-  if (args.quiet) return FinishFactory(args, limits, result);
+  if (args.quiet) return FinishFactory(args, limits, result, &outputs);
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
   std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
@@ -249,8 +253,7 @@ int RunFit(FitArguments args) {
   if (!result.check_errors.empty()) {
     PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
   }
-  std::printf("  wrote %s\n", args.output.c_str());
-  return FinishFactory(args, limits, result);
+  return FinishFactory(args, limits, result, &outputs);
 }
 
 }  // namespace

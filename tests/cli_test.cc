@@ -944,6 +944,115 @@ TEST_F(CliTest, FitReportsErrorsOnAHeldOutRun) {
   EXPECT_LT(written["check"]["gyro_error_rms_radps"].as<double>(), 0.02 * kDegToRad);
 }
 
+// ------------------------------------------------------------------------------------------
+// Inputs as they really arrive: exit 2, one located line, nothing written, nothing damaged.
+
+TEST_F(CliTest, ATruncatedGzipRunIsRefusedNotReadAsComplete) {
+  const std::string whole = ReadBytes(Fixture("mems_6pos_noiseless.csv.gz"));
+  for (const auto& [name, bytes] :
+       {std::pair<std::string, std::string>{"cut.csv.gz", whole.substr(0, whole.size() - 8)},
+        {"garbage.csv.gz", whole + "junk"}}) {
+    const std::string samples = Write(name, bytes);
+    const RunResult r =
+        Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+    EXPECT_EQ(r.status, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name + ": " + (name == "cut.csv.gz" ? "truncated gzip stream" : "trailing garbage")),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(Path("out.csv")));
+  }
+}
+
+TEST_F(CliTest, MultiOutputCommandsWriteAllOrNothing) {
+  const std::string calibration = Write("calibration.yaml", "precious\n");
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"),
+                             "-o", calibration, "--report", Path("missing/report.html"), "-q"});
+  EXPECT_EQ(fit.status, 2) << fit.err;
+  EXPECT_NE(fit.err.find("missing/report.html: cannot create"), std::string::npos) << fit.err;
+  EXPECT_EQ(ReadBytes(calibration), "precious\n")
+      << "the calibration was replaced although the report failed";
+  EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml"}));
+
+  std::string rows = "time_s,gyro_x\n";
+  for (int i = 0; i < 2000; ++i)
+    rows += std::to_string(i * 0.01) + "," + std::to_string((i * 7919 % 101) * 1e-3) + "\n";
+  const std::string samples = Write("rates.csv", rows);
+  const RunResult allan =
+      Run({"allan", "-s", samples, "-o", Path("adev.csv"), "--noise-yaml", Path("missing/noise.yaml"), "-q"});
+  EXPECT_EQ(allan.status, 2) << allan.err;
+  EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml", "rates.csv"})) << "adev.csv written alone";
+}
+
+TEST_F(CliTest, OutputsNeverReplaceALinkOrSpecialFile) {
+  const std::string target = Write("target.csv", "the user's file\n");
+  const std::string link = Path("link.csv");
+  fs::create_symlink(target, link);
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s",
+                           Fixture("mems_6pos_noiseless.csv.gz"), "-o", link, "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("link.csv: is a symbolic link"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(ReadBytes(target), "the user's file\n");
+  EXPECT_EQ(Listing(), (std::set<std::string>{"target.csv", "link.csv"}));
+}
+
+TEST_F(CliTest, NoCommandWritesANonFiniteNumber) {
+  // apply: an absurd temperature overflows the polynomials.
+  const std::string header = "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
+  const std::string samples = Write("hot.csv", header + "0,25,1,2,3,4,5,6\n0.1,1e300,1,2,3,4,5,6\n");
+  RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("hot.csv:3:2: temp_c: the correction at 1e+300 degC is not a finite number"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // apply: a calibration whose scale crosses zero inside its fit range is refused on read.
+  YAML::Node calibration = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  calibration["gyro"]["scale"]["y"][1] =
+      -calibration["gyro"]["scale"]["y"][0].as<double>() / 30.0;  // 0 at 55 degC
+  YAML::Emitter emitter;
+  emitter << calibration;
+  r = Run({"apply", "-c", Write("bad.yaml", emitter.c_str()), "-s", Fixture("mems_6pos_noiseless.csv.gz"),
+           "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("gyro.scale.y: the scale factor changes sign"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // simulate: a temperature that is not a number.
+  r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o",
+           Path("sim.csv"), "--temps", "25,nan", "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("temperatures must be numbers"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("sim.csv")));
+  // allan: a constant column gives zero deviations with zero-width intervals and says why there is
+  // no noise fit.
+  std::string rows = "time_s,gyro_x\n";
+  for (int i = 0; i < 2000; ++i) rows += std::to_string(i * 0.01) + ",0.5\n";
+  r = Run(
+      {"allan", "-s", Write("stuck.csv", rows), "-o", Path("adev.csv"), "--noise-yaml", Path("noise.yaml")});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("the column is constant"), std::string::npos) << r.out;
+  for (const char* output : {"adev.csv", "noise.yaml"}) {
+    const std::string text = ReadBytes(Path(output));
+    EXPECT_FALSE(text.empty()) << output;
+    EXPECT_EQ(text.find("nan"), std::string::npos) << output << ":\n" << text;
+    EXPECT_EQ(text.find("inf"), std::string::npos) << output << ":\n" << text;
+  }
+}
+
+TEST_F(CliTest, HostileInputGivesOneBoundedEscapedLine) {
+  const std::string samples =
+      Write("evil.csv", "time_s,temp_c,\x1b]0;owned\x07" + std::string(3000, 'x') + "\n1,2,3\n");
+  const RunResult r =
+      Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\x07'), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_LT(r.err.size(), 600u) << r.err;
+  const RunResult zero =
+      Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", "/dev/zero", "-o", Path("out.csv")});
+  EXPECT_EQ(zero.status, 2) << zero.err;
+  EXPECT_NE(zero.err.find("/dev/zero:1: line longer than"), std::string::npos) << zero.err;
 // ------------------------------------------------------------------------------ unlabelled logs
 
 // `imufit segment` labels a simulated log written without its segment column (jittered times) as the

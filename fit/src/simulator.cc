@@ -116,6 +116,15 @@ std::string SimulationOptions::Validate() const {
   if (!(transition_s >= 0.0)) return "the transition time cannot be negative";
   if (ramp && passes < 1) return "a ramp needs at least one pass";
   if (!ramp && soak_temps_c.empty()) return "give at least one soak temperature";
+  // A temperature that is not a number would make every sample NaN.
+  std::vector<double> temps = soak_temps_c;
+  if (ramp) temps = {ramp_from_c, ramp_to_c};
+  for (const double t : temps) {
+    if (!(t >= -273.15 && t <= 1000.0)) return "temperatures must be numbers between -273.15 and 1000 degC";
+  }
+  if (!std::isfinite(rate_hz) || !std::isfinite(dwell_s) || !std::isfinite(transition_s)) {
+    return "the sample rate, dwell and transition times must be finite";
+  }
   if (!(bias_correlation_s > 0.0)) return "the bias correlation time must be positive";
   for (double v : {gyro_noise_density, accel_noise_density, gyro_random_walk, accel_random_walk,
                    gyro_bias_instability, accel_bias_instability, temp_noise_c}) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 
 namespace imufit {
@@ -18,6 +19,13 @@ CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::
     corrected.temp_c = raw.temp_c;
     corrected.segment = raw.segment;
     calibration.model.Correct(raw.temp_c, raw.gyro, raw.accel, &corrected.gyro, &corrected.accel);
+    if (!corrected.gyro.allFinite() || !corrected.accel.allFinite()) {
+      // Never a non-finite number in the output: at an absurd temperature the polynomials overflow.
+      reader.Fail("temp_c", "the correction at " + FormatDouble(raw.temp_c) +
+                                " degC is not a finite number (the calibration's fit range is [" +
+                                FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                                FormatDouble(calibration.fit_temp_range_c[1]) + "] degC)");
+    }
     writer.Write(corrected);
     if (report.samples == 0) report.min_temp_c = report.max_temp_c = raw.temp_c;
     report.min_temp_c = std::min(report.min_temp_c, raw.temp_c);
