@@ -1053,6 +1053,8 @@ TEST_F(CliTest, HostileInputGivesOneBoundedEscapedLine) {
       Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", "/dev/zero", "-o", Path("out.csv")});
   EXPECT_EQ(zero.status, 2) << zero.err;
   EXPECT_NE(zero.err.find("/dev/zero:1: line longer than"), std::string::npos) << zero.err;
+}
+
 // ------------------------------------------------------------------------------ unlabelled logs
 
 // `imufit segment` labels a simulated log written without its segment column (jittered times) as the
