@@ -10,7 +10,7 @@ RunWindows ReadRunWindows(const Plan& plan, const std::string& samples_path, con
   std::set<int> ids;
   for (const TableSegment& segment : plan.segments) ids.insert(segment.id);
   SamplesReader reader(samples_path, /*require_segment=*/true);
-  WindowBuilder builder(options);
+  WindowBuilder builder(options, plan.segments);
   Sample sample;
   int last_checked = kTransitionSegment;
   while (reader.Next(&sample)) {
