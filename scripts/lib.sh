@@ -7,7 +7,9 @@ IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # Everything the build, the tests and the Allan plots need, as Debian packages.
 IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
-                     libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev)
+                     libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
+                     pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
+                     python3-matplotlib python3-setuptools python3-wheel python3-pip)
 
 imufit_say() { printf '== %s\n' "$*"; }
 imufit_die() { printf 'error: %s\n' "$*" >&2; exit 1; }

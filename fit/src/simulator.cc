@@ -152,10 +152,22 @@ std::string SimulationOptions::Validate() const {
   if (!(transition_s >= 0.0)) return "the transition time cannot be negative";
   if (ramp && passes < 1) return "a ramp needs at least one pass";
   if (!ramp && soak_temps_c.empty()) return "give at least one soak temperature";
+  // A temperature that is not a number would make every sample NaN.
+  std::vector<double> temps = soak_temps_c;
+  if (ramp) temps = {ramp_from_c, ramp_to_c};
+  for (const double t : temps) {
+    if (!(t >= -273.15 && t <= 1000.0)) return "temperatures must be numbers between -273.15 and 1000 degC";
+  }
+  if (!std::isfinite(rate_hz) || !std::isfinite(dwell_s) || !std::isfinite(transition_s)) {
+    return "the sample rate, dwell and transition times must be finite";
+  }
   if (!(bias_correlation_s > 0.0)) return "the bias correlation time must be positive";
   for (double v : {gyro_noise_density, accel_noise_density, gyro_random_walk, accel_random_walk,
                    gyro_bias_instability, accel_bias_instability, temp_noise_c}) {
     if (!(v >= 0.0)) return "noise figures cannot be negative";
+  }
+  if (!(time_jitter_s >= 0.0 && time_jitter_s < 0.5 / rate_hz)) {
+    return "the time jitter must lie in [0, half the sample interval)";
   }
   return "";
 }
@@ -199,11 +211,17 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
   std::vector<SegmentTruth> dwell_truth;
   for (const TableSegment& segment : segments) dwell_truth.push_back(TruthOf(site, segment));
 
+  // A separate generator for the jitter (seeded from the seed), so that jitter moves only the times.
+  std::mt19937_64 jitter_engine(options.seed ^ 0x6a09e667f3bcc909ULL);
   long long k = 0;
   Sample raw;
   for (const Phase& phase : phases) {
     for (long long j = 0; j < phase.samples; ++j, ++k) {
       raw.time_s = options.start_time_s + static_cast<double>(k) * dt;
+      if (options.time_jitter_s > 0.0) {
+        const double u = static_cast<double>(jitter_engine() >> 11) * 0x1.0p-53;  // [0, 1)
+        raw.time_s += options.time_jitter_s * (2.0 * u - 1.0);
+      }
       if (options.ramp) {
         const double progress = total > 1 ? static_cast<double>(k) / static_cast<double>(total - 1) : 0.0;
         raw.temp_c = options.ramp_from_c + (options.ramp_to_c - options.ramp_from_c) * progress;

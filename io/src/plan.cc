@@ -1,6 +1,7 @@
 #include "imufit/io/plan.h"
 
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "imufit/io/error.h"
@@ -10,13 +11,24 @@ namespace imufit {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
-// `north` may be this far from perpendicular to `up` (SPEC.md: 1 degree).
+// `north` may be this far from perpendicular to `up` (docs/spec.md: 1 degree).
 constexpr double kNorthToleranceRad = 1.0 * kDegToRad;
+// Local gravity anywhere on Earth's surface, with margin (9.76 .. 9.84 m/s^2).
+constexpr double kMinGravity = 9.7;
+constexpr double kMaxGravity = 9.9;
 
 Eigen::Vector3d ReadDirection(const yaml::Located& value) {
   const std::vector<double> xyz = value.Doubles(3);
   const Eigen::Vector3d v(xyz[0], xyz[1], xyz[2]);
-  if (v.norm() == 0.0) value.Fail("a direction cannot be the zero vector");
+  if (v == Eigen::Vector3d::Zero()) value.Fail("a direction cannot be the zero vector");
+  // Its length must be an ordinary number, or normalising it gives zero or nan.
+  const double norm = v.norm();
+  if (!std::isfinite(norm) || norm < 1e-100 || norm > 1e100) {
+    char text[100];
+    std::snprintf(text, sizeof text, "a direction's length must lie between 1e-100 and 1e100 (it is %g)",
+                  norm);
+    value.Fail(text);
+  }
   return v;
 }
 
@@ -38,7 +50,9 @@ Plan ReadPlan(const std::string& path) {
   Plan plan;
   plan.path = path;
   plan.site.gravity_mps2 = root["gravity_mps2"].Double();
-  if (!(plan.site.gravity_mps2 > 0.0)) root["gravity_mps2"].Fail("gravity must be positive");
+  if (!(plan.site.gravity_mps2 >= kMinGravity && plan.site.gravity_mps2 <= kMaxGravity)) {
+    root["gravity_mps2"].Fail("local gravity on Earth lies between 9.7 and 9.9 m/s^2");
+  }
   if (root.Has("latitude_deg")) {
     const double latitude_deg = root["latitude_deg"].Double();
     if (std::abs(latitude_deg) > 90.0) root["latitude_deg"].Fail("latitude must be within [-90, 90] degrees");

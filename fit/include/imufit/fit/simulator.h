@@ -1,7 +1,7 @@
 // imufit — a rate-table run simulated from a known calibration (`imufit simulate`).
 //
 // For each sample the simulator knows the truth (omega_true in rad/s, a_true in m/s^2, body
-// frame, SPEC.md section 2), adds the sensor's noise in SI units at the body frame, and turns
+// frame, docs/spec.md section 2), adds the sensor's noise in SI units at the body frame, and turns
 // the result into raw outputs with the forward form of the shared model:
 //
 //   B = diag(S_g) inv(M_g) (omega_true + n_g + b_g) + V_g + H a_true
@@ -62,6 +62,10 @@ struct SimulationOptions {
   double bias_correlation_s = 100.0;
   double temp_noise_c = 0.0;  // white noise of the temperature reading, degC
   bool quantize = false;      // round raw outputs to integer counts
+  // Time stamps jitter: each time_s is off its nominal k / rate_hz by a uniform deviate in
+  // [-time_jitter_s, +time_jitter_s] (less than half the sample interval, so times still increase).
+  // The deviates come from their own generator: the samples' values are those of the run without jitter.
+  double time_jitter_s = 0.0;
   std::uint64_t seed = 1;
 
   // An empty string when the options are usable, else what is wrong.

@@ -1,4 +1,4 @@
-// imufit — the thermal fit: every coefficient of the model of SPEC.md section 1, with its cubic
+// imufit — the thermal fit: every coefficient of the model of docs/spec.md section 1, with its cubic
 // temperature dependence, estimated jointly from all windows of a multi-position,
 // multi-temperature rate-table run.
 //

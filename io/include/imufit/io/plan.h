@@ -1,4 +1,4 @@
-// imufit — the plan file (SPEC.md section 2): what the rate table did, segment by segment.
+// imufit — the plan file (docs/spec.md section 2): what the rate table did, segment by segment.
 //
 // The reader converts at the edge: rate_dps -> rad/s, latitude_deg -> rad; `up` and `north` are
 // normalised, and `north` is made exactly perpendicular to `up` (it may be off by at most 1

@@ -1,9 +1,12 @@
-// imufit — the truth of a rate-table segment (SPEC.md section 2, docs/conventions.md), in the
-// body frame, SI units. With n the rotation axis (`axis`, else `up`):
+// imufit — the truth of a rate-table segment (docs/spec.md section 2, docs/conventions.md), in
+// the body frame, SI units. With n the rotation axis (`axis`, else `up`):
 //
-//   static:  omega_true = Omega_E sin(phi) up (+ Omega_E cos(phi) north)     a_true = g up
-//   rate:    omega_true = rate n + Omega_E sin(phi) (up . n) n               a_true = g up - rate^2 (r - n (r
-//   . n)) turn:    mean(omega_true) = angle n / duration + Omega_E sin(phi) (up . n) n      a_true = g up
+//   static: omega_true = Omega_E sin(phi) up (+ Omega_E cos(phi) north)
+//           a_true     = g up
+//   rate:   omega_true = rate n + Omega_E sin(phi) (up . n) n
+//           a_true     = g up - rate^2 (r - n (r . n))
+//   turn:   mean(omega_true) = angle n / duration + Omega_E sin(phi) (up . n) n
+//           a_true     = g up
 //
 // up: unit vector opposite to gravity, body axes (for a turn: at its start). north: unit
 // horizontal vector to true north (static segments only: in a rate segment the horizontal Earth
