@@ -226,6 +226,7 @@ int RunAllan(const AllanArguments& args) {
   }
   PlausibilityWarnings(args, series, results);
 
+  OutputTransaction written;  // the curves, the noise YAML and the plot together, or none
   WriteAllanCsv(args.output, results);
   const NoiseRecord record{SoftwareVersion(), args.samples, series.sample_interval_s, n,
                            series.end_time_s - series.start_time_s - series.bridged_time_s};
@@ -237,6 +238,7 @@ int RunAllan(const AllanArguments& args) {
                   static_cast<long long>(n), 100.0 * args.confidence);
     DrawFile(AllanPlot(results, title, args.plot_units == "dph"), args.plot);
   }
+  written.Commit();
   if (!args.quiet) PrintSummary(args, series, n, results);
   return 0;
 }

@@ -10,6 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "imufit/pipeline/segment_run.h"
+
 namespace imufit {
 
 using CommandRunner = std::function<int()>;
@@ -21,6 +23,24 @@ CommandRunner AddAllanCommand(CLI::App* root);
 CommandRunner AddBatchCommand(CLI::App* root);
 CommandRunner AddHistoryCommand(CLI::App* root);
 CommandRunner AddReportCommand(CLI::App* root);
+CommandRunner AddSegmentCommand(CLI::App* root);
+
+// How a command reads samples files without a temp_c or segment column (segment_command.cc).
+struct SamplesInputArguments {
+  double temp_c = 25.0;
+  CLI::Option* temp_c_option = nullptr;
+  SamplesInput input;
+  bool HasTemp() const { return temp_c_option != nullptr && temp_c_option->count() > 0; }
+  SamplesInput Get() const {
+    SamplesInput result = input;
+    if (HasTemp()) result.temp_c = temp_c;
+    return result;
+  }
+};
+// --temp-c.
+void AddTempOption(CLI::App* command, SamplesInputArguments* args);
+// --segment-window, --min-steady, --direction-tolerance, --rate-tolerance.
+void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
 
 // Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).

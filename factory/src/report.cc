@@ -27,7 +27,7 @@ h1 { font-size: 20px; margin: 0 0 6px 0; } h2 { font-size: 15px; border-bottom: 
 h3 { font-size: 13px; margin: 10px 0 4px 0; }
 table { border-collapse: collapse; margin: 4px 0; } td, th { border: 1px solid #bbb; padding: 1px 6px; text-align: left; vertical-align: top; }
 th { background: #eee; } td.num { text-align: right; font-variant-numeric: tabular-nums; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
-thead { display: table-header-group; } tr { break-inside: avoid; page-break-inside: avoid; }
+thead { display: table-header-group; } td:first-child { white-space: nowrap; } tr { break-inside: avoid; page-break-inside: avoid; }
 .hash { font-family: "DejaVu Sans Mono", monospace; font-size: 10px; word-break: break-all; }
 .PASS { color: #06642a; font-weight: bold; } .FAIL { color: #b00; font-weight: bold; }
 .badge { display: inline-block; padding: 3px 14px; font-size: 18px; border: 2px solid; border-radius: 4px; }
@@ -536,8 +536,8 @@ std::vector<PlotFigure> LotPlots(const LotSummary& lot) {
   std::vector<PlotFigure> figures;
   for (const LotFigure& f : lot.figures) {
     PlotFigure figure;
-    figure.width_px = 460;
-    figure.height_px = 170;
+    figure.width_px = 640;
+    figure.height_px = 200;
     Plot plot;
     plot.title = f.name + " (" + f.unit + ")";
     plot.y_tics = false;

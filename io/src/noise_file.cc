@@ -152,7 +152,7 @@ std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysi
   }
   const auto has = [&](ColumnKind kind) {
     return std::any_of(results.begin(), results.end(),
-                       [&](const ColumnAnalysis& r) { return r.kind == kind; });
+                       [&](const ColumnAnalysis& r) { return r.kind == kind && r.fit.fitted; });
   };
   const bool has_gyro = has(ColumnKind::kGyro), has_accel = has(ColumnKind::kAccel);
   if (has_gyro || has_accel) {

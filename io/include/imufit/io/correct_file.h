@@ -7,6 +7,7 @@
 #ifndef IMUFIT_IO_CORRECT_FILE_H_
 #define IMUFIT_IO_CORRECT_FILE_H_
 
+#include <optional>
 #include <string>
 
 #include "imufit/io/calibration.h"
@@ -21,8 +22,9 @@ struct CorrectFileReport {
   double max_temp_c = 0.0;
 };
 
+// `temp_c`: the temperature of every sample of a file without a temp_c column (written to the output).
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path);
+                                     const std::string& output_path, std::optional<double> temp_c = std::nullopt);
 
 }  // namespace imufit
 

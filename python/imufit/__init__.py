@@ -1,0 +1,81 @@
+"""imufit: IMU thermal calibration from Python.
+
+The same C++ libraries as the ``imufit`` command (the shared correction model, the thermal fit,
+the simulator and the Allan analysis), on numpy arrays, so that a notebook and the factory give
+the same numbers. Units are SI unless a name says otherwise (``temp_c``, ``rate_hz``); raw sensor
+outputs are in the unit's own units. See docs/python.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import tempfile
+from collections.abc import Mapping
+from typing import Any
+
+from ._imufit import (
+    COEFFICIENT_NAMES,
+    AllanResult,
+    Calibration,
+    FitError,
+    InputError,
+    NoiseTerms,
+    UndeterminedError,
+    __version__,
+    _fit,
+    allan,
+    fit_options,
+    noise_terms,
+    read_samples,
+    simulate,
+    simulate_options,
+    write_samples,
+)
+
+__all__ = [
+    "COEFFICIENT_NAMES",
+    "AllanResult",
+    "Calibration",
+    "FitError",
+    "FitResult",
+    "InputError",
+    "NoiseTerms",
+    "UndeterminedError",
+    "__version__",
+    "allan",
+    "fit",
+    "fit_options",
+    "noise_terms",
+    "read_samples",
+    "simulate",
+    "simulate_options",
+    "write_samples",
+]
+
+
+@dataclasses.dataclass
+class FitResult:
+    """What imufit.fit() returns: the calibration, the 1-sigma of its coefficients, diagnostics."""
+
+    calibration: Calibration
+    sigma: dict[str, dict[str, Any]]
+    diagnostics: dict[str, Any]
+
+
+def fit(plan: str | os.PathLike[str], samples: str | os.PathLike[str] | Mapping[str, Any], **options: Any) -> FitResult:
+    """Fits the thermal model to a rate-table run, as ``imufit fit`` does (the same library call).
+
+    ``plan`` is a plan YAML path; ``samples`` a samples CSV path or arrays
+    ({time_s, temp_c, segment, gyro, accel}, as simulate() and read_samples() return), which are
+    written to a temporary CSV (shortest round-trip numbers, so the fit sees the same doubles).
+    ``options``: see fit_options(). Raises InputError (a ValueError) on bad input,
+    UndeterminedError naming what is missing when the run does not determine the model, and
+    FitError when the solver does not converge.
+    """
+    if isinstance(samples, Mapping):
+        with tempfile.TemporaryDirectory(prefix="imufit_fit_") as folder:
+            path = os.path.join(folder, "samples.csv")
+            write_samples(path, dict(samples))
+            return FitResult(**_fit(plan, path, options))
+    return FitResult(**_fit(plan, samples, options))

@@ -1,0 +1,238 @@
+"""Type stub of imufit: IMU thermal calibration (the C++ libraries of the imufit command).
+
+Units: SI unless a name says otherwise. Raw outputs ("raw") are the unit's own numbers
+(counts, nominal deg/s, ...). Corrected gyro rates are rad/s, specific forces m/s^2, both in the
+body frame. Temperatures are degC. Coefficients are cubics in dT = T - reference_temp_c (25 degC),
+columns c0..c3 of powers of dT. See docs/python.md and docs/conventions.md.
+"""
+
+import dataclasses
+import os
+from collections.abc import Mapping, Sequence
+from typing import Any, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+ArrayLike = npt.ArrayLike
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+PathLike = str | os.PathLike[str]
+
+COEFFICIENT_NAMES: list[str]
+"""The 21 gyro coefficients in parameter order, "group.axis" ("bias.x" .. "g_sensitivity.zz");
+the accelerometer uses the first 12."""
+
+class InputError(ValueError):
+    """Bad input (a file, a value or an argument). str(): "file:line:column: message"."""
+
+    file: str
+    line: int  # 1-based; 0 = unknown
+    column: int  # 1-based (CSV: field number); 0 = unknown
+    message: str  # without the location
+
+class FitError(RuntimeError):
+    """The fit could not be done (the solver did not converge)."""
+
+    diagnostics: dict[str, Any]
+
+class UndeterminedError(FitError):
+    """The data do not determine the model."""
+
+    missing: list[str]  # one finding each, with what would determine it
+
+class Calibration:
+    """A calibration (calibration.yaml): the shared model's coefficients and their 1-sigma."""
+
+    serial: str
+    created_utc: str  # ISO 8601 UTC
+    software: str
+    fit_temp_range_c: tuple[float, float]  # degC, the temperatures the fit saw
+
+    def __init__(self) -> None:
+        """The identity calibration: unit scale, no bias, misalignment or g-sensitivity."""
+    @staticmethod
+    def load(path: PathLike) -> Calibration:
+        """Reads a calibration YAML; raises InputError (file:line:column) on bad input."""
+    def save(self, path: PathLike) -> None:
+        """Writes the calibration YAML atomically; save -> load gives the same doubles."""
+    def to_yaml(self) -> str: ...
+    @property
+    def reference_temp_c(self) -> float:
+        """Temperature at which dT = 0, degC (25 in files imufit writes)."""
+    @property
+    def gyro(self) -> dict[str, FloatArray]:
+        """Copies: bias (3, 4) raw; scale (3, 4) raw per rad/s; misalignment (6, 4) rows xy xz yx yz
+        zx zy, 1; g_sensitivity (9, 4) rows xx..zz, raw per m/s^2. Columns c0..c3 (per degC^k)."""
+    @property
+    def accel(self) -> dict[str, FloatArray]:
+        """Copies: bias (3, 4) raw; scale (3, 4) raw per m/s^2; misalignment (6, 4)."""
+    @property
+    def sigma(self) -> dict[str, dict[str, FloatArray]] | None:
+        """1-sigma of every coefficient, {"gyro": ..., "accel": ...} as above; None if the file has none."""
+    def parameters(self, sensor: str) -> FloatArray:
+        """Flat parameters of "gyro" (84,) or "accel" (48,): coefficient i, term k at 4 i + k."""
+    def set_coefficients(self, sensor: str, group: str, values: ArrayLike) -> None:
+        """Sets group "bias" | "scale" | "misalignment" | "g_sensitivity" of "gyro" | "accel" from (count, 4)."""
+    def evaluate(self, temp_c: ArrayLike) -> dict[str, dict[str, FloatArray]]:
+        """Coefficients at temp_c (degC, a number or (N,)): {"gyro": {bias (N, 3) raw, scale (N, 3),
+        misalignment (N, 3, 3), g_sensitivity (N, 3, 3)}, "accel": {bias, scale, misalignment}}."""
+    def correct(self, temp_c: ArrayLike, gyro_raw: ArrayLike, accel_raw: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(omega_hat_radps, a_hat_mps2), each (N, 3): bit for bit what `imufit apply` writes.
+        temp_c degC (N,) or a number; gyro_raw, accel_raw raw (N, 3) or (3,). Releases the GIL."""
+    def forward(self, temp_c: ArrayLike, omega_true_radps: ArrayLike, a_true_mps2: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(gyro_raw, accel_raw) a unit with this calibration outputs for the truth: inverse of correct()."""
+
+def read_samples(path: PathLike) -> dict[str, FloatArray | IntArray]:
+    """A samples file (CSV or .csv.gz) as {time_s (N,) s, temp_c (N,) degC, segment (N,) int64 if
+    present, gyro (N, 3), accel (N, 3)}. Raises InputError on bad input."""
+
+def write_samples(path: PathLike, samples: Mapping[str, ArrayLike], comment: str = "") -> None:
+    """Writes {time_s, temp_c, [segment], gyro, accel} atomically, shortest round-trip numbers."""
+
+@dataclasses.dataclass
+class FitResult:
+    calibration: Calibration
+    sigma: dict[str, dict[str, FloatArray]]  # 1-sigma, layout of Calibration.gyro / .accel
+    diagnostics: dict[str, Any]
+    """termination, iterations, initial_cost, final_cost, windows_used, windows_downweighted,
+    distinct_temps_c (degC), temp_range_c, gyro_residual_rms_radps, accel_residual_rms_mps2,
+    gyro_reduced_chi2, accel_reduced_chi2, samples, transition_samples, trimmed_samples,
+    short_windows, brief_report, full_report, windows {segment, occurrence, samples, start_s,
+    end_s, temp_c, gyro_mean, accel_mean, gyro_std, accel_std}, residuals {window, gyro_radps,
+    accel_mps2, gyro_sigma_radps, accel_sigma_mps2, downweighted}, folds, check_errors."""
+
+def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Any) -> FitResult:
+    """Fits the thermal model to a run, as `imufit fit` does. plan: plan YAML path; samples: a path
+    or arrays as simulate() returns. Options (SI; defaults from fit_options()):
+    gyro_temp_order, accel_temp_order (0..3), fit_g_sensitivity, loss ("none" | "huber" |
+    "cauchy"), loss_scale, gyro_bias_stability_radps, accel_bias_stability_mps2,
+    bias_correlation_s, max_iterations, closed_form_start, threads, distinct_temp_c,
+    min_excitation_rate_radps, rank_tolerance, trim_s, window_temp_span_c, window_max_duration_s,
+    window_min_samples, validate, check_samples, check_plan.
+    Raises InputError, UndeterminedError (what is missing), FitError (not converged)."""
+
+def fit_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of every option of fit()."""
+
+def simulate(plan: PathLike, truth: Calibration | PathLike, **options: Any) -> dict[str, FloatArray | IntArray]:
+    """The run `imufit simulate` writes, sample for sample: {time_s, temp_c, segment, gyro, accel
+    (raw), omega_true_radps (rad/s), a_true_mps2 (m/s^2)}. Options (defaults from simulate_options()):
+    soak_temps_c (degC list), ramp_c ((from, to) degC), passes, dwell_s, transition_s, rate_hz,
+    start_time_s, gyro_noise_density (rad/s/sqrt(Hz)), accel_noise_density (m/s^2/sqrt(Hz)),
+    gyro_random_walk (rad/s^2/sqrt(Hz)), accel_random_walk (m/s^3/sqrt(Hz)),
+    gyro_bias_instability (rad/s), accel_bias_instability (m/s^2), bias_correlation_s,
+    temp_noise_c, quantize, seed."""
+
+def simulate_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of every option of simulate()."""
+
+class AllanResult:
+    """An Allan-family deviation at several taus with confidence intervals (NIST SP 1065)."""
+
+    @property
+    def estimator(self) -> str: ...
+    @property
+    def tau0_s(self) -> float: ...
+    @property
+    def n_samples(self) -> int: ...
+    @property
+    def mean(self) -> float:
+        """Mean of y removed before the analysis, units of y."""
+    @property
+    def m(self) -> IntArray:
+        """Averaging factors tau / tau0."""
+    @property
+    def tau_s(self) -> FloatArray:
+        """Averaging times, s."""
+    @property
+    def terms(self) -> IntArray:
+        """Number of terms of the estimator at each tau."""
+    @property
+    def dev(self) -> FloatArray:
+        """Deviation, units of y (tdev: units of y times s)."""
+    @property
+    def dev_lo(self) -> FloatArray:
+        """Lower bound of the confidence interval (nan: no edf)."""
+    @property
+    def dev_hi(self) -> FloatArray:
+        """Upper bound of the confidence interval (nan: no edf)."""
+    @property
+    def edf(self) -> FloatArray: ...
+    @property
+    def alpha(self) -> IntArray: ...
+    def __len__(self) -> int: ...
+
+def allan(
+    y: ArrayLike,
+    tau0_s: float,
+    estimator: str = "oadev",
+    taus: str | Sequence[float] = "octave",
+    confidence: float = 0.683,
+    edf_noise: str = "auto",
+    threads: int = 0,
+) -> AllanResult:
+    """Allan deviation (adev, oadev, mdev, tdev, hdev, ohdev, totdev) of rates y (N,) (e.g. rad/s)
+    sampled every tau0_s s, at taus "octave" | "decade" | "all" | "per-decade:K" | taus in s.
+    Same numbers as `imufit allan` for one column."""
+
+class NoiseTerms:
+    """IEEE 952 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2,
+    SI units of y (gyro in rad/s: Q rad, N rad/sqrt(s), B rad/s, K rad/s/sqrt(s), R rad/s^2)."""
+
+    @property
+    def fitted(self) -> bool: ...
+    @property
+    def message(self) -> str: ...
+    @property
+    def points_used(self) -> int: ...
+    @property
+    def reduced_chi_square(self) -> float: ...
+    @property
+    def value(self) -> dict[str, float]:
+        """quantization, random_walk, bias_instability, rate_random_walk, rate_ramp."""
+    @property
+    def sigma(self) -> dict[str, float]:
+        """1-sigma of each value."""
+    @property
+    def variance(self) -> dict[str, float]: ...
+    @property
+    def variance_sigma(self) -> dict[str, float]: ...
+    @property
+    def free(self) -> dict[str, bool]: ...
+    @property
+    def arw(self) -> float:
+        """N, rad/sqrt(s) for a gyro (x 180/pi x 60 = deg/sqrt(h)); m/s/sqrt(s) for an accelerometer."""
+    @property
+    def arw_sigma(self) -> float: ...
+    @property
+    def bias_instability(self) -> float:
+        """B, rad/s for a gyro (x 180/pi x 3600 = deg/h)."""
+    @property
+    def bias_instability_sigma(self) -> float: ...
+    @property
+    def rrw(self) -> float:
+        """K, rad/s/sqrt(s) for a gyro (x 180/pi x 3600 x 60 = deg/h/sqrt(h))."""
+    @property
+    def rrw_sigma(self) -> float: ...
+    @property
+    def readouts(self) -> dict[str, float]:
+        """IEEE 952 read-outs from the curve: random_walk (at 1 s), bias_instability, bias_tau_s,
+        rate_random_walk (at 3 s); nan where the curve has no such region."""
+    @overload
+    def model_deviation(self, tau_s: float) -> float: ...
+    @overload
+    def model_deviation(self, tau_s: ArrayLike) -> FloatArray: ...
+    def term_deviation(self, term: str, tau_s: ArrayLike) -> FloatArray: ...
+
+def noise_terms(
+    data: ArrayLike | AllanResult,
+    tau0_s: float | None = None,
+    taus: str | Sequence[float] = "octave",
+    min_clusters: float = 8.0,
+    terms: Sequence[str] | None = None,
+) -> NoiseTerms:
+    """IEEE 952 terms with 1-sigma, fitted to the oadev of rates `data` ((N,), every tau0_s s) or to
+    an adev / oadev / totdev AllanResult. `terms` limits the fit to the named terms."""
