@@ -1,5 +1,5 @@
 // imufit allan — Allan deviation (and relatives) of columns of a samples file, their confidence
-// intervals, the IEEE 952 noise terms, a noise YAML file and a plot (SPEC.md section 4, issue 4).
+// intervals, the IEEE 952 noise terms, a noise YAML file and a plot (docs/spec.md section 4, issue 4).
 //
 // Units: the columns are taken as SI rates (a corrected samples file: gyro rad/s, accel m/s^2).
 // Engineer units are converted here, once, on output:
@@ -262,9 +262,9 @@ void WriteNoiseYaml(const std::string& path, const AllanArguments& args, const U
          << YamlNumber(fit.readout_rate_random_walk * k.engineer_per_si) << "\n";
   }
   const bool has_gyro = std::any_of(results.begin(), results.end(),
-                                    [](const ColumnResult& r) { return r.kind == ColumnKind::kGyro; });
+                                    [](const ColumnResult& r) { return r.kind == ColumnKind::kGyro && r.fit.fitted; });
   const bool has_accel = std::any_of(results.begin(), results.end(),
-                                     [](const ColumnResult& r) { return r.kind == ColumnKind::kAccel; });
+                                     [](const ColumnResult& r) { return r.kind == ColumnKind::kAccel && r.fit.fitted; });
   if (has_gyro || has_accel) {
     yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor\n";
     if (has_gyro) {
@@ -421,18 +421,11 @@ std::string PlotScript(const std::string& output, const std::string& title, cons
 void WritePlot(const std::string& gnuplot, const AllanArguments& args, const UniformSeries& series,
                int64_t sample_count, const std::vector<ColumnResult>& results) {
   namespace fs = std::filesystem;
-  const fs::path destination(args.plot);
-  const fs::path folder = destination.parent_path().empty() ? fs::path(".") : destination.parent_path();
-  std::string image = (folder / ("." + destination.filename().string() + ".tmp-XXXXXX")).string();
-  const int image_fd = ::mkstemp(image.data());
-  if (image_fd < 0) throw InputError(args.plot, "cannot create a file in " + folder.string());
-  ::close(image_fd);
+  OutputFile image_file(args.plot);  // gnuplot draws into its temporary file
+  const std::string& image = image_file.temp_path();
   std::string script = (fs::temp_directory_path() / "imufit-allan-XXXXXX").string();
   const int script_fd = ::mkstemp(script.data());
-  if (script_fd < 0) {
-    ::unlink(image.c_str());
-    throw std::runtime_error("cannot create a temporary gnuplot script");
-  }
+  if (script_fd < 0) throw std::runtime_error("cannot create a temporary gnuplot script");
   ::close(script_fd);
   const std::string errors = script + ".err";
   char title[512];
@@ -448,13 +441,9 @@ void WritePlot(const std::string& gnuplot, const AllanArguments& args, const Uni
   ::unlink(errors.c_str());
   std::error_code ec;
   if (status != 0 || fs::file_size(image, ec) == 0) {
-    ::unlink(image.c_str());
     throw std::runtime_error("gnuplot could not draw " + args.plot + ": " + message.substr(0, 600));
   }
-  if (std::rename(image.c_str(), args.plot.c_str()) != 0) {
-    ::unlink(image.c_str());
-    throw InputError(args.plot, "cannot replace the file");
-  }
+  image_file.Commit();
 }
 
 void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64_t sample_count,
@@ -595,9 +584,11 @@ int RunAllan(const AllanArguments& args) {
     results.push_back(std::move(result));
   }
 
+  OutputTransaction written;  // the curves, the noise YAML and the plot together, or none
   WriteCsv(args.output, results);
   if (!args.noise_yaml.empty()) WriteNoiseYaml(args.noise_yaml, args, series, n, results);
   if (!args.plot.empty()) WritePlot(gnuplot, args, series, n, results);
+  written.Commit();
   if (!args.quiet) PrintSummary(args, series, n, results);
   return 0;
 }

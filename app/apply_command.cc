@@ -15,12 +15,13 @@ struct ApplyArguments {
   std::string samples;
   std::string output;
   bool quiet = false;
+  SamplesInputArguments input;
 };
 
 int RunApply(const ApplyArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
   const Calibration calibration = ReadCalibration(args.calibration);
-  const CorrectFileReport report = CorrectSamplesFile(calibration, args.samples, args.output);
+  const CorrectFileReport report = CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().temp_c);
   if (report.outside_temp_range > 0) {
     std::fprintf(stderr,
                  "imufit: warning: %lld of %lld samples (%.1f %%) lie outside the calibration's fit "
@@ -47,6 +48,7 @@ CommandRunner AddApplyCommand(CLI::App* root) {
   command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")->required();
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
   command->add_option("--output,-o", args->output, "corrected samples CSV to write (.gz compresses)")->required();
+  AddTempOption(command, &args->input);
   command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
   return [args] { return RunApply(*args); };
 }

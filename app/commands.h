@@ -1,6 +1,6 @@
 // imufit — the subcommands of the `imufit` program. Each Add*Command registers its options on
 // `root` and returns the function that runs it once the command line has been parsed; that
-// function returns the exit status of SPEC.md section 4 (0 done, 1 could not be done, 2 bad
+// function returns the exit status of docs/spec.md section 4 (0 done, 1 could not be done, 2 bad
 // input; 3 done but failed acceptance limits) and lets InputError escape to main(), which prints it and returns 2.
 #ifndef IMUFIT_APP_COMMANDS_H_
 #define IMUFIT_APP_COMMANDS_H_
@@ -9,6 +9,8 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+
+#include "imufit/pipeline/segment_run.h"
 
 namespace imufit {
 
@@ -21,8 +23,26 @@ CommandRunner AddAllanCommand(CLI::App* root);
 CommandRunner AddBatchCommand(CLI::App* root);
 CommandRunner AddHistoryCommand(CLI::App* root);
 CommandRunner AddReportCommand(CLI::App* root);
+CommandRunner AddSegmentCommand(CLI::App* root);
 
-// Exit status 3 (an addition to SPEC.md section 4, docs/factory.md): the job was done, but a unit
+// How a command reads samples files without a temp_c or segment column (segment_command.cc).
+struct SamplesInputArguments {
+  double temp_c = 25.0;
+  CLI::Option* temp_c_option = nullptr;
+  SamplesInput input;
+  bool HasTemp() const { return temp_c_option != nullptr && temp_c_option->count() > 0; }
+  SamplesInput Get() const {
+    SamplesInput result = input;
+    if (HasTemp()) result.temp_c = temp_c;
+    return result;
+  }
+};
+// --temp-c.
+void AddTempOption(CLI::App* command, SamplesInputArguments* args);
+// --segment-window, --min-steady, --direction-tolerance, --rate-tolerance.
+void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
+
+// Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).
 inline constexpr int kExitFailedLimits = 3;
 

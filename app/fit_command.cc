@@ -1,4 +1,4 @@
-// imufit fit — fits the thermal model of SPEC.md section 1 to a rate-table run.
+// imufit fit — fits the thermal model of docs/spec.md section 1 to a rate-table run.
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -39,6 +39,9 @@ struct FitArguments {
   double accel_bias_stability_ug = 0.0;
   FitOptions fit;
   WindowOptions windows;
+  SamplesInputArguments input;
+  CLI::Option* gyro_order_option = nullptr;
+  CLI::Option* accel_order_option = nullptr;
 };
 
 std::string Format(const char* format, double a, double b) {
@@ -98,7 +101,8 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 
 // --limits, --report, --store: the factory additions, after the calibration is written.
 // Returns the exit status: 0, or kExitFailedLimits.
-int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result) {
+int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result,
+                  OutputTransaction* outputs) {
   const Calibration& calibration = *result.calibration;
   std::optional<Verdict> verdict;
   if (limits) {
@@ -118,8 +122,10 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
                                        verdict);
     report.folds = result.folds;
     WriteUnitReport(args.report, report);
-    if (!args.quiet) std::printf("  wrote %s\n", args.report.c_str());
   }
+  outputs->Commit();  // the calibration and the report together, or neither
+  if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
+  if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
   if (!args.store.empty()) {
     StoredFit row;
     row.serial = calibration.serial.empty() ? args.samples : calibration.serial;
@@ -153,7 +159,19 @@ int RunFit(FitArguments args) {
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
   args.fit.gyro_bias_stability_radps = args.gyro_bias_stability_dph / kRadToDeg / 3600.0;
   args.fit.accel_bias_stability_mps2 = args.accel_bias_stability_ug * 1e-6 * kStandardGravity;
+  const bool fixed_temp = args.input.HasTemp();
+  if (fixed_temp) {
+    // One temperature determines no temperature dependence: order 0, unless the user asked otherwise.
+    const bool explicit_order = args.gyro_order_option->count() > 0 || args.accel_order_option->count() > 0;
+    if (explicit_order && (args.fit.gyro_temp_order != 0 || args.fit.accel_temp_order != 0)) {
+      throw InputError("--temp-c", "one temperature for the whole run determines only order-0 temperature "
+                                   "polynomials: use --gyro-temp-order 0 --accel-temp-order 0 (the default with --temp-c)");
+    }
+    args.fit.gyro_temp_order = 0;
+    args.fit.accel_temp_order = 0;
+  }
   FitRunOptions options;
+  options.input = args.input.Get();
   options.fit = args.fit;
   options.windows = args.windows;
   options.validate = args.validate;
@@ -166,6 +184,16 @@ int RunFit(FitArguments args) {
   const FitSummary& fit = result.fit;
   const WindowStats& stats = result.run.stats;
   const std::vector<Window>& windows = result.run.windows;
+  if (!args.quiet && fixed_temp) {
+    std::printf("imufit fit: note: no temp_c column, every sample at %g degC (--temp-c): temperature orders 0\n",
+                args.input.temp_c);
+  }
+  if (!args.quiet && result.run.segmentation) {
+    const Segmentation& segmentation = *result.run.segmentation;
+    std::printf("imufit fit: no segment column: %zu segments found in %d pass%s through the plan:\n%s",
+                segmentation.matches.size(), segmentation.passes, segmentation.passes == 1 ? "" : "es",
+                SegmentationReport(segmentation).c_str());
+  }
   if (fit.status == FitStatus::kUndetermined) {
     std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n", args.samples.c_str());
     for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
@@ -180,9 +208,10 @@ int RunFit(FitArguments args) {
     std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(), fit.BriefReport().c_str());
     return 1;
   }
+  OutputTransaction outputs;
   WriteCalibration(args.output, *result.calibration);
 
-  if (args.quiet) return FinishFactory(args, limits, result);
+  if (args.quiet) return FinishFactory(args, limits, result, &outputs);
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
   std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
@@ -224,8 +253,7 @@ int RunFit(FitArguments args) {
   if (!result.check_errors.empty()) {
     PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
   }
-  std::printf("  wrote %s\n", args.output.c_str());
-  return FinishFactory(args, limits, result);
+  return FinishFactory(args, limits, result, &outputs);
 }
 
 }  // namespace
@@ -242,12 +270,16 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
   command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
-  command->add_option("--gyro-temp-order", f.gyro_temp_order, "order of the gyro temperature polynomials, 0..3")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 3));
-  command->add_option("--accel-temp-order", f.accel_temp_order, "order of the accel temperature polynomials, 0..3")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 3));
+  args->gyro_order_option =
+      command->add_option("--gyro-temp-order", f.gyro_temp_order, "order of the gyro temperature polynomials, 0..3 (0 with --temp-c)")
+          ->capture_default_str()
+          ->check(CLI::Range(0, 3));
+  args->accel_order_option =
+      command->add_option("--accel-temp-order", f.accel_temp_order, "order of the accel temperature polynomials, 0..3 (0 with --temp-c)")
+          ->capture_default_str()
+          ->check(CLI::Range(0, 3));
+  AddTempOption(command, &args->input);
+  AddSegmentationOptions(command, &args->input);
   command->add_flag("--no-g-sensitivity", args->no_g_sensitivity, "hold the gyro g-sensitivity at zero");
   command->add_option("--loss", args->loss, "robust loss: none, huber, cauchy")->capture_default_str();
   command->add_option("--loss-scale", f.loss_scale,

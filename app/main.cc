@@ -1,5 +1,5 @@
 // imufit — the command. Thin: parse the command line, call the libraries, print, and return
-// the exit status of SPEC.md section 4.
+// the exit status of docs/spec.md section 4.
 #include <cstdio>
 #include <exception>
 #include <utility>
@@ -8,7 +8,9 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "imufit/fit/segmentation.h"
 #include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
 
 namespace imufit {
 
@@ -24,7 +26,8 @@ int main(int argc, char** argv) {
       "runs and characterises noise; runs factory batches with acceptance limits. Exit status: 0 done,\n"
       "1 the job could not be done, 2 bad invocation or bad input, 3 done but acceptance limits failed.",
       "imufit"};
-  app.set_version_flag("--version", std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
+  app.set_version_flag("--version",
+                       std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, imufit::CommandRunner>> commands;
   // The subcommand an Add*Command just registered is the last one defined. (get_subcommands()
@@ -39,7 +42,10 @@ int main(int argc, char** argv) {
   add(imufit::AddBatchCommand(&app));
   add(imufit::AddHistoryCommand(&app));
   add(imufit::AddReportCommand(&app));
+  add(imufit::AddSegmentCommand(&app));
 
+  // Outputs are written to temporary files and renamed when complete; a stopped run removes them.
+  imufit::InstallOutputCleanupOnSignals();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -54,6 +60,12 @@ int main(int argc, char** argv) {
   } catch (const imufit::InputError& e) {
     std::fprintf(stderr, "imufit: %s\n", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "imufit: error: out of memory\n");
+    return 1;
+  } catch (const imufit::PlanMismatchError& e) {  // well-formed files that disagree: exit 1
+    std::fprintf(stderr, "imufit: %s; nothing written\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "imufit: error: %s\n", e.what());
     return 1;

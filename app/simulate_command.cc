@@ -24,6 +24,8 @@ struct SimulateArguments {
   std::vector<double> soak_temps_c;
   std::vector<double> ramp_c;
   bool quiet = false;
+  bool no_segment_column = false;  // an unlabelled log (the truth file keeps the labels)
+  bool no_temp_column = false;     // a log without a thermometer
   SimulationOptions options;
 };
 
@@ -57,7 +59,7 @@ int RunSimulate(SimulateArguments args) {
   std::ostringstream comment;
   comment << "simulated by " << SoftwareVersion() << " from plan " << args.plan << " and calibration "
           << args.calibration << ", seed " << options.seed;
-  SamplesWriter samples(args.output, /*with_segment=*/true, comment.str());
+  SamplesWriter samples(args.output, SampleColumns{!args.no_segment_column, !args.no_temp_column}, comment.str());
   std::optional<SamplesWriter> truth_samples;
   if (!args.truth_output.empty()) {
     truth_samples.emplace(args.truth_output, true,
@@ -131,6 +133,14 @@ CommandRunner AddSimulateCommand(CLI::App* root) {
   command->add_option("--temp-noise", o.temp_noise_c, "white noise of the temperature reading, degC")
       ->capture_default_str();
   command->add_flag("--quantize", o.quantize, "round raw outputs to integer counts");
+  command->add_flag("--no-segment-column", args->no_segment_column,
+                    "leave the segment column out (an unlabelled log; --truth keeps the true labels)");
+  command->add_flag("--no-temp-column", args->no_temp_column,
+                    "leave the temp_c column out (a log without a thermometer; --truth keeps the temperatures)");
+  command->add_option("--time-jitter-s", o.time_jitter_s,
+                      "time stamps off their nominal times by up to this much (uniform), s; below half the "
+                      "sample interval")
+      ->capture_default_str();
   command->add_option("--seed", o.seed, "random seed: the same seed gives the same file")->capture_default_str();
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunSimulate(*args); };

@@ -1,4 +1,4 @@
-// End-to-end tests of the `imufit` command (SPEC.md section 4): the built program (IMUFIT_EXE) is
+// End-to-end tests of the `imufit` command (docs/spec.md section 4): the built program (IMUFIT_EXE) is
 // run on fixtures (IMUFIT_FIXTURES_DIR) and on files written into a fresh temporary folder per
 // test, never the working directory.
 //
@@ -6,7 +6,7 @@
 // `imufit apply` with that calibration, gives back the true rate and specific force of every
 // sample, transitions included, to kRecoveryToleranceSi. It is done twice: on `imufit simulate`'s
 // own output and truth, and on samples this file computes with its own forward model written
-// from SPEC.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
+// from docs/spec.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
 // neither the simulator nor imufit's reader and model are checked only against themselves.
 #include <unistd.h>
 #include <zlib.h>
@@ -43,7 +43,7 @@ constexpr double kRecoveryToleranceSi = 1e-9;
 // Worst-case relative difference between two forward models that do the same arithmetic in a
 // different order.
 constexpr double kForwardAgreementRelative = 1e-12;
-// Earth's rotation rate, rad/s, as SPEC.md section 2 states it.
+// Earth's rotation rate, rad/s, as docs/spec.md section 2 states it.
 constexpr double kEarthRate = 7.292115e-5;
 constexpr double kDegToRad = M_PI / 180.0;
 
@@ -113,7 +113,7 @@ std::string FormatExactly(double value) {
 }
 
 // ------------------------------------------------------------------------------------------
-// A forward model written from SPEC.md section 1, independent of imufit's reader and model:
+// A forward model written from docs/spec.md section 1, independent of imufit's reader and model:
 //   B = diag(S_g) inv(M_g) omega + V_g + H a,   A = diag(S_a) inv(M_a) a + V_a,
 // every coefficient c0 + c1 dT + c2 dT^2 + c3 dT^3 with dT = T - reference_temp_c.
 class SpecForwardModel {
@@ -185,7 +185,7 @@ class SpecForwardModel {
   YAML::Node accel_;
 };
 
-// The truth of a plan's dwell segments, written from SPEC.md section 2 (rad/s, m/s^2, body).
+// The truth of a plan's dwell segments, written from docs/spec.md section 2 (rad/s, m/s^2, body).
 std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> SpecTruthOfPlan(const std::string& plan_path) {
   const YAML::Node plan = YAML::LoadFile(plan_path);
   const auto vector = [](const YAML::Node& v) {
@@ -398,7 +398,7 @@ TEST_F(CliTest, SimulateIsDeterministic) {
   EXPECT_NE(a.substr(a.find("time_s")), c.substr(c.find("time_s")));
 }
 
-// The truth that `imufit simulate --truth` writes for dwell samples is the truth SPEC.md section 2
+// The truth that `imufit simulate --truth` writes for dwell samples is the truth docs/spec.md section 2
 // defines (Earth rate with and without `north`, centripetal term of the lever arm).
 TEST_F(CliTest, SimulatedTruthFollowsTheSpec) {
   for (const char* plan : {"plan_6pos.yaml", "plan_24pos.yaml"}) {
@@ -460,7 +460,7 @@ TEST_F(CliTest, ApplyTurnsTheNoiselessFixtureIntoItsTruth) {
 }
 
 // The same acceptance check without imufit's simulator: raw samples computed here from chosen
-// truths with the forward model of SPEC.md (SpecForwardModel), at random temperatures in
+// truths with the forward model of docs/spec.md (SpecForwardModel), at random temperatures in
 // -40..85 degC, written as a CSV with the columns in another order, an extra column, comments
 // and CRLF line ends.
 TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
@@ -485,7 +485,7 @@ TEST_F(CliTest, ApplyInvertsAnIndependentForwardModel) {
       const Eigen::Vector3d a(force(engine), force(engine), force(engine));
       const Eigen::Vector3d gyro_m = spec.Gyro(temp_c, omega, a);
       const Eigen::Vector3d accel_m = spec.Accel(temp_c, a);
-      // The model header's forward form agrees with SPEC.md's.
+      // The model header's forward form agrees with docs/spec.md's.
       Eigen::Vector3d header_gyro;
       Eigen::Vector3d header_accel;
       header_model.Forward(temp_c, omega, a, &header_gyro, &header_accel);
@@ -681,7 +681,7 @@ const BadInput kBadInputs[] = {
     {"calibration_three_terms", "calibration", "y: [931.52, -0.0895, -0.00017, 2.6e-06]",
      "y: [931.52, -0.0895, -0.00017]", 23, "4 numbers"},
     {"calibration_wrong_unit", "calibration", "unit: rad/s", "unit: deg/s", 16, "deg/s"},
-    {"calibration_zero_scale", "calibration", "z: [209.97,", "z: [0,", 51, "scale c0 is zero"},
+    {"calibration_zero_scale", "calibration", "z: [209.97,", "z: [0,", 51, "scale.z: the scale factor changes sign"},
     {"calibration_missing_group", "calibration", "  misalignment:\n    xy: [-0.00214",
      "  misalign:\n    xy: [-0.00214", 43,
      "accel.misalignment: missing"},  // the line where the `accel` mapping starts
@@ -942,6 +942,249 @@ TEST_F(CliTest, FitReportsErrorsOnAHeldOutRun) {
   EXPECT_NE(fit.out.find("    all      216"), std::string::npos) << fit.out;
   const YAML::Node written = YAML::LoadFile(Path("calibration.yaml"));
   EXPECT_LT(written["check"]["gyro_error_rms_radps"].as<double>(), 0.02 * kDegToRad);
+}
+
+// ------------------------------------------------------------------------------------------
+// Inputs as they really arrive: exit 2, one located line, nothing written, nothing damaged.
+
+TEST_F(CliTest, ATruncatedGzipRunIsRefusedNotReadAsComplete) {
+  const std::string whole = ReadBytes(Fixture("mems_6pos_noiseless.csv.gz"));
+  for (const auto& [name, bytes] :
+       {std::pair<std::string, std::string>{"cut.csv.gz", whole.substr(0, whole.size() - 8)},
+        {"garbage.csv.gz", whole + "junk"}}) {
+    const std::string samples = Write(name, bytes);
+    const RunResult r =
+        Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+    EXPECT_EQ(r.status, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name + ": " + (name == "cut.csv.gz" ? "truncated gzip stream" : "trailing garbage")),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(Path("out.csv")));
+  }
+}
+
+TEST_F(CliTest, MultiOutputCommandsWriteAllOrNothing) {
+  const std::string calibration = Write("calibration.yaml", "precious\n");
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", Fixture("mems_6pos_soak.csv.gz"),
+                             "-o", calibration, "--report", Path("missing/report.html"), "-q"});
+  EXPECT_EQ(fit.status, 2) << fit.err;
+  EXPECT_NE(fit.err.find("missing/report.html: cannot create"), std::string::npos) << fit.err;
+  EXPECT_EQ(ReadBytes(calibration), "precious\n")
+      << "the calibration was replaced although the report failed";
+  EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml"}));
+
+  std::string rows = "time_s,gyro_x\n";
+  for (int i = 0; i < 2000; ++i)
+    rows += std::to_string(i * 0.01) + "," + std::to_string((i * 7919 % 101) * 1e-3) + "\n";
+  const std::string samples = Write("rates.csv", rows);
+  const RunResult allan =
+      Run({"allan", "-s", samples, "-o", Path("adev.csv"), "--noise-yaml", Path("missing/noise.yaml"), "-q"});
+  EXPECT_EQ(allan.status, 2) << allan.err;
+  EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml", "rates.csv"})) << "adev.csv written alone";
+}
+
+TEST_F(CliTest, OutputsNeverReplaceALinkOrSpecialFile) {
+  const std::string target = Write("target.csv", "the user's file\n");
+  const std::string link = Path("link.csv");
+  fs::create_symlink(target, link);
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s",
+                           Fixture("mems_6pos_noiseless.csv.gz"), "-o", link, "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("link.csv: is a symbolic link"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(ReadBytes(target), "the user's file\n");
+  EXPECT_EQ(Listing(), (std::set<std::string>{"target.csv", "link.csv"}));
+}
+
+TEST_F(CliTest, NoCommandWritesANonFiniteNumber) {
+  // apply: an absurd temperature overflows the polynomials.
+  const std::string header = "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
+  const std::string samples = Write("hot.csv", header + "0,25,1,2,3,4,5,6\n0.1,1e300,1,2,3,4,5,6\n");
+  RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("hot.csv:3:2: temp_c: the correction at 1e+300 degC is not a finite number"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // apply: a calibration whose scale crosses zero inside its fit range is refused on read.
+  YAML::Node calibration = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  calibration["gyro"]["scale"]["y"][1] =
+      -calibration["gyro"]["scale"]["y"][0].as<double>() / 30.0;  // 0 at 55 degC
+  YAML::Emitter emitter;
+  emitter << calibration;
+  r = Run({"apply", "-c", Write("bad.yaml", emitter.c_str()), "-s", Fixture("mems_6pos_noiseless.csv.gz"),
+           "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("gyro.scale.y: the scale factor changes sign"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // simulate: a temperature that is not a number.
+  r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o",
+           Path("sim.csv"), "--temps", "25,nan", "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("temperatures must be numbers"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("sim.csv")));
+  // allan: a constant column gives zero deviations with zero-width intervals and says why there is
+  // no noise fit.
+  std::string rows = "time_s,gyro_x\n";
+  for (int i = 0; i < 2000; ++i) rows += std::to_string(i * 0.01) + ",0.5\n";
+  r = Run(
+      {"allan", "-s", Write("stuck.csv", rows), "-o", Path("adev.csv"), "--noise-yaml", Path("noise.yaml")});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("the column is constant"), std::string::npos) << r.out;
+  for (const char* output : {"adev.csv", "noise.yaml"}) {
+    const std::string text = ReadBytes(Path(output));
+    EXPECT_FALSE(text.empty()) << output;
+    EXPECT_EQ(text.find("nan"), std::string::npos) << output << ":\n" << text;
+    EXPECT_EQ(text.find("inf"), std::string::npos) << output << ":\n" << text;
+  }
+}
+
+TEST_F(CliTest, HostileInputGivesOneBoundedEscapedLine) {
+  const std::string samples =
+      Write("evil.csv", "time_s,temp_c,\x1b]0;owned\x07" + std::string(3000, 'x') + "\n1,2,3\n");
+  const RunResult r =
+      Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\x07'), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_LT(r.err.size(), 600u) << r.err;
+  const RunResult zero =
+      Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", "/dev/zero", "-o", Path("out.csv")});
+  EXPECT_EQ(zero.status, 2) << zero.err;
+  EXPECT_NE(zero.err.find("/dev/zero:1: line longer than"), std::string::npos) << zero.err;
+}
+
+// ------------------------------------------------------------------------------ unlabelled logs
+
+// `imufit segment` labels a simulated log written without its segment column (jittered times) as the
+// simulator's truth does: most samples of every dwell get their segment, none a wrong one.
+TEST_F(CliTest, SegmentLabelsAnUnlabelledLogAsTheTruthDoes) {
+  const std::string raw = Path("raw.csv");
+  const std::string truth = Path("truth.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", raw, "--truth",
+                 truth, "--temps=-20,60", "--rate", "50", "--dwell", "5", "--transition", "1", "--gyro-noise-density",
+                 "8.7e-5", "--accel-noise-density", "1.5e-3", "--quantize", "--no-segment-column", "--time-jitter-s",
+                 "0.005", "-q"})
+                .status,
+            0);
+  EXPECT_EQ(ReadTable(raw).header,
+            (std::vector<std::string>{"time_s", "temp_c", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"}));
+  const std::string labelled = Path("labelled.csv");
+  const RunResult r = Run({"segment", "--plan", Fixture("plan_6pos.yaml"), "--samples", raw, "-o", labelled});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("36 segments found in 2 passes"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("segment  pass  kind"), std::string::npos) << r.out;
+  const Table got = ReadTable(labelled);
+  const Table want = ReadTable(truth);
+  ASSERT_EQ(got.rows.size(), want.rows.size());
+  long long truly_labelled = 0;
+  long long correct = 0;
+  long long wrong = 0;
+  for (size_t i = 0; i < got.rows.size(); ++i) {
+    ASSERT_EQ(got.rows[i][got.Column("time_s")], want.rows[i][want.Column("time_s")]);
+    const int label = std::stoi(got.rows[i][got.Column("segment")]);
+    const int true_label = std::stoi(want.rows[i][want.Column("segment")]);
+    truly_labelled += true_label >= 0;
+    correct += label >= 0 && label == true_label;
+    wrong += label >= 0 && label != true_label;
+  }
+  EXPECT_GE(static_cast<double>(correct) / truly_labelled, 0.7);
+  EXPECT_EQ(wrong, 0);
+  // The labelled log fits like any labelled run.
+  const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", labelled, "-o", Path("cal.yaml"),
+                             "--gyro-temp-order", "1", "--accel-temp-order", "1", "--no-g-sensitivity", "-q"});
+  EXPECT_EQ(fit.status, 0) << fit.err;
+}
+
+TEST_F(CliTest, SegmentRefusesALogThatDisagreesWithThePlanWithExitOne) {
+  const std::string raw = Path("raw.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", raw, "--rate",
+                 "50", "--dwell", "5", "--transition", "1", "--no-segment-column", "-q"})
+                .status,
+            0);
+  // The plan without its +x face (12 .. 17 s in the log): an extra rest in the log.
+  YAML::Node root = YAML::Load(ReadFile(Fixture("plan_6pos.yaml")));
+  YAML::Node kept(YAML::NodeType::Sequence);
+  for (const YAML::Node& segment : root["segments"]) {
+    if (segment["id"].as<int>() != 3) kept.push_back(segment);
+  }
+  root["segments"] = kept;
+  YAML::Emitter emitter;
+  emitter << root;
+  const std::string plan = Write("plan.yaml", emitter.c_str());
+  const std::string output = Write("labelled.csv", "precious\n");
+  for (const char* command : {"segment", "fit"}) {
+    const RunResult r = Run({command, "-p", plan, "-s", raw, "-o", output});
+    EXPECT_EQ(r.status, 1) << command << ": " << r.err;
+    EXPECT_NE(r.err.find("raw.csv: the log does not match the plan " + plan + ": at t = "), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("with the raw axes as they are: at t = 12."), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("nothing written"), std::string::npos) << r.err;
+    EXPECT_EQ(ReadBytes(output), "precious\n");
+  }
+  EXPECT_EQ(Listing(), (std::set<std::string>{"raw.csv", "plan.yaml", "labelled.csv"}));
+}
+
+// A lab log without a thermometer and without labels: --temp-c in segment, fit and apply.
+TEST_F(CliTest, ALogWithoutTemperatureOrLabelsCalibratesWithTempC) {
+  const std::string raw = Path("raw.csv");
+  ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", raw, "--temps",
+                 "21", "--rate", "50", "--dwell", "5", "--transition", "1", "--gyro-noise-density", "8.7e-5",
+                 "--accel-noise-density", "1.5e-3", "--quantize", "--no-segment-column", "--no-temp-column", "-q"})
+                .status,
+            0);
+  EXPECT_EQ(ReadTable(raw).header,
+            (std::vector<std::string>{"time_s", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"}));
+  const std::string plan = Fixture("plan_6pos.yaml");
+  const std::string cal = Path("cal.yaml");
+  RunResult r = Run({"fit", "-p", plan, "-s", raw, "-o", cal});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no column \"temp_c\""), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--temp-c"), std::string::npos) << r.err;
+  r = Run({"fit", "-p", plan, "-s", raw, "-o", cal, "--temp-c", "21", "--gyro-temp-order", "3"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("use --gyro-temp-order 0 --accel-temp-order 0"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(cal));
+  r = Run({"fit", "-p", plan, "-s", raw, "-o", cal, "--temp-c", "21"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("no temp_c column, every sample at 21 degC (--temp-c): temperature orders 0"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("no segment column: 18 segments found in 1 pass"), std::string::npos) << r.out;
+  const YAML::Node written = YAML::LoadFile(cal);
+  EXPECT_EQ(written["fit"]["gyro_temp_order"].as<int>(), 0);
+  EXPECT_EQ(written["fit_temp_range_c"][0].as<double>(), 21.0);
+
+  // A file that has temp_c is refused with --temp-c (no reading is silently replaced).
+  const std::string with_temp = Write("with_temp.csv",
+                                      "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n"
+                                      "0,25,1,2,3,4,5,6\n");
+  r = Run({"apply", "-c", cal, "-s", with_temp, "-o", Path("x.csv"), "--temp-c", "21"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("has a temp_c column"), std::string::npos) << r.err;
+  r = Run({"apply", "-c", cal, "-s", raw, "-o", Path("x.csv")});
+  EXPECT_EQ(r.status, 2);
+  r = Run({"apply", "-c", cal, "-s", raw, "-o", Path("corrected.csv"), "--temp-c", "21", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table corrected = ReadTable(Path("corrected.csv"));
+  ASSERT_FALSE(corrected.rows.empty());
+  EXPECT_EQ(corrected.Number(0, "temp_c"), 21.0);
+  EXPECT_NEAR(corrected.Vector(0, "accel").norm(), 9.81274, 0.05);  // at rest, +z up
+
+  // segment keeps the file's columns: temp_c only when given.
+  ASSERT_EQ(Run({"segment", "-p", plan, "-s", raw, "-o", Path("a.csv"), "-q"}).status, 0);
+  EXPECT_EQ(ReadTable(Path("a.csv")).header.size(), 8u);
+  ASSERT_EQ(Run({"segment", "-p", plan, "-s", raw, "-o", Path("b.csv"), "--temp-c", "21", "-q"}).status, 0);
+  EXPECT_EQ(ReadTable(Path("b.csv")).header,
+            (std::vector<std::string>{"time_s", "temp_c", "segment", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y",
+                                      "accel_z"}));
+}
+
+TEST_F(CliTest, SimulateJitterMustKeepTimesIncreasing) {
+  const RunResult r = Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o",
+                           Path("x.csv"), "--rate", "50", "--time-jitter-s", "0.01"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("time jitter"), std::string::npos) << r.err;
 }
 
 }  // namespace

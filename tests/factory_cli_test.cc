@@ -36,7 +36,7 @@ namespace fs = std::filesystem;
 using testing::RunResult;
 
 const std::string kFixtures = IMUFIT_FIXTURES_DIR;
-// The exit statuses of SPEC.md section 4 and the factory addition (docs/factory.md).
+// The exit statuses of docs/spec.md section 4 and the factory addition (docs/factory.md).
 constexpr int kExitBadInput = 2;
 constexpr int kExitNotDone = 1;
 constexpr int kExitFailedLimits = 3;

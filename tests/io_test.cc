@@ -1,6 +1,12 @@
-// Tests of io/: every file format read and written per SPEC.md, and every error located.
+// Tests of io/: every file format read and written per docs/spec.md, and every error located.
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -8,6 +14,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
@@ -21,9 +28,8 @@ namespace fs = std::filesystem;
 class IoTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("imufit_io_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("imufit_io_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -197,6 +203,53 @@ TEST_F(IoTest, PlanIsReadAndConvertedToSi) {
   EXPECT_EQ(*plan.segments[1].lever_arm_m, Eigen::Vector3d(0, 0.02, 0));
   EXPECT_EQ(plan.Find(7), &plan.segments[1]);
   EXPECT_EQ(plan.Find(2), nullptr);
+  EXPECT_EQ(plan.segments[1].RotationAxis(), plan.segments[1].up);
+}
+
+TEST_F(IoTest, PlanReadsTurnsAndRateAxes) {
+  std::string text = kPlan;
+  text +=
+      "  - {id: 8, up: [0, 0, 1], angle_deg: -360, axis: [2, 0, 0]}\n"
+      "  - {id: 9, up: [0, 0, 1], angle_deg: 90}\n"
+      "  - {id: 10, up: [0, 0, 1], rate_dps: 60, axis: [0, 3, 4], lever_arm_m: [0.01, 0, 0]}\n";
+  const Plan plan = ReadPlan(Write("plan.yaml", text));
+  ASSERT_EQ(plan.segments.size(), 5u);
+  const TableSegment& turn = plan.segments[2];
+  EXPECT_TRUE(turn.IsTurn());
+  EXPECT_FALSE(turn.IsStatic());
+  EXPECT_NEAR(*turn.angle_rad, -2.0 * M_PI, 1e-15);
+  EXPECT_EQ(turn.rate_radps, 0.0);
+  EXPECT_EQ(turn.RotationAxis(), Eigen::Vector3d(1, 0, 0));
+  EXPECT_TRUE(plan.segments[3].IsTurn());
+  EXPECT_EQ(plan.segments[3].RotationAxis(), Eigen::Vector3d(0, 0, 1));  // no axis: up
+  const TableSegment& tilted = plan.segments[4];
+  EXPECT_FALSE(tilted.IsTurn());
+  EXPECT_NEAR(tilted.rate_radps, 60.0 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR((tilted.RotationAxis() - Eigen::Vector3d(0, 0.6, 0.8)).norm(), 0.0, 1e-15);
+}
+
+TEST_F(IoTest, InvalidTurnsAndAxesAreRefusedWithLocation) {
+  struct Case {
+    std::string segment, expect;
+  };
+  const Case cases[] = {
+      {"{id: 8, up: [0, 0, 1], angle_deg: 360, rate_dps: 30}", "has no rate_dps"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 0}", "cannot be 0"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: x}", "\"x\" is not a number"},
+      {"{id: 8, up: [0, 0, 1], axis: [1, 0, 0]}", "a static segment has none"},
+      {"{id: 8, up: [0, 0, 1], rate_dps: 0, axis: [1, 0, 0]}", "a static segment has none"},
+      {"{id: 8, up: [0, 0, 1], rate_dps: 10, axis: [0, 0, 0]}", "zero vector"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 90, axis: [1, 0]}", "exactly 3 numbers"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 90, lever_arm_m: [0, 0.01, 0]}", "cannot take a lever arm"},
+      {"{id: 8, up: [0, 0, 1], angle_deg: 90, north: [1, 0, 0]}", "static segments only"},
+      {"{id: 8, up: [0, 0, 1], rate_dps: 10, north: [1, 0, 0]}", "static segments only"},
+  };
+  for (const Case& c : cases) {
+    const std::string text = std::string(kPlan) + "  - " + c.segment + "\n";
+    const InputError e = Catch([&] { ReadPlan(Write("bad.yaml", text)); });
+    EXPECT_NE(e.message().find(c.expect), std::string::npos) << c.segment << ": " << e.what();
+    EXPECT_EQ(e.line(), 15) << c.segment << ": " << e.what();
+  }
 }
 
 TEST_F(IoTest, InvalidPlansAreRefusedWithLocation) {
@@ -265,7 +318,8 @@ TEST_F(IoTest, SamplesErrorsNameLineFieldAndText) {
     });
   };
   InputError e = error_of("0,25,1,1,2,3,4,5,6\n0.1,25,1,1,1.2.3,3,4,5,6\n");
-  EXPECT_STREQ(e.what(), (dir_ / "samples.csv").string().append(":3:5: gyro_y: \"1.2.3\" is not a number").c_str());
+  EXPECT_STREQ(e.what(),
+               (dir_ / "samples.csv").string().append(":3:5: gyro_y: \"1.2.3\" is not a number").c_str());
   e = error_of("0,25,1,1,2,3,4,5,6\n0,25,1,1,2,3,4,5,6\n");
   EXPECT_EQ(e.line(), 3);
   EXPECT_EQ(e.column(), 1);
@@ -278,7 +332,8 @@ TEST_F(IoTest, SamplesErrorsNameLineFieldAndText) {
   EXPECT_NE(e.message().find("segment: \"1.5\" is not an integer"), std::string::npos) << e.what();
   e = error_of("0,nan,1,1,2,3,4,5,6\n");
   EXPECT_NE(e.message().find("not a finite number"), std::string::npos) << e.what();
-  const std::string no_segment = Write("n.csv", "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
+  const std::string no_segment =
+      Write("n.csv", "time_s,temp_c,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
   e = Catch([&] { SamplesReader reader(no_segment, true); });
   EXPECT_NE(e.message().find("no column \"segment\""), std::string::npos) << e.what();
   SamplesReader without(no_segment, false);
@@ -331,7 +386,8 @@ TEST_F(IoTest, AnUncommittedOutputLeavesTheOldFileIntact) {
     // no Commit(): as when an error is thrown half way
   }
   EXPECT_EQ(Read(path), "keep me\n");
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1) << "temporary left behind";
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1)
+      << "temporary left behind";
   {
     OutputFile file(path);
     file.Write("new\n");
@@ -347,6 +403,337 @@ TEST_F(IoTest, OutputsRefuseToReplaceAnInput) {
   RefuseToOverwriteInputs((dir_ / "other.csv").string(), {input});  // fine
   const InputError folder = Catch([&] { OutputFile file((dir_ / "missing" / "x.csv").string()); });
   EXPECT_NE(folder.message().find("cannot create"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- inputs as they really arrive
+
+// Counts the data rows of a CSV file, reading field 0 of each.
+long CountRows(const std::string& path) {
+  CsvReader csv(path);
+  long rows = 0;
+  while (csv.NextRow()) {
+    csv.Field(0);
+    ++rows;
+  }
+  return rows;
+}
+
+std::string CsvRows(int rows) {
+  std::string text = "a,b\n";
+  for (int i = 0; i < rows; ++i) text += std::to_string(i) + "," + std::to_string(i * 7 % 13) + "\n";
+  return text;
+}
+
+TEST_F(IoTest, TruncatedCorruptOrFakeGzipIsRefused) {
+  const std::string text = CsvRows(20000);
+  const std::string good_path = (dir_ / "good.csv.gz").string();
+  WriteFileAtomically(good_path, text);
+  const std::string gz = Read(good_path);
+  ASSERT_GT(gz.size(), 100u);
+  EXPECT_EQ(CountRows(good_path), 20000);
+  const auto error_of = [&](const std::string& name, const std::string& bytes) {
+    const std::string path = Write(name, bytes);
+    return Catch([&] { CountRows(path); }).message();
+  };
+  // No trailer, half the stream, the stream without its last byte.
+  EXPECT_NE(error_of("no_trailer.csv.gz", gz.substr(0, gz.size() - 8)).find("truncated gzip stream"),
+            std::string::npos);
+  EXPECT_NE(error_of("half.csv.gz", gz.substr(0, gz.size() / 2)).find("truncated gzip stream"),
+            std::string::npos);
+  EXPECT_NE(error_of("short.csv.gz", gz.substr(0, gz.size() - 1)).find("truncated gzip stream"),
+            std::string::npos);
+  // A wrong CRC-32, a wrong length.
+  std::string bad_crc = gz;
+  bad_crc[gz.size() - 8] ^= 0x01;
+  EXPECT_NE(error_of("crc.csv.gz", bad_crc).find("incorrect data check"), std::string::npos);
+  std::string bad_length = gz;
+  bad_length[gz.size() - 4] ^= 0x01;
+  EXPECT_NE(error_of("length.csv.gz", bad_length).find("incorrect length check"), std::string::npos);
+  // Bytes after the stream; a plain file named .gz; an empty one.
+  EXPECT_NE(error_of("garbage.csv.gz", gz + "junk").find("trailing garbage after the gzip stream"),
+            std::string::npos);
+  EXPECT_NE(error_of("zeros.csv.gz", gz + std::string(4, '\0')).find("trailing garbage"), std::string::npos);
+  EXPECT_NE(error_of("plain.csv.gz", text).find("not a gzip stream"), std::string::npos);
+  EXPECT_NE(error_of("empty.csv.gz", "").find("not a gzip stream"), std::string::npos);
+  // Concatenated members are one stream, as gzip(1) reads them.
+  const std::string second_path = (dir_ / "second.csv.gz").string();
+  WriteFileAtomically(second_path, "5,6\n7,8\n");
+  EXPECT_EQ(CountRows(Write("two.csv.gz", gz + Read(second_path))), 20002);
+}
+
+// The error of reading every row of `text` (as a CSV file) and parsing field 0 as a number.
+TEST_F(IoTest, MalformedCsvRowsAreRefusedNotGuessed) {
+  const auto error_of = [&](const std::string& text) {
+    const std::string path = Write("bad.csv", text);
+    return Catch([&] {
+      CsvReader csv(path);
+      while (csv.NextRow()) csv.Number(0);
+    });
+  };
+  InputError e = error_of("a,b\n1,2\n1,5,2\n");  // a decimal comma shifts the columns
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_NE(e.message().find("the row has 3 fields, the header names 2"), std::string::npos) << e.what();
+  e = error_of("a,b\n\"1\"2,3\n");
+  EXPECT_EQ(e.column(), 1);
+  EXPECT_NE(e.message().find("text after the closing quote"), std::string::npos) << e.what();
+  e = error_of("a,b\n3,1\"2\"\n");
+  EXPECT_EQ(e.column(), 2);
+  EXPECT_NE(e.message().find("a quote inside an unquoted field"), std::string::npos) << e.what();
+  e = error_of("a,b\n\"12,3\n");
+  EXPECT_NE(e.message().find("a quote is not closed"), std::string::npos) << e.what();
+  for (const char* sign : {"+-25", "++25", "-+25", "--25"}) {
+    e = error_of(std::string("a\n") + sign + "\n");
+    EXPECT_NE(e.message().find("is not a number"), std::string::npos) << sign << ": " << e.what();
+  }
+  // Well-formed quoting still reads.
+  CsvReader csv(Write("good.csv", "a,b\n \"1.5\" ,\"x,\"\"y\"\"\"\n+2,\n"));
+  ASSERT_TRUE(csv.NextRow());
+  EXPECT_EQ(csv.Number(0), 1.5);
+  EXPECT_EQ(csv.Field(1), "x,\"y\"");
+  ASSERT_TRUE(csv.NextRow());
+  EXPECT_EQ(csv.Number(0), 2.0);
+  EXPECT_EQ(csv.Field(1), "");
+}
+
+TEST_F(IoTest, CsvLinesAndColumnsAreBounded) {
+  const auto error_of = [&](const std::string& path) {
+    return Catch([&] {
+      CsvReader csv(path);
+      while (csv.NextRow()) csv.Field(0);
+    });
+  };
+  InputError e = error_of(Write("long.csv", "a,b\n1,2\n" + std::string(3 << 20, '7') + "\n"));
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_NE(e.message().find("line longer than 1048576 bytes"), std::string::npos) << e.what();
+  e = error_of(Write("commas.csv", "a\n" + std::string(CsvReader::kMaxLineBytes - 10, ',') + "\n"));
+  EXPECT_NE(e.message().find("more than 10000 fields"), std::string::npos) << e.what();
+  std::string wide;
+  for (int i = 0; i < 10001; ++i) wide += (i ? ",c" : "c") + std::to_string(i);
+  e = error_of(Write("wide.csv", wide + "\n"));
+  EXPECT_NE(e.message().find("more than 10000 fields"), std::string::npos) << e.what();
+  e = error_of("/dev/zero");
+  EXPECT_NE(e.message().find("line longer than"), std::string::npos) << e.what();
+  // A gzip bomb: 64 MiB of zeros in 64 KiB; refused after reading one line's worth.
+  std::string zeros(1 << 20, '\0');
+  {
+    OutputFile bomb((dir_ / "bomb.csv.gz").string());
+    for (int i = 0; i < 64; ++i) bomb.Write(zeros);
+    bomb.Commit();
+  }
+  e = error_of((dir_ / "bomb.csv.gz").string());
+  EXPECT_NE(e.message().find("line longer than"), std::string::npos) << e.what();
+  // The header's duplicate check is linear; a duplicate is still found at the end of a wide header.
+  std::string names;
+  for (int i = 0; i < 9000; ++i) names += "c" + std::to_string(i) + ",";
+  e = error_of(Write("dup.csv", names + "c17\n"));
+  EXPECT_EQ(e.column(), 9001);
+  EXPECT_NE(e.message().find("\"c17\" appears twice"), std::string::npos) << e.what();
+}
+
+TEST_F(IoTest, ErrorMessagesAreBoundedAndEscaped) {
+  // A header with terminal escapes and a very long name; a value with BEL, CR and NUL.
+  const std::string hostile = "\x1b[31mred\x07" + std::string(5000, 'n');
+  CsvReader csv(Write("hostile.csv", hostile + ",b\n\x07\r\x1b" + std::string("\0z", 2) + ",2\n"));
+  ASSERT_TRUE(csv.NextRow());
+  for (const InputError& e : {Catch([&] { csv.Number(0); }), Catch([&] { csv.RequireColumn("gyro_x"); })}) {
+    const std::string text = e.what();
+    for (const char control : {'\x1b', '\x07', '\r', '\0'}) {
+      EXPECT_EQ(text.find(control), std::string::npos)
+          << "raw control character " << int(control) << " in " << text;
+    }
+    EXPECT_NE(text.find("\\x1b[31mred\\x07"), std::string::npos) << text;
+    EXPECT_LT(text.size(), 400u) << text;
+  }
+  // Any message is bounded, whatever a caller puts in it.
+  const InputError long_one("f.csv", 1, 1, std::string(100000, 'x') + "\x1b");
+  EXPECT_LE(long_one.message().size(), kMaxMessageChars + 3);
+  EXPECT_EQ(std::string(long_one.what()).find('\x1b'), std::string::npos);
+}
+
+TEST_F(IoTest, AUtf8ByteOrderMarkIsSkippedAndUtf16IsNamed) {
+  CsvReader csv(Write("bom.csv", "\xEF\xBB\xBFtime_s,b\n1,2\n"));
+  EXPECT_EQ(csv.header()[0], "time_s");
+  ASSERT_TRUE(csv.NextRow());
+  EXPECT_EQ(csv.Number(csv.RequireColumn("time_s")), 1.0);
+  const InputError e = Catch([&] { CsvReader utf16(Write("utf16.csv", std::string("\xFF\xFEt\0i\0", 6))); });
+  EXPECT_NE(e.message().find("UTF-16"), std::string::npos) << e.what();
+}
+
+TEST_F(IoTest, SilentGarbageInYamlIsRefused) {
+  struct Case {
+    std::string from, to, expect;
+  };
+  const Case cases[] = {
+      {"latitude_deg: 30.27", "latitude_deg: 30.27\nlatitude_deg: 10", "\"latitude_deg\" appears twice"},
+      {"rate_dps: -300", "rate_dps: -300\n    rate_dps: 300", "\"rate_dps\" appears twice"},
+      {"serial: SN0001", "serial: SN0001\n---\nserial: other", "a second YAML document"},
+      {"gravity_mps2: 9.79285", "gravity_mps2: \"9.79285\"", "quoted text"},
+      {"id: 7", "id: '7'", "quoted text"},
+      {"rate_dps: -300", "rate_dps: !!str -300", "quoted text"},
+      {"rate_dps: -300", "rate_dps: +-300", "\"+-300\" is not a number"},
+      {"up: [1, 0, 0]", "up: [1e200, 1e200, 0]", "length must lie between"},
+      {"up: [1, 0, 0]", "up: [1e-200, 0, 0]", "length must lie between"},
+      {"gravity_mps2: 9.79285", "gravity_mps2: 1e308", "between 9.7 and 9.9"},
+      {"gravity_mps2: 9.79285", "gravity_mps2: 0.001", "between 9.7 and 9.9"},
+  };
+  for (const Case& c : cases) {
+    std::string text = kPlan;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    const InputError e = Catch([&] { ReadPlan(Write("bad.yaml", text)); });
+    EXPECT_NE(e.message().find(c.expect), std::string::npos) << c.to << ": " << e.what();
+    EXPECT_GT(e.line(), 0) << c.to << ": " << e.what();
+  }
+  // A limits file whose duplicate key would have let a unit pass.
+  const std::string limits = Write("limits.yaml",
+                                   "format: imufit-limits\nversion: 1\ncriteria:\n"
+                                   "  - {quantity: gyro_bias_dps, max_abs: 0.01, max_abs: 1000}\n");
+  const InputError e = Catch([&] { ReadLimits(limits); });
+  EXPECT_NE(e.message().find("\"max_abs\" appears twice"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), 4);
+  // Found by fuzz_plan: input on which YAML::LoadAll never ends (an endless run of documents).
+  const InputError endless =
+      Catch([&] { ReadPlan(IMUFIT_FIXTURES_DIR "/../fuzz/regressions/fuzz_plan/endless-documents.yaml"); });
+  EXPECT_NE(endless.message().find("a second YAML document"), std::string::npos) << endless.what();
+  // Limits: file size and nesting are bounded.
+  const InputError big = Catch([&] { ReadLimits("/dev/zero"); });
+  EXPECT_NE(big.message().find("larger than 16 MiB"), std::string::npos) << big.what();
+  const InputError deep = Catch(
+      [&] { ReadLimits(Write("deep.yaml", "criteria: " + std::string(100, '[') + std::string(100, ']'))); });
+  EXPECT_NE(deep.message().find("nested deeper than 64"), std::string::npos) << deep.what();
+}
+
+TEST_F(IoTest, ManyUnknownCalibrationKeysAreKeptInLinearTime) {
+  // 30000 unknown keys: a quadratic copy takes many seconds (minutes at 10^5); linear, a fraction.
+  std::string text = CalibrationToYaml(ExampleCalibration());
+  for (int i = 0; i < 30000; ++i) text += "k" + std::to_string(i) + ": " + std::to_string(i) + "\n";
+  const Calibration read = ReadCalibration(Write("many.yaml", text));
+  EXPECT_EQ(read.extra.size(), 30001u);  // with `fit`
+  EXPECT_EQ(read.extra["k29999"].as<int>(), 29999);
+}
+
+TEST_F(IoTest, CalibrationsThatCannotCorrectAreRefusedOnRead) {
+  const Calibration good = ExampleCalibration();
+  const auto error_of = [&](const std::function<void(Calibration*)>& change) {
+    Calibration bad = good;
+    change(&bad);
+    return Catch([&] { ReadCalibration(Write("bad.yaml", CalibrationToYaml(bad))); }).message();
+  };
+  const int sx = kScaleCoefficient * kPolynomialTerms;  // gyro scale x, c0
+  // A scale that crosses zero at 60 degC inside [-40, 85]: 1 - (T - 25) / 35.
+  std::string e = error_of([&](Calibration* c) {
+    c->model.gyro[sx] = 1.0;
+    c->model.gyro[sx + 1] = -1.0 / 35.0;
+    c->model.gyro[sx + 2] = c->model.gyro[sx + 3] = 0.0;
+  });
+  EXPECT_NE(e.find("gyro.scale.x: the scale factor changes sign"), std::string::npos) << e;
+  // A cubic that dips to 1e-6 of its peak between the ends (double root at 50 degC).
+  e = error_of([&](Calibration* c) {
+    const int sy = sx + kPolynomialTerms;
+    c->model.accel[sy] = 625.0 + 1e-4;  // (x - 25)^2 = x^2 - 50 x + 625, x = T - 25
+    c->model.accel[sy + 1] = -50.0;
+    c->model.accel[sy + 2] = 1.0;
+    c->model.accel[sy + 3] = 0.0;
+  });
+  EXPECT_NE(e.find("accel.scale.y: the scale factor comes near zero"), std::string::npos) << e;
+  // A denormal scale; a singular M (xy = yx = 1 makes two rows equal).
+  e = error_of([&](Calibration* c) {
+    c->model.gyro[sx] = 1e-310;
+    c->model.gyro[sx + 1] = c->model.gyro[sx + 2] = c->model.gyro[sx + 3] = 0.0;
+  });
+  EXPECT_NE(e.find("comes near zero"), std::string::npos) << e;
+  e = error_of([&](Calibration* c) {
+    c->model.accel[kMisalignmentCoefficient * kPolynomialTerms] = 1.0;        // xy
+    c->model.accel[(kMisalignmentCoefficient + 2) * kPolynomialTerms] = 1.0;  // yx
+  });
+  EXPECT_NE(e.find("accel.misalignment: M is nearly singular"), std::string::npos) << e;
+  // The example itself, and a scale that crosses zero only outside the fit range, are fine.
+  ReadCalibration(Write("good.yaml", CalibrationToYaml(good)));
+  Calibration outside = good;
+  outside.model.gyro[sx] = 1.0;
+  outside.model.gyro[sx + 1] = -1.0 / 100.0;  // zero at 125 degC
+  outside.model.gyro[sx + 2] = outside.model.gyro[sx + 3] = 0.0;
+  ReadCalibration(Write("outside.yaml", CalibrationToYaml(outside)));
+}
+
+TEST_F(IoTest, OutputsRefuseLinksFifosDevicesAndReadOnlyFiles) {
+  const std::string target = Write("target.csv", "the user's file\n");
+  const std::string link = (dir_ / "link.csv").string();
+  fs::create_symlink(target, link);
+  const std::string fifo = (dir_ / "fifo.csv").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  const std::string read_only = Write("read_only.csv", "locked\n");
+  fs::permissions(read_only, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  struct Case {
+    std::string path, expect;
+  };
+  for (const Case& c : {Case{link, "is a symbolic link"}, Case{fifo, "is a FIFO, not a regular file"},
+                        Case{read_only, "is read-only"}, Case{dir_.string() + "/", "not a file name"}}) {
+    const InputError e = Catch([&] { WriteFileAtomically(c.path, "new\n"); });
+    EXPECT_NE(e.message().find(c.expect), std::string::npos) << c.path << ": " << e.what();
+  }
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(Read(target), "the user's file\n");
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_EQ(Read(read_only), "locked\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 4)
+      << "temporary left behind";
+  // A link that appears while the output is written is not replaced either.
+  const std::string late = (dir_ / "late.csv").string();
+  OutputFile file(late);
+  file.Write("x\n");
+  fs::create_symlink(target, late);
+  EXPECT_NE(Catch([&] { file.Commit(); }).message().find("symbolic link"), std::string::npos);
+  EXPECT_EQ(Read(target), "the user's file\n");
+}
+
+TEST_F(IoTest, AnOutputTransactionWritesAllOrNothing) {
+  const std::string first = Write("first.yaml", "old first\n");
+  const std::string second = (dir_ / "second.html").string();
+  {
+    OutputTransaction outputs;
+    WriteFileAtomically(first, "new first\n");
+    EXPECT_EQ(Read(first), "old first\n") << "renamed before the transaction commits";
+    // The second output fails (its folder does not exist): the first must not change.
+    EXPECT_THROW(WriteFileAtomically((dir_ / "missing" / "x.html").string(), "y"), InputError);
+  }
+  EXPECT_EQ(Read(first), "old first\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1)
+      << "temporary left behind";
+  {
+    OutputTransaction outputs;
+    WriteFileAtomically(first, "new first\n");
+    WriteFileAtomically(second, "new second\n");
+    EXPECT_FALSE(fs::exists(second));
+    outputs.Commit();
+  }
+  EXPECT_EQ(Read(first), "new first\n");
+  EXPECT_EQ(Read(second), "new second\n");
+  // Outside a transaction, Commit() renames at once again.
+  WriteFileAtomically(second, "third\n");
+  EXPECT_EQ(Read(second), "third\n");
+}
+
+TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
+  for (const int signal_number : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string path = (dir_ / ("out" + std::to_string(signal_number) + ".csv.gz")).string();
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      InstallOutputCleanupOnSignals();
+      OutputFile file(path);
+      file.Write(std::string(3 << 20, 'x'));  // past the first flush
+      OutputTransaction outputs;
+      WriteFileAtomically(path + ".other", "pending in a transaction\n");
+      ::raise(signal_number);
+      ::_exit(0);  // not reached
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the child should die of the signal, as without the handler";
+    EXPECT_EQ(WTERMSIG(status), signal_number);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 0)
+        << "temporary file left behind after signal " << signal_number;
+  }
 }
 
 }  // namespace

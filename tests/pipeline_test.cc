@@ -6,10 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include "imufit/fit/simulator.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/samples.h"
+#include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
@@ -112,6 +115,110 @@ TEST(ReadRunWindows, RefusesASegmentThePlanDoesNotHave) {
         << e.what();
     EXPECT_GT(e.line(), 1);
     EXPECT_GT(e.column(), 0);
+  }
+}
+
+// Unlabelled logs (issue 9): a run simulated from the fixture truth, written with and without its
+// segment (and temp_c) column, with jittered time stamps, and fitted through FitRun as `imufit fit`
+// does.
+class UnlabelledRun : public ::testing::Test {
+ protected:
+  // Simulates the 6-position plan and writes it to `name` (in the test's temporary folder) with the
+  // given columns; returns the path.
+  std::string Write(const std::string& name, const SimulationOptions& options, SampleColumns columns) {
+    const std::string path = ::testing::TempDir() + "/imufit_unlabelled_" + name;
+    SamplesWriter writer(path, columns);
+    SimulateRun(options, plan_.site, plan_.segments, truth_.model,
+                [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+    writer.Commit();
+    return path;
+  }
+  static SimulationOptions Options() {
+    SimulationOptions options;
+    options.rate_hz = 50.0;
+    options.dwell_s = 5.0;
+    options.transition_s = 1.0;
+    options.gyro_noise_density = 8.7e-5;
+    options.accel_noise_density = 1.5e-3;
+    options.quantize = true;
+    options.time_jitter_s = 0.006;  // 30 % of the 20 ms interval
+    options.seed = 12;
+    return options;
+  }
+  // Every 25 degC coefficient of `fit` within kTruthSigmas of the truth; and, with `other`, within
+  // kAgreementSigmas of it (the same samples, labelled differently).
+  void ExpectTruth(const FitSummary& fit, const FitSummary* other = nullptr) {
+    for (int c = 0; c < kGyroCoefficients + kAccelCoefficients; ++c) {
+      const bool gyro = c < kGyroCoefficients;
+      const int i = (gyro ? c : c - kGyroCoefficients) * kPolynomialTerms;
+      const double estimate = gyro ? fit.model.gyro[i] : fit.model.accel[i];
+      const double sigma = gyro ? fit.sigma.gyro[i] : fit.sigma.accel[i];
+      const double true_value = gyro ? truth_.model.gyro[i] : truth_.model.accel[i];
+      const CoefficientName& name = kCoefficientNames[gyro ? c : c - kGyroCoefficients];
+      EXPECT_LE(std::abs(estimate - true_value), kTruthSigmas * sigma)
+          << (gyro ? "gyro " : "accel ") << name.group << " " << name.axis;
+      if (other == nullptr) continue;
+      const double other_estimate = gyro ? other->model.gyro[i] : other->model.accel[i];
+      EXPECT_LE(std::abs(estimate - other_estimate), kAgreementSigmas * sigma)
+          << (gyro ? "gyro " : "accel ") << name.group << " " << name.axis << " against the labelled fit";
+    }
+  }
+
+  // The labelled and the unlabelled fit use the same samples but not the same ones in each window
+  // (the segmentation keeps about 80 %): they agree to well within one sigma.
+  static constexpr double kAgreementSigmas = 1.0;
+  const Plan plan_ = ReadPlan(Fixture("plan_6pos.yaml"));
+  const Calibration truth_ = ReadCalibration(Fixture("mems_truth.yaml"));
+};
+
+TEST_F(UnlabelledRun, FitsLikeTheLabelledRunWithJitteredTimes) {
+  SimulationOptions options = Options();
+  options.soak_temps_c = {-40.0, -10.0, 25.0, 55.0, 85.0};
+  const std::string labelled = Write("labelled.csv", options, SampleColumns{true, true});
+  const std::string unlabelled = Write("unlabelled.csv", options, SampleColumns{false, true});
+  FitRunOptions fit_options;
+  const FitRunResult with_labels = FitRun(plan_.path, labelled, fit_options);
+  const FitRunResult found = FitRun(plan_.path, unlabelled, fit_options);
+  ASSERT_TRUE(with_labels.fit.IsSolutionUsable()) << with_labels.fit.FullReport();
+  ASSERT_TRUE(found.fit.IsSolutionUsable()) << found.fit.FullReport();
+  EXPECT_FALSE(with_labels.run.segmentation.has_value());
+  ASSERT_TRUE(found.run.segmentation.has_value());
+  EXPECT_EQ(found.run.segmentation->matches.size(), 5 * plan_.segments.size());
+  EXPECT_EQ(found.run.windows.size(), with_labels.run.windows.size());
+  ExpectTruth(with_labels.fit);
+  ExpectTruth(found.fit, &with_labels.fit);
+}
+
+TEST_F(UnlabelledRun, OneTemperatureWithoutThermometer) {
+  SimulationOptions options = Options();
+  options.soak_temps_c = {25.0};
+  options.dwell_s = 8.0;
+  const std::string path = Write("no_temp.csv", options, SampleColumns{false, false});
+  FitRunOptions fit_options;
+  fit_options.fit.gyro_temp_order = 0;
+  fit_options.fit.accel_temp_order = 0;
+  EXPECT_THROW(FitRun(plan_.path, path, fit_options), InputError);  // no temp_c, no --temp-c
+  fit_options.input.temp_c = 25.0;
+  const FitRunResult result = FitRun(plan_.path, path, fit_options);
+  ASSERT_TRUE(result.fit.IsSolutionUsable()) << result.fit.FullReport();
+  ExpectTruth(result.fit);
+  EXPECT_EQ(result.fit.temp_range_c[0], 25.0);
+  EXPECT_EQ(result.fit.temp_range_c[1], 25.0);
+}
+
+TEST_F(UnlabelledRun, ALogThatDisagreesWithThePlanNamesFileAndTime) {
+  SimulationOptions options = Options();
+  const std::string path = Write("disagrees.csv", options, SampleColumns{false, true});
+  Plan smaller = plan_;
+  smaller.segments.erase(smaller.segments.begin() + 4);  // +y, 24 .. 29 s in the log
+  try {
+    ReadRunWindows(smaller, path, WindowOptions());
+    FAIL() << "no error";
+  } catch (const PlanMismatchError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find(path + ": the log does not match the plan " + plan_.path + ": at t = "), 0u)
+        << message;
+    EXPECT_NE(message.find("with the raw axes as they are: at t = 24."), std::string::npos) << message;
   }
 }
 

@@ -585,7 +585,7 @@ std::string UnitReportHtml(const UnitReport& r) {
   }
   html << "<p class=\"note\">Units: deg/s and mg at 25 degC; 1 g = 9.80665 m/s&sup2;. Coefficient model and "
           "file "
-          "format: SPEC.md; conversions: docs/factory.md.</p>\n</body></html>\n";
+          "format: docs/spec.md; conversions: docs/factory.md.</p>\n</body></html>\n";
   return html.str();
 }
 

@@ -1,5 +1,6 @@
 #include "imufit/fit/simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -43,10 +44,10 @@ class NormalSource {
 
 // A sensor's bias process: random walk plus first-order Gauss-Markov, and white noise.
 struct NoiseProcess {
-  double white_sigma = 0.0;     // per sample
-  double walk_sigma = 0.0;      // per sample step
-  double markov_decay = 0.0;    // exp(-dt / tau)
-  double markov_sigma = 0.0;    // per sample drive
+  double white_sigma = 0.0;   // per sample
+  double walk_sigma = 0.0;    // per sample step
+  double markov_decay = 0.0;  // exp(-dt / tau)
+  double markov_sigma = 0.0;  // per sample drive
   Eigen::Vector3d walk = Eigen::Vector3d::Zero();
   Eigen::Vector3d markov = Eigen::Vector3d::Zero();
 
@@ -108,6 +109,41 @@ SegmentTruth TransitionTruth(const TableSite& site, const TableSegment& a, const
   return truth;
 }
 
+// A turn's motion occupies this middle fraction of its dwell; the table rests before and after,
+// so the stretch labelled with the segment holds the whole motion.
+constexpr double kTurnRestFraction = 0.2;
+
+// Truth during a dwell, `t_s` seconds after it began, for the kinds whose truth changes with
+// time: a turn through angle_rad with a smooth (raised-cosine) rate profile, as a hand or a
+// position-mode table moves, and a constant rate about an axis that is not vertical. The body
+// turns by angle(t) about the body axis n, so world-fixed directions seen from the body turn by
+// -angle(t): up_b(t) = R(n, -angle(t)) up, exactly (no numerical integration). Earth's vertical
+// rate turns with up_b; its horizontal part is left out as everywhere in a rate segment.
+SegmentTruth MovingTruth(const TableSite& site, const TableSegment& segment, double t_s, double dwell_s) {
+  const Eigen::Vector3d& n = segment.RotationAxis();
+  double angle = 0.0;
+  double rate = segment.rate_radps;
+  if (segment.IsTurn()) {
+    const double motion_s = (1.0 - 2.0 * kTurnRestFraction) * dwell_s;
+    const double tau = std::clamp((t_s - kTurnRestFraction * dwell_s) / motion_s, 0.0, 1.0);
+    // s(tau) = tau - sin(2 pi tau) / (2 pi): rate 1 - cos(2 pi tau), zero with zero slope at both ends.
+    angle = *segment.angle_rad * (tau - std::sin(2.0 * M_PI * tau) / (2.0 * M_PI));
+    rate = *segment.angle_rad * (1.0 - std::cos(2.0 * M_PI * tau)) / motion_s;
+  } else {
+    angle = segment.rate_radps * t_s;
+  }
+  const Eigen::Vector3d up = Eigen::AngleAxisd(-angle, n) * segment.up;
+  SegmentTruth truth;
+  truth.omega_radps = rate * n;
+  if (site.latitude_rad) truth.omega_radps += kEarthRateRadps * std::sin(*site.latitude_rad) * up;
+  truth.a_mps2 = site.gravity_mps2 * up;
+  if (!segment.IsTurn() && segment.lever_arm_m) {
+    const Eigen::Vector3d& r = *segment.lever_arm_m;
+    truth.a_mps2 -= rate * rate * (r - n * r.dot(n));
+  }
+  return truth;
+}
+
 }  // namespace
 
 std::string SimulationOptions::Validate() const {
@@ -116,10 +152,22 @@ std::string SimulationOptions::Validate() const {
   if (!(transition_s >= 0.0)) return "the transition time cannot be negative";
   if (ramp && passes < 1) return "a ramp needs at least one pass";
   if (!ramp && soak_temps_c.empty()) return "give at least one soak temperature";
+  // A temperature that is not a number would make every sample NaN.
+  std::vector<double> temps = soak_temps_c;
+  if (ramp) temps = {ramp_from_c, ramp_to_c};
+  for (const double t : temps) {
+    if (!(t >= -273.15 && t <= 1000.0)) return "temperatures must be numbers between -273.15 and 1000 degC";
+  }
+  if (!std::isfinite(rate_hz) || !std::isfinite(dwell_s) || !std::isfinite(transition_s)) {
+    return "the sample rate, dwell and transition times must be finite";
+  }
   if (!(bias_correlation_s > 0.0)) return "the bias correlation time must be positive";
   for (double v : {gyro_noise_density, accel_noise_density, gyro_random_walk, accel_random_walk,
                    gyro_bias_instability, accel_bias_instability, temp_noise_c}) {
     if (!(v >= 0.0)) return "noise figures cannot be negative";
+  }
+  if (!(time_jitter_s >= 0.0 && time_jitter_s < 0.5 / rate_hz)) {
+    return "the time jitter must lie in [0, half the sample interval)";
   }
   return "";
 }
@@ -153,8 +201,8 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
   const long long total = options.SampleCount(segments.size());
 
   NormalSource normal(options.seed);
-  NoiseProcess gyro_noise(options.gyro_noise_density, options.gyro_random_walk,
-                          options.gyro_bias_instability, options.bias_correlation_s, dt);
+  NoiseProcess gyro_noise(options.gyro_noise_density, options.gyro_random_walk, options.gyro_bias_instability,
+                          options.bias_correlation_s, dt);
   NoiseProcess accel_noise(options.accel_noise_density, options.accel_random_walk,
                            options.accel_bias_instability, options.bias_correlation_s, dt);
   gyro_noise.Start(&normal, options.gyro_bias_instability);
@@ -163,11 +211,17 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
   std::vector<SegmentTruth> dwell_truth;
   for (const TableSegment& segment : segments) dwell_truth.push_back(TruthOf(site, segment));
 
+  // A separate generator for the jitter (seeded from the seed), so that jitter moves only the times.
+  std::mt19937_64 jitter_engine(options.seed ^ 0x6a09e667f3bcc909ULL);
   long long k = 0;
   Sample raw;
   for (const Phase& phase : phases) {
     for (long long j = 0; j < phase.samples; ++j, ++k) {
       raw.time_s = options.start_time_s + static_cast<double>(k) * dt;
+      if (options.time_jitter_s > 0.0) {
+        const double u = static_cast<double>(jitter_engine() >> 11) * 0x1.0p-53;  // [0, 1)
+        raw.time_s += options.time_jitter_s * (2.0 * u - 1.0);
+      }
       if (options.ramp) {
         const double progress = total > 1 ? static_cast<double>(k) / static_cast<double>(total - 1) : 0.0;
         raw.temp_c = options.ramp_from_c + (options.ramp_to_c - options.ramp_from_c) * progress;
@@ -180,8 +234,11 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
         truth = TransitionTruth(site, segments[phase.from], segments[phase.to], u, options.transition_s);
         raw.segment = kTransitionSegment;
       } else {
-        truth = dwell_truth[phase.from];
-        raw.segment = segments[phase.from].id;
+        const TableSegment& segment = segments[phase.from];
+        truth = segment.SpecificForceIsKnown() && !segment.IsTurn()
+                    ? dwell_truth[phase.from]
+                    : MovingTruth(site, segment, static_cast<double>(j) * dt, options.dwell_s);
+        raw.segment = segment.id;
       }
       const Eigen::Vector3d omega_sensed = truth.omega_radps + gyro_noise.Step(&normal);
       const Eigen::Vector3d a_sensed = truth.a_mps2 + accel_noise.Step(&normal);
@@ -191,7 +248,8 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
       Eigen::Vector3d accel_m;
       Eigen::Vector3d gyro_m;
       const double x = truth_model.basis.Argument(true_temp_c);
-      const SensorCoefficients<double> accel = CoefficientsAt(truth_model.accel.data(), kAccelCoefficients, x);
+      const SensorCoefficients<double> accel =
+          CoefficientsAt(truth_model.accel.data(), kAccelCoefficients, x);
       const SensorCoefficients<double> gyro = CoefficientsAt(truth_model.gyro.data(), kGyroCoefficients, x);
       accel_m = ForwardSensor(accel, a_sensed, Eigen::Vector3d::Zero().eval());
       gyro_m = ForwardSensor(gyro, omega_sensed, truth.a_mps2);

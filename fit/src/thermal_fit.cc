@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -29,8 +30,8 @@ constexpr int kStartNodes = 9;
 constexpr double kSigmaFloorFraction = 0.1;
 // The robust spread of normalised residuals from their median absolute value (Gaussian).
 constexpr double kMadToSigma = 1.4826;
-// The robust loss never acts on normalised residuals below this (round-off of noise-free runs).
-constexpr double kMinLossThreshold = 1e-6;
+// The robust spread of the normalised residuals is never taken below one measured noise.
+constexpr double kMinRobustSpread = 1.0;
 
 // One sensor's share of the problem.
 struct SensorProblem {
@@ -42,13 +43,18 @@ struct SensorProblem {
   std::vector<double> p0;    // start, fit basis
   std::vector<double> step;  // scale of each parameter
   std::vector<double> q;     // the solver's variables
-  std::vector<int> held;     // parameters held at zero (p0 = 0 there)
-  std::vector<Eigen::Vector3d> sigma;  // per window, SI
+  std::vector<int> held;     // parameters held at their start value
+  // This sensor's windows (the accelerometer's are those whose specific force is known; the
+  // gyro's carry the specific force its g-sensitivity term sees) and their index in the run.
+  std::vector<FitWindow> windows;
+  std::vector<int> window_index;
+  std::vector<Eigen::Vector3d> sigma_raw;  // per window: noise of the mean, raw units (the weights)
+  std::vector<Eigen::Vector3d> sigma;      // the same in SI at the start's scale (for reports)
   std::vector<ceres::ResidualBlockId> blocks;
   ceres::LossFunctionWrapper* loss = nullptr;  // owned by the problem
-  Eigen::MatrixXd jacobian;  // of the normalised residuals in q, free parameters only
-  std::vector<int> free;     // jacobian column -> parameter
-  double loss_threshold = 0.0;  // normalised residual norm where the robust loss starts
+  Eigen::MatrixXd jacobian;                    // of the normalised residuals in q, free parameters only
+  std::vector<int> free;                       // jacobian column -> parameter
+  double loss_threshold = 0.0;                 // normalised residual norm where the robust loss starts
   std::vector<double> Parameters() const {
     std::vector<double> p(parameters);
     for (int i = 0; i < parameters; ++i) p[i] = p0[i] + step[i] * q[i];
@@ -65,13 +71,21 @@ double Median(std::vector<double> values) {
 }
 
 // What a window's sensor responds to: (truth, specific force) for its rows.
-const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) { return gyro ? w.truth.omega_radps : w.truth.a_mps2; }
+const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) {
+  return gyro ? w.truth.omega_radps : w.truth.a_mps2;
+}
 const Eigen::Vector3d& RawFor(const FitWindow& w, bool gyro) {
   return gyro ? w.window->gyro_mean : w.window->accel_mean;
 }
+// The noise of a window's mean, raw units: the per-sample spread over sqrt(samples). Where the
+// truth is constant over the window, the sample standard deviation (it also holds the table's
+// rate ripple and slow noise); in a turn, whose rate varies, the second-difference figure, which
+// sees the noise and not the rate profile (windows.h).
 Eigen::Vector3d RawSigmaFor(const FitWindow& w, bool gyro) {
-  const Eigen::Vector3d& std_dev = gyro ? w.window->gyro_std : w.window->accel_std;
-  return std_dev / std::sqrt(static_cast<double>(w.window->samples));
+  const Window& window = *w.window;
+  const Eigen::Vector3d& spread = window.whole_occurrence ? (gyro ? window.gyro_noise : window.accel_noise)
+                                                          : (gyro ? window.gyro_std : window.accel_std);
+  return spread / std::sqrt(static_cast<double>(window.samples));
 }
 
 // The closed-form start of one sensor: raw_i = sum_j K_ij(x) truth_j + V_i(x) + sum_j H_ij(x) a_j
@@ -90,7 +104,7 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
     Eigen::VectorXd rhs(m);
     for (int r = 0; r < m; ++r) {
       const FitWindow& w = windows[r];
-      const double weight = 1.0 / sensor->sigma[r](i);  // SI sigma: a common scale per axis is harmless
+      const double weight = 1.0 / sensor->sigma_raw[r](i);
       Eigen::Matrix<double, 7, 1> regressor;
       regressor << TruthFor(w, gyro), 1.0, w.truth.a_mps2;
       double power = 1.0;
@@ -100,8 +114,14 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
       rhs(r) = weight * RawFor(w, gyro)(i);
     }
     const Eigen::VectorXd column_norm = design.colwise().norm().transpose().cwiseMax(1e-300);
-    const Eigen::VectorXd solution =
-        design.array().rowwise().operator/(column_norm.transpose().array()).matrix().completeOrthogonalDecomposition().solve(rhs).cwiseQuotient(column_norm);
+    const Eigen::VectorXd solution = design.array()
+                                         .rowwise()
+                                         .
+                                         operator/(column_norm.transpose().array())
+                                         .matrix()
+                                         .completeOrthogonalDecomposition()
+                                         .solve(rhs)
+                                         .cwiseQuotient(column_norm);
     for (int k = 0; k < terms; ++k) {
       for (int j = 0; j < 3; ++j) K(3 * i + j, k) = solution(j * terms + k);
       V(i, k) = solution(3 * terms + k);
@@ -120,7 +140,8 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
   Eigen::MatrixXd vandermonde(kStartNodes, terms);
   Eigen::MatrixXd values(kStartNodes, 9);  // S x, y, z, M xy xz yx yz zx zy
   for (int node = 0; node < kStartNodes; ++node) {
-    const double x = 0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(M_PI * (node + 0.5) / kStartNodes);
+    const double x =
+        0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(M_PI * (node + 0.5) / kStartNodes);
     Eigen::Matrix3d k_at;
     for (int e = 0; e < 9; ++e) {
       const Eigen::Vector4d c = K.row(e).transpose();
@@ -139,13 +160,16 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
   const Eigen::MatrixXd fitted = vandermonde.colPivHouseholderQr().solve(values);  // terms x 9
 
   sensor->p0.assign(sensor->parameters, 0.0);
-  const auto set = [&](int coefficient, int k, double value) { sensor->p0[coefficient * kPolynomialTerms + k] = value; };
+  const auto set = [&](int coefficient, int k, double value) {
+    sensor->p0[coefficient * kPolynomialTerms + k] = value;
+  };
   for (int k = 0; k < terms; ++k) {
     for (int i = 0; i < 3; ++i) {
       set(kBiasCoefficient + i, k, V(i, k));
       set(kScaleCoefficient + i, k, fitted(k, i));
     }
-    for (int m_index = 0; m_index < 6; ++m_index) set(kMisalignmentCoefficient + m_index, k, fitted(k, 3 + m_index));
+    for (int m_index = 0; m_index < 6; ++m_index)
+      set(kMisalignmentCoefficient + m_index, k, fitted(k, 3 + m_index));
     if (sensor->with_g_sensitivity) {
       for (int h = 0; h < 9; ++h) set(kGSensitivityCoefficient + h, k, H(h, k));
     }
@@ -158,28 +182,39 @@ void SetSteps(SensorProblem* sensor) {
   sensor->step.assign(sensor->parameters, 1.0);
   for (int c = 0; c < sensor->coefficients; ++c) {
     double step = 1e-3;
-    const int row = c < kMisalignmentCoefficient ? (c % 3) : c >= kGSensitivityCoefficient ? (c - kGSensitivityCoefficient) / 3 : 0;
+    const int row = c < kMisalignmentCoefficient    ? (c % 3)
+                    : c >= kGSensitivityCoefficient ? (c - kGSensitivityCoefficient) / 3
+                                                    : 0;
     const double scale = std::abs(sensor->p0[(kScaleCoefficient + row) * kPolynomialTerms]);
-    if (c < kMisalignmentCoefficient) step = 1e-3 * scale;               // bias, scale
-    else if (c >= kGSensitivityCoefficient) step = 1e-4 * scale;         // g-sensitivity
-    for (int k = 0; k < kPolynomialTerms; ++k) sensor->step[c * kPolynomialTerms + k] = step > 0.0 ? step : 1e-3;
+    if (c < kMisalignmentCoefficient)
+      step = 1e-3 * scale;  // bias, scale
+    else if (c >= kGSensitivityCoefficient)
+      step = 1e-4 * scale;  // g-sensitivity
+    for (int k = 0; k < kPolynomialTerms; ++k)
+      sensor->step[c * kPolynomialTerms + k] = step > 0.0 ? step : 1e-3;
   }
 }
 
-// Window noise in SI: the noise of the raw mean divided by the scale factor, floored.
-void SetSigmas(const std::vector<FitWindow>& windows, bool gyro, SensorProblem* sensor) {
-  sensor->sigma.assign(windows.size(), Eigen::Vector3d::Ones());
+// Window noise: the noise of the raw mean (the weights, fixed: they do not move with the
+// parameters), floored, and the same in SI at the start's scale factor (for reports and the
+// bias-stability covariance).
+void SetSigmas(bool gyro, SensorProblem* sensor) {
+  const size_t count = sensor->windows.size();
+  sensor->sigma_raw.assign(count, Eigen::Vector3d::Ones());
+  sensor->sigma.assign(count, Eigen::Vector3d::Ones());
   for (int axis = 0; axis < 3; ++axis) {
-    const double scale = std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
     std::vector<double> values;
-    for (size_t w = 0; w < windows.size(); ++w) {
-      sensor->sigma[w](axis) = RawSigmaFor(windows[w], gyro)(axis) / (scale > 0.0 ? scale : 1.0);
-      values.push_back(sensor->sigma[w](axis));
+    for (size_t w = 0; w < count; ++w) {
+      sensor->sigma_raw[w](axis) = RawSigmaFor(sensor->windows[w], gyro)(axis);
+      values.push_back(sensor->sigma_raw[w](axis));
     }
     const double floor = kSigmaFloorFraction * Median(values);
-    for (size_t w = 0; w < windows.size(); ++w) {
-      double& s = sensor->sigma[w](axis);
+    const double scale =
+        std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
+    for (size_t w = 0; w < count; ++w) {
+      double& s = sensor->sigma_raw[w](axis);
       s = floor > 0.0 ? std::max(s, floor) : 1.0;
+      sensor->sigma[w](axis) = s / (scale > 0.0 ? scale : 1.0);
     }
   }
 }
@@ -188,7 +223,10 @@ std::string ParameterName(const SensorProblem& sensor, int parameter) {
   const CoefficientName& name = kCoefficientNames[parameter / kPolynomialTerms];
   const int k = parameter % kPolynomialTerms;
   return std::string(sensor.name) + " " + name.group + " " + name.axis +
-         (k == 0 ? "" : k == 1 ? " (linear term)" : k == 2 ? " (quadratic term)" : " (cubic term)");
+         (k == 0   ? ""
+          : k == 1 ? " (linear term)"
+          : k == 2 ? " (quadratic term)"
+                   : " (cubic term)");
 }
 
 // Blocks of windows within which a slowly wandering bias is taken as constant: a new block starts
@@ -219,7 +257,8 @@ std::vector<int> TimeBlocks(const std::vector<FitWindow>& windows, double correl
 // polynomial, so the residuals do not show it. By linear response, an offset b on axis a of the
 // windows of block k moves the estimate by dq = C J^T dr with dr = b / sigma_w on those rows,
 // C = (J^T J)^-1 (`unscaled_covariance`); the blocks and axes add up independently.
-Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor, const Eigen::MatrixXd& unscaled_covariance,
+Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor,
+                                        const Eigen::MatrixXd& unscaled_covariance,
                                         const std::vector<int>& time_blocks, double stability) {
   const int blocks = time_blocks.empty() ? 0 : *std::max_element(time_blocks.begin(), time_blocks.end()) + 1;
   const int n = static_cast<int>(sensor.free.size());
@@ -231,10 +270,10 @@ Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor, const Eigen
   for (int block = 0; block < blocks; ++block) {
     for (int axis = 0; axis < 3; ++axis) {
       Eigen::VectorXd gradient = Eigen::VectorXd::Zero(n);  // J^T dr
-      for (size_t w = 0; w < time_blocks.size(); ++w) {
-        if (time_blocks[w] != block) continue;
-        const int row = 3 * static_cast<int>(w) + axis;
-        gradient += sensor.jacobian.row(row).transpose() * (stability / sensor.sigma[w](axis));
+      for (size_t b = 0; b < sensor.windows.size(); ++b) {
+        if (time_blocks[sensor.window_index[b]] != block) continue;
+        const int row = 3 * static_cast<int>(b) + axis;
+        gradient += sensor.jacobian.row(row).transpose() * (stability / sensor.sigma[b](axis));
       }
       const Eigen::VectorXd shift = free_covariance * gradient;
       added += shift * shift.transpose();
@@ -251,9 +290,12 @@ Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor, const Eigen
 
 std::string RobustLossName(RobustLoss loss) {
   switch (loss) {
-    case RobustLoss::kNone: return "none";
-    case RobustLoss::kHuber: return "huber";
-    case RobustLoss::kCauchy: return "cauchy";
+    case RobustLoss::kNone:
+      return "none";
+    case RobustLoss::kHuber:
+      return "huber";
+    case RobustLoss::kCauchy:
+      return "cauchy";
   }
   return "?";
 }
@@ -323,9 +365,20 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   }
   std::vector<FitWindow> fit_windows;
   for (const Window& w : windows) {
-    const auto segment = std::find_if(segments.begin(), segments.end(), [&](const TableSegment& s) { return s.id == w.segment; });
+    const auto segment = std::find_if(segments.begin(), segments.end(),
+                                      [&](const TableSegment& s) { return s.id == w.segment; });
     assert(segment != segments.end() && "every window's segment must be in the plan");
-    fit_windows.push_back(FitWindow{&w, TruthOf(site, *segment), basis.Argument(w.temp_c)});
+    // A turn's truth is its whole occurrence's mean rate: the window must be that occurrence.
+    if (segment->IsTurn() && !w.whole_occurrence) {
+      // A programmer error (windows built without the plan): always checked, it would bias the fit.
+      std::fprintf(stderr,
+                   "imufit: internal error: a window of turn segment %d is not its whole occurrence\n",
+                   segment->id);
+      std::abort();
+    }
+    const SegmentTruth truth =
+        segment->IsTurn() ? TurnTruth(site, *segment, w.DurationS()) : TruthOf(site, *segment);
+    fit_windows.push_back(FitWindow{&w, truth, basis.Argument(w.temp_c), segment->SpecificForceIsKnown()});
   }
   summary.windows_used = static_cast<int>(fit_windows.size());
 
@@ -347,19 +400,40 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   accel.parameters = kAccelParameters;
   accel.coefficients = kAccelCoefficients;
   accel.order = options.accel_temp_order;
-  for (SensorProblem* sensor : {&gyro, &accel}) {
+  // The accelerometer first: where gravity turns in the body frame (a turn or a rate about a
+  // non-vertical axis) the gyro's g-sensitivity term sees the window's corrected accelerometer
+  // mean, at the accelerometer's closed-form start (which differs from its fit by far less than
+  // the noise of that mean).
+  for (size_t w = 0; w < fit_windows.size(); ++w) {
+    if (!fit_windows[w].accel_known) continue;
+    accel.windows.push_back(fit_windows[w]);
+    accel.window_index.push_back(static_cast<int>(w));
+  }
+  for (SensorProblem* sensor : {&accel, &gyro}) {
     const bool is_gyro = sensor == &gyro;
-    SetSigmas(fit_windows, is_gyro, sensor);   // raw units until the start is known
-    LinearStart(fit_windows, is_gyro, sensor);
+    if (is_gyro) {
+      for (size_t w = 0; w < fit_windows.size(); ++w) {
+        FitWindow fw = fit_windows[w];
+        if (!fw.accel_known) {
+          const SensorCoefficients<double> c = CoefficientsAt(accel.p0.data(), kAccelCoefficients, fw.x);
+          fw.truth.a_mps2 = CorrectSensor(c, fw.window->accel_mean, Eigen::Vector3d::Zero().eval());
+        }
+        gyro.windows.push_back(fw);
+        gyro.window_index.push_back(static_cast<int>(w));
+      }
+    }
+    SetSigmas(is_gyro, sensor);
+    LinearStart(sensor->windows, is_gyro, sensor);
     if (!options.closed_form_start) {
       // Keep only the nominal scale factors: the solver must find everything else itself.
       for (int i = 0; i < sensor->parameters; ++i) {
         const int c = i / kPolynomialTerms;
-        const bool nominal_scale = c >= kScaleCoefficient && c < kMisalignmentCoefficient && i % kPolynomialTerms == 0;
+        const bool nominal_scale =
+            c >= kScaleCoefficient && c < kMisalignmentCoefficient && i % kPolynomialTerms == 0;
         if (!nominal_scale) sensor->p0[i] = 0.0;
       }
     }
-    SetSigmas(fit_windows, is_gyro, sensor);   // now in SI
+    SetSigmas(is_gyro, sensor);  // the SI figures at the start's scale
     SetSteps(sensor);
     sensor->q.assign(sensor->parameters, 0.0);
     for (int c = 0; c < sensor->coefficients; ++c) {
@@ -375,17 +449,17 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   ceres::Problem problem;
   for (SensorProblem* sensor : {&gyro, &accel}) {
     sensor->loss = new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP);
-    for (size_t w = 0; w < fit_windows.size(); ++w) {
-      const FitWindow& fw = fit_windows[w];
+    for (size_t w = 0; w < sensor->windows.size(); ++w) {
+      const FitWindow& fw = sensor->windows[w];
       ceres::CostFunction* cost = nullptr;
       if (sensor == &gyro) {
         cost = new ceres::AutoDiffCostFunction<WindowCost<kGyroParameters>, 3, kGyroParameters>(
             new WindowCost<kGyroParameters>(RawFor(fw, true), TruthFor(fw, true), fw.truth.a_mps2, fw.x,
-                                            sensor->sigma[w], sensor->p0.data(), sensor->step.data()));
+                                            sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
       } else {
         cost = new ceres::AutoDiffCostFunction<WindowCost<kAccelParameters>, 3, kAccelParameters>(
             new WindowCost<kAccelParameters>(RawFor(fw, false), TruthFor(fw, false), fw.truth.a_mps2, fw.x,
-                                             sensor->sigma[w], sensor->p0.data(), sensor->step.data()));
+                                             sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
       }
       sensor->blocks.push_back(problem.AddResidualBlock(cost, sensor->loss, sensor->q.data()));
     }
@@ -419,9 +493,11 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       // loss_scale times it.
       std::vector<double> components;
       for (double norm : normalised_norms(*sensor)) components.push_back(norm / std::sqrt(3.0));
-      const double spread = kMadToSigma * Median(components);
-      // Noise-free data (simulations) leave only round-off: the loss must not act on that.
-      sensor->loss_threshold = std::max(options.loss_scale * spread, kMinLossThreshold);
+      // The residuals are in units of each window's measured noise, so the spread is at least 1: a
+      // smaller median comes from windows the fit matches exactly (few windows for the parameters,
+      // e.g. one turn per axis setting the scale), and the loss must not act on ordinary noise.
+      const double spread = std::max(kMadToSigma * Median(components), kMinRobustSpread);
+      sensor->loss_threshold = options.loss_scale * spread;
       if (options.loss == RobustLoss::kHuber) {
         sensor->loss->Reset(new ceres::HuberLoss(sensor->loss_threshold), ceres::TAKE_OWNERSHIP);
       } else {
@@ -435,8 +511,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   summary.termination = solver_summary.message;
   if (solver_summary.termination_type != ceres::CONVERGENCE) {
     summary.status = FitStatus::kNotConverged;
-    summary.termination = std::string(ceres::TerminationTypeToString(solver_summary.termination_type)) + ": " +
-                          solver_summary.message;
+    summary.termination = std::string(ceres::TerminationTypeToString(solver_summary.termination_type)) +
+                          ": " + solver_summary.message;
     return summary;
   }
 
@@ -491,13 +567,14 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     double chi2 = 0.0;
     int rows = 0;
     double sum_squares = 0.0;
-    for (size_t w = 0; w < fit_windows.size(); ++w) {
+    for (size_t w = 0; w < sensor->windows.size(); ++w) {
       double residual[3];
       double cost = 0.0;
       problem.EvaluateResidualBlock(sensor->blocks[w], false, &cost, residual, nullptr);
+      // Raw error over the start's scale: the error in SI to first order.
       const Eigen::Vector3d si = Eigen::Map<const Eigen::Vector3d>(residual).cwiseProduct(sensor->sigma[w]);
-      WindowResidual& out = summary.residuals[w];
-      out.window = static_cast<int>(w);
+      WindowResidual& out = summary.residuals[sensor->window_index[w]];
+      out.window = sensor->window_index[w];
       (is_gyro ? out.gyro_radps : out.accel_mps2) = si;
       (is_gyro ? out.gyro_sigma_radps : out.accel_sigma_mps2) = sensor->sigma[w];
       const bool downweighted = options.loss != RobustLoss::kNone && norms[w] > sensor->loss_threshold;
@@ -509,13 +586,14 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       }
     }
     const int free_parameters = sensor->parameters - static_cast<int>(sensor->held.size());
-    const double rms = std::sqrt(sum_squares / (3.0 * fit_windows.size()));
+    const double rms = std::sqrt(sum_squares / (3.0 * std::max<size_t>(sensor->windows.size(), 1)));
     const double reduced_chi2 = rows > free_parameters ? chi2 / (rows - free_parameters) : 1.0;
     (is_gyro ? summary.gyro_rms_radps : summary.accel_rms_mps2) = rms;
     (is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2) = reduced_chi2;
   }
-  summary.windows_downweighted = static_cast<int>(
-      std::count_if(summary.residuals.begin(), summary.residuals.end(), [](const WindowResidual& r) { return r.downweighted; }));
+  summary.windows_downweighted =
+      static_cast<int>(std::count_if(summary.residuals.begin(), summary.residuals.end(),
+                                     [](const WindowResidual& r) { return r.downweighted; }));
 
   // Covariance of q, to p (times step), scaled by the reduced chi-square, to powers of dT.
   ceres::Covariance::Options covariance_options;
@@ -523,8 +601,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   covariance_options.num_threads = options.num_threads;
   covariance_options.apply_loss_function = true;
   ceres::Covariance covariance(covariance_options);
-  const std::vector<std::pair<const double*, const double*>> covariance_blocks = {{gyro.q.data(), gyro.q.data()},
-                                                                                  {accel.q.data(), accel.q.data()}};
+  const std::vector<std::pair<const double*, const double*>> covariance_blocks = {
+      {gyro.q.data(), gyro.q.data()}, {accel.q.data(), accel.q.data()}};
   const bool have_covariance = covariance.Compute(covariance_blocks, &problem);
   const std::vector<int> time_blocks = TimeBlocks(fit_windows, options.bias_correlation_s);
   const Eigen::Matrix4d to_reference = RebaseTemperaturePolynomial(basis, TemperatureBasis::Reference());
@@ -535,7 +613,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     const std::vector<double> p = sensor->Parameters();
     Eigen::MatrixXd cov_q = Eigen::MatrixXd::Zero(sensor->parameters, sensor->parameters);
     if (have_covariance) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> block(sensor->parameters, sensor->parameters);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> block(sensor->parameters,
+                                                                                   sensor->parameters);
       covariance.GetCovarianceBlock(sensor->q.data(), sensor->q.data(), block.data());
       cov_q = block;
     }
@@ -561,7 +640,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     }
   }
   if (!have_covariance) {
-    summary.undetermined.push_back("the covariance could not be computed (the problem is numerically rank deficient)");
+    summary.undetermined.push_back(
+        "the covariance could not be computed (the problem is numerically rank deficient)");
     summary.status = FitStatus::kUndetermined;
     summary.termination = "the run does not determine the model";
     return summary;
@@ -585,7 +665,8 @@ std::string FitSummary::BriefReport() const {
       break;
   }
   std::snprintf(text, sizeof text,
-                "converged in %d iterations; residual RMS gyro %.3g deg/s, accel %.3g mg; %d windows (%d down-weighted) "
+                "converged in %d iterations; residual RMS gyro %.3g deg/s, accel %.3g mg; %d windows (%d "
+                "down-weighted) "
                 "over %zu temperatures",
                 iterations, gyro_rms_radps * kRadToDeg, accel_rms_mps2 / 9.80665 * 1e3, windows_used,
                 windows_downweighted, distinct_temps_c.size());

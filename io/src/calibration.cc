@@ -1,7 +1,11 @@
 #include "imufit/io/calibration.h"
 
+#include <algorithm>
 #include <cassert>
+#include <cmath>
+#include <cstdio>
 #include <ctime>
+#include <limits>
 #include <sstream>
 
 #include "imufit/io/error.h"
@@ -11,9 +15,9 @@
 namespace imufit {
 namespace {
 
-constexpr const char* kKnownKeys[] = {"format",  "version",          "serial",           "created_utc",
-                                      "software", "reference_temp_c", "fit_temp_range_c", "gyro",
-                                      "accel",    "sigma"};
+constexpr const char* kKnownKeys[] = {
+    "format",           "version",          "serial", "created_utc", "software",
+    "reference_temp_c", "fit_temp_range_c", "gyro",   "accel",       "sigma"};
 
 std::string Quoted(const std::string& text) {
   YAML::Emitter emitter;
@@ -46,9 +50,84 @@ void ReadSensor(const yaml::Located& sensor, double* params, int coefficients) {
   }
 }
 
+// The temperatures of [low, high] where a cubic in x = T - center can reach its extremes: the
+// ends and the roots of its derivative inside. A cubic is monotonic between these points, so
+// its smallest magnitude and any change of sign show at one of them.
+std::vector<double> CriticalTemperatures(const double* c, double center_c,
+                                         const std::array<double, 2>& range) {
+  std::vector<double> temps = {range[0], range[1]};
+  // c1 + 2 c2 x + 3 c3 x^2 = 0
+  const double a = 3.0 * c[3], b = 2.0 * c[2], d = c[1];
+  std::vector<double> roots;
+  if (a == 0.0) {
+    if (b != 0.0) roots.push_back(-d / b);
+  } else if (const double disc = b * b - 4.0 * a * d; disc >= 0.0) {
+    roots.push_back((-b + std::sqrt(disc)) / (2.0 * a));
+    roots.push_back((-b - std::sqrt(disc)) / (2.0 * a));
+  }
+  for (const double x : roots) {
+    if (std::isfinite(x) && x + center_c > range[0] && x + center_c < range[1]) temps.push_back(x + center_c);
+  }
+  return temps;
+}
+
+// Refuses a sensor whose correction cannot be computed across the fit temperature range: a
+// scale factor that changes sign, comes near zero (below kMinScale, or below 1/1000 of its
+// largest value) or a misalignment matrix M that is nearly singular (det M below 0.1).
+void CheckInvertible(const yaml::Located& sensor, const double* params, int coefficients, double center_c,
+                     const std::array<double, 2>& range) {
+  constexpr double kMinScale = 1e-9;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double* c = params + (kScaleCoefficient + axis) * kPolynomialTerms;
+    double smallest = std::numeric_limits<double>::infinity(), largest = 0.0, at_c = range[0];
+    double opposite_c = range[0];
+    bool sign_change = false;
+    const double first = EvaluateTemperaturePolynomial(c, range[0] - center_c);
+    for (const double t : CriticalTemperatures(c, center_c, range)) {
+      const double value = EvaluateTemperaturePolynomial(c, t - center_c);
+      if (!sign_change && (value == 0.0 || std::signbit(value) != std::signbit(first))) {
+        sign_change = true;
+        opposite_c = t;
+      }
+      largest = std::max(largest, std::abs(value));
+      if (std::abs(value) < smallest) smallest = std::abs(value), at_c = t;
+    }
+    if (sign_change || !(smallest >= kMinScale) || !(smallest >= 1e-3 * largest) || !std::isfinite(largest)) {
+      char text[240];
+      if (sign_change) {
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
+            "%.4g at %.4g degC); the correction divides by it",
+            range[0], range[1], first, range[0], EvaluateTemperaturePolynomial(c, opposite_c - center_c),
+            opposite_c);
+      } else {
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
+            "at most %.3g elsewhere); the correction divides by it",
+            range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
+      }
+      sensor["scale"][kCoefficientNames[kScaleCoefficient + axis].axis].Fail(text);
+    }
+  }
+  constexpr int kSteps = 64;
+  for (int i = 0; i <= kSteps; ++i) {
+    const double t = range[0] + (range[1] - range[0]) * i / kSteps;
+    const double det = CoefficientsAt(params, coefficients, t - center_c).misalignment.determinant();
+    if (!(det >= 0.1)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "M is nearly singular within fit_temp_range_c: det M = %.3g at %.4g degC", det, t);
+      sensor["misalignment"].Fail(text);
+    }
+  }
+}
+
 void CheckUnit(const yaml::Located& sensor, const std::string& expected) {
   if (sensor.Has("unit") && sensor["unit"].String() != expected) {
-    sensor["unit"].Fail(QuoteForMessage(sensor["unit"].String()) + " is not supported (expected " + expected + ")");
+    sensor["unit"].Fail(QuoteForMessage(sensor["unit"].String()) + " is not supported (expected " + expected +
+                        ")");
   }
 }
 
@@ -72,7 +151,8 @@ Calibration ReadCalibration(const std::string& path) {
   if (root.Has("serial")) calibration.serial = root["serial"].String();
   if (root.Has("created_utc")) calibration.created_utc = root["created_utc"].String();
   if (root.Has("software")) calibration.software = root["software"].String();
-  calibration.model.basis.center_c = root.Has("reference_temp_c") ? root["reference_temp_c"].Double() : kReferenceTempC;
+  calibration.model.basis.center_c =
+      root.Has("reference_temp_c") ? root["reference_temp_c"].Double() : kReferenceTempC;
   calibration.model.basis.half_range_c = 1.0;
   if (root.Has("fit_temp_range_c")) {
     const std::vector<double> range = root["fit_temp_range_c"].Doubles(2);
@@ -85,12 +165,13 @@ Calibration ReadCalibration(const std::string& path) {
   const yaml::Located accel = root["accel"];
   CheckUnit(accel, "m/s^2");
   ReadSensor(accel, calibration.model.accel.data(), kAccelCoefficients);
-  for (int axis = 0; axis < 3; ++axis) {
-    // A zero scale factor would divide by zero in every consumer: refuse it here.
-    const int c0 = (kScaleCoefficient + axis) * kPolynomialTerms;
-    if (calibration.model.gyro[c0] == 0.0) gyro["scale"][kCoefficientNames[3 + axis].axis].Fail("scale c0 is zero");
-    if (calibration.model.accel[c0] == 0.0) accel["scale"][kCoefficientNames[3 + axis].axis].Fail("scale c0 is zero");
-  }
+  // A scale factor near zero or a singular M would make every consumer's correction non-finite
+  // or meaningless: refuse them here.
+  const double center_c = calibration.model.basis.center_c;
+  CheckInvertible(gyro, calibration.model.gyro.data(), kGyroCoefficients, center_c,
+                  calibration.fit_temp_range_c);
+  CheckInvertible(accel, calibration.model.accel.data(), kAccelCoefficients, center_c,
+                  calibration.fit_temp_range_c);
   if (root.Has("sigma")) {
     const yaml::Located sigma = root["sigma"];
     SensorModel sigmas;
@@ -101,10 +182,11 @@ Calibration ReadCalibration(const std::string& path) {
   }
   calibration.extra = YAML::Node(YAML::NodeType::Map);
   for (const auto& entry : root_node) {
-    const std::string key = entry.first.Scalar();
+    const std::string& key = entry.first.Scalar();
     bool known = false;
     for (const char* k : kKnownKeys) known = known || key == k;
-    if (!known) calibration.extra[key] = entry.second;
+    // force_insert: no search, so many keys cost linear time (LoadFile refused duplicates).
+    if (!known) calibration.extra.force_insert(key, entry.second);
   }
   return calibration;
 }

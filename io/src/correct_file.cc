@@ -2,13 +2,14 @@
 
 #include <algorithm>
 
+#include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 
 namespace imufit {
 
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path) {
-  SamplesReader reader(samples_path, /*require_segment=*/false);
+                                     const std::string& output_path, std::optional<double> temp_c) {
+  SamplesReader reader(samples_path, /*require_segment=*/false, temp_c);
   SamplesWriter writer(output_path, reader.has_segment());
   CorrectFileReport report;
   Sample raw;
@@ -18,6 +19,13 @@ CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::
     corrected.temp_c = raw.temp_c;
     corrected.segment = raw.segment;
     calibration.model.Correct(raw.temp_c, raw.gyro, raw.accel, &corrected.gyro, &corrected.accel);
+    if (!corrected.gyro.allFinite() || !corrected.accel.allFinite()) {
+      // Never a non-finite number in the output: at an absurd temperature the polynomials overflow.
+      reader.Fail("temp_c", "the correction at " + FormatDouble(raw.temp_c) +
+                                " degC is not a finite number (the calibration's fit range is [" +
+                                FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                                FormatDouble(calibration.fit_temp_range_c[1]) + "] degC)");
+    }
     writer.Write(corrected);
     if (report.samples == 0) report.min_temp_c = report.max_temp_c = raw.temp_c;
     report.min_temp_c = std::min(report.min_temp_c, raw.temp_c);

@@ -4,10 +4,12 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 
 #include "imufit/io/error.h"
 #include "imufit/io/path.h"
@@ -15,7 +17,13 @@
 namespace imufit {
 namespace {
 
+// The read block. The fuzz build makes it tiny (IMUFIT_CSV_BLOCK_BYTES) so that lines straddle
+// refills all the time.
+#ifdef IMUFIT_CSV_BLOCK_BYTES
+constexpr size_t kBlockBytes = IMUFIT_CSV_BLOCK_BYTES;
+#else
 constexpr size_t kBlockBytes = 4 << 20;
+#endif
 
 std::string_view Trim(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
@@ -43,48 +51,111 @@ bool ParseSmallInteger(std::string_view text, double* value) {
 
 }  // namespace
 
-// Reads bytes from a plain file (read(2)) or a gzip stream (zlib).
+// Reads bytes from a plain file (read(2)) or a gzip stream (zlib's inflate over read(2)). The gzip
+// stream is checked to its end: a stream cut short, one whose CRC-32 or length trailer does not
+// match, bytes after the last member, or a file named .gz that is not gzip are InputErrors.
+// Concatenated members (`cat a.gz b.gz`) are one stream, as gzip(1) reads them.
 class CsvReader::Source {
  public:
   explicit Source(const std::string& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_RDONLY);
+    if (fd_ < 0) throw InputError(path_, std::string("cannot open: ") + std::strerror(errno));
     if (IsGzipPath(path)) {
-      gz_ = gzopen(path.c_str(), "rb");
-      if (gz_ == nullptr) Throw();
-      gzbuffer(gz_, 1 << 18);
-    } else {
-      fd_ = ::open(path.c_str(), O_RDONLY);
-      if (fd_ < 0) Throw();
+      gzip_ = true;
+      raw_.resize(kRawBytes);
+      if (inflateInit2(&stream_, 16 + MAX_WBITS) != Z_OK)
+        throw InputError(path_, "cannot start gzip decompression");
+      inflating_ = true;
     }
   }
   ~Source() {
-    if (gz_ != nullptr) gzclose(gz_);
+    if (inflating_) inflateEnd(&stream_);
     if (fd_ >= 0) ::close(fd_);
   }
   // Reads up to `size` bytes; 0 at the end.
   size_t Read(char* data, size_t size) {
-    if (gz_ != nullptr) {
-      const int n = gzread(gz_, data, static_cast<unsigned>(size));
-      if (n < 0) {
-        int code = 0;
-        const char* message = gzerror(gz_, &code);
-        throw InputError(path_, std::string("cannot decompress: ") + message);
+    if (!gzip_) return ReadRaw(data, size);
+    const uInt want = static_cast<uInt>(std::min<size_t>(size, 1u << 30));
+    stream_.next_out = reinterpret_cast<Bytef*>(data);
+    stream_.avail_out = want;
+    while (stream_.avail_out == want) {  // until some output, or the end
+      if (stream_.avail_in == 0 && !raw_eof_) Refill();
+      if (stream_.avail_in == 0 && raw_eof_) {
+        if (member_started_) {
+          throw InputError(path_, "truncated gzip stream: the file ends before the stream does (after " +
+                                      std::to_string(compressed_bytes_) + " compressed bytes)");
+        }
+        if (members_ == 0) throw InputError(path_, "empty file, not a gzip stream (the name ends in .gz)");
+        return 0;
       }
-      return static_cast<size_t>(n);
+      if (!member_started_) StartMember();
+      const int status = inflate(&stream_, Z_NO_FLUSH);
+      if (status == Z_STREAM_END) {
+        member_started_ = false;
+        ++members_;
+        inflateReset(&stream_);
+      } else if (status == Z_BUF_ERROR && stream_.avail_in == 0) {
+        continue;  // more input needed: refilled above, or reported as truncated
+      } else if (status != Z_OK) {
+        const std::string reason = stream_.msg != nullptr ? stream_.msg : "error " + std::to_string(status);
+        const bool trailer = reason == "incorrect data check" || reason == "incorrect length check";
+        throw InputError(
+            path_, "corrupt gzip stream: " + reason +
+                       (trailer ? " (the CRC-32 or length in its trailer does not match the data)" : ""));
+      }
     }
+    return want - stream_.avail_out;
+  }
+
+ private:
+  static constexpr size_t kRawBytes = 1 << 16;
+
+  size_t ReadRaw(char* data, size_t size) {
     for (;;) {
       const ssize_t n = ::read(fd_, data, size);
       if (n >= 0) return static_cast<size_t>(n);
       if (errno != EINTR) throw InputError(path_, std::string("cannot read: ") + std::strerror(errno));
     }
   }
-
- private:
-  [[noreturn]] void Throw() {
-    throw InputError(path_, std::string("cannot open: ") + std::strerror(errno ? errno : ENOENT));
+  void Refill() {
+    const size_t n = ReadRaw(raw_.data(), raw_.size());
+    if (n == 0) raw_eof_ = true;
+    compressed_bytes_ += static_cast<long long>(n);
+    stream_.next_in = reinterpret_cast<Bytef*>(raw_.data());
+    stream_.avail_in = static_cast<uInt>(n);
   }
+  // A member starts with the gzip magic bytes 1f 8b; anything else is not gzip (at the start)
+  // or garbage after the stream (after a complete member).
+  void StartMember() {
+    if (stream_.avail_in < 2 && !raw_eof_) {
+      // Keep the one byte and read on so both magic bytes are seen together.
+      const unsigned char first = stream_.next_in[0];
+      raw_[0] = static_cast<char>(first);
+      const size_t n = ReadRaw(raw_.data() + 1, raw_.size() - 1);
+      if (n == 0) raw_eof_ = true;
+      compressed_bytes_ += static_cast<long long>(n);
+      stream_.next_in = reinterpret_cast<Bytef*>(raw_.data());
+      stream_.avail_in = static_cast<uInt>(n + 1);
+    }
+    if (stream_.avail_in < 2 || stream_.next_in[0] != 0x1f || stream_.next_in[1] != 0x8b) {
+      if (members_ == 0)
+        throw InputError(path_, "not a gzip stream (the name ends in .gz, the bytes are not gzip)");
+      throw InputError(path_, "trailing garbage after the gzip stream (at compressed byte " +
+                                  std::to_string(compressed_bytes_ - stream_.avail_in) + ")");
+    }
+    member_started_ = true;
+  }
+
   std::string path_;
-  gzFile gz_ = nullptr;
   int fd_ = -1;
+  bool gzip_ = false;
+  bool inflating_ = false;
+  z_stream stream_{};
+  std::vector<char> raw_;
+  bool raw_eof_ = false;
+  bool member_started_ = false;
+  long members_ = 0;
+  long long compressed_bytes_ = 0;
 };
 
 CsvReader::CsvReader(std::string path) : path_(std::move(path)) {
@@ -93,21 +164,22 @@ CsvReader::CsvReader(std::string path) : path_(std::move(path)) {
   buffer_.resize(kBlockBytes);
   std::string_view line;
   while (NextLine(&line)) {
+    if (line_number_ == 1) SkipByteOrderMark(&line);
     if (Trim(line).empty() || line.front() == '#') continue;
     SplitLine(line);
     header_line_ = line_number_;
+    std::unordered_set<std::string_view> seen;  // views into header_, reserved so they stay valid
+    header_.reserve(field_count_);
     for (size_t i = 0; i < field_count_; ++i) {
-      const std::string name(Trim(fields_[i]));
+      const std::string_view name = Trim(fields_[i]);
       if (name.empty()) {
         throw InputError(path_, line_number_, static_cast<long>(i) + 1, "empty column name in the header");
       }
-      for (size_t j = 0; j < header_.size(); ++j) {
-        if (header_[j] == name) {
-          throw InputError(path_, line_number_, static_cast<long>(i) + 1,
-                           "column " + QuoteForMessage(name) + " appears twice in the header");
-        }
+      header_.emplace_back(name);
+      if (!seen.insert(header_.back()).second) {
+        throw InputError(path_, line_number_, static_cast<long>(i) + 1,
+                         "column " + QuoteForMessage(name) + " appears twice in the header");
       }
-      header_.push_back(name);
     }
     return;
   }
@@ -125,10 +197,36 @@ std::optional<int> CsvReader::FindColumn(std::string_view name) const {
 
 int CsvReader::RequireColumn(std::string_view name) const {
   if (const std::optional<int> column = FindColumn(name)) return *column;
+  constexpr size_t kShown = 12;
   std::string have;
-  for (const std::string& h : header_) have += (have.empty() ? "" : ",") + h;
+  for (size_t i = 0; i < header_.size() && i < kShown; ++i)
+    have += (i ? "," : "") + EscapeForMessage(header_[i], 24);
+  if (header_.size() > kShown) have += ",... " + std::to_string(header_.size()) + " columns in all";
   throw InputError(path_, header_line_, 0,
                    "no column " + QuoteForMessage(name) + " in the header (it has: " + have + ")");
+}
+
+void CsvReader::SkipByteOrderMark(std::string_view* line) const {
+  if (line->substr(0, 3) == "\xEF\xBB\xBF") {
+    line->remove_prefix(3);  // UTF-8 byte-order mark, as spreadsheet programs write
+  } else if (line->substr(0, 2) == "\xFF\xFE" || line->substr(0, 2) == "\xFE\xFF") {
+    throw InputError(path_, 1, 1,
+                     "UTF-16 text (it starts with the byte-order mark " +
+                         std::string(line->front() == '\xFF' ? "FF FE" : "FE FF") +
+                         "): save the file as UTF-8 or ASCII");
+  }
+}
+
+void CsvReader::LineTooLong() const {
+  throw InputError(path_, line_number_ + 1, 0,
+                   "line longer than " + std::to_string(kMaxLineBytes) +
+                       " bytes (the limit of a CSV line): not a CSV file of samples?");
+}
+
+void CsvReader::TooManyFields() const {
+  throw InputError(
+      path_, line_number_, 0,
+      "more than " + std::to_string(kMaxColumns) + " fields on one line (the limit of a CSV line)");
 }
 
 bool CsvReader::NextLine(std::string_view* line) {
@@ -137,6 +235,7 @@ bool CsvReader::NextLine(std::string_view* line) {
     const void* newline = std::memchr(start, '\n', end_ - begin_);
     if (newline != nullptr) {
       const char* stop = static_cast<const char*>(newline);
+      if (static_cast<size_t>(stop - start) > kMaxLineBytes) LineTooLong();
       *line = std::string_view(start, stop - start);
       if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
       bytes_read_ += (stop - start) + 1;
@@ -146,6 +245,7 @@ bool CsvReader::NextLine(std::string_view* line) {
     }
     if (eof_) {
       if (begin_ == end_) return false;
+      if (end_ - begin_ > kMaxLineBytes) LineTooLong();
       // A last line without a newline.
       *line = std::string_view(start, end_ - begin_);
       if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
@@ -156,10 +256,11 @@ bool CsvReader::NextLine(std::string_view* line) {
     }
     // Move the partial line to the front and refill; grow for very long lines.
     const size_t partial = end_ - begin_;
+    if (partial > kMaxLineBytes) LineTooLong();
     std::memmove(buffer_.data(), buffer_.data() + begin_, partial);
     begin_ = 0;
     end_ = partial;
-    if (end_ == buffer_.size()) buffer_.resize(buffer_.size() * 2);
+    if (end_ == buffer_.size()) buffer_.resize(std::min(buffer_.size() * 2, kMaxLineBytes + 2));
     const size_t got = source_->Read(buffer_.data() + end_, buffer_.size() - end_);
     if (got == 0) eof_ = true;
     end_ += got;
@@ -182,33 +283,52 @@ void CsvReader::SplitLine(std::string_view line) {
     AddField(std::string_view(start, end - start));
     return;
   }
-  // Slow path: RFC 4180 quoting within one line.
+  // Slow path: RFC 4180 quoting within one line. A field is either quoted whole ("...", with ""
+  // for a quote, blanks allowed around it) or holds no quote at all; anything else ("1"2, 1"2",
+  // an unterminated quote) is an error rather than a guess.
   unquoted_.clear();
   unquoted_.reserve(line.size() + 1);  // no reallocation: fields_ keeps views into these strings
   size_t i = 0;
   for (;;) {
-    std::string field;
-    while (i < line.size() && line[i] != ',') {
-      if (line[i] == '"') {
-        ++i;
-        while (i < line.size()) {
-          if (line[i] == '"') {
-            if (i + 1 < line.size() && line[i + 1] == '"') {
-              field += '"';
-              i += 2;
-              continue;
-            }
-            ++i;
-            break;
-          }
-          field += line[i++];
+    const long column = static_cast<long>(field_count_) + 1;
+    size_t start = i;
+    while (start < line.size() && (line[start] == ' ' || line[start] == '\t')) ++start;
+    if (start < line.size() && line[start] == '"') {
+      std::string field;
+      i = start + 1;
+      for (;;) {
+        if (i >= line.size()) {
+          throw InputError(path_, line_number_, column, "a quote is not closed (a field may not span lines)");
         }
-      } else {
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') {
+            field += '"';
+            i += 2;
+            continue;
+          }
+          ++i;
+          break;
+        }
         field += line[i++];
       }
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+      if (i < line.size() && line[i] != ',') {
+        throw InputError(path_, line_number_, column,
+                         "text after the closing quote of a field: " + QuoteForMessage(line.substr(start)));
+      }
+      unquoted_.push_back(std::move(field));
+      AddField(unquoted_.back());
+    } else {
+      const size_t comma = std::min(line.find(',', i), line.size());
+      const std::string_view field = line.substr(i, comma - i);
+      if (field.find('"') != std::string_view::npos) {
+        throw InputError(path_, line_number_, column,
+                         "a quote inside an unquoted field: " + QuoteForMessage(field) +
+                             " (quote the whole field, with \"\" for a quote)");
+      }
+      AddField(field);
+      i = comma;
     }
-    unquoted_.push_back(std::move(field));
-    AddField(unquoted_.back());
     if (i >= line.size()) return;
     ++i;  // the comma
     if (i == line.size()) {
@@ -224,6 +344,11 @@ bool CsvReader::NextRow() {
     if (line.empty() || line.front() == '#') continue;
     if (Trim(line).empty()) continue;
     SplitLine(line);
+    if (field_count_ > header_.size()) {
+      FailRow("the row has " + std::to_string(field_count_) + " fields, the header names " +
+              std::to_string(header_.size()) +
+              " (a decimal comma, or a comma inside a value that is not quoted?)");
+    }
     return true;
   }
   return false;
@@ -246,7 +371,11 @@ double CsvReader::Number(int column) const {
   if (text.empty()) Fail(column, "empty value, a number is needed");
   const char* first = text.data();
   const char* last = text.data() + text.size();
-  if (*first == '+') ++first;
+  if (*first == '+') {
+    ++first;
+    if (first != last && (*first == '-' || *first == '+'))
+      Fail(column, QuoteForMessage(text) + " is not a number");
+  }
   const auto result = std::from_chars(first, last, value);
   if (result.ec != std::errc() || result.ptr != last) {
     Fail(column, QuoteForMessage(text) + " is not a number");
@@ -267,7 +396,7 @@ long CsvReader::Integer(int column, long if_empty) const {
 }
 
 void CsvReader::Fail(int column, const std::string& message) const {
-  throw InputError(path_, line_number_, column + 1, header_[column] + ": " + message);
+  throw InputError(path_, line_number_, column + 1, EscapeForMessage(header_[column], 40) + ": " + message);
 }
 
 void CsvReader::FailRow(const std::string& message) const {

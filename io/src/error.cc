@@ -6,7 +6,7 @@ namespace imufit {
 namespace {
 
 std::string Locate(const std::string& file, long line, long column) {
-  std::string where = file;
+  std::string where = EscapeForMessage(file, 300);
   if (line > 0) {
     where += ":" + std::to_string(line);
     if (column > 0) where += ":" + std::to_string(column);
@@ -17,28 +17,37 @@ std::string Locate(const std::string& file, long line, long column) {
 }  // namespace
 
 InputError::InputError(std::string file, long line, long column, const std::string& message)
-    : std::runtime_error(Locate(file, line, column) + ": " + message),
+    : std::runtime_error(Locate(file, line, column) + ": " + EscapeForMessage(message, kMaxMessageChars)),
       file_(std::move(file)),
       line_(line),
       column_(column),
-      message_(message) {}
+      message_(EscapeForMessage(message, kMaxMessageChars)) {}
+
+std::string EscapeForMessage(std::string_view text, size_t max_shown) {
+  std::string escaped;
+  for (size_t i = 0; i < text.size() && i < max_shown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      escaped += hex;
+    } else {
+      escaped += static_cast<char>(c);
+    }
+  }
+  if (text.size() > max_shown) escaped += "...";
+  return escaped;
+}
 
 std::string QuoteForMessage(std::string_view text) {
   constexpr size_t kMaxShown = 40;
   std::string quoted = "\"";
   for (size_t i = 0; i < text.size() && i < kMaxShown; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c == '"' || c == '\\') {
-      quoted += '\\';
-      quoted += static_cast<char>(c);
-    } else if (c < 0x20 || c == 0x7f) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
-      quoted += escaped;
-    } else {
-      quoted += static_cast<char>(c);
-    }
+    const char c = text[i];
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
   }
+  quoted = EscapeForMessage(quoted, std::string::npos);
   if (text.size() > kMaxShown) quoted += "...";
   return quoted + "\"";
 }

@@ -5,12 +5,18 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <limits.h>
+#include <signal.h>
+
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 
 #include "imufit/io/error.h"
 #include "imufit/io/path.h"
@@ -20,22 +26,129 @@ namespace {
 
 constexpr size_t kFlushBytes = 1 << 20;
 
+// The temporary files that exist right now, for the signal handler to remove. A fixed table of
+// fixed-size slots: the handler may only read memory and call async-signal-safe functions
+// (unlink, signal, raise). Registration (any thread) takes a mutex; the handler does not.
+struct TempSlot {
+  volatile std::sig_atomic_t used = 0;
+  char path[PATH_MAX] = {};
+};
+constexpr int kTempSlots = 128;
+TempSlot g_temp_slots[kTempSlots];
+std::mutex g_temp_mutex;
+
+int RegisterTempFile(const std::string& path) {
+  if (path.size() >= PATH_MAX) return -1;
+  const std::lock_guard<std::mutex> lock(g_temp_mutex);
+  for (int i = 0; i < kTempSlots; ++i) {
+    if (g_temp_slots[i].used) continue;
+    std::memcpy(g_temp_slots[i].path, path.c_str(), path.size() + 1);
+    std::atomic_signal_fence(std::memory_order_seq_cst);  // the path before the flag
+    g_temp_slots[i].used = 1;
+    return i;
+  }
+  return -1;  // more than kTempSlots outputs at once: this one is not removed on a signal
+}
+
+void UnregisterTempFile(int slot) {
+  if (slot < 0) return;
+  const std::lock_guard<std::mutex> lock(g_temp_mutex);
+  g_temp_slots[slot].used = 0;
+}
+
+extern "C" void RemoveTempFilesAndReraise(int signal_number) {
+  for (TempSlot& slot : g_temp_slots) {
+    if (slot.used) ::unlink(slot.path);
+  }
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
+// Refuses a destination that exists but is not an ordinary, writable file: rename() would
+// replace a symbolic link (not its target), a FIFO or a device node, or a read-only file.
+void CheckDestination(const std::string& path) {
+  struct stat status;
+  if (::lstat(path.c_str(), &status) != 0) return;  // does not exist (yet): fine
+  if (S_ISLNK(status.st_mode)) {
+    throw InputError(path,
+                     "is a symbolic link: imufit neither writes through a link nor replaces it (give the "
+                     "link's target as the output, or remove the link)");
+  }
+  if (S_ISDIR(status.st_mode)) throw InputError(path, "is a directory");
+  if (!S_ISREG(status.st_mode)) {
+    const char* kind = S_ISFIFO(status.st_mode)                             ? "a FIFO"
+                       : S_ISCHR(status.st_mode) || S_ISBLK(status.st_mode) ? "a device"
+                       : S_ISSOCK(status.st_mode)                           ? "a socket"
+                                                                            : "a special file";
+    throw InputError(path, std::string("is ") + kind +
+                               ", not a regular file: imufit writes outputs only to "
+                               "regular files, which it replaces whole");
+  }
+  if ((status.st_mode & 0222) == 0 || ::access(path.c_str(), W_OK) != 0) {
+    throw InputError(path, "is read-only: imufit does not replace a file it may not write");
+  }
+}
+
+thread_local OutputTransaction* g_transaction = nullptr;
+
 }  // namespace
+
+void InstallOutputCleanupOnSignals() {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction previous;
+    if (::sigaction(signal_number, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN)
+      continue;  // nohup
+    struct sigaction action {};
+    action.sa_handler = RemoveTempFilesAndReraise;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
+
+OutputTransaction::OutputTransaction() : previous_(g_transaction) { g_transaction = this; }
+
+OutputTransaction::~OutputTransaction() {
+  g_transaction = previous_;
+  for (const Pending& pending : pending_) {
+    ::unlink(pending.temp_path.c_str());
+    UnregisterTempFile(pending.slot);
+  }
+}
+
+void OutputTransaction::Add(std::string temp_path, std::string path, int slot) {
+  pending_.push_back({std::move(temp_path), std::move(path), slot});
+}
+
+void OutputTransaction::Commit() {
+  if (g_transaction == this) g_transaction = previous_;
+  // Every output is complete and synced on disk; only the renames are left, in one folder each,
+  // so the last thing that can fail has been done for all of them before any is renamed.
+  for (const Pending& pending : pending_) CheckDestination(pending.path);
+  while (!pending_.empty()) {
+    const Pending& pending = pending_.front();
+    if (std::rename(pending.temp_path.c_str(), pending.path.c_str()) != 0) {
+      throw InputError(pending.path, std::string("cannot replace the file: ") + std::strerror(errno));
+    }
+    UnregisterTempFile(pending.slot);
+    pending_.erase(pending_.begin());
+  }
+}
 
 OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
   namespace fs = std::filesystem;
   const fs::path destination(path_);
   if (!destination.has_filename()) throw InputError(path_, "not a file name");
-  std::error_code ec;
-  if (fs::is_directory(destination, ec)) throw InputError(path_, "is a directory");
+  CheckDestination(path_);
   const fs::path folder = destination.parent_path().empty() ? fs::path(".") : destination.parent_path();
   std::string pattern = (folder / ("." + destination.filename().string() + ".tmp-XXXXXX")).string();
   fd_ = ::mkstemp(pattern.data());
   if (fd_ < 0) {
-    throw InputError(path_, std::string("cannot create a file in ") + folder.string() + ": " +
-                                std::strerror(errno));
+    throw InputError(path_,
+                     std::string("cannot create a file in ") + folder.string() + ": " + std::strerror(errno));
   }
   temp_path_ = pattern;
+  temp_slot_ = RegisterTempFile(temp_path_);
   // mkstemp creates mode 0600; give the result the permissions an ordinary new file would get.
   const mode_t mask = ::umask(0);
   ::umask(mask);
@@ -45,6 +158,7 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
     if (gz_ == nullptr) {
       ::close(fd_);
       ::unlink(temp_path_.c_str());
+      UnregisterTempFile(temp_slot_);
       fd_ = -1;
       throw InputError(path_, "cannot start gzip compression");
     }
@@ -60,6 +174,7 @@ OutputFile::~OutputFile() {
     ::close(fd_);
   }
   if (!temp_path_.empty()) ::unlink(temp_path_.c_str());
+  UnregisterTempFile(temp_slot_);
 }
 
 void OutputFile::Write(std::string_view text) {
@@ -80,8 +195,8 @@ void OutputFile::WriteNumber(double value) {
 void OutputFile::Flush() {
   if (buffer_.empty()) return;
   if (gz_ != nullptr) {
-    const int written = gzwrite(static_cast<gzFile>(gz_), buffer_.data(),
-                                static_cast<unsigned>(buffer_.size()));
+    const int written =
+        gzwrite(static_cast<gzFile>(gz_), buffer_.data(), static_cast<unsigned>(buffer_.size()));
     if (written != static_cast<int>(buffer_.size())) {
       throw InputError(path_, "write failed (gzip)");
     }
@@ -121,9 +236,16 @@ void OutputFile::Commit() {
     ::close(fd_);
     fd_ = -1;
   }
+  if (g_transaction != nullptr) {
+    g_transaction->Add(temp_path_, path_, temp_slot_);  // renamed with the others, or removed
+    committed_ = true;
+    return;
+  }
+  CheckDestination(path_);  // again: a link or FIFO may have appeared while we wrote
   if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
     throw InputError(path_, std::string("cannot replace the file: ") + std::strerror(errno));
   }
+  UnregisterTempFile(temp_slot_);
   committed_ = true;
 }
 

@@ -1,6 +1,7 @@
 #include "imufit/io/plan.h"
 
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "imufit/io/error.h"
@@ -10,13 +11,24 @@ namespace imufit {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
-// `north` may be this far from perpendicular to `up` (SPEC.md: 1 degree).
+// `north` may be this far from perpendicular to `up` (docs/spec.md: 1 degree).
 constexpr double kNorthToleranceRad = 1.0 * kDegToRad;
+// Local gravity anywhere on Earth's surface, with margin (9.76 .. 9.84 m/s^2).
+constexpr double kMinGravity = 9.7;
+constexpr double kMaxGravity = 9.9;
 
 Eigen::Vector3d ReadDirection(const yaml::Located& value) {
   const std::vector<double> xyz = value.Doubles(3);
   const Eigen::Vector3d v(xyz[0], xyz[1], xyz[2]);
-  if (v.norm() == 0.0) value.Fail("a direction cannot be the zero vector");
+  if (v == Eigen::Vector3d::Zero()) value.Fail("a direction cannot be the zero vector");
+  // Its length must be an ordinary number, or normalising it gives zero or nan.
+  const double norm = v.norm();
+  if (!std::isfinite(norm) || norm < 1e-100 || norm > 1e100) {
+    char text[100];
+    std::snprintf(text, sizeof text, "a direction's length must lie between 1e-100 and 1e100 (it is %g)",
+                  norm);
+    value.Fail(text);
+  }
   return v;
 }
 
@@ -38,7 +50,9 @@ Plan ReadPlan(const std::string& path) {
   Plan plan;
   plan.path = path;
   plan.site.gravity_mps2 = root["gravity_mps2"].Double();
-  if (!(plan.site.gravity_mps2 > 0.0)) root["gravity_mps2"].Fail("gravity must be positive");
+  if (!(plan.site.gravity_mps2 >= kMinGravity && plan.site.gravity_mps2 <= kMaxGravity)) {
+    root["gravity_mps2"].Fail("local gravity on Earth lies between 9.7 and 9.9 m/s^2");
+  }
   if (root.Has("latitude_deg")) {
     const double latitude_deg = root["latitude_deg"].Double();
     if (std::abs(latitude_deg) > 90.0) root["latitude_deg"].Fail("latitude must be within [-90, 90] degrees");
@@ -51,7 +65,7 @@ Plan ReadPlan(const std::string& path) {
   std::set<int> ids;
   for (size_t i = 0; i < segments.Size(); ++i) {
     const yaml::Located entry = segments.At(i);
-    entry.RejectUnknownKeys({"id", "up", "rate_dps", "north", "lever_arm_m"});
+    entry.RejectUnknownKeys({"id", "up", "rate_dps", "angle_deg", "axis", "north", "lever_arm_m"});
     TableSegment segment;
     const long id = entry["id"].Integer();
     if (id < 0 || id > 1000000000L) entry["id"].Fail("an id is an integer >= 0");
@@ -59,7 +73,35 @@ Plan ReadPlan(const std::string& path) {
     if (!ids.insert(segment.id).second) entry["id"].Fail("id " + std::to_string(id) + " repeats");
     segment.up = ReadDirection(entry["up"]).normalized();
     if (entry.Has("rate_dps")) segment.rate_radps = entry["rate_dps"].Double() * kDegToRad;
+    if (entry.Has("angle_deg")) {
+      if (entry.Has("rate_dps")) {
+        entry["angle_deg"].Fail(
+            "a turn through a known angle (angle_deg) has no rate_dps: give one or the other");
+      }
+      const double angle_deg = entry["angle_deg"].Double();
+      if (angle_deg == 0.0)
+        entry["angle_deg"].Fail("a turn's angle cannot be 0 (a static segment omits angle_deg)");
+      segment.angle_rad = angle_deg * kDegToRad;
+    }
+    if (entry.Has("axis")) {
+      if (segment.IsStatic()) {
+        entry["axis"].Fail(
+            "axis is the rotation axis of a rate_dps or angle_deg segment; a static segment has none");
+      }
+      segment.axis = ReadDirection(entry["axis"]).normalized();
+    }
+    if (entry.Has("lever_arm_m") && segment.IsTurn()) {
+      entry["lever_arm_m"].Fail(
+          "a turn (angle_deg) cannot take a lever arm: its centripetal force depends on the rate profile, "
+          "which "
+          "the plan does not give");
+    }
     if (entry.Has("north")) {
+      if (!segment.IsStatic()) {
+        entry["north"].Fail(
+            "north is for static segments only (in a rate or turn segment the horizontal Earth "
+            "rate turns with the table)");
+      }
       const Eigen::Vector3d north = ReadDirection(entry["north"]).normalized();
       if (std::abs(north.dot(segment.up)) > std::sin(kNorthToleranceRad)) {
         entry["north"].Fail("north is not horizontal: it is " +

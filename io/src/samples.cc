@@ -12,9 +12,22 @@ constexpr const char* kAccelNames[3] = {"accel_x", "accel_y", "accel_z"};
 
 }  // namespace
 
-SamplesReader::SamplesReader(std::string path, bool require_segment) : csv_(std::move(path)) {
+SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c)
+    : csv_(std::move(path)) {
   time_column_ = csv_.RequireColumn("time_s");
-  temp_column_ = csv_.RequireColumn("temp_c");
+  if (!temp_c) {
+    try {
+      temp_column_ = csv_.RequireColumn("temp_c");
+    } catch (const InputError& e) {
+      throw InputError(e.file(), e.line(), e.column(),
+                       e.message() + "; for a run without a thermometer give its temperature (--temp-c)");
+    }
+  } else if (csv_.FindColumn("temp_c")) {
+    throw InputError(csv_.path(), "has a temp_c column: a fixed temperature (--temp-c) is only for samples "
+                                  "without one (leave it out to use the readings)");
+  } else {
+    fixed_temp_c_ = *temp_c;
+  }
   for (int axis = 0; axis < 3; ++axis) {
     gyro_columns_[axis] = csv_.RequireColumn(kGyroNames[axis]);
     accel_columns_[axis] = csv_.RequireColumn(kAccelNames[axis]);
@@ -35,7 +48,7 @@ bool SamplesReader::Next(Sample* sample) {
   }
   first_ = false;
   last_time_s_ = sample->time_s;
-  sample->temp_c = csv_.Number(temp_column_);
+  sample->temp_c = temp_column_ >= 0 ? csv_.Number(temp_column_) : fixed_temp_c_;
   for (int axis = 0; axis < 3; ++axis) {
     sample->gyro(axis) = csv_.Number(gyro_columns_[axis]);
     sample->accel(axis) = csv_.Number(accel_columns_[axis]);
@@ -58,22 +71,25 @@ void SamplesReader::Fail(const std::string& column, const std::string& message) 
   csv_.Fail(*index, message);
 }
 
-SamplesWriter::SamplesWriter(std::string path, bool with_segment, const std::string& comment)
-    : file_(std::move(path)), with_segment_(with_segment) {
+SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment)
+    : file_(std::move(path)), columns_(columns) {
   if (!comment.empty()) {
     std::istringstream lines(comment);
     std::string line;
     while (std::getline(lines, line)) file_.Write("# " + line + "\n");
   }
-  file_.Write(with_segment_ ? "time_s,temp_c,segment," : "time_s,temp_c,");
+  file_.Write(columns_.temp ? "time_s,temp_c," : "time_s,");
+  if (columns_.segment) file_.Write("segment,");
   file_.Write("gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
 }
 
 void SamplesWriter::Write(const Sample& sample) {
   file_.WriteNumber(sample.time_s);
-  file_.Write(",");
-  file_.WriteNumber(sample.temp_c);
-  if (with_segment_) {
+  if (columns_.temp) {
+    file_.Write(",");
+    file_.WriteNumber(sample.temp_c);
+  }
+  if (columns_.segment) {
     file_.Write(",");
     file_.Write(std::to_string(sample.segment));
   }

@@ -4,23 +4,106 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <sstream>
+#include <unordered_set>
+
+#include <yaml-cpp/eventhandler.h>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "imufit/io/error.h"
 
 namespace imufit::yaml {
 
+namespace {
+
+// Refuses a key that appears twice in one mapping (yaml-cpp would keep the first silently) and
+// nesting deeper than kMaxYamlDepth. Linear in the size of the tree.
+void CheckTree(const std::string& path, const YAML::Node& node, int depth) {
+  if (depth > kMaxYamlDepth) {
+    throw InputError(path, node.Mark().line + 1, node.Mark().column + 1,
+                     "nested deeper than " + std::to_string(kMaxYamlDepth) + " levels");
+  }
+  if (node.IsSequence()) {
+    for (const YAML::Node& element : node) CheckTree(path, element, depth + 1);
+  } else if (node.IsMap()) {
+    std::unordered_set<std::string> keys;
+    keys.reserve(node.size());
+    for (const auto& entry : node) {
+      if (!entry.first.IsScalar()) {
+        throw InputError(path, entry.first.Mark().line + 1, entry.first.Mark().column + 1,
+                         "a key must be a plain name, not a list or a mapping");
+      }
+      if (!keys.insert(entry.first.Scalar()).second) {
+        throw InputError(path, entry.first.Mark().line + 1, entry.first.Mark().column + 1,
+                         "key " + QuoteForMessage(entry.first.Scalar()) +
+                             " appears twice in the same mapping (which one is meant?)");
+      }
+      CheckTree(path, entry.second, depth + 1);
+    }
+  }
+}
+
+// Records where each document starts; ignores the rest.
+struct DocumentStarts : YAML::EventHandler {
+  YAML::Mark last = YAML::Mark::null_mark();
+  void OnDocumentStart(const YAML::Mark& mark) override { last = mark; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+  }
+  void OnMapEnd() override {}
+};
+
+}  // namespace
+
 YAML::Node LoadFile(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
-  std::stringstream text;
-  text << stream.rdbuf();
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  std::string text;
+  char block[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, block, sizeof block);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int error = errno;
+      ::close(fd);
+      throw InputError(path, std::string("cannot read: ") + std::strerror(error));
+    }
+    if (n == 0) break;
+    if (text.size() + static_cast<size_t>(n) > kMaxYamlBytes) {
+      ::close(fd);
+      throw InputError(path, "larger than " + std::to_string(kMaxYamlBytes >> 20) +
+                                 " MiB (the limit of a YAML file): not an imufit YAML file?");
+    }
+    text.append(block, static_cast<size_t>(n));
+  }
+  ::close(fd);
+  YAML::Node root;
   try {
-    return YAML::Load(text.str());
+    root = YAML::Load(text);  // the first document
+    // A second document would be ignored: refuse it. Its events are only counted, not built
+    // (YAML::LoadAll can loop forever on some malformed input).
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentStarts starts;
+    parser.HandleNextDocument(starts);
+    if (parser.HandleNextDocument(starts)) {
+      throw InputError(path, starts.last.line >= 0 ? starts.last.line + 1 : 0, 0,
+                       "a second YAML document: an imufit file holds exactly one (remove the `---` and what "
+                       "follows)");
+    }
   } catch (const YAML::Exception& e) {
     throw InputError(path, e.mark.line + 1, e.mark.column + 1, "YAML syntax: " + e.msg);
   }
+  CheckTree(path, root, 0);
+  return root;
 }
 
 void Located::Fail(const std::string& message) const {
@@ -59,26 +142,35 @@ void Located::RequireMap() const {
 void Located::RejectUnknownKeys(std::initializer_list<const char*> allowed) const {
   RequireMap();
   for (const auto& entry : node) {
-    const std::string name = entry.first.Scalar();
+    const std::string& name = entry.first.Scalar();
     bool known = false;
-    std::string list;
-    for (const char* a : allowed) {
-      known = known || name == a;
-      list += (list.empty() ? "" : ", ") + std::string(a);
-    }
+    for (const char* a : allowed) known = known || name == a;
     if (!known) {
+      std::string list;
+      for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
       Located{file, entry.first, key}.Fail("unknown key " + QuoteForMessage(name) + " (known: " + list + ")");
     }
   }
 }
 
+// A quoted scalar ("9.81", '1') or one tagged !!str is text, even when it reads as a number.
+void Located::RefuseText(const char* expected) const {
+  if (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str") {
+    Fail(QuoteForMessage(node.Scalar()) + " is quoted text; " + expected + " is written without quotes");
+  }
+}
+
 double Located::Double() const {
   if (!node.IsScalar()) Fail("expected a number");
+  RefuseText("a number");
   const std::string& text = node.Scalar();
   double value = 0.0;
   const char* first = text.data();
   const char* last = text.data() + text.size();
-  if (first != last && *first == '+') ++first;
+  if (first != last && *first == '+') {
+    ++first;
+    if (first != last && (*first == '-' || *first == '+')) Fail(QuoteForMessage(text) + " is not a number");
+  }
   const auto result = std::from_chars(first, last, value);
   if (result.ec != std::errc() || result.ptr != last || text.empty()) {
     Fail(QuoteForMessage(text) + " is not a number");
@@ -89,6 +181,7 @@ double Located::Double() const {
 
 long Located::Integer() const {
   if (!node.IsScalar()) Fail("expected an integer");
+  RefuseText("an integer");
   const std::string& text = node.Scalar();
   long value = 0;
   const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
@@ -118,8 +211,9 @@ long Located::RequireFormat(const std::string& format, long max_version) const {
   }
   const long version = (*this)["version"].Integer();
   if (version < 1 || version > max_version) {
-    (*this)["version"].Fail("version " + std::to_string(version) + " is not supported (this imufit reads version " +
-                            std::to_string(max_version) + ")");
+    (*this)["version"].Fail("version " + std::to_string(version) +
+                            " is not supported (this imufit reads version " + std::to_string(max_version) +
+                            ")");
   }
   return version;
 }

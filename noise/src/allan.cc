@@ -641,6 +641,10 @@ AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const 
     if (edf && point.dev > 0.0) {
       point.edf = *edf;
       ChiSquaredInterval(point.dev, *edf, options.confidence, &point.dev_lo, &point.dev_hi);
+    } else if (edf && point.dev == 0.0) {
+      // A constant column: the interval scales with the estimate, so it is [0, 0], not nan.
+      point.edf = *edf;
+      point.dev_lo = point.dev_hi = 0.0;
     } else {
       point.edf = std::nan("");
       point.dev_lo = point.dev_hi = std::nan("");

@@ -221,6 +221,14 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
   for (int k = 0; k < kNoiseTerms; ++k) {
     if (options.enabled[k]) enabled_mask |= 1u << k;
   }
+  const bool constant = !all_points.empty() && std::all_of(all_points.begin(), all_points.end(),
+                                                           [](const AllanPoint& p) { return p.dev == 0.0; });
+  if (constant) {
+    summary.message =
+        "the column is constant: every deviation is zero (a stuck sensor, or a signal finer than one "
+        "quantization step?)";
+    return summary;
+  }
   if (points.size() < 2) {
     summary.message = "too few points for a noise fit (" + std::to_string(points.size()) +
                       " with at least " + std::to_string(static_cast<int>(options.min_clusters)) +

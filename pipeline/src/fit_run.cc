@@ -10,6 +10,10 @@ YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path,
   node["plan"] = plan_path;
   node["samples"] = samples_path;
   node["samples_read"] = result.run.stats.samples;
+  if (result.run.segmentation) {
+    node["segments_found_in_data"] = static_cast<int>(result.run.segmentation->matches.size());
+    node["plan_passes_found"] = result.run.segmentation->passes;
+  }
   node["windows_used"] = fit.windows_used;
   node["windows_downweighted"] = fit.windows_downweighted;
   node["distinct_temperatures_c"] = fit.distinct_temps_c;
@@ -34,6 +38,7 @@ YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path,
 std::string FitRunOptions::Validate() const {
   if (std::string problem = fit.Validate(); !problem.empty()) return problem;
   if (std::string problem = windows.Validate(); !problem.empty()) return problem;
+  if (std::string problem = input.Validate(); !problem.empty()) return problem;
   if (check_samples.empty() && !check_plan.empty()) return "a check plan needs check samples";
   return "";
 }
@@ -41,13 +46,13 @@ std::string FitRunOptions::Validate() const {
 FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path, const FitRunOptions& options) {
   FitRunResult result;
   result.plan = ReadPlan(plan_path);
-  result.run = ReadRunWindows(result.plan, samples_path, options.windows);
+  result.run = ReadRunWindows(result.plan, samples_path, options.windows, options.input);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   std::vector<Window> check_windows;
   Plan check_plan;
   if (!options.check_samples.empty()) {
     check_plan = ReadPlan(options.check_plan.empty() ? plan_path : options.check_plan);
-    check_windows = ReadRunWindows(check_plan, options.check_samples, options.windows).windows;
+    check_windows = ReadRunWindows(check_plan, options.check_samples, options.windows, options.input).windows;
   }
 
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);

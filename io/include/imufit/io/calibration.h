@@ -1,4 +1,4 @@
-// imufit — the calibration file (SPEC.md section 3): what the fit exports and consumers read.
+// imufit — the calibration file (docs/spec.md section 3): what the fit exports and consumers read.
 //
 // Coefficients are written as lists c0..c3 of powers of dT = T - 25 degC, each number in its
 // shortest round-trip form, so write -> read gives back the same doubles (==). An optional

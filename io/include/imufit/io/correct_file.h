@@ -2,11 +2,12 @@
 //
 // Streams `samples_path` row by row through the shared model (SensorModel::Correct: the
 // accelerometer first, then the gyro with the corrected specific force of the same row) and
-// writes the corrected layout of SPEC.md (time_s, temp_c, segment if the input had it, gyro in
+// writes the corrected layout of docs/spec.md (time_s, temp_c, segment if the input had it, gyro in
 // rad/s, accel in m/s^2) to `output_path`, atomically.
 #ifndef IMUFIT_IO_CORRECT_FILE_H_
 #define IMUFIT_IO_CORRECT_FILE_H_
 
+#include <optional>
 #include <string>
 
 #include "imufit/io/calibration.h"
@@ -21,8 +22,9 @@ struct CorrectFileReport {
   double max_temp_c = 0.0;
 };
 
+// `temp_c`: the temperature of every sample of a file without a temp_c column (written to the output).
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path);
+                                     const std::string& output_path, std::optional<double> temp_c = std::nullopt);
 
 }  // namespace imufit
 

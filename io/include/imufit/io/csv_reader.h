@@ -1,15 +1,17 @@
-// imufit — a streaming reader for the CSV files of SPEC.md (plain or gzip-compressed).
+// imufit — a streaming reader for the CSV files of docs/spec.md (plain or gzip-compressed).
 //
 // The first line that is neither empty nor a comment (starting with '#') is the header; columns
 // are found by name, in any order; columns nobody asks for are never parsed. Rows are read in
 // blocks of a few MiB, so memory does not grow with the file. Fields may be quoted ("...", with
-// "" for a quote) but may not span lines. Numbers are parsed with std::from_chars.
+// "" for a quote) but may not span lines; a row may not have more fields than the header. A
+// UTF-8 byte-order mark before the header is skipped. Numbers are parsed with std::from_chars.
 //
 // Errors are InputErrors located at file:line:field, e.g.
 //   samples.csv:412:5: gyro_y: "1.2.3" is not a number
 #ifndef IMUFIT_IO_CSV_READER_H_
 #define IMUFIT_IO_CSV_READER_H_
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +22,11 @@ namespace imufit {
 
 class CsvReader {
  public:
+  // Input limits (docs/conventions.md): a longer line or more fields is an InputError, so a
+  // file that is not a CSV of samples (a binary, /dev/zero, one huge line) costs bounded memory.
+  static constexpr size_t kMaxLineBytes = 1 << 20;
+  static constexpr size_t kMaxColumns = 10000;
+
   // Opens `path` (gzip when it ends in ".gz") and reads its header. Throws InputError.
   explicit CsvReader(std::string path);
   ~CsvReader();
@@ -55,6 +62,9 @@ class CsvReader {
   class Source;
   bool NextLine(std::string_view* line);
   void SplitLine(std::string_view line);
+  void SkipByteOrderMark(std::string_view* line) const;
+  [[noreturn]] void LineTooLong() const;
+  [[noreturn]] void TooManyFields() const;
 
   std::string path_;
   std::unique_ptr<Source> source_;
@@ -67,7 +77,10 @@ class CsvReader {
   long long bytes_read_ = 0;
   std::vector<std::string> header_;
   void AddField(std::string_view field) {
-    if (field_count_ == fields_.size()) fields_.resize(2 * fields_.size() + 16);
+    if (field_count_ == fields_.size()) {
+      if (field_count_ >= kMaxColumns) TooManyFields();
+      fields_.resize(std::min(2 * fields_.size() + 16, kMaxColumns));
+    }
     fields_[field_count_++] = field;
   }
   std::vector<std::string_view> fields_;  // the first field_count_ are the current row's

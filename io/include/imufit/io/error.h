@@ -6,6 +6,8 @@
 //
 //   samples.csv:412:5: gyro_y: "1.2.3" is not a number
 //
+// The file name and the message are made safe for a terminal (EscapeForMessage) and bounded.
+//
 // For CSV files the column is the 1-based field number; for YAML files it is the character
 // column that yaml-cpp reports.
 #ifndef IMUFIT_IO_ERROR_H_
@@ -38,6 +40,14 @@ class InputError : public std::runtime_error {
 // Quotes a piece of offending input for an error message, shortened when long and with
 // control characters escaped: "1.2.3".
 std::string QuoteForMessage(std::string_view text);
+
+// `text` for an error message: control characters (ESC, BEL, CR, NUL, ...) and DEL escaped as
+// \xHH, shortened to `max_shown` characters with "..." when longer.
+std::string EscapeForMessage(std::string_view text, size_t max_shown);
+
+// Every message is bounded: the text of an InputError (file name and message together) is at
+// most about this many characters, whatever the input.
+inline constexpr size_t kMaxMessageChars = 1000;
 
 }  // namespace imufit
 

@@ -1,9 +1,13 @@
-// imufit — output files that are written whole or not at all (SPEC.md section 4).
+// imufit — output files that are written whole or not at all (docs/spec.md section 4).
 //
 // An OutputFile writes into a temporary file in the destination's folder and renames it over the
 // destination only in Commit(), after a flush and an fsync. If Commit() is never reached (an
 // error, an exception, a crash) the temporary file is removed and an existing destination is
-// left exactly as it was. Paths ending in ".gz" are written gzip-compressed.
+// left exactly as it was; on SIGINT, SIGTERM or SIGHUP too (InstallOutputCleanupOnSignals).
+// Paths ending in ".gz" are written gzip-compressed.
+//
+// An existing destination must be a regular file that may be written: a symbolic link, FIFO,
+// device node, directory or read-only file is refused (InputError) rather than replaced.
 #ifndef IMUFIT_IO_OUTPUT_FILE_H_
 #define IMUFIT_IO_OUTPUT_FILE_H_
 
@@ -28,6 +32,9 @@ class OutputFile {
   void Commit();
 
   const std::string& path() const { return path_; }
+  // The temporary file, for a program that writes the output itself (gnuplot): whatever is at
+  // this path when Commit() runs becomes the destination.
+  const std::string& temp_path() const { return temp_path_; }
 
  private:
   void Flush();
@@ -38,7 +45,39 @@ class OutputFile {
   int fd_ = -1;
   void* gz_ = nullptr;  // gzFile when compressing
   bool committed_ = false;
+  int temp_slot_ = -1;  // in the table of temporaries removed on a signal
 };
+
+// Several outputs written all or nothing (`fit -o .. --report ..`). While a transaction is open
+// on this thread, OutputFile::Commit() completes its temporary file (flushed, synced, closed)
+// but leaves it in place; the transaction's Commit() renames them all over their destinations.
+// A transaction destroyed without Commit() (an error in any output) removes every temporary,
+// so no destination changes. The renames themselves are the only step after which a failure
+// (of the file system) can leave some outputs replaced and others not.
+class OutputTransaction {
+ public:
+  OutputTransaction();
+  ~OutputTransaction();
+  OutputTransaction(const OutputTransaction&) = delete;
+  OutputTransaction& operator=(const OutputTransaction&) = delete;
+
+  void Commit();
+  // Called by OutputFile::Commit().
+  void Add(std::string temp_path, std::string path, int slot);
+
+ private:
+  struct Pending {
+    std::string temp_path, path;
+    int slot;
+  };
+  std::vector<Pending> pending_;
+  OutputTransaction* previous_;
+};
+
+// Removes the temporary files of uncommitted outputs when the program is stopped by SIGINT,
+// SIGTERM or SIGHUP (then dies of that signal as it would have). Signals that are ignored
+// (nohup) stay ignored. Called once by main().
+void InstallOutputCleanupOnSignals();
 
 // Writes `text` to `path` atomically (OutputFile in one call).
 void WriteFileAtomically(const std::string& path, std::string_view text);

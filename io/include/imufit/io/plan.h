@@ -1,10 +1,12 @@
-// imufit — the plan file (SPEC.md section 2): what the rate table did, segment by segment.
+// imufit — the plan file (docs/spec.md section 2): what the rate table did, segment by segment.
 //
 // The reader converts at the edge: rate_dps -> rad/s, latitude_deg -> rad; `up` and `north` are
 // normalised, and `north` is made exactly perpendicular to `up` (it may be off by at most 1
-// degree in the file). A plan is refused (InputError) when a vector is zero or not three
-// numbers, `north` is not horizontal, an id repeats, a key is unknown, or format/version are
-// not ones this reader knows.
+// degree in the file); angle_deg -> angle_rad, `axis` normalised. A plan is refused (InputError)
+// when a vector is zero or not three numbers, `north` is not horizontal or is given on a rate or
+// turn segment, `axis` is given on a static segment, `angle_deg` is 0 or comes with `rate_dps` or
+// `lever_arm_m`, an id repeats, a key is unknown, or format/version are not ones this reader
+// knows. The truth of each kind of segment: docs/conventions.md.
 #ifndef IMUFIT_IO_PLAN_H_
 #define IMUFIT_IO_PLAN_H_
 

@@ -1,6 +1,7 @@
-// imufit — samples files (SPEC.md section 2): what the unit said, sample by sample.
+// imufit — samples files (docs/spec.md section 2): what the unit said, sample by sample.
 //
-// Columns, by name and in any order: time_s (s, strictly increasing), temp_c (degC), segment
+// Columns, by name and in any order: time_s (s, strictly increasing; the intervals may vary),
+// temp_c (degC; may be absent when the caller gives one temperature for the whole run), segment
 // (plan segment id, -1 or empty while the table moves), gyro_x..z (raw B), accel_x..z (raw A).
 // The reader streams: one row at a time, nothing kept. The writer writes the same layout, numbers
 // in their shortest round-trip form, so a written file reads back bit-exactly.
@@ -8,6 +9,7 @@
 #define IMUFIT_IO_SAMPLES_H_
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "imufit/io/csv_reader.h"
@@ -19,14 +21,17 @@ namespace imufit {
 class SamplesReader {
  public:
   // Opens a samples file; `require_segment` makes the segment column mandatory (imufit fit).
-  // Throws InputError naming the missing column.
-  SamplesReader(std::string path, bool require_segment);
+  // `temp_c`, when given, is the temperature of every sample of a file without a temp_c column
+  // (a run without a thermometer); a file that has the column is then refused, so that no reading
+  // is silently replaced. Throws InputError naming the missing column.
+  SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c = std::nullopt);
 
   // Reads the next sample; false at the end. Throws InputError on a bad value, a time that does
   // not increase, or a segment id below -1.
   bool Next(Sample* sample);
 
   bool has_segment() const { return segment_column_ >= 0; }
+  bool has_temp() const { return temp_column_ >= 0; }
   // Throws an InputError located at the current row and the column called `column`.
   [[noreturn]] void Fail(const std::string& column, const std::string& message) const;
   const std::string& path() const { return csv_.path(); }
@@ -36,7 +41,8 @@ class SamplesReader {
  private:
   CsvReader csv_;
   int time_column_;
-  int temp_column_;
+  int temp_column_ = -1;
+  double fixed_temp_c_ = 0.0;  // without a temp_c column
   int segment_column_ = -1;
   int gyro_columns_[3];
   int accel_columns_[3];
@@ -44,18 +50,26 @@ class SamplesReader {
   double last_time_s_ = 0.0;
 };
 
+// The optional columns a SamplesWriter writes.
+struct SampleColumns {
+  bool segment = true;
+  bool temp = true;
+};
+
 class SamplesWriter {
  public:
   // Starts `path` (atomically: nothing appears until Commit()). `with_segment` adds the
   // segment column. `comment`, if not empty, is written first as '#' lines.
-  SamplesWriter(std::string path, bool with_segment, const std::string& comment = "");
+  SamplesWriter(std::string path, bool with_segment, const std::string& comment = "")
+      : SamplesWriter(std::move(path), SampleColumns{with_segment, true}, comment) {}
+  SamplesWriter(std::string path, SampleColumns columns, const std::string& comment = "");
 
   void Write(const Sample& sample);
   void Commit() { file_.Commit(); }
 
  private:
   OutputFile file_;
-  bool with_segment_;
+  SampleColumns columns_;
 };
 
 }  // namespace imufit

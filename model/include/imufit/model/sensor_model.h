@@ -1,4 +1,4 @@
-// imufit — the shared correction model (SPEC.md section 1).
+// imufit — the shared correction model (docs/spec.md section 1).
 //
 // Gyro (VectorNav's linear gyro model) and accelerometer:
 //
@@ -130,7 +130,7 @@ Vector3<T> ForwardSensor(const SensorCoefficients<T>& c, const Vector3<T>& truth
 }
 
 // The complete correction of one sample: the accelerometer first, then the gyro, whose
-// g-sensitivity term uses the corrected specific force of the same sample (SPEC.md).
+// g-sensitivity term uses the corrected specific force of the same sample (docs/spec.md).
 // `gyro_params` and `accel_params` follow the layout above in the given temperature basis.
 template <typename T>
 void CorrectSample(const T* gyro_params, const T* accel_params, const TemperatureBasis& basis,

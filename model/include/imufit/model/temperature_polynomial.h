@@ -5,7 +5,7 @@
 //
 //   C(T) = c0 + c1 x + c2 x^2 + c3 x^3,   x = (T - center_c) / half_range_c.
 //
-// The exported calibration (SPEC.md section 3) uses center_c = 25 degC and half_range_c = 1,
+// The exported calibration (docs/spec.md section 3) uses center_c = 25 degC and half_range_c = 1,
 // so that x = dT = T - 25 degC and c0..c3 are the coefficients of powers of dT. The fitter
 // uses the same function with a centre and half range that map the run's temperatures to about
 // [-1, 1] (a well-conditioned basis), and converts exactly to powers of dT on export with

@@ -5,7 +5,8 @@
 // asked, and builds the calibration to write (with its `sigma` tree and a `fit:` diagnostics
 // block). It writes nothing. Bad input throws InputError; a run that does not determine the
 // model, or a fit that does not converge, is reported through `fit.status` (then `calibration`
-// is not set).
+// is not set). A samples file without a segment column is labelled from the plan first
+// (segment_run.h); when it does not match the plan, PlanMismatchError is thrown.
 #ifndef IMUFIT_PIPELINE_FIT_RUN_H_
 #define IMUFIT_PIPELINE_FIT_RUN_H_
 
@@ -24,6 +25,8 @@ namespace imufit {
 struct FitRunOptions {
   FitOptions fit;
   WindowOptions windows;
+  // Files without a temp_c or segment column (the held-out run is read the same way).
+  SamplesInput input;
   // Leave each interior temperature out in turn and report the errors on it.
   bool validate = false;
   // A held-out run (and its plan; empty: the fitted run's plan) to report the errors on.

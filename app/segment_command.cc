@@ -1,0 +1,99 @@
+// imufit segment — finds a plan's segments in an unlabelled log and writes it with a segment column.
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
+#include "imufit/io/plan.h"
+
+namespace imufit {
+namespace {
+
+struct SegmentArguments {
+  std::string plan;
+  std::string samples;
+  std::string output;
+  bool quiet = false;
+  SamplesInputArguments input;
+};
+
+int RunSegment(const SegmentArguments& args) {
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples});
+  const SamplesInput input = args.input.Get();
+  if (const std::string problem = input.Validate(); !problem.empty())
+    throw InputError("imufit segment", problem);
+  const Plan plan = ReadPlan(args.plan);
+  const Segmentation segmentation = SegmentSamplesFile(plan, args.samples, input);
+  const LabelledFileReport report = WriteLabelledSamples(segmentation, args.samples, args.output, input);
+  if (args.quiet) return 0;
+  std::printf(
+      "imufit segment: %zu segments found in %d pass%s through the plan; %lld of %lld samples labelled -> "
+      "%s\n",
+      segmentation.matches.size(), segmentation.passes, segmentation.passes == 1 ? "" : "es", report.labelled,
+      report.samples, args.output.c_str());
+  std::printf("  raw axis signs: accel %+.0f %+.0f %+.0f, gyro %+.0f %+.0f %+.0f\n",
+              segmentation.accel_signs.x(), segmentation.accel_signs.y(), segmentation.accel_signs.z(),
+              segmentation.gyro_signs.x(), segmentation.gyro_signs.y(), segmentation.gyro_signs.z());
+  if (report.input_had_segment) {
+    std::printf(
+        "  note: the input's segment column was replaced; %lld of %lld samples (%.2f %%) kept their label\n",
+        report.agreeing, report.samples, 100.0 * static_cast<double>(report.agreeing) / report.samples);
+  }
+  std::printf("%s", SegmentationReport(segmentation).c_str());
+  return 0;
+}
+
+}  // namespace
+
+void AddTempOption(CLI::App* command, SamplesInputArguments* args) {
+  args->temp_c_option = command->add_option(
+      "--temp-c", args->temp_c,
+      "the temperature of every sample, degC, for samples without a temp_c column (a run without a "
+      "thermometer); a file with the column is refused");
+}
+
+void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args) {
+  SegmentationOptions& o = args->input.segmentation;
+  command
+      ->add_option("--segment-window", o.window_s,
+                   "without a segment column: sliding window whose variance tells rest from motion, s")
+      ->capture_default_str();
+  command
+      ->add_option("--min-steady", o.min_steady_s,
+                   "without a segment column: rests and constant rates shorter than this count as motion, s")
+      ->capture_default_str();
+  command
+      ->add_option("--direction-tolerance", o.direction_tolerance_deg,
+                   "without a segment column: how far a measured gravity direction or rotation axis may be "
+                   "from the plan's, deg")
+      ->capture_default_str();
+  command
+      ->add_option(
+          "--rate-tolerance", o.rate_tolerance,
+          "without a segment column: how far the raw size of a rate or turn may be from the others', "
+          "relative")
+      ->capture_default_str();
+}
+
+CommandRunner AddSegmentCommand(CLI::App* root) {
+  auto args = std::make_shared<SegmentArguments>();
+  CLI::App* command = root->add_subcommand(
+      "segment",
+      "Find the plan's segments (rests, constant rates, turns) in a log without a segment column, print the "
+      "match with times, and write the samples with a segment column (-1 while moving). Exit 1 when the log "
+      "and the plan disagree (missing, extra or reordered segments; the message gives the time).");
+  command
+      ->add_option("--plan,-p", args->plan,
+                   "plan YAML of the run: its segments in the order the table ran them")
+      ->required();
+  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
+  command->add_option("--output,-o", args->output, "labelled samples CSV to write (.gz compresses)")
+      ->required();
+  AddTempOption(command, &args->input);
+  AddSegmentationOptions(command, &args->input);
+  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  return [args] { return RunSegment(*args); };
+}
+
+}  // namespace imufit

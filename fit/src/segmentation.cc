@@ -1,0 +1,586 @@
+#include "imufit/fit/segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <sstream>
+#include <utility>
+
+#include <Eigen/Geometry>
+
+namespace imufit {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+// Pass 1 keeps this many samples before it fixes the block length from their mean interval.
+constexpr size_t kHeadSamples = 32;
+// A window holds at least this many samples (slow logs widen it).
+constexpr double kMinWindowSamples = 16.0;
+// A window is this many blocks, centred on the block it classifies.
+constexpr int kWindowHalfBlocks = 2;
+// The variance of a rounded reading (uniform over one count) summed over three axes, raw^2: the
+// noise level of a quantised log cannot be lower.
+constexpr double kQuantisationVar = 3.0 / 12.0;
+// Noise level floor relative to the squared size of the readings (noise-free simulations).
+constexpr double kRelativeVarFloor = 1e-18;
+// Gyro offsets below this many per-sample noise sigmas are rest even in a plan with slow rates.
+constexpr double kRestNoiseSigmas = 3.0;
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double na = a.norm();
+  const double nb = b.norm();
+  if (na == 0.0 || nb == 0.0) return 180.0;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
+}
+
+std::string Vec(const Eigen::Vector3d& v, const char* format = "%+.2f") {
+  std::string text = "(";
+  for (int i = 0; i < 3; ++i) {
+    char number[48];
+    std::snprintf(number, sizeof number, format, v(i));
+    text += number;
+    if (i < 2) text += ", ";
+  }
+  return text + ")";
+}
+
+std::string Seconds(double t) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.2f", t);
+  return text;
+}
+
+std::string Degrees(double deg) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.1f deg", deg);
+  return text;
+}
+
+// Per axis, the median of `values` weighted by `weights`.
+Eigen::Vector3d WeightedMedian(const std::vector<Eigen::Vector3d>& values,
+                               const std::vector<double>& weights) {
+  Eigen::Vector3d median = Eigen::Vector3d::Zero();
+  if (values.empty()) return median;
+  double total = 0.0;
+  for (double w : weights) total += w;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<std::pair<double, double>> sorted;
+    for (size_t i = 0; i < values.size(); ++i) sorted.emplace_back(values[i](axis), weights[i]);
+    std::sort(sorted.begin(), sorted.end());
+    double seen = 0.0;
+    for (const auto& [value, weight] : sorted) {
+      seen += weight;
+      median(axis) = value;
+      if (seen >= 0.5 * total) break;
+    }
+  }
+  return median;
+}
+
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const size_t index =
+      std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())));
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(index), values.end());
+  return values[index];
+}
+
+std::string KindOf(const TableSegment& segment) {
+  if (segment.IsTurn()) return "turn";
+  return segment.IsStatic() ? "static" : "rate";
+}
+
+std::string DescribeSegment(const TableSegment& segment, int pass) {
+  std::string text = "segment " + std::to_string(segment.id) + " (pass " + std::to_string(pass + 1) + ": " +
+                     KindOf(segment) + ", up " + Vec(segment.up, "%+.2g");
+  char number[64];
+  if (segment.IsTurn()) {
+    std::snprintf(number, sizeof number, ", %+.1f deg about ", *segment.angle_rad * kRadToDeg);
+    text += number + Vec(segment.RotationAxis(), "%+.2g");
+  } else if (!segment.IsStatic()) {
+    std::snprintf(number, sizeof number, ", %+.4g deg/s about ", segment.rate_radps * kRadToDeg);
+    text += number + Vec(segment.RotationAxis(), "%+.2g");
+  }
+  return text + ")";
+}
+
+// Where gravity points at the end of a segment, body frame (unknown after a rate about a tilted axis).
+std::optional<Eigen::Vector3d> UpAfter(const TableSegment& segment) {
+  if (segment.IsTurn()) return Eigen::AngleAxisd(-*segment.angle_rad, segment.RotationAxis()) * segment.up;
+  if (segment.IsStatic() || AngleDeg(segment.RotationAxis(), segment.up) < 1.0 ||
+      AngleDeg(segment.RotationAxis(), segment.up) > 179.0) {
+    return segment.up;
+  }
+  return std::nullopt;
+}
+
+// What the whole run looks like, independent of the sign pattern tried.
+struct RunFacts {
+  bool plan_has_rates = false;
+  bool plan_uses_gyro_signs = false;
+  Eigen::Vector3d gyro_rest = Eigen::Vector3d::Zero();  // raw, the run's typical rest
+  double rate_threshold = 0.0;                          // raw: gyro offsets above are rates
+};
+
+// One attempt at matching with one sign pattern of the raw axes.
+class Matcher {
+ public:
+  Matcher(const DetectedRun& run, const std::vector<TableSegment>& segments,
+          const SegmentationOptions& options, const RunFacts& facts, const Eigen::Vector3d& accel_signs,
+          const Eigen::Vector3d& gyro_signs)
+      : run_(run), segments_(segments), options_(options), facts_(facts) {
+    result_.accel_signs = accel_signs;
+    result_.gyro_signs = gyro_signs;
+  }
+
+  // True when the whole run matched; else problem() says where it did not.
+  bool Run();
+  const Segmentation& result() const { return result_; }
+  const std::string& problem() const { return problem_; }
+  double reached_s() const { return reached_s_; }
+  double residual_deg() const { return residual_deg_; }
+
+ private:
+  Eigen::Vector3d Gravity(const MotionPiece& piece) const {
+    return result_.accel_signs.cwiseProduct(piece.accel_mean).normalized();
+  }
+  Eigen::Vector3d GyroBody(const Eigen::Vector3d& raw) const { return result_.gyro_signs.cwiseProduct(raw); }
+  bool IsRest(const MotionPiece& piece, const Eigen::Vector3d& gyro_rest) const {
+    return piece.kind == PieceKind::kSteady &&
+           (!facts_.plan_has_rates || (piece.gyro_mean - gyro_rest).norm() < facts_.rate_threshold);
+  }
+  bool ScaleFits(double scale) const {
+    return !scale_ || std::abs(scale / *scale_ - 1.0) <= options_.rate_tolerance;
+  }
+  bool Fail(const MotionPiece* piece, const std::string& message) {
+    reached_s_ = piece ? piece->start_s : (run_.pieces.empty() ? 0.0 : run_.pieces.back().end_s);
+    problem_ = message;
+    return false;
+  }
+  void Add(const TableSegment& segment, int pass, const MotionPiece& piece, double residual_deg,
+           std::string evidence) {
+    result_.matches.push_back(
+        {segment.id, pass, KindOf(segment), piece.start_s, piece.end_s, std::move(evidence)});
+    residual_deg_ += residual_deg;
+  }
+  // Is pieces[p] (motion) the turn `segment`? Sets *hint when it nearly is.
+  bool TurnFits(size_t p, const TableSegment& segment, int pass, std::string* hint);
+
+  const DetectedRun& run_;
+  const std::vector<TableSegment>& segments_;
+  const SegmentationOptions& options_;
+  const RunFacts& facts_;
+  Segmentation result_;
+  std::string problem_;
+  double reached_s_ = 0.0;
+  double residual_deg_ = 0.0;
+  std::optional<double> scale_;  // raw per rad/s (= raw * s per rad), from the rates and turns matched
+};
+
+bool Matcher::TurnFits(size_t p, const TableSegment& segment, int pass, std::string* hint) {
+  const std::vector<MotionPiece>& pieces = run_.pieces;
+  if (p == 0 || p + 1 >= pieces.size()) return false;
+  const MotionPiece& before = pieces[p - 1];
+  const MotionPiece& turn = pieces[p];
+  const MotionPiece& after = pieces[p + 1];
+  if (before.kind != PieceKind::kSteady || !IsRest(after, before.gyro_mean)) return false;
+  const double tol = options_.direction_tolerance_deg;
+  const double start_error = AngleDeg(Gravity(before), segment.up);
+  const double end_error = AngleDeg(Gravity(after), *UpAfter(segment));
+  if (start_error > tol || end_error > tol) return false;
+  const Eigen::Vector3d bias = 0.5 * (before.gyro_mean + after.gyro_mean);
+  const Eigen::Vector3d theta_raw = turn.gyro_integral - bias * turn.integral_s;
+  const double angle = *segment.angle_rad;
+  const Eigen::Vector3d expected = segment.RotationAxis() * (angle < 0.0 ? -1.0 : 1.0);
+  const double axis_error = AngleDeg(GyroBody(theta_raw), expected);
+  const double scale = theta_raw.norm() / std::abs(angle);
+  if (axis_error > tol || !ScaleFits(scale)) {
+    *hint = "; the motion at t = " + Seconds(turn.start_s) + " .. " + Seconds(turn.end_s) +
+            " s between rests in the turn's positions turned about body " +
+            Vec(GyroBody(theta_raw).normalized()) + " (" + Degrees(axis_error) + " from the plan's axis)" +
+            (ScaleFits(scale) ? std::string()
+                              : ", by an amount out of proportion with the other rates and turns");
+    return false;
+  }
+  if (!scale_) scale_ = scale;
+  Add(segment, pass, turn, start_error + end_error + axis_error,
+      "turn between rests: raw gyro integral " + Vec(theta_raw, "%+.4g") + " about body " +
+          Vec(GyroBody(theta_raw).normalized()) + ", " + Degrees(axis_error) +
+          " from the axis; gravity before " + Degrees(start_error) + " from up, after " + Degrees(end_error) +
+          " from the turned up");
+  return true;
+}
+
+bool Matcher::Run() {
+  const std::vector<MotionPiece>& pieces = run_.pieces;
+  const double tol = options_.direction_tolerance_deg;
+  size_t k = 0;
+  size_t j = 0;
+  int pass = 0;
+  std::optional<Eigen::Vector3d> gravity_now;  // where gravity points now (body), when known
+  Eigen::Vector3d gyro_rest = facts_.gyro_rest;
+  while (true) {
+    const TableSegment& expected = segments_[j];
+    const std::string wanted = DescribeSegment(expected, pass);
+    std::string hint;
+    const TableSegment& before = segments_[(j + segments_.size() - 1) % segments_.size()];
+    if (segments_.size() > 1 && expected.IsStatic() && before.IsStatic() &&
+        AngleDeg(before.up, expected.up) <= tol) {
+      hint =
+          "; segment " + std::to_string(expected.id) + " follows segment " + std::to_string(before.id) +
+          " in the same position: without labels they are told apart only by a move between them (the table "
+          "turning about the vertical), and the log shows none";
+    }
+    bool found = false;
+    size_t p = k;
+    for (; p < pieces.size() && !found; ++p) {
+      const MotionPiece& piece = pieces[p];
+      const Eigen::Vector3d offset = piece.gyro_mean - gyro_rest;
+      const bool turning = facts_.plan_has_rates && offset.norm() >= facts_.rate_threshold;
+      const std::string where = "at t = " + Seconds(piece.start_s) + " .. " + Seconds(piece.end_s) + " s: ";
+      if (piece.kind == PieceKind::kMotion || (piece.kind == PieceKind::kSteadyGyro && !turning)) {
+        found = expected.IsTurn() && TurnFits(p, expected, pass, &hint);
+        if (found) gravity_now = UpAfter(expected);
+        continue;  // else the table moving between segments
+      }
+      if (!turning) {  // a rest
+        const Eigen::Vector3d gravity = Gravity(piece);
+        const double error = AngleDeg(gravity, expected.up);
+        if (expected.IsStatic() && error <= tol) {
+          Add(expected, pass, piece, error,
+              "rest, gravity along body " + Vec(gravity) + ", " + Degrees(error) + " from up; raw accel " +
+                  Vec(piece.accel_mean, "%.6g"));
+          gravity_now = expected.up;
+          gyro_rest = piece.gyro_mean;
+          found = true;
+          continue;
+        }
+        if (gravity_now && AngleDeg(gravity, *gravity_now) <= tol) {
+          gyro_rest = piece.gyro_mean;  // settling after a move
+          continue;
+        }
+        if (!expected.IsStatic() && error <= tol) {
+          gyro_rest = piece.gyro_mean;  // waiting in position for the next rate or turn
+          gravity_now = expected.up;
+          continue;
+        }
+        return Fail(&piece, where + "a rest with gravity along body " + Vec(gravity) + " (raw accel " +
+                                Vec(piece.accel_mean, "%.6g") + ") where " + wanted +
+                                " is expected; it is neither that position nor the one before" +
+                                (gravity_now ? " (up " + Vec(*gravity_now, "%+.2g") + ")" : std::string()) +
+                                ": a segment is missing, extra or out of order" + hint);
+      }
+      // A constant rate.
+      const Eigen::Vector3d offset_body = GyroBody(offset);
+      if (!expected.IsStatic() && !expected.IsTurn()) {
+        const Eigen::Vector3d axis = expected.RotationAxis() * (expected.rate_radps < 0.0 ? -1.0 : 1.0);
+        const double axis_error = AngleDeg(offset_body, axis);
+        const double scale = offset.norm() / std::abs(expected.rate_radps);
+        const std::optional<Eigen::Vector3d> up_after = UpAfter(expected);
+        const bool check_gravity = piece.kind == PieceKind::kSteady && up_after;
+        const double gravity_error = check_gravity ? AngleDeg(Gravity(piece), expected.up) : 0.0;
+        if (axis_error <= tol && ScaleFits(scale) && gravity_error <= tol) {
+          if (!scale_) scale_ = scale;
+          Add(expected, pass, piece, axis_error + gravity_error,
+              "constant rate: raw gyro offset " + Vec(offset, "%+.5g") + " about body " +
+                  Vec(offset_body.normalized()) + ", " + Degrees(axis_error) + " from the axis" +
+                  (check_gravity ? "; gravity " + Degrees(gravity_error) + " from up" : std::string()));
+          gravity_now = up_after;
+          found = true;
+          continue;
+        }
+        return Fail(&piece,
+                    where + "a constant rate about body " + Vec(offset_body.normalized()) +
+                        " (raw gyro offset " + Vec(offset, "%+.5g") + ", " + Degrees(axis_error) +
+                        " from the expected axis" +
+                        (ScaleFits(scale) ? "" : ", its size out of proportion with the other rates") +
+                        (gravity_error > tol ? ", gravity " + Degrees(gravity_error) + " from up" : "") +
+                        ") where " + wanted + " is expected: a segment is missing, extra or out of order");
+      }
+      return Fail(&piece, where + "a constant rate about body " + Vec(offset_body.normalized()) +
+                              " (raw gyro offset " + Vec(offset, "%+.5g") + ") where " + wanted +
+                              " is expected: a segment is missing, extra or out of order");
+    }
+    if (!found) {
+      if (j == 0 && pass > 0) break;  // the run ended after a whole pass
+      const double end_s = pieces.empty() ? 0.0 : pieces.back().end_s;
+      return Fail(nullptr,
+                  "the run ends (t = " + Seconds(end_s) + " s) before " + wanted +
+                      " was found: a segment is missing" + hint +
+                      (pass > 0 || j > 0 ? " (or the last pass through the plan is incomplete)" : ""));
+    }
+    k = p;
+    if (++j == segments_.size()) {
+      j = 0;
+      ++pass;
+    }
+  }
+  result_.passes = pass;
+  return true;
+}
+
+RunFacts Facts(const DetectedRun& run, const std::vector<TableSegment>& segments) {
+  RunFacts facts;
+  double min_rate = 0.0;
+  double max_rate = 0.0;
+  for (const TableSegment& segment : segments) {
+    if (!segment.IsStatic()) facts.plan_uses_gyro_signs = true;
+    if (segment.IsStatic() || segment.IsTurn()) continue;
+    const double rate = std::abs(segment.rate_radps);
+    min_rate = facts.plan_has_rates ? std::min(min_rate, rate) : rate;
+    max_rate = std::max(max_rate, rate);
+    facts.plan_has_rates = true;
+  }
+  std::vector<Eigen::Vector3d> means;
+  std::vector<double> durations;
+  for (const MotionPiece& piece : run.pieces) {
+    if (piece.kind != PieceKind::kSteady) continue;
+    means.push_back(piece.gyro_mean);
+    durations.push_back(piece.end_s - piece.start_s + run.sample_interval_s);
+  }
+  facts.gyro_rest = WeightedMedian(means, durations);
+  if (facts.plan_has_rates) {
+    // The raw scale from the largest steady offset, which the fastest plan rate should make.
+    double largest = 0.0;
+    for (const MotionPiece& piece : run.pieces) {
+      if (piece.kind != PieceKind::kMotion)
+        largest = std::max(largest, (piece.gyro_mean - facts.gyro_rest).norm());
+    }
+    const double scale = largest / max_rate;
+    facts.rate_threshold =
+        std::max(0.5 * scale * min_rate, kRestNoiseSigmas * std::sqrt(run.gyro_noise_var / 3.0));
+  }
+  return facts;
+}
+
+std::vector<Eigen::Vector3d> SignPatterns(bool all) {
+  std::vector<Eigen::Vector3d> patterns;
+  for (int bits = 0; bits < (all ? 8 : 1); ++bits) {
+    patterns.emplace_back(bits & 1 ? -1.0 : 1.0, bits & 2 ? -1.0 : 1.0, bits & 4 ? -1.0 : 1.0);
+  }
+  return patterns;
+}
+
+}  // namespace
+
+std::string SegmentationOptions::Validate() const {
+  if (!(window_s > 0.0)) return "the segmentation window must be positive";
+  if (!(noise_quantile > 0.0 && noise_quantile < 1.0)) return "the noise quantile must lie between 0 and 1";
+  if (!(threshold_factor > 1.0)) return "the steadiness threshold factor must exceed 1";
+  if (!(min_steady_s >= 0.0)) return "the minimum steady time cannot be negative";
+  if (!(direction_tolerance_deg > 0.0 && direction_tolerance_deg < 90.0)) {
+    return "the direction tolerance must lie between 0 and 90 degrees";
+  }
+  if (!(rate_tolerance > 0.0)) return "the rate tolerance must be positive";
+  return "";
+}
+
+MotionDetector::MotionDetector(const SegmentationOptions& options) : options_(options) {}
+
+void MotionDetector::Add(const Sample& sample) {
+  if (!started_) {
+    head_.push_back(sample);
+    if (head_.size() >= kHeadSamples) Start();
+    return;
+  }
+  Accumulate(sample);
+}
+
+void MotionDetector::Start() {
+  started_ = true;
+  if (head_.empty()) return;
+  const double interval_s =
+      head_.size() > 1 ? (head_.back().time_s - head_.front().time_s) / static_cast<double>(head_.size() - 1)
+                       : 1.0;
+  window_s_ = std::max(options_.window_s, kMinWindowSamples * interval_s);
+  block_s_ = window_s_ / (2 * kWindowHalfBlocks + 1);
+  reference_ = head_.front();
+  std::vector<Sample> head;
+  head.swap(head_);
+  for (const Sample& sample : head) Accumulate(sample);
+}
+
+void MotionDetector::Accumulate(const Sample& sample) {
+  for (int axis = 0; axis < 3; ++axis) {
+    integer_gyro_ = integer_gyro_ && sample.gyro(axis) == std::round(sample.gyro(axis));
+    integer_accel_ = integer_accel_ && sample.accel(axis) == std::round(sample.accel(axis));
+  }
+  if (blocks_.empty() || sample.time_s - blocks_.back().first_s >= block_s_) {
+    blocks_.emplace_back();
+    blocks_.back().first_s = sample.time_s;
+  }
+  Block& block = blocks_.back();
+  ++block.n;
+  block.last_s = sample.time_s;
+  const double inv_n = 1.0 / static_cast<double>(block.n);
+  const Eigen::Vector3d gyro = sample.gyro - reference_.gyro;
+  const Eigen::Vector3d accel = sample.accel - reference_.accel;
+  const Eigen::Vector3d gyro_delta = gyro - block.gyro_mean;
+  block.gyro_mean += gyro_delta * inv_n;
+  block.gyro_m2 += gyro_delta.dot(gyro - block.gyro_mean);
+  const Eigen::Vector3d accel_delta = accel - block.accel_mean;
+  block.accel_mean += accel_delta * inv_n;
+  block.accel_m2 += accel_delta.dot(accel - block.accel_mean);
+  if (samples_ > 0) {
+    // Trapezoids on the actual time stamps: exact for any spacing of the samples.
+    const double dt = sample.time_s - previous_.time_s;
+    block.gyro_integral += 0.5 * (sample.gyro + previous_.gyro) * dt;
+    block.integral_s += dt;
+  }
+  previous_ = sample;
+  ++samples_;
+}
+
+DetectedRun MotionDetector::Finish() {
+  if (!started_) Start();
+  DetectedRun run;
+  run.samples = samples_;
+  run.window_s = window_s_;
+  if (blocks_.empty()) return run;
+  run.sample_interval_s =
+      samples_ > 1 ? (blocks_.back().last_s - blocks_.front().first_s) / static_cast<double>(samples_ - 1)
+                   : 0.0;
+
+  // Variance over a window centred on each block: pooled from the blocks' means and deviations.
+  const int count = static_cast<int>(blocks_.size());
+  std::vector<double> gyro_var(blocks_.size(), 0.0);
+  std::vector<double> accel_var(blocks_.size(), 0.0);
+  for (int b = 0; b < count; ++b) {
+    const int lo = std::max(0, b - kWindowHalfBlocks);
+    const int hi = std::min(count - 1, b + kWindowHalfBlocks);
+    double n = 0.0;
+    Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
+    Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
+    for (int i = lo; i <= hi; ++i) {
+      n += static_cast<double>(blocks_[i].n);
+      gyro_mean += static_cast<double>(blocks_[i].n) * blocks_[i].gyro_mean;
+      accel_mean += static_cast<double>(blocks_[i].n) * blocks_[i].accel_mean;
+    }
+    if (n < 2.0) continue;
+    gyro_mean /= n;
+    accel_mean /= n;
+    double gyro_m2 = 0.0;
+    double accel_m2 = 0.0;
+    for (int i = lo; i <= hi; ++i) {
+      const double ni = static_cast<double>(blocks_[i].n);
+      gyro_m2 += blocks_[i].gyro_m2 + ni * (blocks_[i].gyro_mean - gyro_mean).squaredNorm();
+      accel_m2 += blocks_[i].accel_m2 + ni * (blocks_[i].accel_mean - accel_mean).squaredNorm();
+    }
+    gyro_var[b] = gyro_m2 / (n - 1.0);
+    accel_var[b] = accel_m2 / (n - 1.0);
+  }
+  const double gyro_floor = std::max(integer_gyro_ ? kQuantisationVar : 0.0,
+                                     kRelativeVarFloor * (1.0 + reference_.gyro.squaredNorm()));
+  const double accel_floor = std::max(integer_accel_ ? kQuantisationVar : 0.0,
+                                      kRelativeVarFloor * (1.0 + reference_.accel.squaredNorm()));
+  run.gyro_noise_var = std::max(Quantile(gyro_var, options_.noise_quantile), gyro_floor);
+  run.accel_noise_var = std::max(Quantile(accel_var, options_.noise_quantile), accel_floor);
+  run.gyro_threshold_var = options_.threshold_factor * run.gyro_noise_var;
+  run.accel_threshold_var = options_.threshold_factor * run.accel_noise_var;
+
+  // Classify the blocks, then join runs of one class into pieces: [first, last] block ranges.
+  std::vector<PieceKind> kinds(blocks_.size());
+  for (int b = 0; b < count; ++b) {
+    const bool gyro_steady = gyro_var[b] <= run.gyro_threshold_var;
+    const bool accel_steady = accel_var[b] <= run.accel_threshold_var;
+    kinds[b] = !gyro_steady ? PieceKind::kMotion : accel_steady ? PieceKind::kSteady : PieceKind::kSteadyGyro;
+  }
+  struct Range {
+    PieceKind kind;
+    int first;
+    int last;
+  };
+  std::vector<Range> ranges;
+  for (int b = 0; b < count; ++b) {
+    if (ranges.empty() || ranges.back().kind != kinds[b]) {
+      ranges.push_back({kinds[b], b, b});
+    } else {
+      ranges.back().last = b;
+    }
+  }
+  std::vector<Range> merged;
+  for (Range range : ranges) {
+    if (range.kind != PieceKind::kMotion &&
+        blocks_[range.last].last_s - blocks_[range.first].first_s < options_.min_steady_s) {
+      range.kind = PieceKind::kMotion;
+    }
+    if (!merged.empty() && merged.back().kind == PieceKind::kMotion && range.kind == PieceKind::kMotion) {
+      merged.back().last = range.last;
+    } else {
+      merged.push_back(range);
+    }
+  }
+  for (const Range& range : merged) {
+    MotionPiece piece;
+    piece.kind = range.kind;
+    piece.start_s = blocks_[range.first].first_s;
+    piece.end_s = blocks_[range.last].last_s;
+    for (int i = range.first; i <= range.last; ++i) {
+      const Block& block = blocks_[i];
+      piece.samples += block.n;
+      piece.gyro_mean += static_cast<double>(block.n) * block.gyro_mean;
+      piece.accel_mean += static_cast<double>(block.n) * block.accel_mean;
+      piece.gyro_integral += block.gyro_integral;
+      piece.integral_s += block.integral_s;
+    }
+    piece.gyro_mean = piece.gyro_mean / static_cast<double>(piece.samples) + reference_.gyro;
+    piece.accel_mean = piece.accel_mean / static_cast<double>(piece.samples) + reference_.accel;
+    run.pieces.push_back(piece);
+  }
+  return run;
+}
+
+Segmentation MatchPlan(const DetectedRun& run, const std::vector<TableSegment>& segments,
+                       const SegmentationOptions& options) {
+  if (segments.empty()) throw PlanMismatchError("the plan has no segments");
+  if (run.samples == 0) throw PlanMismatchError("the run has no samples");
+  const RunFacts facts = Facts(run, segments);
+  std::optional<Matcher> best_match;
+  std::optional<Matcher> furthest;
+  std::optional<Matcher> as_read;  // the raw axes unflipped
+  for (const Eigen::Vector3d& accel_signs : SignPatterns(true)) {
+    for (const Eigen::Vector3d& gyro_signs : SignPatterns(facts.plan_uses_gyro_signs)) {
+      Matcher matcher(run, segments, options, facts, accel_signs, gyro_signs);
+      if (matcher.Run()) {
+        if (!best_match || matcher.residual_deg() < best_match->residual_deg()) best_match.emplace(matcher);
+        continue;
+      }
+      if (!furthest || matcher.reached_s() > furthest->reached_s()) furthest.emplace(matcher);
+      if (accel_signs == Eigen::Vector3d::Ones() && gyro_signs == Eigen::Vector3d::Ones())
+        as_read.emplace(matcher);
+    }
+  }
+  if (best_match) return best_match->result();
+  // The furthest a sign pattern got is the likeliest place; a flipped axis can also hide a missing
+  // segment for a while, so the first disagreement with the axes as read is named too.
+  std::string message = furthest->problem() + " (raw axis signs: accel " +
+                        Vec(furthest->result().accel_signs, "%+.0f") + ", gyro " +
+                        Vec(furthest->result().gyro_signs, "%+.0f") + ")";
+  if (as_read && as_read->reached_s() != furthest->reached_s()) {
+    message += "; with the raw axes as they are: " + as_read->problem();
+  }
+  throw PlanMismatchError(message);
+}
+
+int Labeller::Label(double time_s) {
+  while (next_ < matches_.size() && matches_[next_].end_s < time_s) ++next_;
+  if (next_ < matches_.size() && time_s >= matches_[next_].start_s) return matches_[next_].segment;
+  return kTransitionSegment;
+}
+
+std::string SegmentationReport(const Segmentation& segmentation) {
+  std::ostringstream out;
+  char line[160];
+  std::snprintf(line, sizeof line, "  %7s  %4s  %-6s  %12s  %12s  %s\n", "segment", "pass", "kind", "start_s",
+                "end_s", "evidence");
+  out << line;
+  for (const SegmentMatch& match : segmentation.matches) {
+    std::snprintf(line, sizeof line, "  %7d  %4d  %-6s  %12.3f  %12.3f  ", match.segment, match.pass + 1,
+                  match.kind.c_str(), match.start_s, match.end_s);
+    out << line << match.evidence << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace imufit

@@ -1,0 +1,46 @@
+// imufit — an unlabelled samples file labelled with its plan's segments: the two passes of
+// fit/segmentation.h over a file (pass 1 finds the segments, pass 2 labels the samples by time).
+// The file is read twice, never held in memory.
+#ifndef IMUFIT_PIPELINE_SEGMENT_RUN_H_
+#define IMUFIT_PIPELINE_SEGMENT_RUN_H_
+
+#include <optional>
+#include <string>
+
+#include "imufit/fit/segmentation.h"
+#include "imufit/io/plan.h"
+
+namespace imufit {
+
+// How a samples file is read when it lacks optional columns.
+struct SamplesInput {
+  // The temperature of every sample, degC, for a file without a temp_c column (a file with one is
+  // then refused).
+  std::optional<double> temp_c;
+  // How the segments are found in a file without a segment column.
+  SegmentationOptions segmentation;
+
+  // An empty string when usable, else what is wrong.
+  std::string Validate() const { return segmentation.Validate(); }
+};
+
+// Pass 1 over `samples_path` and the match with `plan` (its segment column, if any, is ignored).
+// Throws InputError for bad input and PlanMismatchError when the log and the plan disagree.
+Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path, const SamplesInput& input);
+
+struct LabelledFileReport {
+  long long samples = 0;
+  long long labelled = 0;  // samples given a segment id (the rest are -1)
+  bool input_had_segment = false;
+  long long agreeing = 0;  // with input_had_segment: samples whose old and new labels agree
+};
+
+// Pass 2: writes the samples of `samples_path` with the segment column of `segmentation` to
+// `output_path` (atomically; an input segment column is replaced), keeping temp_c when the input has
+// it or `input.temp_c` gives it.
+LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
+                                        const std::string& output_path, const SamplesInput& input);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_PIPELINE_SEGMENT_RUN_H_

@@ -1,0 +1,55 @@
+#include "imufit/pipeline/segment_run.h"
+
+#include <cmath>
+
+#include "imufit/io/csv_reader.h"
+#include "imufit/io/samples.h"
+
+namespace imufit {
+namespace {
+
+// Finding segments needs no temperature: a file without temp_c (and no fixed temperature) is read
+// with NaN in its place, and written without the column.
+std::optional<double> TempToRead(const std::string& samples_path, const SamplesInput& input) {
+  if (input.temp_c) return input.temp_c;
+  if (CsvReader(samples_path).FindColumn("temp_c")) return std::nullopt;
+  return std::nan("");
+}
+
+}  // namespace
+
+Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path,
+                                const SamplesInput& input) {
+  SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
+  MotionDetector detector(input.segmentation);
+  Sample sample;
+  while (reader.Next(&sample)) detector.Add(sample);
+  try {
+    return MatchPlan(detector.Finish(), plan.segments, input.segmentation);
+  } catch (const PlanMismatchError& e) {
+    throw PlanMismatchError(samples_path + ": the log does not match the plan " + plan.path + ": " +
+                            e.what());
+  }
+}
+
+LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
+                                        const std::string& output_path, const SamplesInput& input) {
+  SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
+  SamplesWriter writer(output_path, SampleColumns{true, reader.has_temp() || input.temp_c.has_value()});
+  LabelledFileReport report;
+  report.input_had_segment = reader.has_segment();
+  Labeller labeller(segmentation);
+  Sample sample;
+  while (reader.Next(&sample)) {
+    const int label = labeller.Label(sample.time_s);
+    if (label == sample.segment) ++report.agreeing;
+    sample.segment = label;
+    if (label != kTransitionSegment) ++report.labelled;
+    ++report.samples;
+    writer.Write(sample);
+  }
+  writer.Commit();
+  return report;
+}
+
+}  // namespace imufit
