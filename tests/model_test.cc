@@ -67,7 +67,8 @@ TEST(SensorModel, CorrectInvertsForwardAcrossTemperatures) {
       Eigen::Vector3d omega_hat;
       Eigen::Vector3d a_hat;
       model.Correct(temp_c, gyro_m, accel_m, &omega_hat, &a_hat);
-      EXPECT_LE((omega_hat - omega_true).norm(), kRoundTripRelTol * omega_true.norm()) << unit << " " << temp_c;
+      EXPECT_LE((omega_hat - omega_true).norm(), kRoundTripRelTol * omega_true.norm())
+          << unit << " " << temp_c;
       EXPECT_LE((a_hat - a_true).norm(), kRoundTripRelTol * a_true.norm()) << unit << " " << temp_c;
     }
   }
@@ -75,8 +76,8 @@ TEST(SensorModel, CorrectInvertsForwardAcrossTemperatures) {
 
 TEST(SensorModel, CoefficientsFollowTheLayout) {
   SensorModel model = SensorModel::Identity();
-  model.gyro[(kMisalignmentCoefficient + 1) * 4] = 0.5;  // xz
-  model.gyro[(kMisalignmentCoefficient + 4) * 4] = 0.25;  // zx
+  model.gyro[(kMisalignmentCoefficient + 1) * 4] = 0.5;      // xz
+  model.gyro[(kMisalignmentCoefficient + 4) * 4] = 0.25;     // zx
   model.gyro[(kGSensitivityCoefficient + 5) * 4 + 1] = 2.0;  // yz, c1
   const SensorCoefficients<double> c = CoefficientsAt(model.gyro.data(), kGyroCoefficients, 3.0);
   EXPECT_EQ(c.misalignment(0, 2), 0.5);
@@ -109,7 +110,8 @@ void CorrectWithJets(const SensorModel& model, double temp_c, const Eigen::Vecto
 }
 
 Eigen::Matrix<double, 6, 1> CorrectWithDoubles(const SensorModel& model, double temp_c,
-                                               const Eigen::Vector3d& gyro_m, const Eigen::Vector3d& accel_m) {
+                                               const Eigen::Vector3d& gyro_m,
+                                               const Eigen::Vector3d& accel_m) {
   Eigen::Vector3d omega_hat;
   Eigen::Vector3d a_hat;
   model.Correct(temp_c, gyro_m, accel_m, &omega_hat, &a_hat);
@@ -136,9 +138,9 @@ void ExpectJacobianMatchesCentralDifferences(const SensorModel& model, double te
     const double h = kFiniteDifferenceStep * std::max(1.0, std::abs(parameter_plus)) / std::max(1.0, power);
     parameter_plus += h;
     parameter_minus -= h;
-    const Eigen::Matrix<double, 6, 1> numeric =
-        (CorrectWithDoubles(plus, temp_c, gyro_m, accel_m) - CorrectWithDoubles(minus, temp_c, gyro_m, accel_m)) /
-        (2.0 * h);
+    const Eigen::Matrix<double, 6, 1> numeric = (CorrectWithDoubles(plus, temp_c, gyro_m, accel_m) -
+                                                 CorrectWithDoubles(minus, temp_c, gyro_m, accel_m)) /
+                                                (2.0 * h);
     // Relative to the column, with a floor for the round-off of tiny columns.
     const double scale = std::max(jacobian.col(p).cwiseAbs().maxCoeff(), 1e-4 * jacobian_scale);
     EXPECT_LE((numeric - jacobian.col(p)).cwiseAbs().maxCoeff(), kJacobianRelTol * scale)
@@ -182,11 +184,48 @@ TEST(RateTable, TruthIncludesEarthRateAndLeverArm) {
   spinning.north = Eigen::Vector3d::UnitY();  // ignored while spinning
   spinning.lever_arm_m = Eigen::Vector3d(0.01, 0.02, 0.0);
   const SegmentTruth turning = TruthOf(site, spinning);
-  EXPECT_NEAR(turning.omega_radps.x(), spinning.rate_radps + kEarthRateRadps * std::sin(*site.latitude_rad), 1e-15);
+  EXPECT_NEAR(turning.omega_radps.x(), spinning.rate_radps + kEarthRateRadps * std::sin(*site.latitude_rad),
+              1e-15);
   EXPECT_EQ(turning.omega_radps.y(), 0.0);
   const double w2 = spinning.rate_radps * spinning.rate_radps;
   EXPECT_NEAR(turning.a_mps2.x(), 9.79285, 1e-15);  // the radial part excludes the axis component
   EXPECT_NEAR(turning.a_mps2.y(), -w2 * 0.02, 1e-15);
+}
+
+TEST(RateTable, RateAboutATiltedAxisAndTurns) {
+  TableSite site;
+  site.gravity_mps2 = 9.79285;
+  site.latitude_rad = 30.27 * M_PI / 180.0;
+  const double vertical_earth_rate = kEarthRateRadps * std::sin(*site.latitude_rad);
+  // A two-axis table: z up, spinning about (y + z) / sqrt(2).
+  TableSegment tilted;
+  tilted.up = Eigen::Vector3d::UnitZ();
+  tilted.rate_radps = 1.0;
+  tilted.axis = Eigen::Vector3d(0, 1, 1).normalized();
+  tilted.lever_arm_m = Eigen::Vector3d(0.02, 0.0, 0.0);
+  EXPECT_FALSE(tilted.AxisIsVertical());
+  EXPECT_FALSE(tilted.SpecificForceIsKnown());
+  const SegmentTruth t = TruthOf(site, tilted);
+  // Only the Earth rate along the axis: Omega sin(phi) (up . n) n, (up . n) = 1 / sqrt(2).
+  const Eigen::Vector3d expected_omega = (1.0 + vertical_earth_rate / std::sqrt(2.0)) * *tilted.axis;
+  EXPECT_LE((t.omega_radps - expected_omega).norm(), 1e-15);
+  // The centripetal term about the axis: r is perpendicular to it here.
+  EXPECT_NEAR(t.a_mps2.x(), -0.02, 1e-15);
+
+  // A turn about the vertical: mean rate angle / duration along up, plus the vertical Earth rate.
+  TableSegment turn;
+  turn.up = -Eigen::Vector3d::UnitX();
+  turn.angle_rad = 2.0 * M_PI;
+  turn.axis = Eigen::Vector3d::UnitX();
+  EXPECT_TRUE(turn.IsTurn());
+  EXPECT_TRUE(turn.AxisIsVertical());
+  EXPECT_TRUE(turn.SpecificForceIsKnown());
+  const SegmentTruth mean = TurnTruth(site, turn, 8.0);
+  EXPECT_NEAR(mean.omega_radps.x(), 2.0 * M_PI / 8.0 - vertical_earth_rate, 1e-15);
+  EXPECT_EQ(mean.a_mps2, Eigen::Vector3d(-9.79285, 0, 0));
+  turn.axis = Eigen::Vector3d::UnitY();  // horizontal: gravity turns in the body frame
+  EXPECT_FALSE(turn.SpecificForceIsKnown());
+  EXPECT_LE((TurnTruth(site, turn, 8.0).omega_radps - Eigen::Vector3d(0, 2.0 * M_PI / 8.0, 0)).norm(), 1e-15);
 }
 
 }  // namespace

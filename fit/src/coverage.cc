@@ -63,8 +63,9 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
                                        const FitOptions& options) {
   std::vector<std::string> findings;
   if (windows.empty()) {
-    findings.push_back("the run has no usable windows: no samples with a segment id of the plan that last longer "
-                       "than the trim time");
+    findings.push_back(
+        "the run has no usable windows: no samples with a segment id of the plan that last longer "
+        "than the trim time");
     return findings;
   }
   const std::vector<double> all_temps = TempsWhere(windows, options, [](const FitWindow&) { return true; });
@@ -91,21 +92,26 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
 
   for (int j = 0; j < 3; ++j) {
     const std::string axis(1, kAxis[j]);
-    // Gyro column j of K = diag(S) inv(M): scale j and the misalignments of column j.
+    // Gyro column j of K = diag(S) inv(M): scale j and the misalignments of column j. A rate
+    // segment or a turn (whose truth is its mean rate) about any axis with a component along j.
     const auto spinning = TempsWhere(windows, options, [&](const FitWindow& w) {
       return std::abs(w.truth.omega_radps(j)) >= options.min_excitation_rate_radps;
     });
-    const std::string rate = Shortfall(spinning, gyro_needed, "rate segments about " + axis,
-                                       "no rate segments about the " + axis + " axis (the table must spin with " +
-                                           axis + " up or down)",
-                                       "gyro", gyro_order);
+    const std::string rate =
+        Shortfall(spinning, gyro_needed, "rate segments or turns about " + axis,
+                  "no rate segments or turns about the " + axis + " axis (the table must spin with " + axis +
+                      " up or down, or a rate or turn segment must give an axis along " + axis + ")",
+                  "gyro", gyro_order);
     if (!rate.empty()) {
       findings.push_back("gyro scale " + axis + " and misalignment " + OffDiagonalColumn(j) +
                          " are undetermined: " + rate);
     }
     // Gravity along +j and -j separates H's column j (gyro) and K's column j (accel) from the bias.
-    const auto up = TempsWhere(windows, options, [&](const FitWindow& w) { return w.truth.a_mps2(j) >= along; });
-    const auto down = TempsWhere(windows, options, [&](const FitWindow& w) { return w.truth.a_mps2(j) <= -along; });
+    // Only windows whose specific force is known count (not turns or rates about a tilted axis).
+    const auto up = TempsWhere(
+        windows, options, [&](const FitWindow& w) { return w.accel_known && w.truth.a_mps2(j) >= along; });
+    const auto down = TempsWhere(
+        windows, options, [&](const FitWindow& w) { return w.accel_known && w.truth.a_mps2(j) <= -along; });
     for (const auto& [sensor, order, needed] :
          {std::tuple<const char*, int, size_t>{"gyro", gyro_order, gyro_needed},
           std::tuple<const char*, int, size_t>{"accel", accel_order, accel_needed}}) {
@@ -118,7 +124,8 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
       if (missing.empty()) continue;
       if (std::string(sensor) == "gyro") {
         findings.push_back("gyro g_sensitivity column " + axis + " (x" + axis + ", y" + axis + ", z" + axis +
-                           ") is undetermined: " + missing + " (or leave g-sensitivity out with --no-g-sensitivity)");
+                           ") is undetermined: " + missing +
+                           " (or leave g-sensitivity out with --no-g-sensitivity)");
       } else {
         findings.push_back("accel scale " + axis + " and misalignment " + OffDiagonalColumn(j) +
                            " are undetermined: " + missing);

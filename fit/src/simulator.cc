@@ -1,5 +1,6 @@
 #include "imufit/fit/simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -43,10 +44,10 @@ class NormalSource {
 
 // A sensor's bias process: random walk plus first-order Gauss-Markov, and white noise.
 struct NoiseProcess {
-  double white_sigma = 0.0;     // per sample
-  double walk_sigma = 0.0;      // per sample step
-  double markov_decay = 0.0;    // exp(-dt / tau)
-  double markov_sigma = 0.0;    // per sample drive
+  double white_sigma = 0.0;   // per sample
+  double walk_sigma = 0.0;    // per sample step
+  double markov_decay = 0.0;  // exp(-dt / tau)
+  double markov_sigma = 0.0;  // per sample drive
   Eigen::Vector3d walk = Eigen::Vector3d::Zero();
   Eigen::Vector3d markov = Eigen::Vector3d::Zero();
 
@@ -108,6 +109,41 @@ SegmentTruth TransitionTruth(const TableSite& site, const TableSegment& a, const
   return truth;
 }
 
+// A turn's motion occupies this middle fraction of its dwell; the table rests before and after,
+// so the stretch labelled with the segment holds the whole motion.
+constexpr double kTurnRestFraction = 0.2;
+
+// Truth during a dwell, `t_s` seconds after it began, for the kinds whose truth changes with
+// time: a turn through angle_rad with a smooth (raised-cosine) rate profile, as a hand or a
+// position-mode table moves, and a constant rate about an axis that is not vertical. The body
+// turns by angle(t) about the body axis n, so world-fixed directions seen from the body turn by
+// -angle(t): up_b(t) = R(n, -angle(t)) up, exactly (no numerical integration). Earth's vertical
+// rate turns with up_b; its horizontal part is left out as everywhere in a rate segment.
+SegmentTruth MovingTruth(const TableSite& site, const TableSegment& segment, double t_s, double dwell_s) {
+  const Eigen::Vector3d& n = segment.RotationAxis();
+  double angle = 0.0;
+  double rate = segment.rate_radps;
+  if (segment.IsTurn()) {
+    const double motion_s = (1.0 - 2.0 * kTurnRestFraction) * dwell_s;
+    const double tau = std::clamp((t_s - kTurnRestFraction * dwell_s) / motion_s, 0.0, 1.0);
+    // s(tau) = tau - sin(2 pi tau) / (2 pi): rate 1 - cos(2 pi tau), zero with zero slope at both ends.
+    angle = *segment.angle_rad * (tau - std::sin(2.0 * M_PI * tau) / (2.0 * M_PI));
+    rate = *segment.angle_rad * (1.0 - std::cos(2.0 * M_PI * tau)) / motion_s;
+  } else {
+    angle = segment.rate_radps * t_s;
+  }
+  const Eigen::Vector3d up = Eigen::AngleAxisd(-angle, n) * segment.up;
+  SegmentTruth truth;
+  truth.omega_radps = rate * n;
+  if (site.latitude_rad) truth.omega_radps += kEarthRateRadps * std::sin(*site.latitude_rad) * up;
+  truth.a_mps2 = site.gravity_mps2 * up;
+  if (!segment.IsTurn() && segment.lever_arm_m) {
+    const Eigen::Vector3d& r = *segment.lever_arm_m;
+    truth.a_mps2 -= rate * rate * (r - n * r.dot(n));
+  }
+  return truth;
+}
+
 }  // namespace
 
 std::string SimulationOptions::Validate() const {
@@ -165,8 +201,8 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
   const long long total = options.SampleCount(segments.size());
 
   NormalSource normal(options.seed);
-  NoiseProcess gyro_noise(options.gyro_noise_density, options.gyro_random_walk,
-                          options.gyro_bias_instability, options.bias_correlation_s, dt);
+  NoiseProcess gyro_noise(options.gyro_noise_density, options.gyro_random_walk, options.gyro_bias_instability,
+                          options.bias_correlation_s, dt);
   NoiseProcess accel_noise(options.accel_noise_density, options.accel_random_walk,
                            options.accel_bias_instability, options.bias_correlation_s, dt);
   gyro_noise.Start(&normal, options.gyro_bias_instability);
@@ -198,8 +234,11 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
         truth = TransitionTruth(site, segments[phase.from], segments[phase.to], u, options.transition_s);
         raw.segment = kTransitionSegment;
       } else {
-        truth = dwell_truth[phase.from];
-        raw.segment = segments[phase.from].id;
+        const TableSegment& segment = segments[phase.from];
+        truth = segment.SpecificForceIsKnown() && !segment.IsTurn()
+                    ? dwell_truth[phase.from]
+                    : MovingTruth(site, segment, static_cast<double>(j) * dt, options.dwell_s);
+        raw.segment = segment.id;
       }
       const Eigen::Vector3d omega_sensed = truth.omega_radps + gyro_noise.Step(&normal);
       const Eigen::Vector3d a_sensed = truth.a_mps2 + accel_noise.Step(&normal);
@@ -209,7 +248,8 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
       Eigen::Vector3d accel_m;
       Eigen::Vector3d gyro_m;
       const double x = truth_model.basis.Argument(true_temp_c);
-      const SensorCoefficients<double> accel = CoefficientsAt(truth_model.accel.data(), kAccelCoefficients, x);
+      const SensorCoefficients<double> accel =
+          CoefficientsAt(truth_model.accel.data(), kAccelCoefficients, x);
       const SensorCoefficients<double> gyro = CoefficientsAt(truth_model.gyro.data(), kGyroCoefficients, x);
       accel_m = ForwardSensor(accel, a_sensed, Eigen::Vector3d::Zero().eval());
       gyro_m = ForwardSensor(gyro, omega_sensed, truth.a_mps2);

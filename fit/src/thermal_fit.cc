@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -29,8 +30,8 @@ constexpr int kStartNodes = 9;
 constexpr double kSigmaFloorFraction = 0.1;
 // The robust spread of normalised residuals from their median absolute value (Gaussian).
 constexpr double kMadToSigma = 1.4826;
-// The robust loss never acts on normalised residuals below this (round-off of noise-free runs).
-constexpr double kMinLossThreshold = 1e-6;
+// The robust spread of the normalised residuals is never taken below one measured noise.
+constexpr double kMinRobustSpread = 1.0;
 
 // One sensor's share of the problem.
 struct SensorProblem {
@@ -39,11 +40,16 @@ struct SensorProblem {
   int coefficients = 0;
   int order = 3;
   bool with_g_sensitivity = false;
-  std::vector<double> p0;              // start, fit basis
-  std::vector<double> step;            // scale of each parameter
-  std::vector<double> q;               // the solver's variables
-  std::vector<int> held;               // parameters held at zero (p0 = 0 there)
-  std::vector<Eigen::Vector3d> sigma;  // per window, SI
+  std::vector<double> p0;    // start, fit basis
+  std::vector<double> step;  // scale of each parameter
+  std::vector<double> q;     // the solver's variables
+  std::vector<int> held;     // parameters held at their start value
+  // This sensor's windows (the accelerometer's are those whose specific force is known; the
+  // gyro's carry the specific force its g-sensitivity term sees) and their index in the run.
+  std::vector<FitWindow> windows;
+  std::vector<int> window_index;
+  std::vector<Eigen::Vector3d> sigma_raw;  // per window: noise of the mean, raw units (the weights)
+  std::vector<Eigen::Vector3d> sigma;      // the same in SI at the start's scale (for reports)
   std::vector<ceres::ResidualBlockId> blocks;
   ceres::LossFunctionWrapper* loss = nullptr;  // owned by the problem
   Eigen::MatrixXd jacobian;                    // of the normalised residuals in q, free parameters only
@@ -71,9 +77,15 @@ const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) {
 const Eigen::Vector3d& RawFor(const FitWindow& w, bool gyro) {
   return gyro ? w.window->gyro_mean : w.window->accel_mean;
 }
+// The noise of a window's mean, raw units: the per-sample spread over sqrt(samples). Where the
+// truth is constant over the window, the sample standard deviation (it also holds the table's
+// rate ripple and slow noise); in a turn, whose rate varies, the second-difference figure, which
+// sees the noise and not the rate profile (windows.h).
 Eigen::Vector3d RawSigmaFor(const FitWindow& w, bool gyro) {
-  const Eigen::Vector3d& std_dev = gyro ? w.window->gyro_std : w.window->accel_std;
-  return std_dev / std::sqrt(static_cast<double>(w.window->samples));
+  const Window& window = *w.window;
+  const Eigen::Vector3d& spread = window.whole_occurrence ? (gyro ? window.gyro_noise : window.accel_noise)
+                                                          : (gyro ? window.gyro_std : window.accel_std);
+  return spread / std::sqrt(static_cast<double>(window.samples));
 }
 
 // The closed-form start of one sensor: raw_i = sum_j K_ij(x) truth_j + V_i(x) + sum_j H_ij(x) a_j
@@ -92,7 +104,7 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
     Eigen::VectorXd rhs(m);
     for (int r = 0; r < m; ++r) {
       const FitWindow& w = windows[r];
-      const double weight = 1.0 / sensor->sigma[r](i);  // SI sigma: a common scale per axis is harmless
+      const double weight = 1.0 / sensor->sigma_raw[r](i);
       Eigen::Matrix<double, 7, 1> regressor;
       regressor << TruthFor(w, gyro), 1.0, w.truth.a_mps2;
       double power = 1.0;
@@ -183,21 +195,26 @@ void SetSteps(SensorProblem* sensor) {
   }
 }
 
-// Window noise in SI: the noise of the raw mean divided by the scale factor, floored.
-void SetSigmas(const std::vector<FitWindow>& windows, bool gyro, SensorProblem* sensor) {
-  sensor->sigma.assign(windows.size(), Eigen::Vector3d::Ones());
+// Window noise: the noise of the raw mean (the weights, fixed: they do not move with the
+// parameters), floored, and the same in SI at the start's scale factor (for reports and the
+// bias-stability covariance).
+void SetSigmas(bool gyro, SensorProblem* sensor) {
+  const size_t count = sensor->windows.size();
+  sensor->sigma_raw.assign(count, Eigen::Vector3d::Ones());
+  sensor->sigma.assign(count, Eigen::Vector3d::Ones());
   for (int axis = 0; axis < 3; ++axis) {
-    const double scale =
-        std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
     std::vector<double> values;
-    for (size_t w = 0; w < windows.size(); ++w) {
-      sensor->sigma[w](axis) = RawSigmaFor(windows[w], gyro)(axis) / (scale > 0.0 ? scale : 1.0);
-      values.push_back(sensor->sigma[w](axis));
+    for (size_t w = 0; w < count; ++w) {
+      sensor->sigma_raw[w](axis) = RawSigmaFor(sensor->windows[w], gyro)(axis);
+      values.push_back(sensor->sigma_raw[w](axis));
     }
     const double floor = kSigmaFloorFraction * Median(values);
-    for (size_t w = 0; w < windows.size(); ++w) {
-      double& s = sensor->sigma[w](axis);
+    const double scale =
+        std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
+    for (size_t w = 0; w < count; ++w) {
+      double& s = sensor->sigma_raw[w](axis);
       s = floor > 0.0 ? std::max(s, floor) : 1.0;
+      sensor->sigma[w](axis) = s / (scale > 0.0 ? scale : 1.0);
     }
   }
 }
@@ -253,10 +270,10 @@ Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor,
   for (int block = 0; block < blocks; ++block) {
     for (int axis = 0; axis < 3; ++axis) {
       Eigen::VectorXd gradient = Eigen::VectorXd::Zero(n);  // J^T dr
-      for (size_t w = 0; w < time_blocks.size(); ++w) {
-        if (time_blocks[w] != block) continue;
-        const int row = 3 * static_cast<int>(w) + axis;
-        gradient += sensor.jacobian.row(row).transpose() * (stability / sensor.sigma[w](axis));
+      for (size_t b = 0; b < sensor.windows.size(); ++b) {
+        if (time_blocks[sensor.window_index[b]] != block) continue;
+        const int row = 3 * static_cast<int>(b) + axis;
+        gradient += sensor.jacobian.row(row).transpose() * (stability / sensor.sigma[b](axis));
       }
       const Eigen::VectorXd shift = free_covariance * gradient;
       added += shift * shift.transpose();
@@ -351,21 +368,19 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     const auto segment = std::find_if(segments.begin(), segments.end(),
                                       [&](const TableSegment& s) { return s.id == w.segment; });
     assert(segment != segments.end() && "every window's segment must be in the plan");
-    fit_windows.push_back(FitWindow{&w, TruthOf(site, *segment), basis.Argument(w.temp_c)});
+    // A turn's truth is its whole occurrence's mean rate: the window must be that occurrence.
+    if (segment->IsTurn() && !w.whole_occurrence) {
+      // A programmer error (windows built without the plan): always checked, it would bias the fit.
+      std::fprintf(stderr,
+                   "imufit: internal error: a window of turn segment %d is not its whole occurrence\n",
+                   segment->id);
+      std::abort();
+    }
+    const SegmentTruth truth =
+        segment->IsTurn() ? TurnTruth(site, *segment, w.DurationS()) : TruthOf(site, *segment);
+    fit_windows.push_back(FitWindow{&w, truth, basis.Argument(w.temp_c), segment->SpecificForceIsKnown()});
   }
   summary.windows_used = static_cast<int>(fit_windows.size());
-  for (const TableSegment& segment : segments) {
-    // The plan reader knows these kinds; the fit learns them next (issue 9).
-    if (segment.IsTurn() || (segment.axis && std::abs(segment.axis->dot(segment.up)) < 1.0 - 1e-12)) {
-      summary.undetermined.push_back("segment " + std::to_string(segment.id) +
-                                     ": turns (angle_deg) and rate axes apart from up are not fitted yet");
-    }
-  }
-  if (!summary.undetermined.empty()) {
-    summary.status = FitStatus::kUndetermined;
-    summary.termination = "the run does not determine the model";
-    return summary;
-  }
 
   summary.undetermined = internal::CheckCoverage(fit_windows, site.gravity_mps2, options);
   if (!summary.undetermined.empty()) {
@@ -385,10 +400,30 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   accel.parameters = kAccelParameters;
   accel.coefficients = kAccelCoefficients;
   accel.order = options.accel_temp_order;
-  for (SensorProblem* sensor : {&gyro, &accel}) {
+  // The accelerometer first: where gravity turns in the body frame (a turn or a rate about a
+  // non-vertical axis) the gyro's g-sensitivity term sees the window's corrected accelerometer
+  // mean, at the accelerometer's closed-form start (which differs from its fit by far less than
+  // the noise of that mean).
+  for (size_t w = 0; w < fit_windows.size(); ++w) {
+    if (!fit_windows[w].accel_known) continue;
+    accel.windows.push_back(fit_windows[w]);
+    accel.window_index.push_back(static_cast<int>(w));
+  }
+  for (SensorProblem* sensor : {&accel, &gyro}) {
     const bool is_gyro = sensor == &gyro;
-    SetSigmas(fit_windows, is_gyro, sensor);  // raw units until the start is known
-    LinearStart(fit_windows, is_gyro, sensor);
+    if (is_gyro) {
+      for (size_t w = 0; w < fit_windows.size(); ++w) {
+        FitWindow fw = fit_windows[w];
+        if (!fw.accel_known) {
+          const SensorCoefficients<double> c = CoefficientsAt(accel.p0.data(), kAccelCoefficients, fw.x);
+          fw.truth.a_mps2 = CorrectSensor(c, fw.window->accel_mean, Eigen::Vector3d::Zero().eval());
+        }
+        gyro.windows.push_back(fw);
+        gyro.window_index.push_back(static_cast<int>(w));
+      }
+    }
+    SetSigmas(is_gyro, sensor);
+    LinearStart(sensor->windows, is_gyro, sensor);
     if (!options.closed_form_start) {
       // Keep only the nominal scale factors: the solver must find everything else itself.
       for (int i = 0; i < sensor->parameters; ++i) {
@@ -398,7 +433,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
         if (!nominal_scale) sensor->p0[i] = 0.0;
       }
     }
-    SetSigmas(fit_windows, is_gyro, sensor);  // now in SI
+    SetSigmas(is_gyro, sensor);  // the SI figures at the start's scale
     SetSteps(sensor);
     sensor->q.assign(sensor->parameters, 0.0);
     for (int c = 0; c < sensor->coefficients; ++c) {
@@ -414,17 +449,17 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   ceres::Problem problem;
   for (SensorProblem* sensor : {&gyro, &accel}) {
     sensor->loss = new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP);
-    for (size_t w = 0; w < fit_windows.size(); ++w) {
-      const FitWindow& fw = fit_windows[w];
+    for (size_t w = 0; w < sensor->windows.size(); ++w) {
+      const FitWindow& fw = sensor->windows[w];
       ceres::CostFunction* cost = nullptr;
       if (sensor == &gyro) {
         cost = new ceres::AutoDiffCostFunction<WindowCost<kGyroParameters>, 3, kGyroParameters>(
             new WindowCost<kGyroParameters>(RawFor(fw, true), TruthFor(fw, true), fw.truth.a_mps2, fw.x,
-                                            sensor->sigma[w], sensor->p0.data(), sensor->step.data()));
+                                            sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
       } else {
         cost = new ceres::AutoDiffCostFunction<WindowCost<kAccelParameters>, 3, kAccelParameters>(
             new WindowCost<kAccelParameters>(RawFor(fw, false), TruthFor(fw, false), fw.truth.a_mps2, fw.x,
-                                             sensor->sigma[w], sensor->p0.data(), sensor->step.data()));
+                                             sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
       }
       sensor->blocks.push_back(problem.AddResidualBlock(cost, sensor->loss, sensor->q.data()));
     }
@@ -458,9 +493,11 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       // loss_scale times it.
       std::vector<double> components;
       for (double norm : normalised_norms(*sensor)) components.push_back(norm / std::sqrt(3.0));
-      const double spread = kMadToSigma * Median(components);
-      // Noise-free data (simulations) leave only round-off: the loss must not act on that.
-      sensor->loss_threshold = std::max(options.loss_scale * spread, kMinLossThreshold);
+      // The residuals are in units of each window's measured noise, so the spread is at least 1: a
+      // smaller median comes from windows the fit matches exactly (few windows for the parameters,
+      // e.g. one turn per axis setting the scale), and the loss must not act on ordinary noise.
+      const double spread = std::max(kMadToSigma * Median(components), kMinRobustSpread);
+      sensor->loss_threshold = options.loss_scale * spread;
       if (options.loss == RobustLoss::kHuber) {
         sensor->loss->Reset(new ceres::HuberLoss(sensor->loss_threshold), ceres::TAKE_OWNERSHIP);
       } else {
@@ -530,13 +567,14 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     double chi2 = 0.0;
     int rows = 0;
     double sum_squares = 0.0;
-    for (size_t w = 0; w < fit_windows.size(); ++w) {
+    for (size_t w = 0; w < sensor->windows.size(); ++w) {
       double residual[3];
       double cost = 0.0;
       problem.EvaluateResidualBlock(sensor->blocks[w], false, &cost, residual, nullptr);
+      // Raw error over the start's scale: the error in SI to first order.
       const Eigen::Vector3d si = Eigen::Map<const Eigen::Vector3d>(residual).cwiseProduct(sensor->sigma[w]);
-      WindowResidual& out = summary.residuals[w];
-      out.window = static_cast<int>(w);
+      WindowResidual& out = summary.residuals[sensor->window_index[w]];
+      out.window = sensor->window_index[w];
       (is_gyro ? out.gyro_radps : out.accel_mps2) = si;
       (is_gyro ? out.gyro_sigma_radps : out.accel_sigma_mps2) = sensor->sigma[w];
       const bool downweighted = options.loss != RobustLoss::kNone && norms[w] > sensor->loss_threshold;
@@ -548,7 +586,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       }
     }
     const int free_parameters = sensor->parameters - static_cast<int>(sensor->held.size());
-    const double rms = std::sqrt(sum_squares / (3.0 * fit_windows.size()));
+    const double rms = std::sqrt(sum_squares / (3.0 * std::max<size_t>(sensor->windows.size(), 1)));
     const double reduced_chi2 = rows > free_parameters ? chi2 / (rows - free_parameters) : 1.0;
     (is_gyro ? summary.gyro_rms_radps : summary.accel_rms_mps2) = rms;
     (is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2) = reduced_chi2;

@@ -15,6 +15,13 @@ std::string WindowOptions::Validate() const {
 
 WindowBuilder::WindowBuilder(const WindowOptions& options) : options_(options) {}
 
+WindowBuilder::WindowBuilder(const WindowOptions& options, const std::vector<TableSegment>& segments)
+    : options_(options) {
+  for (const TableSegment& segment : segments) {
+    if (segment.IsTurn()) turn_ids_.push_back(segment.id);
+  }
+}
+
 void WindowBuilder::Add(const Sample& sample) {
   if (stats_.samples == 0) {
     stats_.min_temp_c = stats_.max_temp_c = sample.temp_c;
@@ -38,18 +45,20 @@ void WindowBuilder::Add(const Sample& sample) {
       }
       current_occurrence_ = it->second++;
       occurrence_start_s_ = sample.time_s;
+      whole_occurrence_ = std::find(turn_ids_.begin(), turn_ids_.end(), sample.segment) != turn_ids_.end();
     }
   }
   if (sample.segment == kTransitionSegment) {
     ++stats_.transition_samples;
     return;
   }
-  if (sample.time_s - occurrence_start_s_ < options_.trim_s) {
+  if (!whole_occurrence_ && sample.time_s - occurrence_start_s_ < options_.trim_s) {
     ++stats_.trimmed_samples;
     return;
   }
-  if (open_ && (std::abs(sample.temp_c - window_first_temp_c_) > options_.max_temp_span_c ||
-                (options_.max_duration_s > 0.0 && sample.time_s - start_s_ >= options_.max_duration_s))) {
+  if (open_ && !whole_occurrence_ &&
+      (std::abs(sample.temp_c - window_first_temp_c_) > options_.max_temp_span_c ||
+       (options_.max_duration_s > 0.0 && sample.time_s - start_s_ >= options_.max_duration_s))) {
     Close();
   }
   if (!open_) {
@@ -61,6 +70,7 @@ void WindowBuilder::Add(const Sample& sample) {
     temp_min_ = temp_max_ = sample.temp_c;
     mean_.setZero();
     m2_.setZero();
+    second_difference_sum_.setZero();
   }
   ++n_;
   end_s_ = sample.time_s;
@@ -73,6 +83,9 @@ void WindowBuilder::Add(const Sample& sample) {
   const Eigen::Matrix<double, 6, 1> delta = value - mean_;
   mean_ += delta * inv_n;
   m2_ += delta.cwiseProduct(value - mean_);
+  if (n_ >= 3) second_difference_sum_ += (value - 2.0 * previous_[1] + previous_[0]).cwiseAbs2();
+  previous_[0] = previous_[1];
+  previous_[1] = value;
 }
 
 void WindowBuilder::Close() {
@@ -96,6 +109,13 @@ void WindowBuilder::Close() {
   window.accel_mean = mean_.tail<3>();
   window.gyro_std = std_dev.head<3>();
   window.accel_std = std_dev.tail<3>();
+  if (n_ > 2) {
+    const Eigen::Matrix<double, 6, 1> noise =
+        (second_difference_sum_ / (6.0 * static_cast<double>(n_ - 2))).cwiseSqrt();
+    window.gyro_noise = noise.head<3>();
+    window.accel_noise = noise.tail<3>();
+  }
+  window.whole_occurrence = whole_occurrence_;
   windows_.push_back(window);
 }
 

@@ -80,21 +80,34 @@ void CheckInvertible(const yaml::Located& sensor, const double* params, int coef
   for (int axis = 0; axis < 3; ++axis) {
     const double* c = params + (kScaleCoefficient + axis) * kPolynomialTerms;
     double smallest = std::numeric_limits<double>::infinity(), largest = 0.0, at_c = range[0];
+    double opposite_c = range[0];
     bool sign_change = false;
     const double first = EvaluateTemperaturePolynomial(c, range[0] - center_c);
     for (const double t : CriticalTemperatures(c, center_c, range)) {
       const double value = EvaluateTemperaturePolynomial(c, t - center_c);
-      sign_change = sign_change || value == 0.0 || std::signbit(value) != std::signbit(first);
+      if (!sign_change && (value == 0.0 || std::signbit(value) != std::signbit(first))) {
+        sign_change = true;
+        opposite_c = t;
+      }
       largest = std::max(largest, std::abs(value));
       if (std::abs(value) < smallest) smallest = std::abs(value), at_c = t;
     }
     if (sign_change || !(smallest >= kMinScale) || !(smallest >= 1e-3 * largest) || !std::isfinite(largest)) {
-      char text[200];
-      std::snprintf(text, sizeof text,
-                    "the scale factor %s within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC); the "
-                    "correction divides by it",
-                    sign_change ? "changes sign" : "comes near zero", range[0], range[1],
-                    EvaluateTemperaturePolynomial(c, at_c - center_c), at_c);
+      char text[240];
+      if (sign_change) {
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
+            "%.4g at %.4g degC); the correction divides by it",
+            range[0], range[1], first, range[0], EvaluateTemperaturePolynomial(c, opposite_c - center_c),
+            opposite_c);
+      } else {
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
+            "at most %.3g elsewhere); the correction divides by it",
+            range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
+      }
       sensor["scale"][kCoefficientNames[kScaleCoefficient + axis].axis].Fail(text);
     }
   }

@@ -17,7 +17,7 @@ RunWindows ReadRunWindows(const Plan& plan, const std::string& samples_path, con
     run.segmentation = SegmentSamplesFile(plan, samples_path, input);
     labeller.emplace(*run.segmentation);
   }
-  WindowBuilder builder(options);
+  WindowBuilder builder(options, plan.segments);
   Sample sample;
   int last_checked = kTransitionSegment;
   while (reader.Next(&sample)) {

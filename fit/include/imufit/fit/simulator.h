@@ -16,6 +16,13 @@
 // to the new direction with a smooth (cubic) profile about the axis old x new, while the table
 // rate changes linearly; omega_true = rate(t) up(t) + angle'(t) axis (+ Earth rate along up),
 // a_true = g up(t). The same seed gives the same samples, bit for bit, on every platform.
+//
+// A turn through a known angle (angle_deg) rests for the first and last 20 % of its dwell and
+// turns in between with a raised-cosine rate profile (zero rate and zero angular acceleration at
+// both ends, as a hand or a position-mode table moves); a rate segment about an axis that is not
+// vertical spins at its rate from the start of the dwell. In both, world-fixed directions turn in
+// the body frame exactly (up_b(t) = R(n, -angle(t)) up): gravity, the vertical Earth rate and
+// the g-sensitivity term follow the orientation sample by sample.
 #ifndef IMUFIT_FIT_SIMULATOR_H_
 #define IMUFIT_FIT_SIMULATOR_H_
 
@@ -38,10 +45,10 @@ struct SimulationOptions {
   double ramp_from_c = -40.0;
   double ramp_to_c = 85.0;
   int passes = 4;
-  double dwell_s = 10.0;       // time in each segment
-  double transition_s = 2.0;   // time the table moves between segments (segment -1)
-  double rate_hz = 100.0;      // sample rate
-  double start_time_s = 0.0;   // time_s of the first sample
+  double dwell_s = 10.0;      // time in each segment
+  double transition_s = 2.0;  // time the table moves between segments (segment -1)
+  double rate_hz = 100.0;     // sample rate
+  double start_time_s = 0.0;  // time_s of the first sample
   // White noise densities (Kalibr's units): rad/s/sqrt(Hz) and m/s^2/sqrt(Hz).
   double gyro_noise_density = 0.0;
   double accel_noise_density = 0.0;

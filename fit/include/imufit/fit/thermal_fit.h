@@ -6,11 +6,14 @@
 // plan, Earth rate and lever arms included, model/rate_table.h) and temperature x_w in the fit
 // basis (x = (T - centre) / half range, about [-1, 1] over the run):
 //
-//   minimise  sum_w rho(|(correct_g(B_w; x_w, a_w) - omega_w) / sigma_g,w|^2)
-//                 + rho(|(correct_a(A_w; x_w) - a_w) / sigma_a,w|^2)
+//   minimise  sum_w rho(|K_g (correct_g(B_w; x_w, a_w) - omega_w) / sigma_g,w|^2)
+//                 + rho(|K_a (correct_a(A_w; x_w) - a_w) / sigma_a,w|^2)     [accel: a_w known]
 //
-// with window_cost.h's residual, the shared model's correction. Gyro and accelerometer
-// parameters form two blocks (84 and 48); terms above the chosen temperature order, and the
+// with window_cost.h's residual, the shared model's correction mapped back to raw units by
+// K = diag(S) inv(M), and sigma the window's noise of the mean in raw units (fixed weights). A
+// turn's window is its whole occurrence with omega_w its mean rate; where gravity turns in the
+// body frame the accelerometer is not fitted and a_w is the corrected accelerometer mean. Gyro and
+// accelerometer parameters form two blocks (84 and 48); terms above the chosen temperature order, and the
 // g-sensitivity when it is left out, are held at zero.
 //
 // Start. The forward model raw = K(x) truth + V(x) + H(x) a with K = diag(S) inv(M) is linear
@@ -85,12 +88,12 @@ struct FitOptions {
 
 // The residual of one window after the fit, SI units, body frame.
 struct WindowResidual {
-  int window = 0;                 // index into the windows given to the fit
+  int window = 0;  // index into the windows given to the fit
   Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyro_sigma_radps = Eigen::Vector3d::Zero();  // the weights used
   Eigen::Vector3d accel_sigma_mps2 = Eigen::Vector3d::Zero();
-  bool downweighted = false;      // the robust loss acted on this window
+  bool downweighted = false;  // the robust loss acted on this window
 };
 
 enum class FitStatus {

@@ -48,10 +48,10 @@ ErrorStats SummariseErrors(const std::vector<WindowError>& errors);
 std::vector<ErrorStats> ErrorsBySegment(const std::vector<WindowError>& errors);
 
 struct HeldOutGroup {
-  double temp_c = 0.0;       // centre of the held-out group
-  bool fitted = false;       // false: the rest of the run did not determine the model
-  std::string why_not;       // when !fitted
-  ErrorStats errors;         // of the held-out windows
+  double temp_c = 0.0;  // centre of the held-out group
+  bool fitted = false;  // false: the rest of the run did not determine the model
+  std::string why_not;  // when !fitted
+  ErrorStats errors;    // of the held-out windows
 };
 
 // Temperature groups: the distinct temperatures of the run, or at most `max_groups` bands of

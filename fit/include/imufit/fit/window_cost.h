@@ -1,11 +1,17 @@
 // imufit — the residual the thermal fit minimises, one window of one sensor at a time.
 //
-//   r = (correct(mean raw output of the window) - truth) / sigma          [dimensionless]
+//   r = diag(S) inv(M) (correct(mean raw output of the window) - truth) / sigma_raw
+//     = (mean raw output - forward(truth)) / sigma_raw                      [dimensionless]
 //
 // where correct() is the shared model of model/sensor_model.h (CoefficientsAt + CorrectSensor,
-// exactly what `imufit apply` runs), evaluated at the window's mean temperature, and sigma the
-// window's measured noise of the mean converted to SI, per axis. The gyro's g-sensitivity term
-// is given the true specific force of the window. Parameters are scaled for the solver:
+// exactly what `imufit apply` runs), evaluated at the window's mean temperature, and sigma_raw the
+// window's noise of the mean in the sensor's raw units, per axis. The error is mapped back to raw
+// units through the current K = diag(S) inv(M) because the noise lives there: a residual in SI
+// divided by a fixed SI noise figure would shrink as the fitted scale grows, and the solver could
+// trade a few scale-setting windows against the normalisation of every other window. In raw
+// units the weights do not depend on the parameters. The gyro's g-sensitivity term is given the
+// window's specific force (true, or the corrected accelerometer mean where gravity turns in the
+// body frame). Parameters are scaled for the solver:
 //
 //   p = p0 + step .* q,
 //
@@ -31,25 +37,32 @@ class WindowCost {
 
   // `raw_mean`: the window's mean raw output; `truth`: its true rate (rad/s) or specific force
   // (m/s^2); `a_true`: its true specific force (for the g-sensitivity; ignored for the
-  // accelerometer); `x`: its temperature in the fit basis; `sigma`: noise of the mean in SI.
+  // accelerometer); `x`: its temperature in the fit basis; `sigma_raw`: noise of the mean, raw.
   WindowCost(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& truth, const Eigen::Vector3d& a_true,
-             double x, const Eigen::Vector3d& sigma, const double* p0, const double* step)
-      : raw_mean_(raw_mean), truth_(truth), a_true_(a_true), x_(x), inverse_sigma_(sigma.cwiseInverse()) {
+             double x, const Eigen::Vector3d& sigma_raw, const double* p0, const double* step)
+      : raw_mean_(raw_mean), truth_(truth), a_true_(a_true), x_(x), inverse_sigma_(sigma_raw.cwiseInverse()) {
     std::copy(p0, p0 + kParameters, p0_.begin());
     std::copy(step, step + kParameters, step_.begin());
   }
 
   template <typename T>
   bool operator()(const T* q, T* residual) const {
+    Vector3<T> corrected;
+    Evaluate(q, &corrected, residual);
+    return true;
+  }
+
+  // The corrected window mean (SI, what `imufit apply` computes) and the normalised residual.
+  template <typename T>
+  void Evaluate(const T* q, Vector3<T>* corrected, T* residual) const {
     T p[kParameters];
     for (int i = 0; i < kParameters; ++i) p[i] = T(p0_[i]) + T(step_[i]) * q[i];
     const SensorCoefficients<T> c = CoefficientsAt(p, kCoefficients, T(x_));
-    const Vector3<T> corrected =
-        CorrectSensor(c, raw_mean_.template cast<T>().eval(), a_true_.template cast<T>().eval());
-    for (int axis = 0; axis < 3; ++axis) {
-      residual[axis] = (corrected(axis) - T(truth_(axis))) * T(inverse_sigma_(axis));
-    }
-    return true;
+    *corrected = CorrectSensor(c, raw_mean_.template cast<T>().eval(), a_true_.template cast<T>().eval());
+    const Vector3<T> error = *corrected - truth_.template cast<T>();
+    // diag(S) inv(M) error: the same error in raw units.
+    const Vector3<T> raw_error = c.scale.cwiseProduct(c.misalignment.partialPivLu().solve(error));
+    for (int axis = 0; axis < 3; ++axis) residual[axis] = raw_error(axis) * T(inverse_sigma_(axis));
   }
 
  private:

@@ -9,6 +9,16 @@
 // after a move). Samples with segment -1 are skipped. Only running sums are kept: memory does
 // not grow with the run.
 //
+// A turn through a known angle (TableSegment::IsTurn) is different: its truth is the integral of
+// the rate over the whole occurrence, so each occurrence of a turn is exactly one window, neither
+// trimmed nor split by temperature or duration.
+//
+// Besides the sample standard deviation (which, in a window whose truth varies, measures the
+// signal), every window carries a per-sample noise figure from second differences,
+// sqrt(sum (x_i - 2 x_(i-1) + x_(i-2))^2 / (6 (n - 2))): for white noise its expectation is the
+// noise's variance, and a smooth signal (a turn's rate profile) contributes only its second
+// derivative times dt^2.
+//
 // Units: whatever the samples carry (raw for a fit, SI for a check of a corrected run).
 #ifndef IMUFIT_FIT_WINDOWS_H_
 #define IMUFIT_FIT_WINDOWS_H_
@@ -18,6 +28,7 @@
 
 #include <Eigen/Core>
 
+#include "imufit/model/rate_table.h"
 #include "imufit/model/sample.h"
 
 namespace imufit {
@@ -39,17 +50,27 @@ struct WindowOptions {
 // The statistics of one window.
 struct Window {
   int segment = 0;
-  int occurrence = 0;      // 0 for the first contiguous stretch of this segment id, 1 ...
+  int occurrence = 0;  // 0 for the first contiguous stretch of this segment id, 1 ...
   long long samples = 0;
   double start_s = 0.0;
   double end_s = 0.0;
-  double temp_c = 0.0;     // mean temperature reading
+  double temp_c = 0.0;      // mean temperature reading
   double min_temp_c = 0.0;  // extremes of the readings in the window
   double max_temp_c = 0.0;
   Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();
-  Eigen::Vector3d gyro_std = Eigen::Vector3d::Zero();   // sample standard deviation
+  Eigen::Vector3d gyro_std = Eigen::Vector3d::Zero();  // sample standard deviation
   Eigen::Vector3d accel_std = Eigen::Vector3d::Zero();
+  // Per-sample noise from second differences (see above); zero with fewer than 3 samples.
+  Eigen::Vector3d gyro_noise = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_noise = Eigen::Vector3d::Zero();
+  bool whole_occurrence = false;  // a turn's occurrence: one window, untrimmed
+
+  // The time the window's samples stand for: samples x their mean interval, s.
+  double DurationS() const {
+    return samples > 1 ? (end_s - start_s) * static_cast<double>(samples) / static_cast<double>(samples - 1)
+                       : 0.0;
+  }
 };
 
 // Counts of what went into the windows and what did not.
@@ -67,6 +88,8 @@ struct WindowStats {
 class WindowBuilder {
  public:
   explicit WindowBuilder(const WindowOptions& options = WindowOptions());
+  // As above; the occurrences of the turns among `segments` become one window each.
+  WindowBuilder(const WindowOptions& options, const std::vector<TableSegment>& segments);
 
   // Adds the next sample of the run (in time order).
   void Add(const Sample& sample);
@@ -81,6 +104,8 @@ class WindowBuilder {
   WindowStats stats_;
   std::vector<Window> windows_;
   std::vector<std::pair<int, int>> occurrences_;  // segment id -> occurrences so far
+  std::vector<int> turn_ids_;                     // segments whose occurrence is one window
+  bool whole_occurrence_ = false;                 // the current segment is a turn
   // The open window: running mean and sum of squared deviations (Welford), per channel.
   bool open_ = false;
   int current_segment_ = kTransitionSegment;
@@ -95,6 +120,9 @@ class WindowBuilder {
   double temp_max_ = 0.0;
   Eigen::Matrix<double, 6, 1> mean_ = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> m2_ = Eigen::Matrix<double, 6, 1>::Zero();
+  // The last two samples and the sum of squared second differences.
+  Eigen::Matrix<double, 6, 1> previous_[2];
+  Eigen::Matrix<double, 6, 1> second_difference_sum_ = Eigen::Matrix<double, 6, 1>::Zero();
 };
 
 }  // namespace imufit

@@ -1,12 +1,23 @@
-// imufit — the truth of a rate-table segment (docs/spec.md section 2), in the body frame, SI units.
+// imufit — the truth of a rate-table segment (docs/spec.md section 2, docs/conventions.md), in
+// the body frame, SI units. With n the rotation axis (`axis`, else `up`):
 //
-//   omega_true = rate * up + Omega_E sin(phi) up            (+ Omega_E cos(phi) north, static)
-//   a_true     = g up - rate^2 (r - up (r . up))            (centripetal, rate segments with r)
+//   static: omega_true = Omega_E sin(phi) up (+ Omega_E cos(phi) north)
+//           a_true     = g up
+//   rate:   omega_true = rate n + Omega_E sin(phi) (up . n) n
+//           a_true     = g up - rate^2 (r - n (r . n))
+//   turn:   mean(omega_true) = angle n / duration + Omega_E sin(phi) (up . n) n
+//           a_true     = g up
 //
-// up: unit vector opposite to gravity, body axes. north: unit horizontal vector to true north
-// (static segments only: in a rate segment the horizontal Earth rate turns with the table and
-// averages out, so it is left out of the truth). r: the sensor's position relative to the table
-// axis, metres, body axes. The Earth-rate terms are present only when the latitude is known.
+// up: unit vector opposite to gravity, body axes (for a turn: at its start). north: unit
+// horizontal vector to true north (static segments only: in a rate segment the horizontal Earth
+// rate turns with the table and averages out, so it is left out of the truth; only the Earth rate
+// along the axis is constant). r: the sensor's position relative to the table axis, metres, body
+// axes. The Earth-rate terms are present only when the latitude is known.
+//
+// The specific force is constant only when the axis is vertical (n parallel to up). About any
+// other axis gravity turns in the body frame: a_true above is then its value at the start of the
+// segment, and `SpecificForceIsKnown()` is false: the fit does not use the accelerometer there.
+// A turn's rate profile is unknown; only its mean over the whole turn is (TurnTruth()).
 #ifndef IMUFIT_MODEL_RATE_TABLE_H_
 #define IMUFIT_MODEL_RATE_TABLE_H_
 
@@ -38,6 +49,12 @@ struct TableSegment {
   bool IsStatic() const { return rate_radps == 0.0 && !angle_rad; }
   bool IsTurn() const { return angle_rad.has_value(); }
   const Eigen::Vector3d& RotationAxis() const { return axis ? *axis : up; }
+  // The rotation axis is vertical (parallel or antiparallel to up, to 1e-6 rad).
+  bool AxisIsVertical() const { return std::abs(RotationAxis().dot(up)) >= kVerticalAxisCosine; }
+  // The specific force is constant and known from the plan (static, or about a vertical axis).
+  bool SpecificForceIsKnown() const { return IsStatic() || AxisIsVertical(); }
+
+  static constexpr double kVerticalAxisCosine = 1.0 - 5e-13;  // cos(1e-6 rad)
 };
 
 // The site of the run: local gravity and, optionally, latitude.
@@ -52,21 +69,38 @@ struct SegmentTruth {
   Eigen::Vector3d a_mps2 = Eigen::Vector3d::Zero();
 };
 
+// The truth of a static or rate segment (for a rate about a non-vertical axis, a_true at the
+// segment's starting orientation); for a turn, omega_true is its Earth rate only (see TurnTruth).
 inline SegmentTruth TruthOf(const TableSite& site, const TableSegment& segment) {
   SegmentTruth truth;
-  truth.omega_radps = segment.rate_radps * segment.up;
+  const Eigen::Vector3d& n = segment.RotationAxis();
+  truth.omega_radps = segment.rate_radps * n;
   if (site.latitude_rad) {
-    truth.omega_radps += kEarthRateRadps * std::sin(*site.latitude_rad) * segment.up;
-    if (segment.IsStatic() && segment.north) {
-      truth.omega_radps += kEarthRateRadps * std::cos(*site.latitude_rad) * *segment.north;
+    const double vertical_earth_rate = kEarthRateRadps * std::sin(*site.latitude_rad);
+    if (segment.IsStatic()) {
+      truth.omega_radps += vertical_earth_rate * segment.up;
+      if (segment.north) truth.omega_radps += kEarthRateRadps * std::cos(*site.latitude_rad) * *segment.north;
+    } else {
+      // Only the part along the axis is constant in the body frame (with no `axis`, n is up).
+      truth.omega_radps += segment.axis ? Eigen::Vector3d(vertical_earth_rate * segment.up.dot(n) * n)
+                                        : Eigen::Vector3d(vertical_earth_rate * segment.up);
     }
   }
   truth.a_mps2 = site.gravity_mps2 * segment.up;
-  if (!segment.IsStatic() && segment.lever_arm_m) {
+  if (!segment.IsStatic() && !segment.IsTurn() && segment.lever_arm_m) {
     const Eigen::Vector3d& r = *segment.lever_arm_m;
-    const Eigen::Vector3d radial = r - segment.up * r.dot(segment.up);
+    const Eigen::Vector3d radial = r - n * r.dot(n);
     truth.a_mps2 -= segment.rate_radps * segment.rate_radps * radial;
   }
+  return truth;
+}
+
+// The truth of a window covering one whole occurrence of a turn of `duration_s` (its samples
+// times their mean interval): the mean rate angle n / duration plus the Earth rate along n, and
+// g up (meaningful when the axis is vertical).
+inline SegmentTruth TurnTruth(const TableSite& site, const TableSegment& segment, double duration_s) {
+  SegmentTruth truth = TruthOf(site, segment);
+  truth.omega_radps += segment.angle_rad.value_or(0.0) / duration_s * segment.RotationAxis();
   return truth;
 }
 
