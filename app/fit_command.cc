@@ -251,6 +251,10 @@ int RunFit(FitArguments args) {
       std::printf("    without %6.1f degC: %3d held-out windows, gyro RMS %.5f deg/s (max %.5f), accel RMS %.4f mg (max %.4f)\n",
                   g.temp_c, g.errors.windows, DpsFromRadps(g.errors.gyro_rms_radps), DpsFromRadps(g.errors.gyro_max_radps),
                   MgFromMps2(g.errors.accel_rms_mps2), MgFromMps2(g.errors.accel_max_mps2));
+      if (g.order_lowered) {
+        std::printf("      (held out at temperature order %d gyro / %d accel: the other temperatures determine no more)\n",
+                    g.gyro_temp_order, g.accel_temp_order);
+      }
     }
   }
   if (!result.check_errors.empty()) {

@@ -371,6 +371,30 @@ TEST_F(KnownTruth, LeaveOneTemperatureOutReportsInteriorTemperatures) {
   }
 }
 
+// Four temperatures: each interior fold keeps three, too few for a cubic, so it is fitted at
+// order 2 (and says so) instead of not at all.
+TEST_F(KnownTruth, LeaveOneTemperatureOutLowersTheOrderTheFoldCannotDetermine) {
+  std::vector<Window> four_temps;
+  for (const Window& w : *windows_) {
+    if (std::abs(w.temp_c - (-10.0)) > 5.0) four_temps.push_back(w);
+  }
+  const std::vector<HeldOutGroup> folds =
+      LeaveOneTemperatureOut(four_temps, Site(), SixPositionPlan(), FitOptions());
+  ASSERT_EQ(folds.size(), 2u);  // 25 and 55 degC
+  for (const HeldOutGroup& g : folds) {
+    ASSERT_TRUE(g.fitted) << g.temp_c << ": " << g.why_not;
+    EXPECT_TRUE(g.order_lowered);
+    EXPECT_EQ(g.gyro_temp_order, 2);
+    EXPECT_EQ(g.accel_temp_order, 2);
+    EXPECT_EQ(g.errors.windows, 18);
+  }
+  // With all five temperatures every fold keeps four: the cubic stays.
+  for (const HeldOutGroup& g : LeaveOneTemperatureOut(*windows_, Site(), SixPositionPlan(), FitOptions())) {
+    EXPECT_FALSE(g.order_lowered);
+    EXPECT_EQ(g.gyro_temp_order, 3);
+  }
+}
+
 TEST(Fit, ExactOnANoiseFreeRampWithEarthRateAndLeverArms) {
   // Without noise the fit must reproduce the truth to round-off: any modelling error (Earth
   // rate, centripetal term, temperature inside a window) would show here.

@@ -379,6 +379,9 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     row.gyro_max_dps = DpsFromRadps(g.errors.gyro_max_radps);
     row.accel_rms_mg = MgFromMps2(g.errors.accel_rms_mps2);
     row.accel_max_mg = MgFromMps2(g.errors.accel_max_mps2);
+    row.gyro_temp_order = g.gyro_temp_order;
+    row.accel_temp_order = g.accel_temp_order;
+    row.order_lowered = g.order_lowered;
     c.validation.push_back(row);
   }
   return c;

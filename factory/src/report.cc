@@ -449,6 +449,15 @@ void Validation(Html* h, const Certificate& c) {
     h->Close("tr");
   }
   h->Close("tbody").Close("table");
+  for (const ValidationRow& v : c.validation) {
+    if (!v.fitted || !v.order_lowered) continue;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "Without %.1f degC the fold is fitted at temperature order %d (gyro) / %d (accel): the "
+                  "other temperatures determine no more.",
+                  v.temp_c, v.gyro_temp_order, v.accel_temp_order);
+    h->Element("p", text, {{"class", "note"}});
+  }
 }
 
 }  // namespace

@@ -90,7 +90,16 @@ std::vector<HeldOutGroup> LeaveOneTemperatureOut(const std::vector<Window>& wind
     HeldOutGroup group;
     group.temp_c = centres[g];
     FitOptions fold = options;
-    fold.num_threads = options.num_threads;
+    std::vector<double> kept_temps;
+    for (const Window& w : kept) kept_temps.push_back(w.temp_c);
+    const int highest_order =
+        static_cast<int>(DistinctTemperatures(kept_temps, options.distinct_temp_c).size()) - 1;
+    fold.gyro_temp_order = std::max(0, std::min(options.gyro_temp_order, highest_order));
+    fold.accel_temp_order = std::max(0, std::min(options.accel_temp_order, highest_order));
+    group.gyro_temp_order = fold.gyro_temp_order;
+    group.accel_temp_order = fold.accel_temp_order;
+    group.order_lowered =
+        fold.gyro_temp_order < options.gyro_temp_order || fold.accel_temp_order < options.accel_temp_order;
     const FitSummary fit = FitThermalModel(kept, site, segments, fold);
     if (!fit.IsSolutionUsable()) {
       group.why_not = fit.undetermined.empty() ? fit.termination : fit.undetermined.front();

@@ -105,7 +105,8 @@ class FitResult:
     gyro_reduced_chi2, accel_reduced_chi2, samples, transition_samples, trimmed_samples,
     short_windows, brief_report, full_report, windows {segment, occurrence, samples, start_s,
     end_s, temp_c, gyro_mean, accel_mean, gyro_std, accel_std}, residuals {window, gyro_radps,
-    accel_mps2, gyro_sigma_radps, accel_sigma_mps2, downweighted}, folds, check_errors."""
+    accel_mps2, gyro_sigma_radps, accel_sigma_mps2, downweighted}, folds {temp_c, fitted, why_not,
+    gyro_temp_order, accel_temp_order, order_lowered, errors}, check_errors."""
 
 def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Any) -> FitResult:
     """Fits the thermal model to a run, as `imufit fit` does. plan: plan YAML path; samples: a path

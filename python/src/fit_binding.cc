@@ -271,6 +271,9 @@ py::dict Diagnostics(const FitRunResult& result) {
     fold["temp_c"] = g.temp_c;
     fold["fitted"] = g.fitted;
     fold["why_not"] = g.why_not;
+    fold["gyro_temp_order"] = g.gyro_temp_order;
+    fold["accel_temp_order"] = g.accel_temp_order;
+    fold["order_lowered"] = g.order_lowered;
     fold["errors"] = ErrorStatsDict(g.errors);
     folds.append(fold);
   }

@@ -123,6 +123,9 @@ struct ValidationRow {
   std::string why_not;
   int windows = 0;
   double gyro_rms_dps = 0.0, gyro_max_dps = 0.0, accel_rms_mg = 0.0, accel_max_mg = 0.0;
+  // The held-out fit's temperature orders; lowered when the other temperatures determine no more.
+  int gyro_temp_order = 0, accel_temp_order = 0;
+  bool order_lowered = false;
 };
 
 // The fit's settings and diagnostics, from the calibration's `fit:` block (known = false without).

@@ -8,7 +8,9 @@
 //
 // LeaveOneTemperatureOut() refits without each interior temperature group in turn and predicts
 // the windows left out. The lowest and highest groups are not left out: that would test
-// extrapolation, not calibration.
+// extrapolation, not calibration. When the temperatures left in a fold cannot determine the
+// chosen order (a cubic needs four), the fold is fitted at the highest order they determine, and
+// says so (HeldOutGroup::gyro_temp_order / accel_temp_order), instead of not being fitted at all.
 #ifndef IMUFIT_FIT_VALIDATION_H_
 #define IMUFIT_FIT_VALIDATION_H_
 
@@ -50,6 +52,11 @@ std::vector<ErrorStats> ErrorsBySegment(const std::vector<WindowError>& errors);
 struct HeldOutGroup {
   double temp_c = 0.0;  // centre of the held-out group
   bool fitted = false;  // false: the rest of the run did not determine the model
+  // The temperature orders the held-out fit used: the options' orders, or lower when the
+  // temperatures left in the fold determine no more (distinct temperatures - 1).
+  int gyro_temp_order = 0;
+  int accel_temp_order = 0;
+  bool order_lowered = false;
   std::string why_not;  // when !fitted
   ErrorStats errors;    // of the held-out windows
 };
