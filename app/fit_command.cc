@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/certificate.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/fit/thermal_fit.h"
@@ -14,13 +15,11 @@
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g, for mg and deg/s/g
 
 struct FitArguments {
   std::string plan;
@@ -35,6 +34,7 @@ struct FitArguments {
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
   std::string report;  // certificate HTML to write
   std::string store;   // results store to record the fit in
+  std::string serial;  // the unit's serial; empty: the plan's
   double gyro_bias_stability_dph = 0.0;
   double accel_bias_stability_ug = 0.0;
   FitOptions fit;
@@ -50,41 +50,35 @@ std::string Format(const char* format, double a, double b) {
   return text;
 }
 
-// The 25 degC values a test engineer reads first, in familiar units, with 1-sigma.
+// The 25 degC values a test engineer reads first, in familiar units (io/units.h), with 1-sigma.
 void PrintCoefficients(const FitSummary& fit) {
-  const auto c0 = [](const std::array<double, kGyroParameters>& p, int coefficient) { return p[coefficient * kPolynomialTerms]; };
-  const auto a0 = [](const std::array<double, kAccelParameters>& p, int coefficient) { return p[coefficient * kPolynomialTerms]; };
+  const auto at25 = [&](Sensor sensor, int coefficient) {
+    return EngineeringCoefficient(fit.model, &fit.sigma, sensor, coefficient, kFigureTempC);
+  };
+  const auto text = [](const char* format, const EngineeringValue& v) { return Format(format, v.value, v.sigma); };
   const char* axes = "xyz";
   std::printf("  at 25 degC (+- 1 sigma):\n");
   for (int i = 0; i < 3; ++i) {
-    const double scale = c0(fit.model.gyro, kScaleCoefficient + i);  // raw per rad/s
-    const double to_dps = kRadToDeg / scale;
     std::printf("    gyro %c   bias %s deg/s   scale %s raw/(deg/s)\n", axes[i],
-                Format("%+.5f +- %.5f", c0(fit.model.gyro, kBiasCoefficient + i) * to_dps,
-                       c0(fit.sigma.gyro, kBiasCoefficient + i) * to_dps).c_str(),
-                Format("%.5f +- %.5f", scale / kRadToDeg, c0(fit.sigma.gyro, kScaleCoefficient + i) / kRadToDeg).c_str());
+                text("%+.5f +- %.5f", at25(Sensor::kGyro, kBiasCoefficient + i)).c_str(),
+                text("%.5f +- %.5f", at25(Sensor::kGyro, kScaleCoefficient + i)).c_str());
   }
   for (int i = 0; i < 3; ++i) {
-    const double scale = a0(fit.model.accel, kScaleCoefficient + i);  // raw per m/s^2
-    const double to_mg = 1e3 / (scale * kStandardGravity);
     std::printf("    accel %c  bias %s mg      scale %s raw/g\n", axes[i],
-                Format("%+.4f +- %.4f", a0(fit.model.accel, kBiasCoefficient + i) * to_mg,
-                       a0(fit.sigma.accel, kBiasCoefficient + i) * to_mg).c_str(),
-                Format("%.4f +- %.4f", scale * kStandardGravity, a0(fit.sigma.accel, kScaleCoefficient + i) * kStandardGravity).c_str());
+                text("%+.4f +- %.4f", at25(Sensor::kAccel, kBiasCoefficient + i)).c_str(),
+                text("%.4f +- %.4f", at25(Sensor::kAccel, kScaleCoefficient + i)).c_str());
   }
   std::printf("    misalignment, mrad:          gyro                      accel\n");
   for (int m = 0; m < 6; ++m) {
     const int c = kMisalignmentCoefficient + m;
     std::printf("      %-2s  %s   %s\n", kCoefficientNames[c].axis,
-                Format("%+9.4f +- %.4f", c0(fit.model.gyro, c) * 1e3, c0(fit.sigma.gyro, c) * 1e3).c_str(),
-                Format("%+9.4f +- %.4f", a0(fit.model.accel, c) * 1e3, a0(fit.sigma.accel, c) * 1e3).c_str());
+                text("%+9.4f +- %.4f", at25(Sensor::kGyro, c)).c_str(),
+                text("%+9.4f +- %.4f", at25(Sensor::kAccel, c)).c_str());
   }
   std::printf("    gyro g-sensitivity, deg/s/g:\n");
   for (int h = 0; h < 9; ++h) {
     const int c = kGSensitivityCoefficient + h;
-    const double to_dps_per_g = kRadToDeg * kStandardGravity / c0(fit.model.gyro, kScaleCoefficient + h / 3);
-    std::printf("      %-2s  %s%s", kCoefficientNames[c].axis,
-                Format("%+.5f +- %.5f", c0(fit.model.gyro, c) * to_dps_per_g, c0(fit.sigma.gyro, c) * to_dps_per_g).c_str(),
+    std::printf("      %-2s  %s%s", kCoefficientNames[c].axis, text("%+.5f +- %.5f", at25(Sensor::kGyro, c)).c_str(),
                 h % 3 == 2 ? "\n" : "   ");
   }
 }
@@ -93,9 +87,9 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
   std::printf("  %s\n    segment  windows   gyro RMS / max, deg/s      accel RMS / max, mg\n", title);
   for (const ErrorStats& s : stats) {
     std::printf("    %7s  %7d   %10.5f / %-10.5f   %8.4f / %-8.4f\n",
-                s.segment < 0 ? "all" : std::to_string(s.segment).c_str(), s.windows, s.gyro_rms_radps * kRadToDeg,
-                s.gyro_max_radps * kRadToDeg, s.accel_rms_mps2 / kStandardGravity * 1e3,
-                s.accel_max_mps2 / kStandardGravity * 1e3);
+                s.segment < 0 ? "all" : std::to_string(s.segment).c_str(), s.windows, DpsFromRadps(s.gyro_rms_radps),
+                DpsFromRadps(s.gyro_max_radps), MgFromMps2(s.accel_rms_mps2),
+                MgFromMps2(s.accel_max_mps2));
   }
 }
 
@@ -104,25 +98,33 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result,
                   OutputTransaction* outputs) {
   const Calibration& calibration = *result.calibration;
-  std::optional<Verdict> verdict;
-  if (limits) {
-    verdict = EvaluateLimits(*limits, calibration);
-    if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
-  }
   std::string plan_sha256, samples_sha256;
   if (!args.report.empty() || !args.store.empty()) {
     plan_sha256 = Sha256OfFile(args.plan);
     samples_sha256 = Sha256OfFile(args.samples);
   }
+  std::optional<Certificate> certificate;
   if (!args.report.empty()) {
-    UnitReport report = MakeUnitReport(calibration, result.plan, result.run,
-                                       {{"plan", args.plan, plan_sha256},
-                                        {"samples", args.samples, samples_sha256},
-                                        {"limits", args.limits, ""}},
-                                       verdict);
-    report.folds = result.folds;
-    WriteUnitReport(args.report, report);
+    CertificateSources sources;
+    sources.calibration = calibration;
+    sources.plan = result.plan;
+    sources.run = result.run;
+    sources.windows = args.windows;
+    sources.folds = result.folds;
+    sources.limits = limits;  // judged with the noise the certificate measures
+    // The calibration is not renamed into place yet (one transaction): hash the text it holds.
+    sources.inputs = {{"calibration", args.output, Sha256Hex(CalibrationToYaml(calibration))},
+                      {"plan", args.plan, plan_sha256},
+                      {"samples", args.samples, samples_sha256},
+                      {"limits", args.limits, ""}};
+    certificate = MakeCertificate(sources);
   }
+  std::optional<Verdict> verdict;
+  if (limits) {
+    verdict = certificate ? *certificate->verdict : EvaluateLimits(*limits, calibration);
+    if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
+  }
+  if (certificate) WriteCertificate(args.report, *certificate);
   outputs->Commit();  // the calibration and the report together, or neither
   if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
   if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
@@ -157,8 +159,8 @@ int RunFit(FitArguments args) {
   std::string error;
   if (!ParseRobustLoss(args.loss, &args.fit.loss, &error)) throw InputError("--loss", error);
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
-  args.fit.gyro_bias_stability_radps = args.gyro_bias_stability_dph / kRadToDeg / 3600.0;
-  args.fit.accel_bias_stability_mps2 = args.accel_bias_stability_ug * 1e-6 * kStandardGravity;
+  args.fit.gyro_bias_stability_radps = RadpsFromDph(args.gyro_bias_stability_dph);
+  args.fit.accel_bias_stability_mps2 = Mps2FromUg(args.accel_bias_stability_ug);
   const bool fixed_temp = args.input.HasTemp();
   if (fixed_temp) {
     // One temperature determines no temperature dependence: order 0, unless the user asked otherwise.
@@ -178,6 +180,7 @@ int RunFit(FitArguments args) {
   options.check_samples = args.check_samples;
   options.check_plan = args.check_plan;
   options.software = SoftwareVersion();
+  options.serial = args.serial;
   if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
 
   const FitRunResult result = FitRun(args.plan, args.samples, options);
@@ -217,7 +220,7 @@ int RunFit(FitArguments args) {
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
               stats.trimmed_samples);
   std::printf("  residual RMS: gyro %.5f deg/s, accel %.4f mg (reduced chi-square %.3g / %.3g)\n",
-              fit.gyro_rms_radps * kRadToDeg, fit.accel_rms_mps2 / kStandardGravity * 1e3, fit.gyro_reduced_chi2,
+              DpsFromRadps(fit.gyro_rms_radps), MgFromMps2(fit.accel_rms_mps2), fit.gyro_reduced_chi2,
               fit.accel_reduced_chi2);
   if (fit.windows_downweighted > 0) {
     std::printf("  down-weighted by the %s loss:", RobustLossName(args.fit.loss).c_str());
@@ -246,8 +249,8 @@ int RunFit(FitArguments args) {
         continue;
       }
       std::printf("    without %6.1f degC: %3d held-out windows, gyro RMS %.5f deg/s (max %.5f), accel RMS %.4f mg (max %.4f)\n",
-                  g.temp_c, g.errors.windows, g.errors.gyro_rms_radps * kRadToDeg, g.errors.gyro_max_radps * kRadToDeg,
-                  g.errors.accel_rms_mps2 / kStandardGravity * 1e3, g.errors.accel_max_mps2 / kStandardGravity * 1e3);
+                  g.temp_c, g.errors.windows, DpsFromRadps(g.errors.gyro_rms_radps), DpsFromRadps(g.errors.gyro_max_radps),
+                  MgFromMps2(g.errors.accel_rms_mps2), MgFromMps2(g.errors.accel_max_mps2));
     }
   }
   if (!result.check_errors.empty()) {
@@ -312,6 +315,7 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   command->add_option("--limits,-l", args->limits,
                       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
+  command->add_option("--serial", args->serial, "the unit's serial (default: the plan's serial)");
   command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
   command->add_option("--store", args->store, "record the fit in this results store (SQLite; created when missing)");
   return [args] { return RunFit(*args); };

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "imufit/factory/certificate.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
@@ -18,6 +19,8 @@ struct ReportArguments {
   std::string samples;
   std::string limits;
   std::string output;
+  std::string serial;
+  bool allow_mismatch = false;
   WindowOptions windows;
 };
 
@@ -25,18 +28,34 @@ int RunReport(const ReportArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.plan, args.samples, args.limits});
   if (const std::string problem = args.windows.Validate(); !problem.empty())
     throw InputError("imufit report", problem);
-  const Calibration calibration = ReadCalibration(args.calibration);
-  std::optional<Verdict> verdict;
-  if (!args.limits.empty()) verdict = EvaluateLimits(ReadLimits(args.limits), calibration);
-  const Plan plan = ReadPlan(args.plan);
-  RunWindows run = ReadRunWindows(plan, args.samples, args.windows);
-  const UnitReport report = MakeUnitReport(calibration, plan, std::move(run),
-                                           {{"calibration", args.calibration, ""},
-                                            {"plan", args.plan, ""},
-                                            {"samples", args.samples, ""},
-                                            {"limits", args.limits, ""}},
-                                           verdict);
-  WriteUnitReport(args.output, report);
+  CertificateSources sources;
+  sources.calibration = ReadCalibration(args.calibration);
+  if (!args.serial.empty()) sources.calibration.serial = args.serial;
+  if (!args.limits.empty()) sources.limits = ReadLimits(args.limits);
+  // A certificate of a calibration for another run's data would certify nothing.
+  const std::vector<std::string> mismatches = InputMismatches(sources.calibration, args.plan, args.samples);
+  if (!mismatches.empty() && !args.allow_mismatch) {
+    throw InputError(args.calibration, mismatches.front() + "; give --allow-mismatch to certify it anyway");
+  }
+  for (const std::string& m : mismatches) {
+    sources.warnings.push_back(m + " (certified with --allow-mismatch)");
+    std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
+  }
+  sources.plan = ReadPlan(args.plan);
+  sources.run = ReadRunWindows(sources.plan, args.samples, args.windows);
+  sources.windows = args.windows;
+  sources.inputs = {{"calibration", args.calibration, ""},
+                    {"plan", args.plan, ""},
+                    {"samples", args.samples, ""},
+                    {"limits", args.limits, ""}};
+  const Certificate certificate = MakeCertificate(sources);
+  if (certificate.serial.empty()) {
+    std::fprintf(stderr,
+                 "imufit: warning: %s: no serial (give --serial): the certificate says \"(no serial)\"\n",
+                 args.calibration.c_str());
+  }
+  WriteCertificate(args.output, certificate);
+  const std::optional<Verdict>& verdict = certificate.verdict;
   std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
               verdict ? (verdict->pass ? " (acceptance PASS)" : " (acceptance FAIL)") : "");
   return verdict && !verdict->pass ? kExitFailedLimits : 0;
@@ -56,6 +75,10 @@ CommandRunner AddReportCommand(CLI::App* root) {
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz) of the run")->required();
   command->add_option("--limits,-l", args->limits, "acceptance limits YAML");
   command->add_option("--output,-o", args->output, "HTML file to write")->required();
+  command->add_option("--serial", args->serial, "the unit's serial (default: the calibration's)");
+  command->add_flag("--allow-mismatch", args->allow_mismatch,
+                    "certify even when the calibration records other plan/samples hashes than these files' "
+                    "(the certificate says so)");
   command->add_option("--trim", args->windows.trim_s, "as imufit fit --trim")->capture_default_str();
   return [args] { return RunReport(*args); };
 }

@@ -33,8 +33,8 @@ cache=$IMUFIT_ROOT/build-release/CMakeCache.txt
 if grep -q '^IMUFIT_BUILD_PYTHON:BOOL=ON' "$cache"; then
   imufit_say "Python module: pytest (python/tests)"
   python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$cache")
-  PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$IMUFIT_ROOT/build-release/python" IMUFIT_BINARY="$IMUFIT_ROOT/build-release/app/imufit" \
-    "$python" -m pytest -q -p no:cacheprovider "$IMUFIT_ROOT/python/tests"
+  PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$IMUFIT_ROOT/build-release/python" \
+    IMUFIT_BINARY="$IMUFIT_ROOT/build-release/app/imufit" "$python" -m pytest -q -p no:cacheprovider "$IMUFIT_ROOT/python/tests"
 else
   imufit_say "Python module not built (pybind11 or the Python headers not found): pytest skipped"
 fi

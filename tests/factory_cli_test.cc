@@ -450,32 +450,111 @@ TEST_F(FactoryCliTest, ReportShowsTheGyroNoiseOfALongStaticStretch) {
   }
 }
 
-// The certificate as a browser draws it: headless Chromium renders it to a PNG of the page's width.
-TEST_F(FactoryCliTest, ChromiumRendersTheCertificate) {
-  const std::string chromium = "/usr/bin/chromium";
-  if (!fs::exists(chromium) || !fs::exists("/usr/bin/timeout")) GTEST_SKIP() << "no " << chromium;
+// imufit allan on raw counts or millisecond timestamps says so; --scale and --time-unit silence it.
+TEST_F(FactoryCliTest, AllanWarnsOnRawCountsAndMillisecondTimestamps) {
+  const std::string plan = Write("static_plan.yaml",
+                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+                                 "  - {id: 1, up: [0, 0, 1]}\n");
   RunResult r =
-      Run({"fit", "-p", Path("units/unit-04/plan.yaml"), "-s", Path("units/unit-04/samples.csv.gz"), "-o",
-           Path("cal4.yaml"), "--limits", Path("limits.yaml"), "--report", Path("unit4.html"), "-q"});
-  ASSERT_EQ(r.status, kExitFailedLimits) << r.err;
-  const std::string png = Path("unit4.png");
-  r = RunProgram("/usr/bin/timeout",
-                 {"120", chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-                  "--user-data-dir=" + Path("chromium-profile"), "--screenshot=" + png,
-                  "--window-size=1000,3000", "file://" + Path("unit4.html")});
+      Run({"simulate", "--plan", plan, "--calibration", kFixtures + "/mems_truth.yaml", "-o",
+           Path("static.csv"), "--rate", "10", "--dwell", "120", "--temps", "25", "--seed", "9", "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
-  const std::string image = ReadBytes(png);
-  ASSERT_GT(image.size(), 24u);
-  ASSERT_EQ(image.substr(1, 3), "PNG");
-  const auto be32 = [&](size_t at) {
-    return (static_cast<unsigned char>(image[at]) << 24) | (static_cast<unsigned char>(image[at + 1]) << 16) |
-           (static_cast<unsigned char>(image[at + 2]) << 8) | static_cast<unsigned char>(image[at + 3]);
+  r = Run({"allan", "-s", Path("static.csv"), "-c", "gyro_x", "-o", Path("a.csv"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("gyro_x has a mean of"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("raw counts"), std::string::npos) << r.err;
+  r = Run(
+      {"allan", "-s", Path("static.csv"), "-c", "gyro_x", "-o", Path("b.csv"), "-q", "--scale", "939.65"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  // The same log with time_s in milliseconds.
+  std::string text = ReadBytes(Path("static.csv"));
+  std::string ms = "time_s,gyro_x\n";
+  std::istringstream lines(text);
+  std::string line;
+  int n = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("time_s", 0) == 0) continue;
+    ms += std::to_string(100 * n++) + ",0.001\n";
+  }
+  Write("ms.csv", ms);
+  r = Run({"allan", "-s", Path("ms.csv"), "-c", "gyro_x", "-o", Path("c.csv"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("--time-unit ms"), std::string::npos) << r.err;
+  r = Run({"allan", "-s", Path("ms.csv"), "-c", "gyro_x", "-o", Path("d.csv"), "-q", "--time-unit", "ms"});
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(ReadBytes(Path("d.csv")).find("gyro_x,oadev,0.1,"), std::string::npos);
+}
+
+// The certificate and the lot page as a quality engineer prints them: a lot with one failing, one
+// corrupt and one incomplete unit, printed to PDF by headless Chromium, each page rasterised by
+// pdftoppm and checked: page count, "page x of y" and the serial in the running header, no blank page.
+TEST_F(FactoryCliTest, CertificatesAndLotPagePrintToPdf) {
+  const std::string chromium = "/usr/bin/chromium";
+  for (const char* tool : {"/usr/bin/chromium", "/usr/bin/pdftoppm", "/usr/bin/pdfinfo", "/usr/bin/pdftotext",
+                           "/usr/bin/timeout"}) {
+    if (!fs::exists(tool)) GTEST_SKIP() << "no " << tool << " (Debian: chromium poppler-utils)";
+  }
+  // unit-06: a run cut short after its second temperature (the rig stopped).
+  fs::create_directories(dir_ / "units" / "unit-06");
+  Simulate(UnitPlan("unit-06", "SN-06"), kFixtures + "/mems_truth.yaml", Path("units/unit-06/samples.csv"),
+           6);
+  const std::string full = ReadBytes(Path("units/unit-06/samples.csv"));
+  Write("units/unit-06/samples.csv", full.substr(0, full.find('\n', full.size() * 2 / 5) + 1));
+  RunResult r = Run(BatchArgs("out"));
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  auto summary = Summary("out");
+  EXPECT_EQ(summary["unit-04"]["verdict"], "FAIL");
+  EXPECT_EQ(summary["unit-05"]["status"], "error");
+  EXPECT_EQ(summary["unit-06"]["status"], "not-fitted") << summary["unit-06"]["message"];
+
+  const auto print = [&](const std::string& html, const std::string& name) {
+    const std::string pdf = Path(name + ".pdf");
+    const RunResult p =
+        RunProgram("/usr/bin/timeout",
+                   {"120", chromium, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                    "--no-first-run", "--disable-background-networking", "--disable-component-update",
+                    "--disable-sync", "--user-data-dir=" + Path("chromium-" + name), "--no-pdf-header-footer",
+                    "--print-to-pdf=" + pdf, "file://" + html});
+    EXPECT_EQ(p.status, 0) << p.err;
+    const RunResult info = RunProgram("/usr/bin/pdfinfo", {pdf});
+    std::smatch match;
+    int pages = 0;
+    if (std::regex_search(info.out, match, std::regex("Pages:\\s+(\\d+)"))) pages = std::stoi(match[1]);
+    EXPECT_EQ(RunProgram("/usr/bin/pdftoppm", {"-r", "30", "-png", pdf, Path(name + "-page")}).status, 0);
+    for (int page = 1; page <= pages; ++page) {
+      // pdftoppm numbers pages with as many digits as the last one needs.
+      const std::string png =
+          Path(name + "-page-" + (pages >= 10 && page < 10 ? "0" : "") + std::to_string(page) + ".png");
+      const std::string image = ReadBytes(png);
+      EXPECT_EQ(image.substr(1, 3), "PNG") << png;
+      // A page with text and plots compresses to far more than a blank one (about 1 kB at 30 dpi).
+      constexpr size_t kMinimumPrintedPagePngBytes = 4000;
+      EXPECT_GT(image.size(), kMinimumPrintedPagePngBytes) << png;
+      const RunResult text = RunProgram("/usr/bin/pdftotext", {"-f", std::to_string(page), "-l",
+                                                               std::to_string(page), pdf, Path("page.txt")});
+      EXPECT_EQ(text.status, 0);
+      const std::string words = ReadBytes(Path("page.txt"));
+      EXPECT_NE(words.find("page " + std::to_string(page) + " of " + std::to_string(pages)),
+                std::string::npos)
+          << name << " page " << page;
+    }
+    return pages;
   };
-  EXPECT_EQ(be32(16), 1000u);  // IHDR width
-  EXPECT_EQ(be32(20), 3000u);  // IHDR height
-  // A page of tables and plots compresses to far more than a blank page (a few kB).
-  constexpr size_t kMinimumDrawnPngBytes = 100000;
-  EXPECT_GT(image.size(), kMinimumDrawnPngBytes);
+  // A passing unit fits on a handful of pages; every page says whose certificate it is.
+  constexpr int kMostPagesOfACertificate = 6;
+  const int passing = print(Path("out/unit-01/report.html"), "unit-01");
+  EXPECT_GE(passing, 2);
+  EXPECT_LE(passing, kMostPagesOfACertificate);
+  EXPECT_EQ(
+      RunProgram("/usr/bin/pdftotext", {"-f", "2", "-l", "2", Path("unit-01.pdf"), Path("p2.txt")}).status,
+      0);
+  EXPECT_NE(ReadBytes(Path("p2.txt")).find("IMU calibration certificate SN-01"), std::string::npos);
+  const int failing = print(Path("out/unit-04/report.html"), "unit-04");
+  EXPECT_LE(failing, kMostPagesOfACertificate);
+  EXPECT_EQ(RunProgram("/usr/bin/pdftotext", {"-l", "1", Path("unit-04.pdf"), Path("p1.txt")}).status, 0);
+  EXPECT_NE(ReadBytes(Path("p1.txt")).find("FAIL"), std::string::npos);
+  EXPECT_GE(print(Path("out/lot.html"), "lot"), 1);
 }
 
 }  // namespace

@@ -8,17 +8,22 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/certificate.h"
+#include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/sha256.h"
+#include "imufit/io/units.h"
+#include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
 namespace {
@@ -258,6 +263,167 @@ TEST_F(FactoryTest, StoreRefusesANewerSchemaAndForeignFiles) {
   EXPECT_THROW(
       ResultsStore(Write("text.db", "this is not a database, just some text long enough to matter\n")),
       InputError);
+}
+
+// Issue 10 item 4: a calibration whose coefficients are written about another reference
+// temperature (40 degC) states the same unit: every figure is the same, to rounding.
+TEST_F(FactoryTest, FiguresDoNotDependOnTheReferenceTemperature) {
+  const Calibration at25 = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  Calibration at40 = at25;
+  TemperatureBasis basis40;
+  basis40.center_c = 40.0;
+  const Eigen::Matrix4d L = RebaseTemperaturePolynomial(at25.model.basis, basis40);
+  const auto rebase = [&](double* params, int coefficients) {
+    for (int i = 0; i < coefficients; ++i) {
+      Eigen::Map<Eigen::Vector4d> c(params + i * kPolynomialTerms);
+      c = (L * c).eval();
+    }
+  };
+  rebase(at40.model.gyro.data(), kGyroCoefficients);
+  rebase(at40.model.accel.data(), kAccelCoefficients);
+  at40.model.basis = basis40;
+  const std::string path = Write("cal40.yaml", CalibrationToYaml(at40));
+  const Calibration read40 = ReadCalibration(path);
+  ASSERT_EQ(read40.model.basis.center_c, 40.0);
+  ASSERT_NE(read40.model.gyro[0], at25.model.gyro[0]);  // the c0 terms differ: the file really moved
+  // Relative agreement of a figure recomputed through a rebased cubic (rounding of L * c only).
+  constexpr double kRebaseRelative = 1e-9;
+  const std::vector<Figure> figures25 = KeyFigures(at25), figures40 = KeyFigures(read40);
+  ASSERT_EQ(figures25.size(), figures40.size());
+  for (size_t i = 0; i < figures25.size(); ++i) {
+    EXPECT_NEAR(figures40[i].value, figures25[i].value,
+                std::abs(figures25[i].value) * kRebaseRelative + 1e-12)
+        << figures25[i].name;
+  }
+  // Off the reference too: the g-sensitivity xx at 60 degC.
+  const double h25 =
+      EngineeringCoefficient(at25.model, nullptr, Sensor::kGyro, kGSensitivityCoefficient, 60.0).value;
+  const double h40 =
+      EngineeringCoefficient(read40.model, nullptr, Sensor::kGyro, kGSensitivityCoefficient, 60.0).value;
+  EXPECT_NEAR(h40, h25, std::abs(h25) * kRebaseRelative);
+}
+
+TEST(Html, EscapesByConstructionAndChecksNesting) {
+  Html h;
+  h.Open("p", {{"data-x", "a\"b<c>"}}).Text("<script>alert('x') & co</script>").Close("p");
+  const std::string page = h.Finish();
+  EXPECT_NE(page.find("data-x=\"a&quot;b&lt;c&gt;\""), std::string::npos) << page;
+  EXPECT_NE(page.find("&lt;script&gt;alert(&#39;x&#39;) &amp; co&lt;/script&gt;"), std::string::npos) << page;
+  EXPECT_EQ(page.find("<script>"), std::string::npos);
+  EXPECT_DEATH(
+      {
+        Html bad;
+        bad.Open("table").Close("tr");
+      },
+      "closing an element that is not open");
+  EXPECT_DEATH(
+      {
+        Html open;
+        open.Open("div");
+        open.Finish();
+      },
+      "open element");
+}
+
+TEST(RobustZScores, NoiseBetweenIdenticalUnitsIsNotAnOutlier) {
+  // 6.0 is far out by the spread, but within 3 of its own 1-sigma (2.0) of the median: not flagged.
+  EXPECT_FALSE(RobustZScores({0.8, 0.9, 1.0, 1.1, 6.0}, {0.1, 0.1, 0.1, 0.1, 2.0})[4].outlier);
+  EXPECT_TRUE(RobustZScores({0.8, 0.9, 1.0, 1.1, 6.0}, {0.1, 0.1, 0.1, 0.1, 0.1})[4].outlier);
+}
+
+// The certificate of the MEMS soak fixture: asserted on the struct, not on HTML.
+class CertificateTest : public FactoryTest {
+ protected:
+  Certificate Make(const std::string& plan_path, const std::optional<Limits>& limits) {
+    const std::string samples = kFixtures + "/mems_6pos_soak.csv.gz";
+    FitRunOptions options;
+    options.software = "imufit test";
+    const FitRunResult fit = FitRun(plan_path, samples, options);
+    if (!fit.calibration) throw std::runtime_error(fit.fit.BriefReport());
+    CertificateSources sources;
+    sources.calibration = *fit.calibration;
+    sources.plan = fit.plan;
+    sources.run = fit.run;
+    sources.limits = limits;
+    sources.inputs = {{"plan", plan_path, ""}, {"samples", samples, ""}};
+    EXPECT_TRUE(InputMismatches(sources.calibration, plan_path, samples).empty());
+    EXPECT_FALSE(
+        InputMismatches(sources.calibration, plan_path, kFixtures + "/mems_6pos_noiseless.csv.gz").empty());
+    return MakeCertificate(sources);
+  }
+};
+
+TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
+  const Certificate c = Make(kFixtures + "/plan_6pos.yaml", std::nullopt);
+  // No serial anywhere: said, not hidden.
+  EXPECT_TRUE(c.serial.empty());
+  ASSERT_FALSE(c.warnings.empty());
+  EXPECT_NE(c.warnings[0].find("no serial"), std::string::npos);
+  ASSERT_EQ(c.inputs.size(), 2u);
+  EXPECT_EQ(c.inputs[1].sha256, Sha256OfFile(kFixtures + "/mems_6pos_soak.csv.gz"));
+  // Key figures: expanded uncertainty k = 2; the fit recovers the truth within its own uncertainty.
+  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  const std::vector<Figure> truth_figures = KeyFigures(truth);
+  for (const KeyFigureRow& f : c.figures) {
+    if (f.sigma >= 0.0) EXPECT_EQ(f.expanded, 2.0 * f.sigma) << f.name;
+  }
+  const auto figure = [&](const std::string& name) {
+    for (const KeyFigureRow& f : c.figures) {
+      if (f.name == name) return f;
+    }
+    ADD_FAILURE() << name;
+    return KeyFigureRow();
+  };
+  constexpr double kRecoverySigmas = 5.0;  // worst case, per figure
+  for (const char* name : {"gyro_bias_dps.x", "gyro_g_sensitivity_dpsg.xx", "accel_bias_mg.z"}) {
+    const KeyFigureRow f = figure(name);
+    ASSERT_GT(f.sigma, 0.0) << name;
+    EXPECT_NEAR(f.value, FindFigure(truth_figures, name)->value, kRecoverySigmas * f.sigma) << name;
+  }
+  // Curves: the gyro bias curve passes through the 25 degC figure; the g-sensitivity is a 3x3 grid.
+  ASSERT_EQ(c.curves.size(), 7u);
+  EXPECT_EQ(c.curves[0].title, "Gyro bias");
+  EXPECT_EQ(c.curves[3].curves.size(), 9u);
+  EXPECT_TRUE(c.curves[3].grid);
+  // Residuals: the correction removes almost all of the error the scale-only correction leaves.
+  ASSERT_FALSE(c.residual_table.empty());
+  const ResidualRow& all = c.residual_table.back();
+  EXPECT_EQ(all.segment, -1);
+  EXPECT_LT(all.gyro_rms_dps, 0.01 * all.gyro_rms_before_dps);
+  EXPECT_EQ(c.residuals.gyro_dps[0].size(), static_cast<size_t>(c.run.windows));
+  // A 6-position soak has no minute-long static stretch: the Allan section says why not.
+  EXPECT_FALSE(c.noise.computed);
+  EXPECT_NE(c.noise.why_not.find("at least 60 s"), std::string::npos) << c.noise.why_not;
+  EXPECT_TRUE(c.settings.known);
+  EXPECT_EQ(c.settings.loss, "huber");
+  EXPECT_FALSE(c.verdict.has_value());
+  // The plots hold the certificate's data.
+  const std::vector<PlotFigure> plots = CertificatePlots(c);
+  ASSERT_EQ(plots.size(), c.curves.size() + 2);
+  EXPECT_EQ(plots[3].panels.size(), 9u);
+  EXPECT_EQ(plots[0].panels[0].series[1].y, c.curves[0].curves[0].value);
+}
+
+TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {
+  std::string plan = "";
+  {
+    std::ifstream in(kFixtures + "/plan_6pos.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    plan = text.str();
+  }
+  plan += "  - {id: 99, up: [0, 0, -1]}\n";
+  const std::string plan_path = Write("plan.yaml", plan);
+  const Certificate c = Make(plan_path, ReadLimits(Write("limits.yaml",
+                                                         "format: imufit-limits\nversion: 1\ncriteria:\n"
+                                                         "  - {quantity: coverage, max_abs: 1}\n")));
+  bool warned = false;
+  for (const std::string& w : c.warnings) warned = warned || w.find("plan segment 99") != std::string::npos;
+  EXPECT_TRUE(warned);
+  ASSERT_TRUE(c.verdict.has_value());
+  EXPECT_FALSE(c.verdict->pass);
+  EXPECT_EQ(c.verdict->criteria[0].name, "coverage");
+  EXPECT_EQ(c.verdict->criteria[0].measured, 1.0);
 }
 
 }  // namespace

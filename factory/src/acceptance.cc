@@ -5,18 +5,16 @@
 #include <optional>
 #include <utility>
 
+#include "imufit/io/noise_file.h"
+
 namespace imufit {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 std::string Number(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", value);
   return text;
 }
-
-double Term0(const double* params, int coefficient) { return params[coefficient * kPolynomialTerms]; }
 
 double FitNumber(const Calibration& calibration, const char* key, bool* found) {
   *found = false;
@@ -32,56 +30,26 @@ double FitNumber(const Calibration& calibration, const char* key, bool* found) {
   }
 }
 
-// [value, 1-sigma] of noise.columns.gyro_<axis>.<key>, when there.
-std::optional<std::array<double, 2>> NoiseFigure(const Calibration& calibration, const char* axis,
-                                                 const char* key) {
-  if (!calibration.extra || !calibration.extra.IsMap()) return std::nullopt;
-  try {
-    const YAML::Node node = calibration.extra["noise"]["columns"][std::string("gyro_") + axis][key];
-    if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
-    return std::array<double, 2>{node[0].as<double>(), node[1].as<double>()};
-  } catch (const YAML::Exception&) {
-    return std::nullopt;
-  }
-}
-
 }  // namespace
 
 std::vector<Figure> KeyFigures(const Calibration& calibration) {
-  const double* gyro = calibration.model.gyro.data();
-  const double* accel = calibration.model.accel.data();
-  const double* gyro_sigma = calibration.sigma ? calibration.sigma->gyro.data() : nullptr;
-  const double* accel_sigma = calibration.sigma ? calibration.sigma->accel.data() : nullptr;
+  const SensorModel* sigma = calibration.sigma ? &*calibration.sigma : nullptr;
   std::vector<Figure> figures;
-  const auto add = [&](std::string quantity, std::string sensor, int coefficient, const char* unit,
-                       double factor, const double* params, const double* sigma) {
+  const auto add = [&](const std::string& quantity, Sensor sensor, int coefficient) {
     const CoefficientName& n = kCoefficientNames[coefficient];
-    figures.push_back({quantity + "." + n.axis, sensor + "." + n.group + "." + n.axis, unit,
-                       Term0(params, coefficient) * factor,
-                       sigma ? Term0(sigma, coefficient) * std::abs(factor) : -1.0});
+    const EngineeringValue v =
+        EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, kFigureTempC);
+    figures.push_back({quantity + "." + n.axis,
+                       std::string(sensor == Sensor::kGyro ? "gyro." : "accel.") + n.group + "." + n.axis,
+                       EngineeringUnit(sensor, coefficient), v.value, v.sigma});
   };
-  for (int i = 0; i < 3; ++i) {
-    add("gyro_bias_dps", "gyro", kBiasCoefficient + i, "deg/s",
-        kRadToDeg / Term0(gyro, kScaleCoefficient + i), gyro, gyro_sigma);
-  }
-  for (int i = 0; i < 3; ++i) {
-    add("accel_bias_mg", "accel", kBiasCoefficient + i, "mg",
-        1e3 / (Term0(accel, kScaleCoefficient + i) * kStandardGravityMps2), accel, accel_sigma);
-  }
-  for (int i = 0; i < 3; ++i)
-    add("gyro_scale_per_dps", "gyro", kScaleCoefficient + i, "raw/(deg/s)", 1.0 / kRadToDeg, gyro,
-        gyro_sigma);
-  for (int i = 0; i < 3; ++i)
-    add("accel_scale_per_g", "accel", kScaleCoefficient + i, "raw/g", kStandardGravityMps2, accel,
-        accel_sigma);
-  for (int m = 0; m < 6; ++m)
-    add("gyro_misalignment_mrad", "gyro", kMisalignmentCoefficient + m, "mrad", 1e3, gyro, gyro_sigma);
-  for (int m = 0; m < 6; ++m)
-    add("accel_misalignment_mrad", "accel", kMisalignmentCoefficient + m, "mrad", 1e3, accel, accel_sigma);
-  for (int h = 0; h < 9; ++h) {
-    add("gyro_g_sensitivity_dpsg", "gyro", kGSensitivityCoefficient + h, "deg/s/g",
-        kRadToDeg * kStandardGravityMps2 / Term0(gyro, kScaleCoefficient + h / 3), gyro, gyro_sigma);
-  }
+  for (int i = 0; i < 3; ++i) add("gyro_bias_dps", Sensor::kGyro, kBiasCoefficient + i);
+  for (int i = 0; i < 3; ++i) add("accel_bias_mg", Sensor::kAccel, kBiasCoefficient + i);
+  for (int i = 0; i < 3; ++i) add("gyro_scale_per_dps", Sensor::kGyro, kScaleCoefficient + i);
+  for (int i = 0; i < 3; ++i) add("accel_scale_per_g", Sensor::kAccel, kScaleCoefficient + i);
+  for (int m = 0; m < 6; ++m) add("gyro_misalignment_mrad", Sensor::kGyro, kMisalignmentCoefficient + m);
+  for (int m = 0; m < 6; ++m) add("accel_misalignment_mrad", Sensor::kAccel, kMisalignmentCoefficient + m);
+  for (int h = 0; h < 9; ++h) add("gyro_g_sensitivity_dpsg", Sensor::kGyro, kGSensitivityCoefficient + h);
   // Noise figures, when the calibration carries a `noise:` block (imufit allan --noise-yaml,
   // docs/allan.md): [value, 1-sigma] per gyro column.
   const char* axes[] = {"x", "y", "z"};
@@ -94,7 +62,8 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
                                  {"gyro_bias_instability_dph", "bias_instability_deg_per_hr", "deg/h"}};
   for (const auto& [name, key, unit] : noise_keys) {
     for (const char* axis : axes) {
-      if (const std::optional<std::array<double, 2>> pair = NoiseFigure(calibration, axis, key)) {
+      if (const std::optional<std::array<double, 2>> pair =
+              ReadNoiseFigure(calibration.extra, std::string("gyro_") + axis, key)) {
         figures.push_back({std::string(name) + "." + axis, std::string("noise.gyro_") + axis + "." + key,
                            unit, (*pair)[0], (*pair)[1]});
       }
@@ -104,11 +73,12 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
   const double gyro_rms = FitNumber(calibration, "gyro_residual_rms_radps", &found);
   if (found)
     figures.push_back(
-        {"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", gyro_rms * kRadToDeg, -1.0});
+        {"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(gyro_rms), -1.0});
+  const double missing = FitNumber(calibration, "missing_segments", &found);
+  if (found) figures.push_back({"coverage", "fit.missing_segments", "segments missing", missing, -1.0});
   const double accel_rms = FitNumber(calibration, "accel_residual_rms_mps2", &found);
   if (found) {
-    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg",
-                       accel_rms / kStandardGravityMps2 * 1e3, -1.0});
+    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(accel_rms), -1.0});
   }
   return figures;
 }
@@ -154,10 +124,12 @@ std::string Verdict::Table() const {
   return text;
 }
 
-Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration) {
+Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
+                       const std::vector<Figure>& measured) {
   Verdict verdict;
   verdict.limits_name = limits.name;
-  const std::vector<Figure> figures = KeyFigures(calibration);
+  std::vector<Figure> figures = measured;  // found first: they take the place of the calibration's
+  for (const Figure& f : KeyFigures(calibration)) figures.push_back(f);
   for (const LimitCriterion& criterion : limits.criteria) {
     const bool sigma = criterion.statistic == LimitStatistic::kSigma;
     if (criterion.kind == LimitKind::kCoverage) {
@@ -205,8 +177,10 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration) {
         r.margin = -r.limit;
         r.pass = false;
       } else {
+        // A max_abs criterion judges |value|: that is what it shows (a residual RMS is >= 0 anyway).
+        r.measured = std::abs(r.measured);
         r.measured_text = Number(r.measured) + " " + criterion.unit;
-        r.margin = r.limit - std::abs(r.measured);
+        r.margin = r.limit - r.measured;
         r.pass = r.margin > 0.0;
       }
       verdict.criteria.push_back(r);

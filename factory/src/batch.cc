@@ -8,15 +8,18 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <mutex>
 #include <thread>
 
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/factory/certificate.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/error.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 
@@ -47,6 +50,7 @@ constexpr const char* kManifestFormat = "imufit-unit-manifest";
 struct Manifest {
   std::string software, plan_sha256, samples_sha256, limits_sha256;
   std::string serial, status, verdict, message;
+  std::string calibration_sha256;  // of the calibration written (fitted units)
 };
 
 std::optional<Manifest> ReadManifest(const std::string& path) {
@@ -61,6 +65,7 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
     const char* keys[] = {"software", "plan_sha256", "samples_sha256", "limits_sha256",
                           "serial",   "status",      "verdict",        "message"};
     for (int i = 0; i < 8; ++i) *fields[i] = node[keys[i]].as<std::string>();
+    if (node["calibration_sha256"]) m.calibration_sha256 = node["calibration_sha256"].as<std::string>();
     return m;
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the unit is done again
@@ -78,7 +83,8 @@ void WriteManifest(const std::string& path, const Manifest& m) {
                                                                {"serial", &m.serial},
                                                                {"status", &m.status},
                                                                {"verdict", &m.verdict},
-                                                               {"message", &m.message}};
+                                                               {"message", &m.message},
+                                                               {"calibration_sha256", &m.calibration_sha256}};
   for (const auto& [key, value] : fields)
     out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
   out << YAML::EndMap;
@@ -141,6 +147,16 @@ void Judge(const Shared& shared, const Calibration& calibration, UnitOutcome* ou
   outcome->message = outcome->verdict_detail.FailedSummary();
 }
 
+// The serial in UNIT/serial.txt (its first line, trimmed), or "" without that file.
+std::string UnitSerial(const fs::path& unit_dir) {
+  std::ifstream stream(unit_dir / "serial.txt");
+  std::string line;
+  if (!stream || !std::getline(stream, line)) return "";
+  const size_t first = line.find_first_not_of(" \t\r");
+  const size_t last = line.find_last_not_of(" \t\r");
+  return first == std::string::npos ? "" : line.substr(first, last - first + 1);
+}
+
 UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
   const BatchOptions& options = *shared.options;
   const auto start = std::chrono::steady_clock::now();
@@ -165,6 +181,7 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     }
     outcome.plan_path = plan;
     outcome.samples_path = samples;
+    const std::string serial_file = UnitSerial(unit_dir);
     outcome.plan_sha256 = Sha256OfFile(plan);
     outcome.samples_sha256 = Sha256OfFile(samples);
     manifest = {options.fit.software,
@@ -194,8 +211,13 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
 
     fs::create_directories(out_dir);
     RemoveLeftovers(out_dir);
-    FitRunResult result = FitRun(plan, samples, options.fit);
+    FitRunOptions fit_options = options.fit;
+    fit_options.serial = serial_file;
+    fit_options.plan_sha256 = outcome.plan_sha256;
+    fit_options.samples_sha256 = outcome.samples_sha256;
+    FitRunResult result = FitRun(plan, samples, fit_options);
     if (!result.plan.serial.empty()) outcome.serial = result.plan.serial;
+    if (!serial_file.empty()) outcome.serial = serial_file;
     if (result.fit.status == FitStatus::kUndetermined) {
       outcome.status = "not-fitted";
       outcome.message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");
@@ -208,11 +230,20 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
       if (calibration.serial.empty()) calibration.serial = outcome.serial;
       calibration_yaml = CalibrationToYaml(calibration);
       WriteFileAtomically(calibration_path, calibration_yaml);
+      manifest.calibration_sha256 = Sha256Hex(calibration_yaml);
       Judge(shared, calibration, &outcome);
     }
     outcome.fit = std::move(result);
     if (outcome.status == "fitted" && options.write_reports) {
-      WriteUnitReport((out_dir / "report.html").string(), MakeUnitReport(outcome, options.limits_path));
+      const Certificate certificate =
+          MakeCertificate(outcome, options.limits_path, shared.limits, calibration_path, options.fit.windows);
+      // The certificate judges with the noise it measured itself: its verdict is the unit's.
+      if (certificate.verdict) {
+        outcome.verdict_detail = *certificate.verdict;
+        outcome.verdict = certificate.verdict->pass ? "PASS" : "FAIL";
+        outcome.message = certificate.verdict->FailedSummary();
+      }
+      WriteCertificate((out_dir / "report.html").string(), certificate);
     }
   } catch (const InputError& e) {
     outcome.status = "error";
@@ -382,8 +413,10 @@ BatchResult RunBatch(const BatchOptions& options) {
   if (result.complete) {
     WriteLotSummary((fs::path(options.output_dir) / "lot_summary.csv").string(), result);
     if (options.write_reports) {
+      std::optional<Limits> limits;
+      if (!options.limits_path.empty()) limits = ReadLimits(options.limits_path);
       WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(),
-                          LotReportHtml(shared.lot, result, options.fit.software));
+                          LotPageHtml(MakeLotSummary(shared.lot, result, options.fit.software, limits)));
     }
   }
   return result;

@@ -1,14 +1,21 @@
 #include "imufit/pipeline/fit_run.h"
 
+#include <set>
+
+#include "imufit/io/sha256.h"
+
 namespace imufit {
 namespace {
 
-YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path, const std::string& samples_path,
-                       const FitOptions& options) {
+YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path,
+                       const std::string& samples_path, const std::string& plan_sha256,
+                       const std::string& samples_sha256, const FitOptions& options) {
   const FitSummary& fit = result.fit;
   YAML::Node node;
   node["plan"] = plan_path;
   node["samples"] = samples_path;
+  node["plan_sha256"] = plan_sha256;
+  node["samples_sha256"] = samples_sha256;
   node["samples_read"] = result.run.stats.samples;
   if (result.run.segmentation) {
     node["segments_found_in_data"] = static_cast<int>(result.run.segmentation->matches.size());
@@ -30,6 +37,16 @@ YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path,
   node["gyro_bias_stability_radps"] = options.gyro_bias_stability_radps;
   node["accel_bias_stability_mps2"] = options.accel_bias_stability_mps2;
   node["bias_correlation_s"] = options.bias_correlation_s;
+  // Plan segments without a single usable window (never visited, or every visit too short).
+  std::set<int> visited;
+  for (const Window& w : result.run.windows) visited.insert(w.segment);
+  YAML::Node missing(YAML::NodeType::Sequence);
+  for (const TableSegment& segment : result.plan.segments) {
+    if (visited.count(segment.id) == 0) missing.push_back(segment.id);
+  }
+  node["segments_without_windows"] = missing;
+  node["segments_without_windows"].SetStyle(YAML::EmitterStyle::Flow);
+  node["missing_segments"] = static_cast<int>(missing.size());
   return node;
 }
 
@@ -43,7 +60,8 @@ std::string FitRunOptions::Validate() const {
   return "";
 }
 
-FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path, const FitRunOptions& options) {
+FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
+                    const FitRunOptions& options) {
   FitRunResult result;
   result.plan = ReadPlan(plan_path);
   result.run = ReadRunWindows(result.plan, samples_path, options.windows, options.input);
@@ -59,17 +77,21 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   if (!result.fit.IsSolutionUsable()) return result;
 
   Calibration calibration;
-  calibration.serial = result.plan.serial;
+  calibration.serial = options.serial.empty() ? result.plan.serial : options.serial;
   calibration.created_utc = UtcNow();
   calibration.software = options.software;
   calibration.fit_temp_range_c = result.fit.temp_range_c;
   calibration.model = result.fit.model;
   calibration.sigma = result.fit.sigma;
   calibration.extra = YAML::Node(YAML::NodeType::Map);
-  calibration.extra["fit"] = Diagnostics(result, plan_path, samples_path, options.fit);
+  calibration.extra["fit"] = Diagnostics(
+      result, plan_path, samples_path,
+      options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256,
+      options.samples_sha256.empty() ? Sha256OfFile(samples_path) : options.samples_sha256, options.fit);
 
   if (options.validate) {
-    result.folds = LeaveOneTemperatureOut(result.run.windows, result.plan.site, result.plan.segments, options.fit);
+    result.folds =
+        LeaveOneTemperatureOut(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   }
   if (!check_windows.empty()) {
     const std::vector<WindowError> errors =

@@ -1,12 +1,10 @@
 // imufit — a unit's key figures and its acceptance verdict against a limits file.
 //
-// Key figures are the calibration's coefficients at 25 degC (term c0 of each cubic in
-// dT = T - 25 degC) in the units a test engineer reads, each with its 1-sigma from the `sigma` tree:
-//   gyro bias deg/s       = V_g / S_g * 180/pi           accel bias mg = V_a / S_a / g0 * 1e3
-//   gyro scale raw/(deg/s) = S_g * pi/180                  accel scale raw/g = S_a * g0
-//   misalignment mrad     = M_ij * 1e3
-//   g-sensitivity deg/s/g = H_ij / S_g,i * 180/pi * g0     (g0 = 9.80665 m/s^2 per g)
-// plus the fit's residual RMS (deg/s, mg) from the calibration's `fit:` block.
+// Key figures are the calibration's coefficients at 25 degC, evaluated through the model's
+// polynomial (whatever the calibration's reference_temp_c), in the units a test engineer reads
+// (io/units.h: deg/s, mg, raw/(deg/s), raw/g, mrad, deg/s/g), each with its 1-sigma from the
+// `sigma` tree; plus the fit's residual RMS (deg/s, mg) from the calibration's `fit:` block and
+// the gyro noise figures of a `noise:` block (io/noise_file.h).
 #ifndef IMUFIT_FACTORY_ACCEPTANCE_H_
 #define IMUFIT_FACTORY_ACCEPTANCE_H_
 
@@ -15,10 +13,9 @@
 
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/units.h"
 
 namespace imufit {
-
-inline constexpr double kStandardGravityMps2 = 9.80665;  // m/s^2 per g, for mg and deg/s/g
 
 struct Figure {
   std::string name;         // quantity.axis, e.g. "gyro_bias_dps.x", "gyro_residual_rms_dps"
@@ -36,7 +33,7 @@ const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& 
 struct CriterionResult {
   std::string name;  // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"
   std::string unit;
-  double measured = 0.0;  // for coverage: the margin's side that binds
+  double measured = 0.0;  // |value| for max_abs criteria; for coverage: the margin's side that binds
   double limit = 0.0;
   double margin = 0.0;  // limit - |measured| (coverage: degC to spare at the tighter end); >= 0 passes
   std::string measured_text;
@@ -56,7 +53,10 @@ struct Verdict {
   std::string Table() const;
 };
 
-Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration);
+// `measured`: figures measured elsewhere (a certificate's own Allan deviation: ARW, bias
+// instability) that take the place of the calibration's figures of the same name.
+Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
+                       const std::vector<Figure>& measured = {});
 
 }  // namespace imufit
 

@@ -52,6 +52,9 @@ inline constexpr LimitQuantity kLimitQuantities[] = {
     {"gyro_residual_rms_dps", LimitKind::kFigure, "", "deg/s"},
     {"accel_residual_rms_mg", LimitKind::kFigure, "", "mg"},
     {"fit_temp_range_c", LimitKind::kCoverage, "", "degC"},
+    // Plan segments without a usable window in the run (`fit:` block): {quantity: coverage,
+    // max_abs: 1} passes when every segment of the plan was measured.
+    {"coverage", LimitKind::kFigure, "", "segments missing"},
     // From a `noise:` block in the calibration (imufit allan --noise-yaml appended to it).
     {"gyro_arw_deg_per_sqrt_hr", LimitKind::kCoefficient, "x y z", "deg/sqrt(h)"},
     {"gyro_bias_instability_dph", LimitKind::kCoefficient, "x y z", "deg/h"},

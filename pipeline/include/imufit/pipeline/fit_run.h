@@ -34,6 +34,12 @@ struct FitRunOptions {
   std::string check_plan;
   // Written into the calibration's `software` key, e.g. "imufit 0.1.0".
   std::string software;
+  // The unit's serial (--serial); empty: the plan's `serial`.
+  std::string serial;
+  // SHA-256 of the plan and samples files, recorded in the calibration's `fit:` block so that a
+  // certificate can tell that a calibration and a run belong together; computed when empty.
+  std::string plan_sha256;
+  std::string samples_sha256;
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;

@@ -1,0 +1,238 @@
+// imufit — what a unit's calibration certificate and a lot page say, computed in one place.
+//
+// MakeCertificate() turns a calibration, the run it was fitted to, the fit's validation and the
+// acceptance verdict into a Certificate: every number a quality engineer reads, already in
+// engineering units (io/units.h) and rounded nowhere. The renderer (report.h) only formats and
+// draws it; tests assert on this struct. Likewise MakeLotSummary() for a batch's lot page.
+//
+// Figures are quoted at 25 degC through the model's polynomial (whatever the calibration's
+// reference temperature); expanded uncertainties are k = 2 times the 1-sigma. Curves against
+// temperature take the polynomial's terms as independent for their band (the file holds no
+// correlations): indicative, exact at the reference temperature.
+#ifndef IMUFIT_FACTORY_CERTIFICATE_H_
+#define IMUFIT_FACTORY_CERTIFICATE_H_
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imufit/factory/acceptance.h"
+#include "imufit/factory/batch.h"
+#include "imufit/fit/validation.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/limits.h"
+#include "imufit/io/plan.h"
+#include "imufit/pipeline/run_windows.h"
+
+namespace imufit {
+
+inline constexpr double kCoverageFactor = 2.0;  // k of the expanded uncertainty
+// The certificate's Allan section needs a static stretch at least this long, s.
+inline constexpr double kMinAllanStretchS = 60.0;
+
+struct ReportInput {
+  std::string role;  // "calibration", "plan", "samples", "limits", "station"
+  std::string path;
+  std::string sha256;  // computed from the file when empty
+};
+
+// Everything a certificate is computed from.
+struct CertificateSources {
+  std::string unit;  // the batch unit folder, or empty
+  Calibration calibration;
+  Plan plan;
+  RunWindows run;
+  WindowOptions windows;            // how the run was cut into windows (trim, ...)
+  std::vector<HeldOutGroup> folds;  // empty when validation was not run
+  std::optional<Verdict> verdict;   // judged by the caller; replaced when `limits` is given
+  // Acceptance limits: judged here, with the ARW and bias instability this certificate measures
+  // taking the place of a `noise:` block's.
+  std::optional<Limits> limits;
+  std::vector<ReportInput> inputs;    // files to hash and list
+  std::vector<std::string> warnings;  // from the caller (e.g. a mismatch the user allowed)
+};
+
+struct KeyFigureRow {
+  std::string name;  // e.g. "gyro_bias_dps.x"
+  std::string unit;
+  double value = 0.0;
+  double sigma = -1.0;     // 1-sigma; < 0: none
+  double expanded = -1.0;  // k = 2; < 0: none
+};
+
+// One coefficient against temperature: the polynomial with its 1-sigma band.
+struct CoefficientCurve {
+  std::string axis;  // "x", "xy", ...
+  std::vector<double> temp_c, value, lo, hi;
+};
+struct CoefficientGroup {
+  std::string title;  // "Gyro bias"
+  std::string unit;
+  bool grid = false;  // draw each curve in its own panel (3x3 for g-sensitivity)
+  std::vector<CoefficientCurve> curves;
+};
+
+// Per window, signed per-axis errors (corrected - true) before and after correction, in deg/s and
+// mg, with the window mean's own noise (1-sigma from the samples' spread) for the band.
+struct WindowResiduals {
+  std::vector<double> time_s, temp_c;
+  std::vector<int> segment;
+  std::vector<bool> is_static;
+  std::array<std::vector<double>, 3> gyro_dps, gyro_before_dps, gyro_noise_dps;
+  std::array<std::vector<double>, 3> accel_mg, accel_before_mg, accel_noise_mg;
+  // Histogram of the normalised errors (error / noise) after correction, all axes.
+  std::vector<double> histogram_center;
+  std::vector<double> gyro_histogram, accel_histogram;
+  double normalised_gyro_rms = 0.0, normalised_accel_rms = 0.0;  // ~1 when the model explains the run
+};
+
+struct ResidualRow {
+  int segment = -1;  // -1: all
+  std::string up;    // "[0, 0, 1]"
+  double rate_dps = 0.0;
+  int windows = 0;
+  double gyro_rms_before_dps = 0.0, gyro_rms_dps = 0.0, gyro_max_dps = 0.0;
+  double accel_rms_before_mg = 0.0, accel_rms_mg = 0.0, accel_max_mg = 0.0;
+};
+
+struct NoiseAxis {
+  std::string axis;
+  bool fitted = false;
+  std::string why_not;
+  double arw_deg_per_sqrt_hr = 0.0, arw_sigma = 0.0;
+  bool arw_resolved = false;
+  double bias_instability_dph = 0.0, bias_instability_sigma = 0.0;
+  bool bias_instability_resolved = false;
+  int points = 0;
+  std::vector<double> tau_s, dev_dph;          // the measured overlapping Allan deviation, deg/h
+  std::vector<double> model_tau_s, model_dph;  // the fitted IEEE 952 model
+};
+struct NoiseSection {
+  bool computed = false;
+  std::string why_not;
+  int segment = -1;
+  double duration_s = 0.0;
+  double temp_c = 0.0;
+  std::vector<NoiseAxis> axes;
+};
+
+struct ValidationRow {
+  double temp_c = 0.0;
+  bool fitted = false;
+  std::string why_not;
+  int windows = 0;
+  double gyro_rms_dps = 0.0, gyro_max_dps = 0.0, accel_rms_mg = 0.0, accel_max_mg = 0.0;
+};
+
+// The fit's settings and diagnostics, from the calibration's `fit:` block (known = false without).
+struct FitSettings {
+  bool known = false;
+  std::string loss, termination;
+  int iterations = 0, windows_used = 0, windows_downweighted = 0;
+  int gyro_temp_order = 3, accel_temp_order = 3;
+  bool g_sensitivity_fitted = true;
+  double gyro_reduced_chi2 = 0.0, accel_reduced_chi2 = 0.0;
+  double gyro_bias_stability_dph = 0.0, accel_bias_stability_ug = 0.0;  // 0: not in the sigmas
+  double trim_s = 0.0, window_temp_span_c = 0.0;
+};
+
+struct RunSummary {
+  std::string plan_path;
+  int segments = 0, static_segments = 0;
+  std::vector<double> rates_dps;  // distinct |rate| of the rate segments
+  double gravity_mps2 = 0.0;
+  std::optional<double> latitude_deg;
+  long long samples = 0;
+  int windows = 0;
+  std::vector<double> temperatures_c;  // distinct window temperatures, rounded to 1 degC
+  std::array<double, 2> temp_range_c{0.0, 0.0};
+  std::vector<double> time_s, window_temp_c;  // temperature against time, per window
+};
+
+struct Certificate {
+  std::string serial;  // empty: none known (then a warning says so)
+  std::string unit;
+  std::string calibrated_utc, written_utc;
+  std::string calibration_software, report_software, git_revision;
+  double reference_temp_c = 25.0;
+  std::vector<ReportInput> inputs;  // with their hashes
+  std::vector<std::string> warnings;
+  RunSummary run;
+  FitSettings settings;
+  std::optional<Verdict> verdict;
+  std::vector<KeyFigureRow> figures;
+  std::vector<CoefficientGroup> curves;
+  WindowResiduals residuals;
+  std::vector<ResidualRow> residual_table;  // per segment, then all
+  NoiseSection noise;
+  std::vector<ValidationRow> validation;  // empty: not run
+};
+
+// Computes the certificate; reads the samples input once more for the Allan section. Throws
+// InputError when an input file cannot be read.
+Certificate MakeCertificate(const CertificateSources& sources);
+// From a batch unit just fitted (its FitRunResult is in unit.fit).
+Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
+                            const std::optional<Limits>& limits, const std::string& calibration_path,
+                            const WindowOptions& windows = WindowOptions());
+
+// The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
+std::vector<Figure> MeasuredFigures(const Certificate& certificate);
+
+// Where a calibration says it was fitted to other files than the ones given (SHA-256 in its `fit:`
+// block): one message per mismatch, empty when they belong together or the calibration does not say.
+std::vector<std::string> InputMismatches(const Calibration& calibration, const std::string& plan_path,
+                                         const std::string& samples_path);
+
+// ---------------------------------------------------------------- the lot page
+
+// Outliers: robust z = 0.6745 (x - median) / MAD beyond kOutlierRobustZ, and (when the unit's own
+// 1-sigma is known) more than kOutlierOwnSigmas of its own sigmas from the median, so that noise
+// between identical units is not flagged.
+inline constexpr double kOutlierRobustZ = 3.5;
+inline constexpr double kOutlierOwnSigmas = 3.0;
+struct RobustZ {
+  double z = 0.0;
+  bool outlier = false;
+};
+// Robust z-scores of `values` (all 0 and no outliers with fewer than 3 values or a zero MAD);
+// `sigmas` (each unit's own 1-sigma, < 0 unknown) may be empty.
+std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std::vector<double>& sigmas = {});
+
+struct LotUnitRow {
+  std::string unit, serial, status, verdict, message;
+  bool has_report = false;
+};
+
+struct LotFigure {
+  std::string name, unit;
+  std::vector<std::string> units;  // per point: the unit folder
+  std::vector<double> value, sigma, jitter;
+  std::vector<RobustZ> z;
+  std::vector<bool> failed;  // the unit failed its limits
+  double mean = 0.0, stdev = 0.0;
+  std::optional<double> limit;  // the max_abs of a limit on this figure
+  std::optional<double> ppk;    // min(limit - mean, mean + limit) / (3 stdev)
+};
+
+struct LotOutlier {
+  std::string unit, serial, figure, figure_unit;
+  double value = 0.0, z = 0.0;
+};
+
+struct LotSummary {
+  std::string lot, written_utc, software, git_revision;
+  int units = 0, passed = 0, failed = 0, not_fitted = 0, errors = 0;
+  double yield_pct = 0.0;
+  std::vector<LotUnitRow> rows;
+  std::vector<LotFigure> figures;
+  std::vector<LotOutlier> outliers;
+};
+
+LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, const std::string& software,
+                          const std::optional<Limits>& limits);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FACTORY_CERTIFICATE_H_

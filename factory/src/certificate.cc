@@ -1,0 +1,531 @@
+#include "imufit/factory/certificate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "imufit/io/output_file.h"
+#include "imufit/io/samples.h"
+#include "imufit/io/sha256.h"
+#include "imufit/io/units.h"
+#include "imufit/noise/column_analysis.h"
+
+namespace imufit {
+namespace {
+
+constexpr int kCurvePoints = 61;             // temperatures at which the coefficient curves are drawn
+constexpr int kModelCurvePoints = 80;        // taus at which the fitted Allan model is drawn
+constexpr double kHistogramHalfWidth = 5.0;  // normalised errors binned over [-5, 5]
+constexpr int kHistogramBins = 20;
+
+std::string Vector3Text(const Eigen::Vector3d& v) {
+  char text[96];
+  std::snprintf(text, sizeof text, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  return text;
+}
+
+// A number from the calibration's `fit:` block, when there.
+bool FitValue(const Calibration& calibration, const char* key, double* value) {
+  if (!calibration.extra || !calibration.extra.IsMap() || !calibration.extra["fit"]) return false;
+  const YAML::Node node = calibration.extra["fit"][key];
+  if (!node || !node.IsScalar()) return false;
+  try {
+    *value = node.as<double>();
+    return true;
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+std::string FitText(const Calibration& calibration, const char* key) {
+  if (!calibration.extra || !calibration.extra.IsMap() || !calibration.extra["fit"]) return "";
+  const YAML::Node node = calibration.extra["fit"][key];
+  return node && node.IsScalar() ? node.Scalar() : "";
+}
+
+FitSettings Settings(const Calibration& calibration, const WindowOptions& windows) {
+  FitSettings s;
+  s.trim_s = windows.trim_s;
+  s.window_temp_span_c = windows.max_temp_span_c;
+  double v = 0.0;
+  if (!FitValue(calibration, "windows_used", &v)) return s;
+  s.known = true;
+  s.windows_used = static_cast<int>(v);
+  if (FitValue(calibration, "windows_downweighted", &v)) s.windows_downweighted = static_cast<int>(v);
+  if (FitValue(calibration, "iterations", &v)) s.iterations = static_cast<int>(v);
+  if (FitValue(calibration, "gyro_temp_order", &v)) s.gyro_temp_order = static_cast<int>(v);
+  if (FitValue(calibration, "accel_temp_order", &v)) s.accel_temp_order = static_cast<int>(v);
+  if (FitValue(calibration, "gyro_reduced_chi2", &v)) s.gyro_reduced_chi2 = v;
+  if (FitValue(calibration, "accel_reduced_chi2", &v)) s.accel_reduced_chi2 = v;
+  if (FitValue(calibration, "gyro_bias_stability_radps", &v)) s.gyro_bias_stability_dph = DphFromRadps(v);
+  if (FitValue(calibration, "accel_bias_stability_mps2", &v)) s.accel_bias_stability_ug = UgFromMps2(v);
+  s.g_sensitivity_fitted = FitText(calibration, "g_sensitivity_fitted") != "false";
+  s.loss = FitText(calibration, "loss");
+  s.termination = FitText(calibration, "termination");
+  return s;
+}
+
+RunSummary SummariseRun(const Calibration& calibration, const Plan& plan, const RunWindows& run) {
+  RunSummary r;
+  r.plan_path = plan.path;
+  r.segments = static_cast<int>(plan.segments.size());
+  std::set<double> rates;
+  for (const TableSegment& s : plan.segments) {
+    if (s.IsStatic()) {
+      ++r.static_segments;
+    } else {
+      rates.insert(std::abs(DpsFromRadps(s.rate_radps)));
+    }
+  }
+  r.rates_dps.assign(rates.begin(), rates.end());
+  r.gravity_mps2 = plan.site.gravity_mps2;
+  if (plan.site.latitude_rad) r.latitude_deg = *plan.site.latitude_rad * kRadToDeg;
+  r.samples = run.stats.samples;
+  r.windows = static_cast<int>(run.windows.size());
+  std::set<long> temps;
+  for (const Window& w : run.windows) {
+    temps.insert(std::lround(w.temp_c));
+    r.time_s.push_back(0.5 * (w.start_s + w.end_s));
+    r.window_temp_c.push_back(w.temp_c);
+  }
+  for (long t : temps) r.temperatures_c.push_back(static_cast<double>(t));
+  r.temp_range_c = calibration.fit_temp_range_c;
+  return r;
+}
+
+std::vector<CoefficientGroup> CoefficientCurves(const Calibration& cal) {
+  const double lo = cal.fit_temp_range_c[0], hi = cal.fit_temp_range_c[1];
+  const SensorModel* sigma = cal.sigma ? &*cal.sigma : nullptr;
+  std::vector<CoefficientGroup> groups;
+  const auto group = [&](const char* title, Sensor sensor, int first, int count, bool scale_change,
+                         bool grid) {
+    CoefficientGroup g;
+    g.title = title;
+    g.unit = scale_change ? "ppm" : EngineeringUnit(sensor, first);
+    g.grid = grid;
+    for (int i = 0; i < count; ++i) {
+      CoefficientCurve curve;
+      curve.axis = kCoefficientNames[first + i].axis;
+      for (int p = 0; p < kCurvePoints; ++p) {
+        const double t = lo + (hi - lo) * p / (kCurvePoints - 1);
+        const EngineeringValue v = scale_change
+                                       ? ScaleChangePpm(cal.model, sigma, sensor, i, t)
+                                       : EngineeringCoefficient(cal.model, sigma, sensor, first + i, t);
+        const double s = std::max(v.sigma, 0.0);
+        curve.temp_c.push_back(t);
+        curve.value.push_back(v.value);
+        curve.lo.push_back(v.value - s);
+        curve.hi.push_back(v.value + s);
+      }
+      g.curves.push_back(std::move(curve));
+    }
+    groups.push_back(std::move(g));
+  };
+  group("Gyro bias", Sensor::kGyro, kBiasCoefficient, 3, false, false);
+  group("Gyro scale factor change from 25 degC", Sensor::kGyro, kScaleCoefficient, 3, true, false);
+  group("Gyro misalignment", Sensor::kGyro, kMisalignmentCoefficient, 6, false, false);
+  group("Gyro g-sensitivity", Sensor::kGyro, kGSensitivityCoefficient, 9, false, true);
+  group("Accelerometer bias", Sensor::kAccel, kBiasCoefficient, 3, false, false);
+  group("Accelerometer scale factor change from 25 degC", Sensor::kAccel, kScaleCoefficient, 3, true, false);
+  group("Accelerometer misalignment", Sensor::kAccel, kMisalignmentCoefficient, 6, false, false);
+  return groups;
+}
+
+// The raw outputs divided by the unit's own 25 degC scale factors only (no bias, misalignment,
+// g-sensitivity or temperature dependence): what the calibration fixes.
+SensorModel ScaleOnly(const Calibration& cal) {
+  SensorModel scale_only = SensorModel::Identity();
+  for (int axis = 0; axis < 3; ++axis) {
+    const int c0 = (kScaleCoefficient + axis) * kPolynomialTerms;
+    const double x = cal.model.basis.Argument(kFigureTempC);
+    scale_only.gyro[c0] = EvaluateTemperaturePolynomial(cal.model.gyro.data() + c0, x);
+    scale_only.accel[c0] = EvaluateTemperaturePolynomial(cal.model.accel.data() + c0, x);
+  }
+  return scale_only;
+}
+
+WindowResiduals Residuals(const Calibration& cal, const Plan& plan, const std::vector<Window>& windows,
+                          const std::vector<WindowError>& after, const std::vector<WindowError>& before) {
+  WindowResiduals r;
+  std::vector<double> gyro_normalised, accel_normalised;
+  for (size_t i = 0; i < after.size(); ++i) {
+    const WindowError& e = after[i];
+    const Window& w = windows[e.window];
+    const TableSegment* segment = plan.Find(e.segment);
+    r.time_s.push_back(0.5 * (w.start_s + w.end_s));
+    r.temp_c.push_back(e.temp_c);
+    r.segment.push_back(e.segment);
+    r.is_static.push_back(segment != nullptr && segment->IsStatic());
+    const double root_n = std::sqrt(static_cast<double>(std::max<long long>(w.samples, 1)));
+    const double x = cal.model.basis.Argument(w.temp_c);
+    for (int axis = 0; axis < 3; ++axis) {
+      const double gyro_scale = EvaluateTemperaturePolynomial(
+          cal.model.gyro.data() + (kScaleCoefficient + axis) * kPolynomialTerms, x);
+      const double accel_scale = EvaluateTemperaturePolynomial(
+          cal.model.accel.data() + (kScaleCoefficient + axis) * kPolynomialTerms, x);
+      const double gyro_noise = DpsFromRadps(w.gyro_std(axis) / root_n / std::abs(gyro_scale));
+      const double accel_noise = MgFromMps2(w.accel_std(axis) / root_n / std::abs(accel_scale));
+      r.gyro_dps[axis].push_back(DpsFromRadps(e.gyro_radps(axis)));
+      r.gyro_before_dps[axis].push_back(DpsFromRadps(before[i].gyro_radps(axis)));
+      r.gyro_noise_dps[axis].push_back(gyro_noise);
+      r.accel_mg[axis].push_back(MgFromMps2(e.accel_mps2(axis)));
+      r.accel_before_mg[axis].push_back(MgFromMps2(before[i].accel_mps2(axis)));
+      r.accel_noise_mg[axis].push_back(accel_noise);
+      if (gyro_noise > 0.0) gyro_normalised.push_back(r.gyro_dps[axis].back() / gyro_noise);
+      if (accel_noise > 0.0) accel_normalised.push_back(r.accel_mg[axis].back() / accel_noise);
+    }
+  }
+  const double bin = 2.0 * kHistogramHalfWidth / kHistogramBins;
+  r.gyro_histogram.assign(kHistogramBins, 0.0);
+  r.accel_histogram.assign(kHistogramBins, 0.0);
+  for (int b = 0; b < kHistogramBins; ++b)
+    r.histogram_center.push_back(-kHistogramHalfWidth + (b + 0.5) * bin);
+  const auto fill = [&](const std::vector<double>& values, std::vector<double>* counts, double* rms) {
+    double sum = 0.0;
+    for (double v : values) {
+      sum += v * v;
+      const int b = static_cast<int>(std::floor(
+          (std::clamp(v, -kHistogramHalfWidth, kHistogramHalfWidth - 1e-9) + kHistogramHalfWidth) / bin));
+      (*counts)[std::clamp(b, 0, kHistogramBins - 1)] += 1.0;
+    }
+    *rms = values.empty() ? 0.0 : std::sqrt(sum / values.size());
+  };
+  fill(gyro_normalised, &r.gyro_histogram, &r.normalised_gyro_rms);
+  fill(accel_normalised, &r.accel_histogram, &r.normalised_accel_rms);
+  return r;
+}
+
+std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<WindowError>& after,
+                                       const std::vector<WindowError>& before) {
+  std::vector<ErrorStats> stats = ErrorsBySegment(after);
+  stats.push_back(SummariseErrors(after));
+  std::vector<ErrorStats> stats_before = ErrorsBySegment(before);
+  stats_before.push_back(SummariseErrors(before));
+  std::vector<ResidualRow> rows;
+  for (size_t i = 0; i < stats.size(); ++i) {
+    const ErrorStats& s = stats[i];
+    const ErrorStats& b = stats_before[i];  // the same segments, in the same order
+    ResidualRow row;
+    row.segment = s.segment;
+    if (const TableSegment* seg = s.segment < 0 ? nullptr : plan.Find(s.segment)) {
+      row.up = Vector3Text(seg->up);
+      row.rate_dps = DpsFromRadps(seg->rate_radps);
+    }
+    row.windows = s.windows;
+    row.gyro_rms_before_dps = DpsFromRadps(b.gyro_rms_radps);
+    row.gyro_rms_dps = DpsFromRadps(s.gyro_rms_radps);
+    row.gyro_max_dps = DpsFromRadps(s.gyro_max_radps);
+    row.accel_rms_before_mg = MgFromMps2(b.accel_rms_mps2);
+    row.accel_rms_mg = MgFromMps2(s.accel_rms_mps2);
+    row.accel_max_mg = MgFromMps2(s.accel_max_mps2);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The Allan deviation of the gyro over the longest static stretch of the run (raw outputs over the
+// scale factor at the stretch's temperature: rad/s), with the IEEE 952 fit's ARW and bias
+// instability.
+NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::string& samples_path) {
+  NoiseSection section;
+  SamplesReader reader(samples_path, true);
+  std::vector<Sample> best, current;
+  Sample sample;
+  const auto close_stretch = [&] {
+    if (current.size() > best.size()) best.swap(current);
+    current.clear();
+  };
+  while (reader.Next(&sample)) {
+    const TableSegment* segment = plan.Find(sample.segment);
+    const bool is_static = segment != nullptr && segment->IsStatic();
+    if (!is_static || (!current.empty() && current.back().segment != sample.segment)) close_stretch();
+    if (is_static) current.push_back(sample);
+  }
+  close_stretch();
+  section.duration_s = best.size() > 1 ? best.back().time_s - best.front().time_s : 0.0;
+  if (section.duration_s < kMinAllanStretchS) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the longest static stretch is %.1f s; at least %.0f s are needed (imufit allan on a long "
+                  "static log)",
+                  section.duration_s, kMinAllanStretchS);
+    section.why_not = text;
+    return section;
+  }
+  section.computed = true;
+  section.segment = best.front().segment;
+  double temp_sum = 0.0;
+  for (const Sample& s : best) temp_sum += s.temp_c;
+  section.temp_c = temp_sum / best.size();
+  const double tau0_s = section.duration_s / (best.size() - 1);
+  std::vector<int64_t> factors;
+  AveragingFactors(TauSpec(), AllanEstimator::kOadev, static_cast<int64_t>(best.size()), tau0_s, &factors);
+  AllanOptions options;
+  options.threads = 1;
+  const double x = cal.model.basis.Argument(section.temp_c);
+  const char* axes[] = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    const double scale = EvaluateTemperaturePolynomial(
+        cal.model.gyro.data() + (kScaleCoefficient + axis) * kPolynomialTerms, x);
+    std::vector<double> rates;
+    rates.reserve(best.size());
+    for (const Sample& s : best) rates.push_back(s.gyro(axis) / scale);
+    const ColumnAnalysis analysis = AnalyseColumn(std::string("gyro_") + axes[axis], ColumnKind::kGyro,
+                                                  std::move(rates), tau0_s, factors, options);
+    NoiseAxis a;
+    a.axis = axes[axis];
+    for (const AllanPoint& p : analysis.allan.points) {
+      a.tau_s.push_back(p.tau_s);
+      a.dev_dph.push_back(DphFromRadps(p.dev));
+    }
+    const NoiseFitSummary& fit = analysis.fit;
+    a.fitted = fit.fitted;
+    a.why_not = fit.message;
+    if (fit.fitted) {
+      a.points = fit.points_used;
+      a.arw_deg_per_sqrt_hr = DegPerSqrtHrFromRadPerSqrtS(fit.value[kRandomWalk]);
+      a.arw_sigma = DegPerSqrtHrFromRadPerSqrtS(fit.sigma[kRandomWalk]);
+      a.arw_resolved = IsResolved(fit, kRandomWalk);
+      a.bias_instability_dph = DphFromRadps(fit.value[kBiasInstability]);
+      a.bias_instability_sigma = DphFromRadps(fit.sigma[kBiasInstability]);
+      a.bias_instability_resolved = IsResolved(fit, kBiasInstability);
+      if (!a.tau_s.empty()) {
+        const double first = a.tau_s.front(), last = a.tau_s.back();
+        for (int i = 0; i <= kModelCurvePoints; ++i) {
+          const double tau = first * std::pow(last / first, static_cast<double>(i) / kModelCurvePoints);
+          a.model_tau_s.push_back(tau);
+          a.model_dph.push_back(DphFromRadps(fit.ModelDeviation(tau)));
+        }
+      }
+    }
+    section.axes.push_back(std::move(a));
+  }
+  return section;
+}
+
+// Warnings a signer must see: no serial, plan segments the run never visited.
+void CoverageWarnings(const Plan& plan, const RunWindows& run, std::vector<std::string>* warnings) {
+  std::map<int, int> windows_per_segment;
+  for (const Window& w : run.windows) ++windows_per_segment[w.segment];
+  for (const TableSegment& s : plan.segments) {
+    if (windows_per_segment.count(s.id) == 0) {
+      warnings->push_back(
+          "plan segment " + std::to_string(s.id) +
+          " has no usable window in the samples (never occurs, or every occurrence is shorter "
+          "than the trim and the minimum window)");
+    }
+  }
+}
+
+}  // namespace
+
+Certificate MakeCertificate(const CertificateSources& sources) {
+  const Calibration& cal = sources.calibration;
+  Certificate c;
+  c.serial = cal.serial;
+  c.unit = sources.unit;
+  c.calibrated_utc = cal.created_utc;
+  c.written_utc = UtcNow();
+  c.calibration_software = cal.software;
+  c.report_software = cal.software;
+  c.git_revision = IMUFIT_GIT_REVISION;
+  c.reference_temp_c = cal.model.basis.center_c;
+  for (ReportInput input : sources.inputs) {
+    if (input.path.empty()) continue;
+    if (input.sha256.empty()) input.sha256 = Sha256OfFile(input.path);
+    c.inputs.push_back(input);
+  }
+  if (c.serial.empty()) {
+    c.warnings.push_back("no serial: neither the calibration, the plan nor --serial names the unit");
+  }
+  for (const std::string& w : sources.warnings) c.warnings.push_back(w);
+  CoverageWarnings(sources.plan, sources.run, &c.warnings);
+  c.run = SummariseRun(cal, sources.plan, sources.run);
+  c.settings = Settings(cal, sources.windows);
+
+  for (const Figure& f : KeyFigures(cal)) {
+    c.figures.push_back(
+        {f.name, f.unit, f.value, f.sigma, f.sigma >= 0.0 ? kCoverageFactor * f.sigma : -1.0});
+  }
+  c.curves = CoefficientCurves(cal);
+  const std::vector<WindowError> after =
+      PredictWindows(cal.model, sources.run.windows, sources.plan.site, sources.plan.segments);
+  const std::vector<WindowError> before =
+      PredictWindows(ScaleOnly(cal), sources.run.windows, sources.plan.site, sources.plan.segments);
+  c.residuals = Residuals(cal, sources.plan, sources.run.windows, after, before);
+  c.residual_table = ResidualTable(sources.plan, after, before);
+
+  c.noise.why_not = "no samples file given";
+  for (const ReportInput& in : c.inputs) {
+    if (in.role != "samples") continue;
+    try {
+      c.noise = GyroNoise(cal, sources.plan, in.path);
+    } catch (const std::exception& e) {
+      c.noise = NoiseSection();
+      c.noise.why_not = e.what();
+    }
+  }
+  c.verdict = sources.verdict;
+  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, MeasuredFigures(c));
+  for (const HeldOutGroup& g : sources.folds) {
+    ValidationRow row;
+    row.temp_c = g.temp_c;
+    row.fitted = g.fitted;
+    row.why_not = g.why_not;
+    row.windows = g.errors.windows;
+    row.gyro_rms_dps = DpsFromRadps(g.errors.gyro_rms_radps);
+    row.gyro_max_dps = DpsFromRadps(g.errors.gyro_max_radps);
+    row.accel_rms_mg = MgFromMps2(g.errors.accel_rms_mps2);
+    row.accel_max_mg = MgFromMps2(g.errors.accel_max_mps2);
+    c.validation.push_back(row);
+  }
+  return c;
+}
+
+std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
+  std::vector<Figure> figures;
+  for (const NoiseAxis& a : certificate.noise.axes) {
+    if (!a.fitted) continue;
+    if (a.arw_resolved) {
+      figures.push_back({"gyro_arw_deg_per_sqrt_hr." + a.axis, "certificate.gyro_" + a.axis + ".arw",
+                         "deg/sqrt(h)", a.arw_deg_per_sqrt_hr, a.arw_sigma});
+    }
+    if (a.bias_instability_resolved) {
+      figures.push_back({"gyro_bias_instability_dph." + a.axis,
+                         "certificate.gyro_" + a.axis + ".bias_instability", "deg/h", a.bias_instability_dph,
+                         a.bias_instability_sigma});
+    }
+  }
+  return figures;
+}
+
+std::vector<std::string> InputMismatches(const Calibration& calibration, const std::string& plan_path,
+                                         const std::string& samples_path) {
+  std::vector<std::string> mismatches;
+  const auto check = [&](const char* key, const char* role, const std::string& path) {
+    const std::string recorded = FitText(calibration, key);
+    if (recorded.empty() || path.empty()) return;
+    const std::string actual = Sha256OfFile(path);
+    if (actual != recorded) {
+      mismatches.push_back(std::string("the calibration was fitted to a ") + role + " with SHA-256 " +
+                           recorded.substr(0, 16) + "..., not " + path + " (" + actual.substr(0, 16) +
+                           "...)");
+    }
+  };
+  check("plan_sha256", "plan", plan_path);
+  check("samples_sha256", "samples file", samples_path);
+  return mismatches;
+}
+
+Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
+                            const std::optional<Limits>& limits, const std::string& calibration_path,
+                            const WindowOptions& windows) {
+  const FitRunResult& fit = *unit.fit;
+  CertificateSources sources;
+  sources.unit = unit.unit;
+  sources.calibration = *fit.calibration;
+  sources.calibration.serial = unit.serial;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  sources.windows = windows;
+  sources.folds = fit.folds;
+  if (!unit.verdict.empty()) sources.verdict = unit.verdict_detail;
+  sources.limits = limits;
+  sources.inputs = {{"calibration", calibration_path, ""},
+                    {"plan", unit.plan_path, unit.plan_sha256},
+                    {"samples", unit.samples_path, unit.samples_sha256},
+                    {"limits", limits_path, ""}};
+  return MakeCertificate(sources);
+}
+
+// ---------------------------------------------------------------- the lot page
+
+std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std::vector<double>& sigmas) {
+  std::vector<RobustZ> scores(values.size());
+  if (values.size() < 3) return scores;
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  const double m = median(values);
+  std::vector<double> deviations;
+  for (double v : values) deviations.push_back(std::abs(v - m));
+  const double mad = median(deviations);
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!(mad > 0.0)) continue;  // half the lot identical: no spread to judge by
+    scores[i].z = 0.6745 * (values[i] - m) / mad;
+    const bool beyond_own_sigma =
+        i >= sigmas.size() || !(sigmas[i] > 0.0) || std::abs(values[i] - m) > kOutlierOwnSigmas * sigmas[i];
+    scores[i].outlier = std::abs(scores[i].z) > kOutlierRobustZ && beyond_own_sigma;
+  }
+  return scores;
+}
+
+LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, const std::string& software,
+                          const std::optional<Limits>& limits) {
+  LotSummary s;
+  s.lot = lot;
+  s.written_utc = UtcNow();
+  s.software = software;
+  s.git_revision = IMUFIT_GIT_REVISION;
+  s.units = static_cast<int>(batch.units.size());
+  s.passed = batch.passed;
+  s.failed = batch.failed;
+  s.not_fitted = batch.not_fitted;
+  s.errors = batch.errors;
+  s.yield_pct = s.units > 0 ? 100.0 * batch.passed / s.units : 0.0;
+  for (const UnitOutcome& u : batch.units) {
+    s.rows.push_back({u.unit, u.serial, u.status, u.verdict, u.message, u.status == "fitted"});
+  }
+  for (const std::string& name : kSummaryFigures) {
+    LotFigure f;
+    f.name = name;
+    for (const UnitOutcome& u : batch.units) {
+      const Figure* figure = FindFigure(u.figures, name);
+      if (figure == nullptr) continue;
+      f.unit = figure->unit;
+      f.units.push_back(u.unit);
+      f.value.push_back(figure->value);
+      f.sigma.push_back(figure->sigma);
+      f.jitter.push_back((f.value.size() % 5) * 0.15);  // spread the dots of a strip plot vertically
+      f.failed.push_back(u.verdict == "FAIL");
+    }
+    if (f.value.empty()) continue;
+    f.z = RobustZScores(f.value, f.sigma);
+    double sum = 0.0, squares = 0.0;
+    for (double v : f.value) sum += v;
+    f.mean = sum / f.value.size();
+    for (double v : f.value) squares += (v - f.mean) * (v - f.mean);
+    f.stdev = f.value.size() > 1 ? std::sqrt(squares / (f.value.size() - 1)) : 0.0;
+    if (limits) {
+      const std::string quantity = name.substr(0, name.find('.'));
+      const std::string axis = name.find('.') == std::string::npos ? "" : name.substr(name.find('.') + 1);
+      for (const LimitCriterion& criterion : limits->criteria) {
+        if (criterion.quantity != quantity || criterion.kind == LimitKind::kCoverage ||
+            criterion.statistic == LimitStatistic::kSigma) {
+          continue;
+        }
+        if (!axis.empty() &&
+            std::find(criterion.axes.begin(), criterion.axes.end(), axis) == criterion.axes.end())
+          continue;
+        if (!f.limit || criterion.max_abs < *f.limit) f.limit = criterion.max_abs;
+      }
+    }
+    if (f.limit && f.stdev > 0.0) f.ppk = std::min(*f.limit - f.mean, f.mean + *f.limit) / (3.0 * f.stdev);
+    for (size_t i = 0; i < f.value.size(); ++i) {
+      if (!f.z[i].outlier) continue;
+      const UnitOutcome* owner = nullptr;
+      for (const UnitOutcome& u : batch.units) {
+        if (u.unit == f.units[i]) owner = &u;
+      }
+      s.outliers.push_back({f.units[i], owner ? owner->serial : "", name, f.unit, f.value[i], f.z[i].z});
+    }
+    s.figures.push_back(std::move(f));
+  }
+  return s;
+}
+
+}  // namespace imufit

@@ -1,0 +1,245 @@
+#include "imufit/factory/plot.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "imufit/io/output_file.h"
+#include "imufit/io/path.h"
+
+extern char** environ;
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Quote(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += (c == '\n') ? ' ' : c;
+  }
+  return quoted + "\"";
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::stringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+void WriteData(std::ostream& gp, const std::string& name, const PlotSeries& s) {
+  gp << name << " << EOD\n";
+  bool any = false;
+  for (size_t i = 0; i < s.x.size(); ++i) {
+    const bool band = s.style == PlotSeries::Style::kBand || s.style == PlotSeries::Style::kErrorBars;
+    const double y = i < s.y.size() ? s.y[i] : NAN;
+    const bool symmetric = band && i < s.error.size();
+    if (band && !symmetric && (i >= s.lo.size() || i >= s.hi.size())) continue;
+    gp << s.x[i] << " " << (std::isfinite(y) ? y : NAN);
+    if (symmetric) gp << " " << y - s.error[i] << " " << y + s.error[i];
+    if (band && !symmetric) gp << " " << s.lo[i] << " " << s.hi[i];
+    gp << "\n";
+    any = true;
+  }
+  if (!any) gp << "NaN NaN NaN NaN\n";  // gnuplot refuses an empty block
+  gp << "EOD\n";
+}
+
+std::string With(const PlotSeries& s) {
+  std::ostringstream w;
+  const std::string color = "lc rgb '" + s.color + "'";
+  switch (s.style) {
+    case PlotSeries::Style::kLines:
+      w << "using 1:2 with lines lw " << s.line_width << (s.dashed ? " dt 2 " : " ") << color;
+      break;
+    case PlotSeries::Style::kPoints:
+      w << "using 1:2 with points pt " << s.point_type << " ps " << s.point_size << " " << color;
+      break;
+    case PlotSeries::Style::kLinesPoints:
+      w << "using 1:2 with linespoints lw " << s.line_width << " pt " << s.point_type << " ps "
+        << s.point_size << (s.dashed ? " dt 2 " : " ") << color;
+      break;
+    case PlotSeries::Style::kBand:
+      w << "using 1:3:4 with filledcurves fs transparent solid 0.18 noborder " << color;
+      break;
+    case PlotSeries::Style::kErrorBars:
+      w << "using 1:2:3:4 with yerrorbars pt " << s.point_type << " ps " << s.point_size << " " << color;
+      break;
+  }
+  w << " " << (s.title.empty() ? "notitle" : "title " + Quote(s.title));
+  return w.str();
+}
+
+std::string RunGnuplot(const std::string& script_text, const std::string& folder) {
+  const std::string script_path = folder + "/plot.gp", errors_path = folder + "/errors.txt";
+  std::ofstream(script_path) << script_text;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, errors_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::string program = "gnuplot", argument = script_path;
+  std::vector<char*> argv = {program.data(), argument.data(), nullptr};
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  int status = -1;
+  if (spawned == 0) waitpid(pid, &status, 0);
+  if (spawned != 0) return "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    return "gnuplot failed: " + ReadBytes(errors_path).substr(0, 400);
+  return "";
+}
+
+// A private temporary folder, removed with its contents when the object goes.
+struct TempFolder {
+  std::string path;
+  TempFolder() {
+    path = (fs::temp_directory_path() / "imufit-plot-XXXXXX").string();
+    if (::mkdtemp(path.data()) == nullptr)
+      throw std::runtime_error("cannot create a temporary folder for gnuplot");
+  }
+  ~TempFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+}  // namespace
+
+const char* PlotColor(int index) {
+  static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
+                                        "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
+  return kColors[((index % 10) + 10) % 10];
+}
+
+std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal, const std::string& output) {
+  std::ostringstream gp;
+  gp.precision(12);
+  const std::string size = std::to_string(figure.width_px) + "," + std::to_string(figure.height_px);
+  if (terminal == "png") {
+    gp << "set terminal pngcairo size " << size
+       << " noenhanced font 'DejaVu Sans,10' background rgb 'white'\n";
+  } else {
+    gp << "set terminal svg size " << size
+       << " dynamic noenhanced font 'DejaVu Sans,10' background rgb 'white'\n";
+  }
+  gp << "set output " << Quote(output) << "\n";
+  for (size_t p = 0; p < figure.panels.size(); ++p) {
+    for (size_t s = 0; s < figure.panels[p].series.size(); ++s) {
+      WriteData(gp, "$d" + std::to_string(p) + "_" + std::to_string(s), figure.panels[p].series[s]);
+    }
+  }
+  const bool multi = figure.rows * figure.cols > 1 || !figure.title.empty();
+  if (multi) {
+    gp << "set multiplot layout " << figure.rows << "," << figure.cols;
+    if (!figure.title.empty()) gp << " title " << Quote(figure.title);
+    gp << "\n";
+  }
+  for (size_t p = 0; p < figure.panels.size(); ++p) {
+    const Plot& plot = figure.panels[p];
+    gp << "reset\nset encoding utf8\nset grid lc rgb '#dddddd'\nset border lc rgb '#444444'\n";
+    gp << "set title " << Quote(plot.title) << "\n";
+    gp << "set xlabel " << Quote(plot.x_label) << "\nset ylabel " << Quote(plot.y_label) << "\n";
+    if (plot.log_x)
+      gp << "set logscale x\nset format x '%g'\nset mxtics 10\n";
+    else
+      gp << "set format x '%g'\n";
+    if (plot.log_y)
+      gp << "set logscale y\nset format y '%g'\nset mytics 10\n";
+    else
+      gp << "set format y '%g'\n";
+    if (!plot.y_tics) gp << "unset ytics\n";
+    if (plot.x_range) gp << "set xrange [" << (*plot.x_range)[0] << ":" << (*plot.x_range)[1] << "]\n";
+    if (plot.y_range) gp << "set yrange [" << (*plot.y_range)[0] << ":" << (*plot.y_range)[1] << "]\n";
+    if (!plot.x_range) gp << "set offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n";
+    gp << (plot.key ? "set key outside right top samplen 2\n" : "unset key\n");
+    int object = 1;
+    for (const PlotMarker& m : plot.markers) {
+      if (m.vertical) {
+        gp << "set arrow " << object << " from first " << m.value << ", graph 0 to first " << m.value
+           << ", graph 1 nohead dt 2 lw 1.5 lc rgb '" << m.color << "'\n";
+        gp << "set label " << object << " " << Quote(m.label) << " at first " << m.value
+           << ", graph 1.02 center textcolor rgb '" << m.color << "'\n";
+      } else {
+        gp << "set arrow " << object << " from graph 0, first " << m.value << " to graph 1, first " << m.value
+           << " nohead dt 2 lw 1.5 lc rgb '" << m.color << "'\n";
+        gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first " << m.value
+           << " left textcolor rgb '" << m.color << "'\n";
+      }
+      ++object;
+    }
+    constexpr double kLabelStep = 0.06;  // graph units between stacked labels
+    for (size_t l = 0; l < plot.labels.size(); ++l) {
+      const double y =
+          plot.labels_at_bottom ? 0.05 + kLabelStep * (plot.labels.size() - 1 - l) : 0.94 - kLabelStep * l;
+      gp << "set label " << object++ << " " << Quote(plot.labels[l].text) << " at graph 0.03, graph " << y
+         << " left front\n";
+    }
+    gp << "plot ";
+    if (plot.series.empty()) gp << "NaN notitle";
+    for (size_t s = 0; s < plot.series.size(); ++s) {
+      gp << (s ? ", \\\n  " : "") << "$d" << p << "_" << s << " " << With(plot.series[s]);
+    }
+    gp << "\n";
+  }
+  if (multi) gp << "unset multiplot\n";
+  gp << "unset output\n";
+  return gp.str();
+}
+
+std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
+  if (figures.empty()) return {};
+  TempFolder folder;
+  std::string script;
+  for (size_t i = 0; i < figures.size(); ++i) {
+    script += GnuplotScript(figures[i], "svg", folder.path + "/" + std::to_string(i) + ".svg");
+  }
+  if (const std::string failure = RunGnuplot(script, folder.path); !failure.empty())
+    throw std::runtime_error(failure);
+  std::vector<Svg> svgs;
+  for (size_t i = 0; i < figures.size(); ++i) {
+    const std::string svg = ReadBytes(folder.path + "/" + std::to_string(i) + ".svg");
+    const size_t start = svg.find("<svg");  // drop the XML prolog and doctype: inline SVG in HTML
+    if (start == std::string::npos) throw std::runtime_error("gnuplot drew no SVG");
+    svgs.push_back({svg.substr(start)});
+  }
+  return svgs;
+}
+
+void DrawFile(const PlotFigure& figure, const std::string& path) {
+  const bool png = HasSuffix(path, ".png");
+  TempFolder folder;
+  const std::string image = folder.path + (png ? "/figure.png" : "/figure.svg");
+  if (const std::string failure = RunGnuplot(GnuplotScript(figure, png ? "png" : "svg", image), folder.path);
+      !failure.empty()) {
+    throw std::runtime_error("gnuplot could not draw " + path + ": " + failure);
+  }
+  const std::string bytes = ReadBytes(image);
+  if (bytes.empty()) throw std::runtime_error("gnuplot could not draw " + path);
+  WriteFileAtomically(path, bytes);
+}
+
+bool GnuplotAvailable() {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return false;
+  std::stringstream folders(path);
+  std::string folder;
+  while (std::getline(folders, folder, ':')) {
+    if (!folder.empty() && ::access((folder + "/gnuplot").c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace imufit

@@ -1,0 +1,194 @@
+#include "imufit/io/noise_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "imufit/io/output_file.h"
+#include "imufit/io/units.h"
+
+namespace imufit {
+namespace {
+
+// YAML scalar: shortest round-trip text, .nan / .inf as YAML spells them.
+std::string YamlNumber(double value) {
+  if (std::isnan(value)) return ".nan";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  return FormatDouble(value);
+}
+
+std::string YamlString(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+// The largest fitted value of `term` over the columns of `kind` (Kalibr takes one number for all
+// three axes: the worst one is the safe choice), or nan when there is none.
+double WorstAxis(const std::vector<ColumnAnalysis>& results, ColumnKind kind, int term) {
+  double worst = std::nan("");
+  for (const ColumnAnalysis& result : results) {
+    if (result.kind != kind || !result.fit.fitted) continue;
+    if (!(worst >= result.fit.value[term])) worst = result.fit.value[term];
+  }
+  return worst;
+}
+
+}  // namespace
+
+const NoiseTermUnits& UnitsOf(ColumnKind kind, int term) {
+  static const NoiseTermUnits kGyro[kNoiseTerms] = {
+      {"quantization_rad", "rad", "", "", 1.0, "quantization"},
+      {"random_walk_rad_per_sqrt_s", "rad/sqrt(s)", "arw_deg_per_sqrt_hr", "deg/sqrt(h)",
+       kRadToDeg * kSqrtSecondsPerSqrtHour, "angle random walk"},
+      {"bias_instability_radps", "rad/s", "bias_instability_deg_per_hr", "deg/h", kRadToDeg * kSecondsPerHour,
+       "bias instability"},
+      {"rate_random_walk_radps_per_sqrt_s", "rad/s/sqrt(s)", "rrw_deg_per_hr_per_sqrt_hr", "deg/h/sqrt(h)",
+       kRadToDeg * kSecondsPerHour * kSqrtSecondsPerSqrtHour, "rate random walk"},
+      {"rate_ramp_radps_per_s", "rad/s^2", "rate_ramp_deg_per_hr_per_hr", "deg/h/h",
+       kRadToDeg * kSecondsPerHour * kSecondsPerHour, "rate ramp"}};
+  static const NoiseTermUnits kAccel[kNoiseTerms] = {
+      {"quantization_mps", "m/s", "", "", 1.0, "quantization"},
+      {"random_walk_mps_per_sqrt_s", "m/s/sqrt(s)", "vrw_mps_per_sqrt_hr", "m/s/sqrt(h)",
+       kSqrtSecondsPerSqrtHour, "velocity random walk"},
+      {"bias_instability_mps2", "m/s^2", "bias_instability_ug", "micro-g", 1e6 / kStandardGravityMps2,
+       "bias instability"},
+      {"rate_random_walk_mps2_per_sqrt_s", "m/s^2/sqrt(s)", "acceleration_random_walk_mps_per_hr_per_sqrt_hr",
+       "m/s/h/sqrt(h)", kSecondsPerHour * kSqrtSecondsPerSqrtHour, "acceleration random walk"},
+      {"rate_ramp_mps3", "m/s^3", "rate_ramp_ug_per_hr", "micro-g/h",
+       1e6 / kStandardGravityMps2 * kSecondsPerHour, "acceleration ramp"}};
+  static const NoiseTermUnits kOther[kNoiseTerms] = {
+      {"quantization_y_s", "unit*s", "", "", 1.0, "quantization"},
+      {"random_walk_y_sqrt_s", "unit*sqrt(s)", "", "", 1.0, "random walk (white)"},
+      {"bias_instability_y", "unit", "", "", 1.0, "bias instability (flicker)"},
+      {"rate_random_walk_y_per_sqrt_s", "unit/sqrt(s)", "", "", 1.0, "rate random walk"},
+      {"rate_ramp_y_per_s", "unit/s", "", "", 1.0, "ramp"}};
+  switch (kind) {
+    case ColumnKind::kGyro:
+      return kGyro[term];
+    case ColumnKind::kAccel:
+      return kAccel[term];
+    case ColumnKind::kOther:
+      break;
+  }
+  return kOther[term];
+}
+
+void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results) {
+  OutputFile file(path);
+  file.Write("column,estimator,tau_s,terms,dev,dev_lo,dev_hi\n");
+  for (const ColumnAnalysis& result : results) {
+    for (const AllanPoint& point : result.curve.points) {
+      file.Write(result.name + "," + ToString(result.curve.estimator) + ",");
+      file.WriteNumber(point.tau_s);
+      file.Write("," + std::to_string(point.terms) + ",");
+      file.WriteNumber(point.dev);
+      file.Write(",");
+      file.WriteNumber(point.dev_lo);
+      file.Write(",");
+      file.WriteNumber(point.dev_hi);
+      file.Write("\n");
+    }
+  }
+  file.Commit();
+}
+
+std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysis>& results) {
+  std::ostringstream yaml;
+  yaml << "# Noise figures by imufit allan: the IEEE Std 952 model fitted to the overlapping Allan\n"
+       << "# variance. Every figure is [value, 1-sigma uncertainty]. Merge into a calibration by\n"
+       << "# appending this file: its only top-level key is `noise`.\n"
+       << "noise:\n"
+       << "  format: imufit-noise\n"
+       << "  version: 1\n"
+       << "  software: " << YamlString(record.software) << "\n"
+       << "  samples: " << YamlString(record.samples) << "\n"
+       << "  sample_interval_s: " << YamlNumber(record.sample_interval_s) << "\n"
+       << "  sample_count: " << record.sample_count << "\n"
+       << "  duration_s: " << YamlNumber(record.duration_s) << "\n"
+       << "  model: \"sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2\"\n"
+       << "  columns:\n";
+  for (const ColumnAnalysis& result : results) {
+    const NoiseFitSummary& fit = result.fit;
+    yaml << "    " << result.name << ":\n"
+         << "      kind: " << ToString(result.kind) << "\n"
+         << "      unit: " << YamlString(SiUnit(result.kind)) << "\n"
+         << "      fitted: " << (fit.fitted ? "true" : "false") << "\n";
+    if (!fit.fitted) {
+      yaml << "      reason: " << YamlString(fit.message) << "\n";
+      continue;
+    }
+    yaml << "      points_used: " << fit.points_used << "\n"
+         << "      reduced_chi_square: " << YamlNumber(fit.reduced_chi_square) << "\n";
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      const NoiseTermUnits& units = UnitsOf(result.kind, k);
+      yaml << "      " << units.si_key << ": [" << YamlNumber(fit.value[k]) << ", "
+           << YamlNumber(fit.sigma[k]) << "]\n";
+    }
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      const NoiseTermUnits& units = UnitsOf(result.kind, k);
+      if (*units.engineer_key == '\0') continue;
+      yaml << "      " << units.engineer_key << ": [" << YamlNumber(fit.value[k] * units.engineer_per_si)
+           << ", " << YamlNumber(fit.sigma[k] * units.engineer_per_si) << "]\n";
+    }
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      if (!IsResolved(fit, k)) yaml << "      " << UnitsOf(result.kind, k).si_key << "_resolved: false\n";
+    }
+    const NoiseTermUnits& n = UnitsOf(result.kind, kRandomWalk);
+    const NoiseTermUnits& b = UnitsOf(result.kind, kBiasInstability);
+    const NoiseTermUnits& k = UnitsOf(result.kind, kRateRandomWalk);
+    const bool engineer = *n.engineer_key != '\0';
+    yaml << "      readout:  # IEEE 952 graphical read-outs of the measured curve\n"
+         << "        " << (engineer ? n.engineer_key : n.si_key) << ": "
+         << YamlNumber(fit.readout_random_walk * n.engineer_per_si) << "\n"
+         << "        " << (engineer ? b.engineer_key : b.si_key) << ": "
+         << YamlNumber(fit.readout_bias_instability * b.engineer_per_si) << "\n"
+         << "        bias_instability_tau_s: " << YamlNumber(fit.readout_bias_tau_s) << "\n"
+         << "        " << (engineer ? k.engineer_key : k.si_key) << ": "
+         << YamlNumber(fit.readout_rate_random_walk * k.engineer_per_si) << "\n";
+  }
+  const auto has = [&](ColumnKind kind) {
+    return std::any_of(results.begin(), results.end(),
+                       [&](const ColumnAnalysis& r) { return r.kind == kind && r.fit.fitted; });
+  };
+  const bool has_gyro = has(ColumnKind::kGyro), has_accel = has(ColumnKind::kAccel);
+  if (has_gyro || has_accel) {
+    yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor\n";
+    if (has_gyro) {
+      yaml << "    gyroscope_noise_density: "
+           << YamlNumber(WorstAxis(results, ColumnKind::kGyro, kRandomWalk)) << "  # rad/s/sqrt(Hz)\n"
+           << "    gyroscope_random_walk: "
+           << YamlNumber(WorstAxis(results, ColumnKind::kGyro, kRateRandomWalk)) << "  # rad/s^2/sqrt(Hz)\n";
+    }
+    if (has_accel) {
+      yaml << "    accelerometer_noise_density: "
+           << YamlNumber(WorstAxis(results, ColumnKind::kAccel, kRandomWalk)) << "  # m/s^2/sqrt(Hz)\n"
+           << "    accelerometer_random_walk: "
+           << YamlNumber(WorstAxis(results, ColumnKind::kAccel, kRateRandomWalk)) << "  # m/s^3/sqrt(Hz)\n";
+    }
+    yaml << "    update_rate: " << YamlNumber(1.0 / record.sample_interval_s) << "  # Hz\n";
+  }
+  return yaml.str();
+}
+
+void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
+                    const std::vector<ColumnAnalysis>& results) {
+  WriteFileAtomically(path, NoiseYaml(record, results));
+}
+
+std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& extra, const std::string& column,
+                                                     const std::string& key) {
+  if (!extra || !extra.IsMap()) return std::nullopt;
+  try {
+    const YAML::Node node = extra["noise"]["columns"][column][key];
+    if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
+    return std::array<double, 2>{node[0].as<double>(), node[1].as<double>()};
+  } catch (const YAML::Exception&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace imufit
