@@ -1187,5 +1187,77 @@ TEST_F(CliTest, SimulateJitterMustKeepTimesIncreasing) {
   EXPECT_NE(r.err.find("time jitter"), std::string::npos) << r.err;
 }
 
+// Done when (issue 9): a hand-rotated session, six faces and a 360 deg turn about each axis, in raw
+// counts, without labels or a thermometer, calibrates end to end through the README's commands, the
+// gyro scale (set by the three turns alone) within its stated sigma.
+TEST_F(CliTest, HandSessionWithoutLabelsOrTemperatureCalibratesEndToEnd) {
+  // Within this many of its reported sigmas (worst case over the 25 degC coefficients).
+  constexpr double kTruthSigmas = 3.5;
+  const std::string plan = Fixture("plan_hand_6faces_3turns.yaml");
+  const std::string raw = Path("hand.csv");
+  const std::string truth = Path("hand_truth.csv");
+  ASSERT_EQ(Run({"simulate", "--plan", plan, "--calibration", Fixture("mems_truth.yaml"), "-o", raw, "--temps", "25",
+                 "--rate", "100", "--dwell", "10", "--transition", "2", "--gyro-noise-density", "8.7e-5",
+                 "--accel-noise-density", "1.5e-3", "--quantize", "--no-segment-column", "--no-temp-column",
+                 "--time-jitter-s", "0.003", "--seed", "4", "--truth", truth, "-q"})
+                .status,
+            0);
+  const RunResult segment = Run({"segment", "--plan", plan, "--samples", raw, "-o", Path("hand_labelled.csv")});
+  ASSERT_EQ(segment.status, 0) << segment.err;
+  EXPECT_NE(segment.out.find("9 segments found in 1 pass"), std::string::npos) << segment.out;
+  EXPECT_EQ(std::count(segment.out.begin(), segment.out.end(), '\n') - 3, 9) << segment.out;
+  const std::string calibration = Path("hand_cal.yaml");
+  const RunResult fit = Run({"fit", "--plan", plan, "--samples", raw, "--temp-c", "25", "-o", calibration});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("temperature orders 0"), std::string::npos) << fit.out;
+
+  const YAML::Node got = YAML::LoadFile(calibration);
+  const YAML::Node want = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  int checked = 0;
+  for (const char* sensor : {"gyro", "accel"}) {
+    for (const auto& group : got[sensor]) {
+      const std::string name = group.first.as<std::string>();
+      if (name == "unit") continue;
+      for (const auto& coefficient : group.second) {
+        const std::string axis = coefficient.first.as<std::string>();
+        const double estimate = coefficient.second[0].as<double>();
+        const double sigma = got["sigma"][sensor][name][axis][0].as<double>();
+        const double true_value = want[sensor][name][axis][0].as<double>();  // at 25 degC
+        ASSERT_GT(sigma, 0.0) << sensor << " " << name << " " << axis;
+        EXPECT_LE(std::abs(estimate - true_value), kTruthSigmas * sigma)
+            << sensor << " " << name << " " << axis << ": " << estimate << " vs " << true_value << " +- " << sigma;
+        if (std::string(sensor) == "gyro" && name == "scale") {
+          EXPECT_LT(sigma / true_value, 1e-4) << "the turns set the gyro scale to better than 100 ppm";
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 21 + 12);
+
+  // The calibration corrects the session: every resting sample's mean within what the noise leaves.
+  const RunResult apply = Run({"apply", "--calibration", calibration, "--samples", raw, "--temp-c", "25", "-o",
+                               Path("hand_corrected.csv"), "-q"});
+  ASSERT_EQ(apply.status, 0) << apply.err;
+  const Table corrected = ReadTable(Path("hand_corrected.csv"));
+  const Table true_values = ReadTable(truth);
+  ASSERT_EQ(corrected.rows.size(), true_values.rows.size());
+  std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> error_sum;  // per static face
+  std::map<int, int> count;
+  for (size_t i = 0; i < corrected.rows.size(); ++i) {
+    const int face = std::stoi(true_values.rows[i][true_values.Column("segment")]);
+    if (face < 1 || face > 6) continue;
+    error_sum.try_emplace(face, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    error_sum[face].first += corrected.Vector(i, "gyro") - true_values.Vector(i, "gyro");
+    error_sum[face].second += corrected.Vector(i, "accel") - true_values.Vector(i, "accel");
+    ++count[face];
+  }
+  ASSERT_EQ(error_sum.size(), 6u);
+  for (const auto& [face, sums] : error_sum) {
+    EXPECT_LT((sums.first / count[face]).norm(), 0.005 * kDegToRad) << "face " << face << ", rad/s";
+    EXPECT_LT((sums.second / count[face]).norm(), 0.5e-3 * 9.80665) << "face " << face << ", m/s^2";
+  }
+}
+
 }  // namespace
 }  // namespace imufit

@@ -375,7 +375,7 @@ TEST(Segmentation, HandSessionWithTurnsThroughKnownAngles) {
     EXPECT_EQ(segmentation.accel_signs, accel_signs);
     EXPECT_EQ(segmentation.gyro_signs, gyro_signs);
     // Every turning sample is in its turn's occurrence (the integral is whole); rests are never
-    // labelled with another segment; a turn's label reaches at most a window into the rests.
+    // labelled with another segment; a turn's label reaches a little way into the rests.
     Labeller labeller(segmentation);
     long long static_correct = 0;
     long long static_total = 0;
@@ -393,7 +393,7 @@ TEST(Segmentation, HandSessionWithTurnsThroughKnownAngles) {
     EXPECT_GE(static_cast<double>(static_correct) / static_total, kMinLabelledFraction);
     for (const SegmentMatch& match : segmentation.matches) {
       if (match.kind != "turn") continue;
-      // The detected turn spans the true one plus at most a window (1 s) each side.
+      // The detected turn spans the true one plus at most the turn margin and a window each side.
       double true_start = 1e9;
       double true_end = -1e9;
       for (size_t i = 0; i < run.samples.size(); ++i) {
@@ -403,8 +403,9 @@ TEST(Segmentation, HandSessionWithTurnsThroughKnownAngles) {
       }
       EXPECT_LE(match.start_s, true_start);
       EXPECT_GE(match.end_s, true_end);
-      EXPECT_GE(match.start_s, true_start - 1.0);
-      EXPECT_LE(match.end_s, true_end + 1.0);
+      const double reach_s = SegmentationOptions().turn_margin_s + SegmentationOptions().window_s;
+      EXPECT_GE(match.start_s, true_start - reach_s);
+      EXPECT_LE(match.end_s, true_end + reach_s);
     }
   }
 }

@@ -158,11 +158,23 @@ class Matcher {
     problem_ = message;
     return false;
   }
+  // Records a match over [start_s, end_s]; a match that reaches into the one before shortens it
+  // (labels never overlap).
+  void Add(const TableSegment& segment, int pass, double start_s, double end_s, double residual_deg,
+           std::string evidence) {
+    if (!result_.matches.empty() && result_.matches.back().end_s >= start_s) {
+      result_.matches.back().end_s = std::nextafter(start_s, -INFINITY);
+    }
+    result_.matches.push_back({segment.id, pass, KindOf(segment), start_s, end_s, std::move(evidence)});
+    residual_deg_ += residual_deg;
+  }
   void Add(const TableSegment& segment, int pass, const MotionPiece& piece, double residual_deg,
            std::string evidence) {
-    result_.matches.push_back(
-        {segment.id, pass, KindOf(segment), piece.start_s, piece.end_s, std::move(evidence)});
-    residual_deg_ += residual_deg;
+    const double start_s =
+        result_.matches.empty()
+            ? piece.start_s
+            : std::max(piece.start_s, std::nextafter(result_.matches.back().end_s, INFINITY));
+    Add(segment, pass, start_s, piece.end_s, residual_deg, std::move(evidence));
   }
   // Is pieces[p] (motion) the turn `segment`? Sets *hint when it nearly is.
   bool TurnFits(size_t p, const TableSegment& segment, int pass, std::string* hint);
@@ -204,7 +216,12 @@ bool Matcher::TurnFits(size_t p, const TableSegment& segment, int pass, std::str
     return false;
   }
   if (!scale_) scale_ = scale;
-  Add(segment, pass, turn, start_error + end_error + axis_error,
+  // The slow start and end of a turn lie below the detection threshold: the label reaches into the
+  // rests either side (which add nothing to the integral), up to turn_margin_s or half of each rest.
+  const double margin_before = std::min(options_.turn_margin_s, 0.5 * (before.end_s - before.start_s));
+  const double margin_after = std::min(options_.turn_margin_s, 0.5 * (after.end_s - after.start_s));
+  Add(segment, pass, turn.start_s - margin_before, turn.end_s + margin_after,
+      start_error + end_error + axis_error,
       "turn between rests: raw gyro integral " + Vec(theta_raw, "%+.4g") + " about body " +
           Vec(GyroBody(theta_raw).normalized()) + ", " + Degrees(axis_error) +
           " from the axis; gravity before " + Degrees(start_error) + " from up, after " + Degrees(end_error) +
@@ -382,6 +399,7 @@ std::string SegmentationOptions::Validate() const {
     return "the direction tolerance must lie between 0 and 90 degrees";
   }
   if (!(rate_tolerance > 0.0)) return "the rate tolerance must be positive";
+  if (!(turn_margin_s >= 0.0)) return "the turn margin cannot be negative";
   return "";
 }
 

@@ -71,9 +71,14 @@ void WindowBuilder::Add(const Sample& sample) {
     mean_.setZero();
     m2_.setZero();
     second_difference_sum_.setZero();
+    time_sum_ = 0.0;
+    index_time_sum_ = 0.0;
   }
   ++n_;
   end_s_ = sample.time_s;
+  // For the mean sample interval: time against sample index, k = n - 1 (see Close()).
+  time_sum_ += sample.time_s - start_s_;
+  index_time_sum_ += static_cast<double>(n_ - 1) * (sample.time_s - start_s_);
   const double inv_n = 1.0 / static_cast<double>(n_);
   temp_mean_ += (sample.temp_c - temp_mean_) * inv_n;
   temp_min_ = std::min(temp_min_, sample.temp_c);
@@ -101,6 +106,10 @@ void WindowBuilder::Close() {
   window.samples = n_;
   window.start_s = start_s_;
   window.end_s = end_s_;
+  // The least-squares slope of time against index: jitter of single time stamps averages out,
+  // where (end_s - start_s) / (n - 1) would carry the jitter of the two ends whole.
+  const double n = static_cast<double>(n_);
+  window.interval_s = (index_time_sum_ - 0.5 * (n - 1.0) * time_sum_) / (n * (n * n - 1.0) / 12.0);
   window.temp_c = temp_mean_;
   window.min_temp_c = temp_min_;
   window.max_temp_c = temp_max_;

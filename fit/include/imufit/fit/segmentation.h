@@ -28,7 +28,8 @@
 //       turn:   a motion piece between two rests whose integrated gyro (less the bias of the rests)
 //               points along the rotation axis with the sign of the angle; the rest before has
 //               gravity along `up`, the rest after along `up` turned by -angle about the axis
-//               (d(up)/dt = -omega x up), and successive turns agree in raw per radian.
+//               (d(up)/dt = -omega x up), and successive turns agree in raw per radian. Its label
+//               reaches turn_margin_s into the rests either side, so that it holds the whole motion.
 //     Between segments it passes over motion (the table moving: label -1) and rests in the position
 //     of the segment before or of the next one (settling, the pause before a turn). Raw axes may have
 //     any scale and sign: every sign pattern of the accelerometer and of the gyro axes is tried
@@ -74,6 +75,9 @@ struct SegmentationOptions {
   // How far the raw size of a rate (per rad/s) or of a turn (per rad) may be from the others',
   // relative.
   double rate_tolerance = 0.25;
+  // A turn's label reaches this far into the rests either side (at most half of each), s: the slow
+  // start and end of a turn lie below the detection threshold, and the turn's integral must be whole.
+  double turn_margin_s = 2.0;
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;

@@ -66,11 +66,12 @@ struct Window {
   Eigen::Vector3d accel_noise = Eigen::Vector3d::Zero();
   bool whole_occurrence = false;  // a turn's occurrence: one window, untrimmed
 
+  // Mean sample interval, s: the least-squares slope of the samples' times against their index, so
+  // that jittered time stamps do not move it (the two end stamps alone would).
+  double interval_s = 0.0;
+
   // The time the window's samples stand for: samples x their mean interval, s.
-  double DurationS() const {
-    return samples > 1 ? (end_s - start_s) * static_cast<double>(samples) / static_cast<double>(samples - 1)
-                       : 0.0;
-  }
+  double DurationS() const { return samples > 1 ? static_cast<double>(samples) * interval_s : 0.0; }
 };
 
 // Counts of what went into the windows and what did not.
@@ -123,6 +124,9 @@ class WindowBuilder {
   // The last two samples and the sum of squared second differences.
   Eigen::Matrix<double, 6, 1> previous_[2];
   Eigen::Matrix<double, 6, 1> second_difference_sum_ = Eigen::Matrix<double, 6, 1>::Zero();
+  // Sums of (t - start_s) and of k (t - start_s) over the window's samples k = 0, 1, ...
+  double time_sum_ = 0.0;
+  double index_time_sum_ = 0.0;
 };
 
 }  // namespace imufit
