@@ -110,6 +110,7 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
     sources.plan = result.plan;
     sources.run = result.run;
     sources.windows = args.windows;
+    sources.samples_input = args.input.Get();
     sources.folds = result.folds;
     sources.limits = limits;  // judged with the noise the certificate measures
     // The calibration is not renamed into place yet (one transaction): hash the text it holds.

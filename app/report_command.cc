@@ -22,6 +22,7 @@ struct ReportArguments {
   std::string serial;
   bool allow_mismatch = false;
   WindowOptions windows;
+  SamplesInputArguments input;  // --temp-c and the segmentation options, as imufit fit has them
 };
 
 int RunReport(const ReportArguments& args) {
@@ -42,7 +43,8 @@ int RunReport(const ReportArguments& args) {
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
   sources.plan = ReadPlan(args.plan);
-  sources.run = ReadRunWindows(sources.plan, args.samples, args.windows);
+  sources.samples_input = args.input.Get();
+  sources.run = ReadRunWindows(sources.plan, args.samples, args.windows, sources.samples_input);
   sources.windows = args.windows;
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
@@ -80,6 +82,8 @@ CommandRunner AddReportCommand(CLI::App* root) {
                     "certify even when the calibration records other plan/samples hashes than these files' "
                     "(the certificate says so)");
   command->add_option("--trim", args->windows.trim_s, "as imufit fit --trim")->capture_default_str();
+  AddTempOption(command, &args->input);
+  AddSegmentationOptions(command, &args->input);
   return [args] { return RunReport(*args); };
 }
 

@@ -1207,9 +1207,21 @@ TEST_F(CliTest, HandSessionWithoutLabelsOrTemperatureCalibratesEndToEnd) {
   EXPECT_NE(segment.out.find("9 segments found in 1 pass"), std::string::npos) << segment.out;
   EXPECT_EQ(std::count(segment.out.begin(), segment.out.end(), '\n') - 3, 9) << segment.out;
   const std::string calibration = Path("hand_cal.yaml");
-  const RunResult fit = Run({"fit", "--plan", plan, "--samples", raw, "--temp-c", "25", "-o", calibration});
+  const RunResult fit = Run({"fit", "--plan", plan, "--samples", raw, "--temp-c", "25", "-o", calibration,
+                             "--report", Path("hand_fit.html"), "--serial", "HAND-1"});
   ASSERT_EQ(fit.status, 0) << fit.err;
   EXPECT_NE(fit.out.find("temperature orders 0"), std::string::npos) << fit.out;
+  // The certificate reads the run as the fit did (labels found in the data, --temp-c): its noise
+  // section looks for the longest rest instead of failing on the missing columns.
+  const RunResult report = Run({"report", "-c", calibration, "-p", plan, "-s", raw, "--temp-c", "25", "-o",
+                                Path("hand_report.html"), "--serial", "HAND-1"});
+  ASSERT_EQ(report.status, 0) << report.err;
+  for (const char* html : {"hand_fit.html", "hand_report.html"}) {
+    const std::string text = ReadBytes(Path(html));
+    EXPECT_NE(text.find("the longest static stretch is"), std::string::npos) << html;
+    EXPECT_EQ(text.find("no segment column"), std::string::npos) << html;
+    EXPECT_EQ(text.find("temp_c"), std::string::npos) << html << ": a missing-column message";
+  }
 
   const YAML::Node got = YAML::LoadFile(calibration);
   const YAML::Node want = YAML::LoadFile(Fixture("mems_truth.yaml"));

@@ -228,9 +228,16 @@ std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<Windo
 // The Allan deviation of the gyro over the longest static stretch of the run (raw outputs over the
 // scale factor at the stretch's temperature: rad/s), with the IEEE 952 fit's ARW and bias
 // instability.
-NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::string& samples_path) {
+NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::string& samples_path,
+                       const SamplesInput& input, const std::optional<Segmentation>& segmentation) {
   NoiseSection section;
-  SamplesReader reader(samples_path, true);
+  // The samples are read as the fit read them: without a segment column, labelled from the plan
+  // (the fit's own segmentation when it has one, else found again).
+  SamplesReader reader(samples_path, /*require_segment=*/false, input.temp_c);
+  std::optional<Labeller> labeller;
+  if (!reader.has_segment()) {
+    labeller.emplace(segmentation ? *segmentation : SegmentSamplesFile(plan, samples_path, input));
+  }
   std::vector<Sample> best, current;
   Sample sample;
   const auto close_stretch = [&] {
@@ -238,6 +245,7 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
     current.clear();
   };
   while (reader.Next(&sample)) {
+    if (labeller) sample.segment = labeller->Label(sample.time_s);
     const TableSegment* segment = plan.Find(sample.segment);
     const bool is_static = segment != nullptr && segment->IsStatic();
     if (!is_static || (!current.empty() && current.back().segment != sample.segment)) close_stretch();
@@ -361,7 +369,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   for (const ReportInput& in : c.inputs) {
     if (in.role != "samples") continue;
     try {
-      c.noise = GyroNoise(cal, sources.plan, in.path);
+      c.noise = GyroNoise(cal, sources.plan, in.path, sources.samples_input, sources.run.segmentation);
     } catch (const std::exception& e) {
       c.noise = NoiseSection();
       c.noise.why_not = e.what();

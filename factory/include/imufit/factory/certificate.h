@@ -42,8 +42,9 @@ struct CertificateSources {
   std::string unit;  // the batch unit folder, or empty
   Calibration calibration;
   Plan plan;
-  RunWindows run;
+  RunWindows run;                   // run.segmentation: the labels of a file without a segment column
   WindowOptions windows;            // how the run was cut into windows (trim, ...)
+  SamplesInput samples_input;       // how the samples file is read (--temp-c for a file without temp_c)
   std::vector<HeldOutGroup> folds;  // empty when validation was not run
   std::optional<Verdict> verdict;   // judged by the caller; replaced when `limits` is given
   // Acceptance limits: judged here, with the ARW and bias instability this certificate measures
