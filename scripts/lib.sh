@@ -9,7 +9,20 @@ IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
                      libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
                      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
-                     python3-matplotlib python3-setuptools python3-wheel python3-pip)
+                     python3-matplotlib python3-setuptools python3-wheel python3-pip clang libfuzzer-14-dev)
+
+# True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
+imufit_fuzz_available() {
+  command -v clang++ >/dev/null 2>&1 || return 1
+  local probe
+  probe=$(mktemp -d "${TMPDIR:-/tmp}/imufit_fuzz_probe.XXXXXX")
+  printf '#include <cstdint>\n#include <cstddef>\nextern "C" int LLVMFuzzerTestOneInput(const uint8_t*, size_t) { return 0; }\n' \
+    >"$probe/probe.cc"
+  local ok=1
+  clang++ -fsanitize=fuzzer "$probe/probe.cc" -o "$probe/probe" >/dev/null 2>&1 && ok=0
+  rm -rf "$probe"
+  return $ok
+}
 
 imufit_say() { printf '== %s\n' "$*"; }
 imufit_die() { printf 'error: %s\n' "$*" >&2; exit 1; }

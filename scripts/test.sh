@@ -2,7 +2,8 @@
 # The whole test suite, from a fresh Debian machine: installs what is missing, then builds and runs
 # every test with ctest twice: in a Release build (build-release/) and in a build with
 # AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/, -DIMUFIT_SANITIZE=ON); after the
-# Release tests, the Python module's tests with pytest (python/tests).
+# Release tests, the Python module's tests with pytest (python/tests); at the end, when clang with
+# libFuzzer is installed, a short run (12 s) of every fuzz target (scripts/fuzz.sh, build-fuzz/).
 # Exits non-zero on the first failure. This is what CI runs (.ci/run).
 #
 #   bash scripts/test.sh
@@ -32,8 +33,8 @@ cache=$IMUFIT_ROOT/build-release/CMakeCache.txt
 if grep -q '^IMUFIT_BUILD_PYTHON:BOOL=ON' "$cache"; then
   imufit_say "Python module: pytest (python/tests)"
   python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$cache")
-  PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$IMUFIT_ROOT/build-release/python" IMUFIT_BINARY="$IMUFIT_ROOT/build-release/app/imufit" \
-    "$python" -m pytest -q -p no:cacheprovider "$IMUFIT_ROOT/python/tests"
+  PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$IMUFIT_ROOT/build-release/python" \
+    IMUFIT_BINARY="$IMUFIT_ROOT/build-release/app/imufit" "$python" -m pytest -q -p no:cacheprovider "$IMUFIT_ROOT/python/tests"
 else
   imufit_say "Python module not built (pybind11 or the Python headers not found): pytest skipped"
 fi
@@ -45,3 +46,10 @@ started=$SECONDS
 imufit_build "$IMUFIT_ROOT/build-sanitize" -- -DIMUFIT_SANITIZE=ON -DIMUFIT_BUILD_BENCH=OFF -DIMUFIT_BUILD_PYTHON=OFF \
   "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"
 run_suite "ASan+UBSan" "$IMUFIT_ROOT/build-sanitize"
+
+# The readers under libFuzzer, briefly (scripts/fuzz.sh --seconds N for a campaign).
+if imufit_fuzz_available; then
+  bash "$IMUFIT_ROOT/scripts/fuzz.sh" --seconds "${IMUFIT_FUZZ_SECONDS:-12}"
+else
+  imufit_say "clang++ with libFuzzer not found: the fuzz targets are skipped (apt-get install clang libfuzzer-14-dev)"
+fi

@@ -681,7 +681,7 @@ const BadInput kBadInputs[] = {
     {"calibration_three_terms", "calibration", "y: [931.52, -0.0895, -0.00017, 2.6e-06]",
      "y: [931.52, -0.0895, -0.00017]", 23, "4 numbers"},
     {"calibration_wrong_unit", "calibration", "unit: rad/s", "unit: deg/s", 16, "deg/s"},
-    {"calibration_zero_scale", "calibration", "z: [209.97,", "z: [0,", 51, "scale c0 is zero"},
+    {"calibration_zero_scale", "calibration", "z: [209.97,", "z: [0,", 51, "scale.z: the scale factor changes sign"},
     {"calibration_missing_group", "calibration", "  misalignment:\n    xy: [-0.00214",
      "  misalign:\n    xy: [-0.00214", 43,
      "accel.misalignment: missing"},  // the line where the `accel` mapping starts
@@ -1053,6 +1053,8 @@ TEST_F(CliTest, HostileInputGivesOneBoundedEscapedLine) {
       Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", "/dev/zero", "-o", Path("out.csv")});
   EXPECT_EQ(zero.status, 2) << zero.err;
   EXPECT_NE(zero.err.find("/dev/zero:1: line longer than"), std::string::npos) << zero.err;
+}
+
 // ------------------------------------------------------------------------------ unlabelled logs
 
 // `imufit segment` labels a simulated log written without its segment column (jittered times) as the

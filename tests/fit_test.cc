@@ -599,7 +599,8 @@ TEST(ScaleSign, ASignFlippedTurnIsRefusedWithTheConventionToCheck) {
   const SensorModel truth = testing::RandomMemsModel(2026);
   const std::vector<TableSegment> run = FacesAndTurns();
   WindowBuilder builder(WindowOptions(), run);
-  SimulateRun(OneTemperature(5), NoLatitude(), run, truth, [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
+  SimulateRun(OneTemperature(5), NoLatitude(), run, truth,
+              [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
   std::vector<TableSegment> flipped = run;
   flipped[6].angle_rad = -*flipped[6].angle_rad;
   const FitSummary fit = FitThermalModel(builder.Finish(), NoLatitude(), flipped, OrderZero());
@@ -608,7 +609,8 @@ TEST(ScaleSign, ASignFlippedTurnIsRefusedWithTheConventionToCheck) {
   ASSERT_EQ(fit.refusals.size(), 1u);
   EXPECT_NE(fit.refusals[0].find("gyro scale x is negative"), std::string::npos) << fit.refusals[0];
   EXPECT_NE(fit.refusals[0].find("right-hand rule"), std::string::npos) << fit.refusals[0];
-  EXPECT_NE(fit.BriefReport().find("fit refused: gyro scale x is negative"), std::string::npos) << fit.BriefReport();
+  EXPECT_NE(fit.BriefReport().find("fit refused: gyro scale x is negative"), std::string::npos)
+      << fit.BriefReport();
 }
 
 TEST(TiltedRates, TwoAxisTableRecoversTheModelWithinSigmas) {

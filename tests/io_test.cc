@@ -590,6 +590,10 @@ TEST_F(IoTest, SilentGarbageInYamlIsRefused) {
   const InputError e = Catch([&] { ReadLimits(limits); });
   EXPECT_NE(e.message().find("\"max_abs\" appears twice"), std::string::npos) << e.what();
   EXPECT_EQ(e.line(), 4);
+  // Found by fuzz_plan: input on which YAML::LoadAll never ends (an endless run of documents).
+  const InputError endless =
+      Catch([&] { ReadPlan(IMUFIT_FIXTURES_DIR "/../fuzz/regressions/fuzz_plan/endless-documents.yaml"); });
+  EXPECT_NE(endless.message().find("a second YAML document"), std::string::npos) << endless.what();
   // Limits: file size and nesting are bounded.
   const InputError big = Catch([&] { ReadLimits("/dev/zero"); });
   EXPECT_NE(big.message().find("larger than 16 MiB"), std::string::npos) << big.what();

@@ -332,8 +332,8 @@ std::vector<TableSegment> SixFacesThreeTurnsPlan() {
   return plan;
 }
 
-LabelledRun HandRun(const Eigen::Vector3d& accel_signs, const Eigen::Vector3d& gyro_signs,
-                    std::uint64_t seed) {
+LabelledRun HandRun(const Eigen::Vector3d& accel_signs, const Eigen::Vector3d& gyro_signs, std::uint64_t seed,
+                    bool quarter_turn = true) {
   HandSession hand(accel_signs, gyro_signs, seed);
   // Faces: +z, -z, +x, -x, +y, -y (each move: the body turns so that gravity goes to the next face).
   const Eigen::Vector3d faces[6] = {Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ(),
@@ -357,8 +357,10 @@ LabelledRun HandRun(const Eigen::Vector3d& accel_signs, const Eigen::Vector3d& g
   hand.Rest(3.0, kTransitionSegment);
   hand.Move(Eigen::Vector3d::UnitZ(), 360.0, 4.0, 9);
   hand.Rest(3.0, kTransitionSegment);
-  hand.Move(Eigen::Vector3d::UnitX(), 90.0, 2.0, 10);
-  hand.Rest(3.0, kTransitionSegment);
+  if (quarter_turn) {
+    hand.Move(Eigen::Vector3d::UnitX(), 90.0, 2.0, 10);
+    hand.Rest(3.0, kTransitionSegment);
+  }
   return hand.run();
 }
 
@@ -405,6 +407,20 @@ TEST(Segmentation, HandSessionWithTurnsThroughKnownAngles) {
       EXPECT_LE(match.end_s, true_end + 1.0);
     }
   }
+}
+
+TEST(Segmentation, ALogThatEndsAtRestAfterItsLastTurn) {
+  // The rest after turn 9 has gravity along +z, as segment 1 does: it is the turn's settling, not
+  // the start of another pass.
+  const LabelledRun run =
+      HandRun(Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones(), 23, /*quarter_turn=*/false);
+  std::vector<TableSegment> plan = SixFacesThreeTurnsPlan();
+  plan.pop_back();
+  const Segmentation segmentation = Segment(run, plan);
+  EXPECT_EQ(segmentation.passes, 1);
+  ASSERT_EQ(segmentation.matches.size(), plan.size());
+  EXPECT_EQ(segmentation.matches.back().segment, 9);
+  EXPECT_EQ(segmentation.matches.back().kind, "turn");
 }
 
 TEST(Segmentation, TurnsThatDisagreeWithThePlan) {

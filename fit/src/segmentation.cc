@@ -221,6 +221,15 @@ bool Matcher::Run() {
   std::optional<Eigen::Vector3d> gravity_now;  // where gravity points now (body), when known
   Eigen::Vector3d gyro_rest = facts_.gyro_rest;
   while (true) {
+    if (j == 0 && pass > 0 && segments_.size() > 1 && gravity_now) {
+      // A whole pass is done: a log that ends at rest where the last segment left the unit (the
+      // rest after a final turn) has no further pass in it.
+      bool settling = true;
+      for (size_t p = k; p < pieces.size() && settling; ++p) {
+        settling = IsRest(pieces[p], gyro_rest) && AngleDeg(Gravity(pieces[p]), *gravity_now) <= tol;
+      }
+      if (settling) break;
+    }
     const TableSegment& expected = segments_[j];
     const std::string wanted = DescribeSegment(expected, pass);
     std::string hint;

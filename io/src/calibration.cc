@@ -70,12 +70,23 @@ void CheckInvertible(const yaml::Located& sensor, const double* params, int coef
     const double at_c = std::abs(e.min_value) < std::abs(e.max_value) ? e.min_at_c : e.max_at_c;
     if (sign_change || negative || !(smallest >= kMinScale) || !(smallest >= 1e-3 * largest) ||
         !std::isfinite(largest)) {
-      char text[400];
-      std::snprintf(text, sizeof text,
-                    "the scale factor %s within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC); %s",
-                    sign_change ? "changes sign" : negative ? "is negative" : "comes near zero", range[0], range[1],
-                    EvaluateTemperaturePolynomial(c, at_c - center_c), at_c,
-                    sign_change || negative ? ScaleSignAdvice(gyro, axis).c_str() : "the correction divides by it");
+      char text[480];
+      if (sign_change) {
+        std::snprintf(text, sizeof text,
+                      "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
+                      "%.4g at %.4g degC); the correction divides by it; %s",
+                      range[0], range[1], e.min_value, e.min_at_c, e.max_value, e.max_at_c,
+                      ScaleSignAdvice(gyro, axis).c_str());
+      } else if (negative) {
+        std::snprintf(text, sizeof text,
+                      "the scale factor is negative within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC); %s",
+                      range[0], range[1], e.max_value, e.max_at_c, ScaleSignAdvice(gyro, axis).c_str());
+      } else {
+        std::snprintf(text, sizeof text,
+                      "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
+                      "at most %.3g elsewhere); the correction divides by it",
+                      range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
+      }
       sensor["scale"][kCoefficientNames[kScaleCoefficient + axis].axis].Fail(text);
     }
   }

@@ -154,7 +154,6 @@ class CsvReader::Source {
   std::vector<char> raw_;
   bool raw_eof_ = false;
   bool member_started_ = false;
-  bool done_ = false;
   long members_ = 0;
   long long compressed_bytes_ = 0;
 };

@@ -4,7 +4,10 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 #include <unordered_set>
+
+#include <yaml-cpp/eventhandler.h>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -42,6 +45,22 @@ void CheckTree(const std::string& path, const YAML::Node& node, int depth) {
   }
 }
 
+// Records where each document starts; ignores the rest.
+struct DocumentStarts : YAML::EventHandler {
+  YAML::Mark last = YAML::Mark::null_mark();
+  void OnDocumentStart(const YAML::Mark& mark) override { last = mark; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+  }
+  void OnMapEnd() override {}
+};
+
 }  // namespace
 
 YAML::Node LoadFile(const std::string& path) {
@@ -66,21 +85,25 @@ YAML::Node LoadFile(const std::string& path) {
     text.append(block, static_cast<size_t>(n));
   }
   ::close(fd);
-  std::vector<YAML::Node> documents;
+  YAML::Node root;
   try {
-    documents = YAML::LoadAll(text);
+    root = YAML::Load(text);  // the first document
+    // A second document would be ignored: refuse it. Its events are only counted, not built
+    // (YAML::LoadAll can loop forever on some malformed input).
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentStarts starts;
+    parser.HandleNextDocument(starts);
+    if (parser.HandleNextDocument(starts)) {
+      throw InputError(path, starts.last.line >= 0 ? starts.last.line + 1 : 0, 0,
+                       "a second YAML document: an imufit file holds exactly one (remove the `---` and what "
+                       "follows)");
+    }
   } catch (const YAML::Exception& e) {
     throw InputError(path, e.mark.line + 1, e.mark.column + 1, "YAML syntax: " + e.msg);
   }
-  if (documents.empty()) return YAML::Node();
-  if (documents.size() > 1) {
-    const YAML::Mark mark = documents[1].Mark();
-    throw InputError(
-        path, mark.line >= 0 ? mark.line + 1 : 0, 0,
-        "a second YAML document: an imufit file holds exactly one (remove the `---` and what follows)");
-  }
-  CheckTree(path, documents[0], 0);
-  return documents[0];
+  CheckTree(path, root, 0);
+  return root;
 }
 
 void Located::Fail(const std::string& message) const {

@@ -21,6 +21,7 @@ from ._imufit import (
     FitError,
     InputError,
     NoiseTerms,
+    PlanMismatchError,
     UndeterminedError,
     __version__,
     _fit,
@@ -41,6 +42,7 @@ __all__ = [
     "FitResult",
     "InputError",
     "NoiseTerms",
+    "PlanMismatchError",
     "UndeterminedError",
     "__version__",
     "allan",
@@ -70,8 +72,9 @@ def fit(plan: str | os.PathLike[str], samples: str | os.PathLike[str] | Mapping[
     ({time_s, temp_c, segment, gyro, accel}, as simulate() and read_samples() return), which are
     written to a temporary CSV (shortest round-trip numbers, so the fit sees the same doubles).
     ``options``: see fit_options(). Raises InputError (a ValueError) on bad input,
-    UndeterminedError naming what is missing when the run does not determine the model, and
-    FitError when the solver does not converge.
+    UndeterminedError naming what is missing when the run does not determine the model,
+    PlanMismatchError when a run without a segment column does not match the plan, and FitError
+    when the solver does not converge.
     """
     if isinstance(samples, Mapping):
         with tempfile.TemporaryDirectory(prefix="imufit_fit_") as folder:

@@ -43,6 +43,9 @@ class UndeterminedError(FitError):
 
     missing: list[str]  # one finding each, with what would determine it
 
+class PlanMismatchError(FitError):
+    """A samples file without a segment column does not match its plan (the message says where)."""
+
 class Calibration:
     """A calibration (calibration.yaml): the shared model's coefficients and their 1-sigma."""
 
@@ -111,8 +114,11 @@ def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: 
     "cauchy"), loss_scale, gyro_bias_stability_radps, accel_bias_stability_mps2,
     bias_correlation_s, max_iterations, closed_form_start, threads, distinct_temp_c,
     min_excitation_rate_radps, rank_tolerance, trim_s, window_temp_span_c, window_max_duration_s,
-    window_min_samples, validate, check_samples, check_plan.
-    Raises InputError, UndeterminedError (what is missing), FitError (not converged)."""
+    window_min_samples, temp_c (degC for a run without a temp_c column), segment_window_s,
+    segment_noise_quantile, segment_threshold_factor, min_steady_s, direction_tolerance_deg,
+    rate_tolerance (finding the segments of a run without a segment column), validate,
+    check_samples, check_plan.
+    Raises InputError, UndeterminedError (what is missing), PlanMismatchError, FitError (not converged)."""
 
 def fit_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of fit()."""
@@ -124,7 +130,7 @@ def simulate(plan: PathLike, truth: Calibration | PathLike, **options: Any) -> d
     start_time_s, gyro_noise_density (rad/s/sqrt(Hz)), accel_noise_density (m/s^2/sqrt(Hz)),
     gyro_random_walk (rad/s^2/sqrt(Hz)), accel_random_walk (m/s^3/sqrt(Hz)),
     gyro_bias_instability (rad/s), accel_bias_instability (m/s^2), bias_correlation_s,
-    temp_noise_c, quantize, seed."""
+    time_jitter_s, temp_noise_c, quantize, seed."""
 
 def simulate_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of simulate()."""

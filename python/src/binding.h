@@ -11,6 +11,7 @@
 //   imufit.FitError(RuntimeError)    the fit did not converge
 //   imufit.UndeterminedError(FitError)  the data do not determine the model; `missing` lists
 //                                    what is missing, one finding each
+//   imufit.PlanMismatchError(FitError)  a log without a segment column does not match its plan
 #ifndef IMUFIT_PYTHON_BINDING_H_
 #define IMUFIT_PYTHON_BINDING_H_
 
@@ -35,6 +36,7 @@ struct Exceptions {
   py::object input_error;
   py::object fit_error;
   py::object undetermined_error;
+  py::object plan_mismatch_error;
 };
 Exceptions& GetExceptions();
 

@@ -127,6 +127,33 @@ const OptionTable<FitRunOptions>& FitOptionTable() {
                        [](O& o) -> double& { return o.windows.max_duration_s; })
         .Field<int>("window_min_samples", "windows with fewer samples are dropped",
                     [](O& o) -> int& { return o.windows.min_samples; })
+        .Custom(
+            "temp_c",
+            "the temperature of every sample, degC, for samples without a temp_c column (None: read it)",
+            [](const py::handle& value, O* o) {
+              o->input.temp_c = value.is_none() ? std::nullopt : std::optional<double>(value.cast<double>());
+            },
+            [](const O& o) { return o.input.temp_c ? py::cast(*o.input.temp_c) : py::none(); })
+        .Field<double>("segment_window_s",
+                       "without a segment column: sliding window whose variance tells rest from motion, s",
+                       [](O& o) -> double& { return o.input.segmentation.window_s; })
+        .Field<double>("segment_noise_quantile",
+                       "without a segment column: the noise level is this quantile of the windows' variances",
+                       [](O& o) -> double& { return o.input.segmentation.noise_quantile; })
+        .Field<double>("segment_threshold_factor",
+                       "without a segment column: steady below this multiple of the noise level",
+                       [](O& o) -> double& { return o.input.segmentation.threshold_factor; })
+        .Field<double>("min_steady_s",
+                       "without a segment column: shorter rests and constant rates count as motion, s",
+                       [](O& o) -> double& { return o.input.segmentation.min_steady_s; })
+        .Field<double>("direction_tolerance_deg",
+                       "without a segment column: how far a measured direction may be from the plan's, deg",
+                       [](O& o) -> double& { return o.input.segmentation.direction_tolerance_deg; })
+        .Field<double>(
+            "rate_tolerance",
+            "without a segment column: how far the raw size of a rate or turn may be from the others', "
+            "relative",
+            [](O& o) -> double& { return o.input.segmentation.rate_tolerance; })
         .Field<bool>("validate", "leave each interior temperature out in turn and report the errors on it",
                      [](O& o) -> bool& { return o.validate; })
         .Custom(
@@ -349,6 +376,9 @@ const OptionTable<SimulationOptions>& SimulateOptionTable() {
                        [](O& o) -> double& { return o.accel_bias_instability; })
         .Field<double>("bias_correlation_s", "correlation time of the Gauss-Markov bias, s",
                        [](O& o) -> double& { return o.bias_correlation_s; })
+        .Field<double>("time_jitter_s",
+                       "uniform jitter of the time stamps, +- s (less than half the interval)",
+                       [](O& o) -> double& { return o.time_jitter_s; })
         .Field<double>("temp_noise_c", "white noise of the temperature reading, degC",
                        [](O& o) -> double& { return o.temp_noise_c; })
         .Field<bool>("quantize", "round raw outputs to integer counts",

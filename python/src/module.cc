@@ -2,6 +2,7 @@
 #include <exception>
 
 #include "binding.h"
+#include "imufit/fit/segmentation.h"
 #include "imufit/io/error.h"
 #include "imufit/model/sensor_model.h"
 
@@ -99,11 +100,17 @@ PYBIND11_MODULE(_imufit, m) {
       m, "UndeterminedError", exceptions.fit_error.ptr(),
       "The data do not determine the model. `missing` lists what is missing, one finding each, "
       "with what would determine it.");
+  exceptions.plan_mismatch_error = NewExceptionType(
+      m, "PlanMismatchError", exceptions.fit_error.ptr(),
+      "A samples file without a segment column does not match its plan: the message says where the log "
+      "and the plan disagree.");
   py::register_exception_translator([](std::exception_ptr pointer) {
     try {
       if (pointer) std::rethrow_exception(pointer);
     } catch (const imufit::InputError& error) {
       RaiseInputError(error.what(), error.file(), error.line(), error.column(), error.message());
+    } catch (const imufit::PlanMismatchError& error) {
+      PyErr_SetString(GetExceptions().plan_mismatch_error.ptr(), error.what());
     }
   });
 

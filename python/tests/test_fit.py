@@ -145,3 +145,20 @@ def test_bad_options(fixtures):
         imufit.simulate(plan, imufit.Calibration(), temps=[1])
     with pytest.raises(imufit.InputError, match="imufit.simulate"):
         imufit.simulate(plan, imufit.Calibration(), rate_hz=-1)
+
+
+def test_unlabelled_run_is_segmented_as_the_command_does(fixtures, tmp_path, run_imufit):
+    plan = fixtures / "plan_6pos.yaml"
+    run = imufit.simulate(plan, fixtures / "mems_truth.yaml", **SOAK)
+    unlabelled = {key: run[key] for key in ("time_s", "temp_c", "gyro", "accel")}  # no segment column
+    imufit.write_samples(tmp_path / "unlabelled.csv", unlabelled)
+    run_imufit("fit", "--plan", plan, "--samples", tmp_path / "unlabelled.csv", "-o", tmp_path / "cli.yaml", "-q")
+    cli = imufit.Calibration.load(tmp_path / "cli.yaml")
+    cal = imufit.fit(plan, unlabelled).calibration
+    assert_parameters_close({"gyro": cal.gyro, "accel": cal.accel}, {"gyro": cli.gyro, "accel": cli.accel})
+    # Against a plan it does not follow: the command exits 1, the module raises PlanMismatchError.
+    assert run_imufit("fit", "--plan", fixtures / "plan_24pos.yaml", "--samples", tmp_path / "unlabelled.csv",
+                      "-o", tmp_path / "no.yaml", check=False).returncode == 1
+    with pytest.raises(imufit.PlanMismatchError) as error:
+        imufit.fit(fixtures / "plan_24pos.yaml", unlabelled)
+    assert isinstance(error.value, imufit.FitError) and str(error.value)

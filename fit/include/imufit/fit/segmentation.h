@@ -65,8 +65,9 @@ struct SegmentationOptions {
   double noise_quantile = 0.1;
   // A window is steady when its variance is below this multiple of the noise level.
   double threshold_factor = 8.0;
-  // Steady stretches shorter than this count as motion, s.
-  double min_steady_s = 1.0;
+  // Steady stretches shorter than this count as motion, s. The centred window already trims half a
+  // window off each end, so a rest must last about min_steady_s + window_s to count.
+  double min_steady_s = 0.5;
   // How far a measured gravity direction or rotation axis may be from the plan's, degrees (raw
   // biases, unequal axis scales and misalignment tilt the raw directions by a few degrees).
   double direction_tolerance_deg = 25.0;

@@ -112,11 +112,13 @@ inline std::string ScaleSignAdvice(bool gyro, int axis) {
   const std::string name = std::string(gyro ? "gyro " : "accel ") + "xyz"[axis];
   if (gyro) {
     return "a scale factor is positive by convention: check the sign of the unit's " + name +
-           " axis against the body frame, and that the plan's rate_dps and angle_deg follow the right-hand rule "
+           " axis against the body frame, and that the plan's rate_dps and angle_deg follow the right-hand "
+           "rule "
            "about their axis (positive = counter-clockwise seen from the axis tip)";
   }
   return "a scale factor is positive by convention: check the sign of the unit's " + name +
-         " axis against the body frame: at rest an accelerometer reads +g along up (specific force, not gravity)";
+         " axis against the body frame: at rest an accelerometer reads +g along up (specific force, not "
+         "gravity)";
 }
 
 }  // namespace imufit

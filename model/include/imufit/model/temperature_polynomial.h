@@ -83,8 +83,7 @@ inline PolynomialExtremes ExtremesOverRange(const double* c, double center_c, do
 //
 // With x_f = (T - a_f) / h_f and x_t = (T - a_t) / h_t we have x_f = (h_t x_t + a_t - a_f) / h_f
 // = s x_t + d, and (s x_t + d)^k = sum_j binom(k, j) s^j d^(k-j) x_t^j.
-inline Eigen::Matrix4d RebaseTemperaturePolynomial(const TemperatureBasis& from,
-                                                   const TemperatureBasis& to) {
+inline Eigen::Matrix4d RebaseTemperaturePolynomial(const TemperatureBasis& from, const TemperatureBasis& to) {
   const double s = to.half_range_c / from.half_range_c;
   const double d = (to.center_c - from.center_c) / from.half_range_c;
   Eigen::Matrix4d binomial = Eigen::Matrix4d::Zero();
