@@ -44,9 +44,11 @@ struct FitArguments {
   CLI::Option* accel_order_option = nullptr;
 };
 
-std::string Format(const char* format, double a, double b) {
+// A value and its 1-sigma: the sigma goes through the same unit conversion as the value, whose
+// factor may be negative (a scale in the denominator), but a sigma is a magnitude.
+std::string Format(const char* format, double value, double sigma) {
   char text[96];
-  std::snprintf(text, sizeof text, format, a, b);
+  std::snprintf(text, sizeof text, format, value, std::abs(sigma));
   return text;
 }
 

@@ -1269,6 +1269,53 @@ TEST_F(CliTest, HandSessionWithoutLabelsOrTemperatureCalibratesEndToEnd) {
     EXPECT_LT((sums.first / count[face]).norm(), 0.005 * kDegToRad) << "face " << face << ", rad/s";
     EXPECT_LT((sums.second / count[face]).norm(), 0.5e-3 * 9.80665) << "face " << face << ", m/s^2";
   }
+// Issue 9: a hand-rotated cube (six faces, one 360 degree turn about each axis, raw counts, one
+// temperature) calibrates end to end with the gyro scale within its stated sigma, and the same
+// run against a plan with one turn's sign flipped is refused, naming the convention to check.
+TEST_F(CliTest, HandRotatedCubeCalibratesAndASignFlipIsRefused) {
+  std::string plan_text =
+      "format: imufit-plan\nversion: 1\ngravity_mps2: 9.80665\nsegments:\n"
+      "  - {id: 1, up: [0, 0, 1]}\n  - {id: 2, up: [0, 0, -1]}\n  - {id: 3, up: [1, 0, 0]}\n"
+      "  - {id: 4, up: [-1, 0, 0]}\n  - {id: 5, up: [0, 1, 0]}\n  - {id: 6, up: [0, -1, 0]}\n"
+      "  - {id: 7, up: [0, 0, 1], angle_deg: 360, axis: [1, 0, 0]}\n"
+      "  - {id: 8, up: [0, 0, 1], angle_deg: 360, axis: [0, 1, 0]}\n"
+      "  - {id: 9, up: [0, 0, 1], angle_deg: 360}\n";
+  const std::string plan = Write("cube.yaml", plan_text);
+  RunResult r = Run({"simulate", "-p", plan, "-c", Fixture("mems_truth.yaml"), "-o", Path("cube.csv"),
+                     "--gyro-noise-density", "1e-4", "--accel-noise-density", "5e-4", "--quantize", "--seed", "3",
+                     "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Run({"fit", "-p", plan, "-s", Path("cube.csv"), "-o", Path("cal.yaml"), "--gyro-temp-order", "0",
+           "--accel-temp-order", "0"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const YAML::Node fitted = YAML::LoadFile(Path("cal.yaml"));
+  const YAML::Node truth = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  for (const char* axis : {"x", "y", "z"}) {
+    const double estimate = fitted["gyro"]["scale"][axis][0].as<double>();
+    const double sigma = fitted["sigma"]["gyro"]["scale"][axis][0].as<double>();
+    EXPECT_LT(std::abs(estimate - truth["gyro"]["scale"][axis][0].as<double>()), 3.0 * sigma) << axis;
+  }
+  // The printed sigmas are magnitudes.
+  EXPECT_EQ(r.out.find("+- -"), std::string::npos) << r.out;
+
+  plan_text.replace(plan_text.find("angle_deg: 360, axis: [1, 0, 0]"), 14, "angle_deg: -360");
+  r = Run({"fit", "-p", Write("flipped.yaml", plan_text), "-s", Path("cube.csv"), "-o", Path("flipped_cal.yaml"),
+           "--gyro-temp-order", "0", "--accel-temp-order", "0"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("gyro scale x is negative"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("right-hand rule"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("flipped_cal.yaml")));
+
+  // apply refuses a calibration with a negative scale as bad input.
+  YAML::Node negative = YAML::LoadFile(Path("cal.yaml"));
+  negative["gyro"]["scale"]["y"][0] = -negative["gyro"]["scale"]["y"][0].as<double>();
+  YAML::Emitter emitter;
+  emitter << negative;
+  r = Run({"apply", "-c", Write("negative.yaml", emitter.c_str()), "-s", Path("cube.csv"), "-o",
+           Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("gyro.scale.y: the scale factor is negative"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
 }
 
 }  // namespace

@@ -618,6 +618,25 @@ TEST(Turns, AQuarterTurnAboutAHorizontalAxisIsExactWithoutNoise) {
   }
 }
 
+TEST(ScaleSign, ASignFlippedTurnIsRefusedWithTheConventionToCheck) {
+  // The unit turned +360 degrees about x, the plan says -360: the fitted gyro x scale is negative.
+  const SensorModel truth = testing::RandomMemsModel(2026);
+  const std::vector<TableSegment> run = FacesAndTurns();
+  WindowBuilder builder(WindowOptions(), run);
+  SimulateRun(OneTemperature(5), NoLatitude(), run, truth,
+              [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
+  std::vector<TableSegment> flipped = run;
+  flipped[6].angle_rad = -*flipped[6].angle_rad;
+  const FitSummary fit = FitThermalModel(builder.Finish(), NoLatitude(), flipped, OrderZero());
+  ASSERT_EQ(fit.status, FitStatus::kRefused) << fit.FullReport();
+  EXPECT_FALSE(fit.IsSolutionUsable());
+  ASSERT_EQ(fit.refusals.size(), 1u);
+  EXPECT_NE(fit.refusals[0].find("gyro scale x is negative"), std::string::npos) << fit.refusals[0];
+  EXPECT_NE(fit.refusals[0].find("right-hand rule"), std::string::npos) << fit.refusals[0];
+  EXPECT_NE(fit.BriefReport().find("fit refused: gyro scale x is negative"), std::string::npos)
+      << fit.BriefReport();
+}
+
 TEST(TiltedRates, TwoAxisTableRecoversTheModelWithinSigmas) {
   const SensorModel truth = testing::RandomMemsModel(31);
   const std::vector<TableSegment> plan = FacesAndTiltedRates();

@@ -635,6 +635,15 @@ TEST_F(IoTest, CalibrationsThatCannotCorrectAreRefusedOnRead) {
     c->model.accel[sy + 3] = 0.0;
   });
   EXPECT_NE(e.find("accel.scale.y: the scale factor comes near zero"), std::string::npos) << e;
+  // A negative scale (a sign-flipped axis or rotation): the convention to check is named.
+  e = error_of([&](Calibration* c) { c->model.accel[sx + 2 * kPolynomialTerms] *= -1.0; });
+  EXPECT_NE(e.find("accel.scale.z: the scale factor is negative"), std::string::npos) << e;
+  EXPECT_NE(e.find("+g along up"), std::string::npos) << e;
+  e = error_of([&](Calibration* c) {
+    for (int k = 0; k < kPolynomialTerms; ++k) c->model.gyro[sx + k] *= -1.0;
+  });
+  EXPECT_NE(e.find("gyro.scale.x: the scale factor is negative"), std::string::npos) << e;
+  EXPECT_NE(e.find("right-hand rule"), std::string::npos) << e;
   // A denormal scale; a singular M (xy = yx = 1 makes two rows equal).
   e = error_of([&](Calibration* c) {
     c->model.gyro[sx] = 1e-310;

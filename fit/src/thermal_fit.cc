@@ -646,6 +646,27 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     summary.termination = "the run does not determine the model";
     return summary;
   }
+  // A negative scale factor corrects every reading of its axis with the wrong sign: the unit's
+  // (or the plan's) sign convention is the opposite of the body frame's. Refuse it by name.
+  for (const bool is_gyro : {true, false}) {
+    const double* params = is_gyro ? summary.model.gyro.data() : summary.model.accel.data();
+    for (int axis = 0; axis < 3; ++axis) {
+      const double* c = params + (kScaleCoefficient + axis) * kPolynomialTerms;
+      const PolynomialExtremes e = ExtremesOverRange(c, summary.model.basis.center_c, summary.temp_range_c[0],
+                                                     summary.temp_range_c[1]);
+      if (e.min_value > 0.0) continue;
+      char text[200];
+      std::snprintf(text, sizeof text, "%s scale %c %s over the run's temperatures (%.6g at %.4g degC)",
+                    is_gyro ? "gyro" : "accel", kAxis[axis],
+                    e.max_value < 0.0 ? "is negative" : "changes sign", e.min_value, e.min_at_c);
+      summary.refusals.push_back(std::string(text) + "; " + ScaleSignAdvice(is_gyro, axis));
+    }
+  }
+  if (!summary.refusals.empty()) {
+    summary.status = FitStatus::kRefused;
+    summary.termination = "a scale factor is negative or changes sign";
+    return summary;
+  }
   summary.status = FitStatus::kConverged;
   return summary;
 }
@@ -661,6 +682,11 @@ std::string FitSummary::BriefReport() const {
       return text;
     case FitStatus::kNotConverged:
       return "fit did not converge: " + termination;
+    case FitStatus::kRefused: {
+      std::string text = "fit refused: ";
+      for (size_t i = 0; i < refusals.size(); ++i) text += (i ? "; and " : "") + refusals[i];
+      return text;
+    }
     case FitStatus::kConverged:
       break;
   }

@@ -10,6 +10,7 @@
 
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
+#include "imufit/model/rate_table.h"
 #include "yaml_util.h"
 
 namespace imufit {
@@ -50,63 +51,41 @@ void ReadSensor(const yaml::Located& sensor, double* params, int coefficients) {
   }
 }
 
-// The temperatures of [low, high] where a cubic in x = T - center can reach its extremes: the
-// ends and the roots of its derivative inside. A cubic is monotonic between these points, so
-// its smallest magnitude and any change of sign show at one of them.
-std::vector<double> CriticalTemperatures(const double* c, double center_c,
-                                         const std::array<double, 2>& range) {
-  std::vector<double> temps = {range[0], range[1]};
-  // c1 + 2 c2 x + 3 c3 x^2 = 0
-  const double a = 3.0 * c[3], b = 2.0 * c[2], d = c[1];
-  std::vector<double> roots;
-  if (a == 0.0) {
-    if (b != 0.0) roots.push_back(-d / b);
-  } else if (const double disc = b * b - 4.0 * a * d; disc >= 0.0) {
-    roots.push_back((-b + std::sqrt(disc)) / (2.0 * a));
-    roots.push_back((-b - std::sqrt(disc)) / (2.0 * a));
-  }
-  for (const double x : roots) {
-    if (std::isfinite(x) && x + center_c > range[0] && x + center_c < range[1]) temps.push_back(x + center_c);
-  }
-  return temps;
-}
-
-// Refuses a sensor whose correction cannot be computed across the fit temperature range: a
-// scale factor that changes sign, comes near zero (below kMinScale, or below 1/1000 of its
-// largest value) or a misalignment matrix M that is nearly singular (det M below 0.1).
+// Refuses a sensor whose correction cannot be computed across the fit temperature range, or
+// whose scale factor is negative: a scale factor that changes sign, comes near zero (below
+// kMinScale, or below 1/1000 of its largest magnitude), is negative (the unit's axis or rotation
+// sign convention is the opposite of the body frame's), or a misalignment matrix M that is nearly
+// singular (det M below 0.1).
 void CheckInvertible(const yaml::Located& sensor, const double* params, int coefficients, double center_c,
                      const std::array<double, 2>& range) {
   constexpr double kMinScale = 1e-9;
+  const bool gyro = coefficients == kGyroCoefficients;
   for (int axis = 0; axis < 3; ++axis) {
     const double* c = params + (kScaleCoefficient + axis) * kPolynomialTerms;
-    double smallest = std::numeric_limits<double>::infinity(), largest = 0.0, at_c = range[0];
-    double opposite_c = range[0];
-    bool sign_change = false;
-    const double first = EvaluateTemperaturePolynomial(c, range[0] - center_c);
-    for (const double t : CriticalTemperatures(c, center_c, range)) {
-      const double value = EvaluateTemperaturePolynomial(c, t - center_c);
-      if (!sign_change && (value == 0.0 || std::signbit(value) != std::signbit(first))) {
-        sign_change = true;
-        opposite_c = t;
-      }
-      largest = std::max(largest, std::abs(value));
-      if (std::abs(value) < smallest) smallest = std::abs(value), at_c = t;
-    }
-    if (sign_change || !(smallest >= kMinScale) || !(smallest >= 1e-3 * largest) || !std::isfinite(largest)) {
-      char text[240];
+    const PolynomialExtremes e = ExtremesOverRange(c, center_c, range[0], range[1]);
+    const bool sign_change = e.min_value <= 0.0 && e.max_value >= 0.0;
+    const bool negative = e.max_value < 0.0;
+    const double largest = std::max(std::abs(e.min_value), std::abs(e.max_value));
+    const double smallest = std::min(std::abs(e.min_value), std::abs(e.max_value));
+    const double at_c = std::abs(e.min_value) < std::abs(e.max_value) ? e.min_at_c : e.max_at_c;
+    if (sign_change || negative || !(smallest >= kMinScale) || !(smallest >= 1e-3 * largest) ||
+        !std::isfinite(largest)) {
+      char text[480];
       if (sign_change) {
-        std::snprintf(
-            text, sizeof text,
-            "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
-            "%.4g at %.4g degC); the correction divides by it",
-            range[0], range[1], first, range[0], EvaluateTemperaturePolynomial(c, opposite_c - center_c),
-            opposite_c);
+        std::snprintf(text, sizeof text,
+                      "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
+                      "%.4g at %.4g degC); the correction divides by it; %s",
+                      range[0], range[1], e.min_value, e.min_at_c, e.max_value, e.max_at_c,
+                      ScaleSignAdvice(gyro, axis).c_str());
+      } else if (negative) {
+        std::snprintf(text, sizeof text,
+                      "the scale factor is negative within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC); %s",
+                      range[0], range[1], e.max_value, e.max_at_c, ScaleSignAdvice(gyro, axis).c_str());
       } else {
-        std::snprintf(
-            text, sizeof text,
-            "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
-            "at most %.3g elsewhere); the correction divides by it",
-            range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
+        std::snprintf(text, sizeof text,
+                      "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
+                      "at most %.3g elsewhere); the correction divides by it",
+                      range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
       }
       sensor["scale"][kCoefficientNames[kScaleCoefficient + axis].axis].Fail(text);
     }

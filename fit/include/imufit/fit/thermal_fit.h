@@ -101,6 +101,7 @@ enum class FitStatus {
   kConverged,     // solved; the calibration is usable
   kNotConverged,  // the solver stopped without converging
   kUndetermined,  // the data do not determine the model; see `undetermined`
+  kRefused,       // solved, but a scale factor is negative or changes sign; see `refusals`
 };
 
 struct FitSummary {
@@ -113,6 +114,9 @@ struct FitSummary {
   int windows_downweighted = 0;
   // What the data do not determine, one readable finding each, with what would determine it.
   std::vector<std::string> undetermined;
+  // Why a solved model is refused (kRefused): a scale factor that is negative or changes sign over
+  // the run's temperatures, with the sign convention to check.
+  std::vector<std::string> refusals;
   // Distinct temperatures of the run (cluster centres), degC, and the range of the readings
   // in its windows (the calibration's fit_temp_range_c).
   std::vector<double> distinct_temps_c;

@@ -23,6 +23,7 @@
 
 #include <cmath>
 #include <optional>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -102,6 +103,22 @@ inline SegmentTruth TurnTruth(const TableSite& site, const TableSegment& segment
   SegmentTruth truth = TruthOf(site, segment);
   truth.omega_radps += segment.angle_rad.value_or(0.0) / duration_s * segment.RotationAxis();
   return truth;
+}
+
+// What to check when a fitted or read scale factor is negative or changes sign: the unit's axis
+// or rotation sign convention against the body frame's and the plan's (right-handed rates and
+// turns, specific force along up at rest). For the messages of `imufit fit` and of the readers.
+inline std::string ScaleSignAdvice(bool gyro, int axis) {
+  const std::string name = std::string(gyro ? "gyro " : "accel ") + "xyz"[axis];
+  if (gyro) {
+    return "a scale factor is positive by convention: check the sign of the unit's " + name +
+           " axis against the body frame, and that the plan's rate_dps and angle_deg follow the right-hand "
+           "rule "
+           "about their axis (positive = counter-clockwise seen from the axis tip)";
+  }
+  return "a scale factor is positive by convention: check the sign of the unit's " + name +
+         " axis against the body frame: at rest an accelerometer reads +g along up (specific force, not "
+         "gravity)";
 }
 
 }  // namespace imufit

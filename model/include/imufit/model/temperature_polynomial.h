@@ -14,6 +14,8 @@
 #ifndef IMUFIT_MODEL_TEMPERATURE_POLYNOMIAL_H_
 #define IMUFIT_MODEL_TEMPERATURE_POLYNOMIAL_H_
 
+#include <cmath>
+
 #include <Eigen/Core>
 
 namespace imufit {
@@ -44,14 +46,44 @@ T EvaluateTemperaturePolynomial(const T* c, const T& x) {
   return c[0] + x * (c[1] + x * (c[2] + x * c[3]));
 }
 
+// The smallest and largest value of a cubic in x = T - center_c (the calibration's basis) over
+// [low_c, high_c], and where they occur. A cubic is monotonic between the ends of the range and
+// the roots of its derivative c1 + 2 c2 x + 3 c3 x^2 inside it, so its extremes are among them.
+struct PolynomialExtremes {
+  double min_value = 0.0;
+  double min_at_c = 0.0;
+  double max_value = 0.0;
+  double max_at_c = 0.0;
+};
+inline PolynomialExtremes ExtremesOverRange(const double* c, double center_c, double low_c, double high_c) {
+  double candidates[4] = {low_c, high_c, low_c, low_c};
+  int count = 2;
+  const double a = 3.0 * c[3], b = 2.0 * c[2], d = c[1];
+  const auto add = [&](double x) {
+    if (std::isfinite(x) && x + center_c > low_c && x + center_c < high_c) candidates[count++] = x + center_c;
+  };
+  if (a == 0.0) {
+    if (b != 0.0) add(-d / b);
+  } else if (const double disc = b * b - 4.0 * a * d; disc >= 0.0) {
+    add((-b + std::sqrt(disc)) / (2.0 * a));
+    add((-b - std::sqrt(disc)) / (2.0 * a));
+  }
+  PolynomialExtremes extremes;
+  for (int i = 0; i < count; ++i) {
+    const double value = EvaluateTemperaturePolynomial(c, candidates[i] - center_c);
+    if (i == 0 || value < extremes.min_value) extremes.min_value = value, extremes.min_at_c = candidates[i];
+    if (i == 0 || value > extremes.max_value) extremes.max_value = value, extremes.max_at_c = candidates[i];
+  }
+  return extremes;
+}
+
 // The 4x4 matrix L that converts coefficients in basis `from` into coefficients in basis `to`,
 // exactly (binomial expansion): c_to = L * c_from. Because the map is linear, a covariance
 // converts as L * Sigma * L^T.
 //
 // With x_f = (T - a_f) / h_f and x_t = (T - a_t) / h_t we have x_f = (h_t x_t + a_t - a_f) / h_f
 // = s x_t + d, and (s x_t + d)^k = sum_j binom(k, j) s^j d^(k-j) x_t^j.
-inline Eigen::Matrix4d RebaseTemperaturePolynomial(const TemperatureBasis& from,
-                                                   const TemperatureBasis& to) {
+inline Eigen::Matrix4d RebaseTemperaturePolynomial(const TemperatureBasis& from, const TemperatureBasis& to) {
   const double s = to.half_range_c / from.half_range_c;
   const double d = (to.center_c - from.center_c) / from.half_range_c;
   Eigen::Matrix4d binomial = Eigen::Matrix4d::Zero();
