@@ -1269,6 +1269,8 @@ TEST_F(CliTest, HandSessionWithoutLabelsOrTemperatureCalibratesEndToEnd) {
     EXPECT_LT((sums.first / count[face]).norm(), 0.005 * kDegToRad) << "face " << face << ", rad/s";
     EXPECT_LT((sums.second / count[face]).norm(), 0.5e-3 * 9.80665) << "face " << face << ", m/s^2";
   }
+}
+
 // Issue 9: a hand-rotated cube (six faces, one 360 degree turn about each axis, raw counts, one
 // temperature) calibrates end to end with the gyro scale within its stated sigma, and the same
 // run against a plan with one turn's sign flipped is refused, naming the convention to check.
