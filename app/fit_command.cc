@@ -29,6 +29,8 @@ struct FitArguments {
   std::string check_samples;
   std::string loss = "huber";
   bool no_g_sensitivity = false;
+  std::string groups = "all";  // --fit
+  std::string prior;           // --prior: the held groups' values
   bool validate = false;
   bool quiet = false;
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
@@ -53,11 +55,21 @@ std::string Format(const char* format, double value, double sigma) {
 }
 
 // The 25 degC values a test engineer reads first, in familiar units (io/units.h), with 1-sigma.
-void PrintCoefficients(const FitSummary& fit) {
-  const auto at25 = [&](Sensor sensor, int coefficient) {
-    return EngineeringCoefficient(fit.model, &fit.sigma, sensor, coefficient, kFigureTempC);
+// Held groups (--fit) show their value and "held" instead of a sigma.
+void PrintCoefficients(const FitSummary& fit, const FitOptions& options) {
+  struct Figure {
+    EngineeringValue value;
+    bool held;
   };
-  const auto text = [](const char* format, const EngineeringValue& v) { return Format(format, v.value, v.sigma); };
+  const auto at25 = [&](Sensor sensor, int coefficient) {
+    return Figure{EngineeringCoefficient(fit.model, &fit.sigma, sensor, coefficient, kFigureTempC),
+                  !options.Fits(sensor == Sensor::kGyro, coefficient)};
+  };
+  const auto text = [](const char* format, const Figure& f) {
+    std::string out = Format(format, f.value.value, f.value.sigma);
+    if (f.held) out = out.substr(0, out.find(" +- ")) + " (held)";
+    return out;
+  };
   const char* axes = "xyz";
   std::printf("  at 25 degC (+- 1 sigma):\n");
   for (int i = 0; i < 3; ++i) {
@@ -152,7 +164,8 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
 }
 
 int RunFit(FitArguments args) {
-  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits});
+  RefuseToOverwriteInputs(
+      args.output, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits, args.prior});
   if (!args.report.empty()) {
     RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits, args.output});
   }
@@ -162,6 +175,8 @@ int RunFit(FitArguments args) {
   std::string error;
   if (!ParseRobustLoss(args.loss, &args.fit.loss, &error)) throw InputError("--loss", error);
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
+  if (!ParseFitGroups(args.groups, &args.fit, &error)) throw InputError("--fit", error);
+  if (!args.prior.empty()) args.fit.held = ReadCalibration(args.prior).model;
   args.fit.gyro_bias_stability_radps = RadpsFromDph(args.gyro_bias_stability_dph);
   args.fit.accel_bias_stability_mps2 = Mps2FromUg(args.accel_bias_stability_ug);
   const bool fixed_temp = args.input.HasTemp();
@@ -235,7 +250,7 @@ int RunFit(FitArguments args) {
     }
     std::printf("%s\n", fit.windows_downweighted > 10 ? " ..." : "");
   }
-  PrintCoefficients(fit);
+  PrintCoefficients(fit, args.fit);
   if (args.fit.gyro_bias_stability_radps == 0.0 || args.fit.accel_bias_stability_mps2 == 0.0) {
     std::printf("  note: the sigmas reflect white noise only%s; give the unit's in-run bias stability\n"
                 "        (--gyro-bias-stability-dph, --accel-bias-stability-ug) if its bias wanders\n",
@@ -291,6 +306,13 @@ CommandRunner AddFitCommand(CLI::App* root) {
   AddTempOption(command, &args->input);
   AddSegmentationOptions(command, &args->input);
   command->add_flag("--no-g-sensitivity", args->no_g_sensitivity, "hold the gyro g-sensitivity at zero");
+  command
+      ->add_option("--fit", args->groups,
+                   "what to fit, comma-separated: all, gyro, gyro-bias, accel, accel-bias; the rest is held "
+                   "(--fit accel calibrates the accelerometer from a static-only run)")
+      ->capture_default_str();
+  command->add_option("--prior", args->prior,
+                      "calibration YAML whose values the held groups keep (default: scale 1, the rest 0)");
   command->add_option("--loss", args->loss, "robust loss: none, huber, cauchy")->capture_default_str();
   command->add_option("--loss-scale", f.loss_scale,
                       "where the robust loss acts, in robust spreads of the windows' normalised residuals")

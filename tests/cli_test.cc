@@ -889,6 +889,60 @@ TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
   EXPECT_EQ(constant.status, 0) << constant.err;
 }
 
+// A static-only run: refused as a whole (naming the gyro scale, suggesting --fit accel), fitted
+// with --fit accel: the accelerometer near the truth, the gyro held at scale 1 and 0 with sigma 0.
+TEST_F(CliTest, FitAccelAloneCalibratesAStaticOnlyRun) {
+  const std::string plan =
+      Write("static.yaml",
+            "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81274\nlatitude_deg: 52.27\n"
+            "segments:\n"
+            "  - {id: 1, up: [0, 0, 1], north: [1, 0, 0]}\n"
+            "  - {id: 2, up: [0, 0, -1], north: [1, 0, 0]}\n"
+            "  - {id: 3, up: [1, 0, 0], north: [0, 1, 0]}\n"
+            "  - {id: 4, up: [-1, 0, 0], north: [0, 1, 0]}\n"
+            "  - {id: 5, up: [0, 1, 0], north: [0, 0, 1]}\n"
+            "  - {id: 6, up: [0, -1, 0], north: [0, 0, 1]}\n");
+  const std::string samples = SimulateNoiseless(plan, Fixture("mems_truth.yaml"), "static",
+                                                {"--temps=-20,5,30,55,80", "--dwell", "3"})
+                                  .first;
+  const RunResult whole = Run({"fit", "-p", plan, "-s", samples, "-o", Path("whole.yaml")});
+  EXPECT_EQ(whole.status, 1);
+  EXPECT_NE(whole.err.find("gyro scale z and misalignment xz, yz are undetermined"), std::string::npos)
+      << whole.err;
+  EXPECT_NE(whole.err.find("--fit accel"), std::string::npos) << whole.err;
+  EXPECT_FALSE(fs::exists(Path("whole.yaml")));
+
+  const RunResult fit = Run({"fit", "-p", plan, "-s", samples, "-o", Path("accel.yaml"), "--fit", "accel"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("gyro x   bias +0.00000 (held) deg/s"), std::string::npos) << fit.out;
+  const YAML::Node got = YAML::LoadFile(Path("accel.yaml"));
+  const YAML::Node truth = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  for (const char* group : {"bias", "scale", "misalignment"}) {
+    for (const auto& entry : truth["accel"][group]) {
+      const std::string name = entry.first.as<std::string>();
+      for (int k = 0; k < 4; ++k) {
+        const double want = entry.second[k].as<double>();
+        EXPECT_NEAR(got["accel"][group][name][k].as<double>(), want, 1e-6 * std::max(1.0, std::abs(want)))
+            << "accel." << group << "." << name << "[" << k << "]";
+      }
+      EXPECT_EQ(got["sigma"]["accel"][group][name].size(), 4u);
+    }
+    for (const auto& entry : got["gyro"][group]) {
+      const bool unit_scale = std::string(group) == "scale";
+      EXPECT_EQ(entry.second[0].as<double>(), unit_scale ? 1.0 : 0.0) << "gyro." << group;
+      EXPECT_EQ(got["sigma"]["gyro"][group][entry.first.as<std::string>()][0].as<double>(), 0.0);
+    }
+  }
+  EXPECT_EQ(got["fit"]["fitted"].as<std::vector<std::string>>(),
+            (std::vector<std::string>{"accel.bias", "accel.scale", "accel.misalignment"}));
+  EXPECT_EQ(got["fit"]["held"].size(), 4u);
+  EXPECT_EQ(got["fit"]["held_values"].as<std::string>(), "scale 1, others 0");
+  const RunResult bad =
+      Run({"fit", "-p", plan, "-s", samples, "-o", Path("bad.yaml"), "--fit", "accelerometer"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("is not a group to fit"), std::string::npos) << bad.err;
+}
+
 TEST_F(CliTest, FitNamesAnAxisGravityNeverPointsAlong) {
   // The 6-position plan without its -y face: g-sensitivity and accelerometer column y are lost.
   std::string plan = ReadFile(Fixture("plan_6pos.yaml"));

@@ -761,6 +761,73 @@ TEST(Undetermined, NoWindowsAtAll) {
   EXPECT_TRUE(Mentions(fit.undetermined, "no usable windows"));
 }
 
+// ---------------------------------------------------------------- fitting a subset
+
+// A static-only run (six faces, no rotation) at five temperatures: the whole model is refused,
+// naming the gyro scale and suggesting --fit accel; the accelerometer alone is recovered within
+// its sigmas, and the held gyro keeps its stated values (scale 1, the rest 0) with sigma 0.
+TEST(Subset, AStaticOnlyRunCalibratesTheAccelerometerAlone) {
+  const std::vector<TableSegment> plan = SixPositionPlan(/*with_rates=*/false);
+  const SensorModel truth = testing::RandomMemsModel(31);
+  const std::vector<Window> windows = Simulate(MemsNoise(31), plan, truth);
+  const FitSummary whole = FitThermalModel(windows, Site(), plan, FitOptions());
+  ASSERT_EQ(whole.status, FitStatus::kUndetermined);
+  EXPECT_TRUE(Mentions(whole.undetermined, "gyro scale x and misalignment yx, zx are undetermined"));
+  EXPECT_TRUE(Mentions(whole.undetermined, "fit a subset: --fit accel"));
+
+  FitOptions options;
+  std::string error;
+  ASSERT_TRUE(ParseFitGroups("accel", &options, &error)) << error;
+  EXPECT_EQ(options.Groups(true),
+            (std::vector<std::string>{"accel.bias", "accel.scale", "accel.misalignment"}));
+  const FitSummary fit = FitThermalModel(windows, Site(), plan, options);
+  ASSERT_TRUE(fit.IsSolutionUsable()) << fit.FullReport();
+  double worst = 0.0;
+  for (int c = 0; c < kAccelCoefficients; ++c) {
+    const int i = c * kPolynomialTerms;
+    ASSERT_GT(fit.sigma.accel[i], 0.0) << c;
+    const double z = (fit.model.accel[i] - truth.accel[i]) / fit.sigma.accel[i];
+    worst = std::max(worst, std::abs(z));
+    EXPECT_LT(std::abs(z), 3.5) << "accel coefficient " << c << ": " << fit.model.accel[i] << " vs "
+                                << truth.accel[i] << " +- " << fit.sigma.accel[i];
+  }
+  std::printf("static-only, accel alone: worst |z| over 12 accel coefficients at 25 degC %.2f\n", worst);
+  for (int i = 0; i < kGyroParameters; ++i) {
+    const bool constant_scale = i % kPolynomialTerms == 0 && i / kPolynomialTerms >= kScaleCoefficient &&
+                                i / kPolynomialTerms < kMisalignmentCoefficient;
+    EXPECT_EQ(fit.model.gyro[i], constant_scale ? 1.0 : 0.0) << i;
+    EXPECT_EQ(fit.sigma.gyro[i], 0.0) << i;
+  }
+
+  // The gyro bias too, the rest of the gyro held at the truth (a prior calibration).
+  ASSERT_TRUE(ParseFitGroups("gyro-bias,accel", &options, &error)) << error;
+  options.held = truth;
+  const FitSummary with_bias = FitThermalModel(windows, Site(), plan, options);
+  ASSERT_TRUE(with_bias.IsSolutionUsable()) << with_bias.FullReport();
+  for (int axis = 0; axis < 3; ++axis) {
+    const int i = (kBiasCoefficient + axis) * kPolynomialTerms;
+    EXPECT_LT(std::abs(with_bias.model.gyro[i] - truth.gyro[i]), 3.5 * with_bias.sigma.gyro[i]) << axis;
+    const int s = (kScaleCoefficient + axis) * kPolynomialTerms;
+    EXPECT_NEAR(with_bias.model.gyro[s], truth.gyro[s], 1e-9 * truth.gyro[s]) << axis;
+    EXPECT_EQ(with_bias.sigma.gyro[s], 0.0);
+  }
+}
+
+TEST(Subset, ParsesTheGroupsToFit) {
+  FitOptions options;
+  std::string error;
+  ASSERT_TRUE(ParseFitGroups("gyro-bias,accel", &options, &error));
+  EXPECT_EQ(options.gyro_fit, SensorFit::kBias);
+  EXPECT_EQ(options.accel_fit, SensorFit::kAll);
+  EXPECT_EQ(options.Groups(false),
+            (std::vector<std::string>{"gyro.scale", "gyro.misalignment", "gyro.g_sensitivity"}));
+  ASSERT_TRUE(ParseFitGroups("all", &options, &error));
+  EXPECT_TRUE(options.Groups(false).empty());
+  EXPECT_FALSE(ParseFitGroups("accel,magnetometer", &options, &error));
+  EXPECT_NE(error.find("\"magnetometer\" is not a group to fit"), std::string::npos) << error;
+  EXPECT_FALSE(ParseFitGroups("", &options, &error));
+}
+
 TEST(FitOptions, ValidateAndLossNames) {
   FitOptions options;
   EXPECT_EQ(options.Validate(), "");

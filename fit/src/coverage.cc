@@ -71,7 +71,11 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
   const std::vector<double> all_temps = TempsWhere(windows, options, [](const FitWindow&) { return true; });
   const int gyro_order = options.gyro_temp_order;
   const int accel_order = options.accel_temp_order;
-  const size_t most_needed = static_cast<size_t>(std::max(gyro_order, accel_order)) + 1;
+  // A held sensor (SensorFit::kNone) needs no temperatures; its groups are not checked.
+  const bool gyro_held = options.gyro_fit == SensorFit::kNone;
+  const bool accel_held = options.accel_fit == SensorFit::kNone;
+  const size_t most_needed =
+      static_cast<size_t>(std::max(gyro_held ? 0 : gyro_order, accel_held ? 0 : accel_order)) + 1;
   bool temps_short = false;
   if (all_temps.size() < most_needed) {
     temps_short = true;
@@ -90,6 +94,8 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
   const size_t accel_needed = temps_short ? 1 : static_cast<size_t>(accel_order) + 1;
   const double along = kAlongFraction * gravity_mps2;
 
+  bool gyro_rotation_missing = false;
+  bool accel_missing = false;
   for (int j = 0; j < 3; ++j) {
     const std::string axis(1, kAxis[j]);
     // Gyro column j of K = diag(S) inv(M): scale j and the misalignments of column j. A rate
@@ -102,7 +108,8 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
                   "no rate segments or turns about the " + axis + " axis (the table must spin with " + axis +
                       " up or down, or a rate or turn segment must give an axis along " + axis + ")",
                   "gyro", gyro_order);
-    if (!rate.empty()) {
+    if (!rate.empty() && options.Fits(true, kScaleCoefficient + j)) {
+      gyro_rotation_missing = true;
       findings.push_back("gyro scale " + axis + " and misalignment " + OffDiagonalColumn(j) +
                          " are undetermined: " + rate);
     }
@@ -115,22 +122,32 @@ std::vector<std::string> CheckCoverage(const std::vector<FitWindow>& windows, do
     for (const auto& [sensor, order, needed] :
          {std::tuple<const char*, int, size_t>{"gyro", gyro_order, gyro_needed},
           std::tuple<const char*, int, size_t>{"accel", accel_order, accel_needed}}) {
-      if (std::string(sensor) == "gyro" && !options.fit_g_sensitivity) continue;
+      const bool gyro = std::string(sensor) == "gyro";
+      if (!options.Fits(gyro, gyro ? kGSensitivityCoefficient : kScaleCoefficient)) continue;
       std::string missing = Shortfall(up, needed, "gravity along +" + axis,
                                       "no positions with gravity along +" + axis, sensor, order);
       const std::string missing_down = Shortfall(down, needed, "gravity along -" + axis,
                                                  "no positions with gravity along -" + axis, sensor, order);
       if (!missing_down.empty()) missing += (missing.empty() ? "" : "; ") + missing_down;
       if (missing.empty()) continue;
-      if (std::string(sensor) == "gyro") {
+      if (gyro) {
         findings.push_back("gyro g_sensitivity column " + axis + " (x" + axis + ", y" + axis + ", z" + axis +
                            ") is undetermined: " + missing +
                            " (or leave g-sensitivity out with --no-g-sensitivity)");
       } else {
+        accel_missing = true;
         findings.push_back("accel scale " + axis + " and misalignment " + OffDiagonalColumn(j) +
                            " are undetermined: " + missing);
       }
     }
+  }
+  // A run without rotation (a static-only run) still determines the accelerometer and the gyro
+  // bias: say how to fit just those when the whole model was asked for.
+  const bool whole_model = options.gyro_fit == SensorFit::kAll && options.accel_fit == SensorFit::kAll;
+  if (whole_model && gyro_rotation_missing && !accel_missing) {
+    findings.push_back(
+        "to calibrate only what this run determines, fit a subset: --fit accel (the gyro held), or --fit "
+        "gyro-bias,accel (the gyro scale and misalignment held; give their values with --prior CAL.yaml)");
   }
   return findings;
 }

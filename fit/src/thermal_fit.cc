@@ -61,6 +61,7 @@ struct SensorProblem {
     return p;
   }
   bool IsHeld(int i) const { return std::find(held.begin(), held.end(), i) != held.end(); }
+  bool IsFullyHeld() const { return static_cast<int>(held.size()) == parameters; }
 };
 
 double Median(std::vector<double> values) {
@@ -172,6 +173,50 @@ void LinearStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem
       set(kMisalignmentCoefficient + m_index, k, fitted(k, 3 + m_index));
     if (sensor->with_g_sensitivity) {
       for (int h = 0; h < 9; ++h) set(kGSensitivityCoefficient + h, k, H(h, k));
+    }
+  }
+}
+
+// The stated values of one sensor's groups in the fit basis `basis`: the prior calibration's, or
+// scale 1 and everything else 0 (FitOptions::held).
+std::vector<double> HeldParameters(const FitOptions& options, bool gyro, const TemperatureBasis& basis) {
+  const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
+  std::vector<double> p(coefficients * kPolynomialTerms, 0.0);
+  if (!options.held) {
+    for (int axis = 0; axis < 3; ++axis) p[(kScaleCoefficient + axis) * kPolynomialTerms] = 1.0;
+    return p;
+  }
+  const Eigen::Matrix4d rebase = RebaseTemperaturePolynomial(options.held->basis, basis);
+  const double* prior = gyro ? options.held->gyro.data() : options.held->accel.data();
+  for (int c = 0; c < coefficients; ++c) {
+    Eigen::Map<Eigen::Vector4d>(p.data() + c * kPolynomialTerms) =
+        rebase * Eigen::Map<const Eigen::Vector4d>(prior + c * kPolynomialTerms);
+  }
+  return p;
+}
+
+// The start of a bias-only sensor whose other groups are held at `sensor->p0`: the bias
+// polynomial by weighted linear least squares on raw - ForwardSensor(held groups, truth).
+void BiasStart(const std::vector<FitWindow>& windows, bool gyro, SensorProblem* sensor) {
+  const int terms = sensor->order + 1;
+  const int m = static_cast<int>(windows.size());
+  std::vector<double> held = sensor->p0;
+  for (int i = 0; i < 3 * kPolynomialTerms; ++i) held[kBiasCoefficient * kPolynomialTerms + i] = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::MatrixXd design(m, terms);
+    Eigen::VectorXd rhs(m);
+    for (int r = 0; r < m; ++r) {
+      const FitWindow& w = windows[r];
+      const double weight = 1.0 / sensor->sigma_raw[r](i);
+      const SensorCoefficients<double> c = CoefficientsAt(held.data(), sensor->coefficients, w.x);
+      const Eigen::Vector3d predicted = ForwardSensor(c, TruthFor(w, gyro), w.truth.a_mps2);
+      double power = 1.0;
+      for (int k = 0; k < terms; ++k, power *= w.x) design(r, k) = weight * power;
+      rhs(r) = weight * (RawFor(w, gyro)(i) - predicted(i));
+    }
+    const Eigen::VectorXd bias = design.completeOrthogonalDecomposition().solve(rhs);
+    for (int k = 0; k < kPolynomialTerms; ++k) {
+      sensor->p0[(kBiasCoefficient + i) * kPolynomialTerms + k] = k < terms ? bias(k) : 0.0;
     }
   }
 }
@@ -311,6 +356,59 @@ bool ParseRobustLoss(const std::string& name, RobustLoss* loss, std::string* err
   return false;
 }
 
+bool FitOptions::Fits(bool gyro, int coefficient) const {
+  const SensorFit fit = gyro ? gyro_fit : accel_fit;
+  if (fit == SensorFit::kNone) return false;
+  if (coefficient < kScaleCoefficient) return true;
+  if (fit == SensorFit::kBias) return false;
+  return coefficient < kGSensitivityCoefficient || fit_g_sensitivity;
+}
+
+std::vector<std::string> FitOptions::Groups(bool fitted) const {
+  std::vector<std::string> names;
+  for (const bool gyro : {true, false}) {
+    const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
+    for (const int c :
+         {kBiasCoefficient, kScaleCoefficient, kMisalignmentCoefficient, kGSensitivityCoefficient}) {
+      if (c >= coefficients || Fits(gyro, c) != fitted) continue;
+      names.push_back(std::string(gyro ? "gyro." : "accel.") + kCoefficientNames[c].group);
+    }
+  }
+  return names;
+}
+
+bool ParseFitGroups(const std::string& list, FitOptions* options, std::string* error) {
+  SensorFit gyro = SensorFit::kNone;
+  SensorFit accel = SensorFit::kNone;
+  const auto at_least = [](SensorFit* fit, SensorFit wanted) {
+    if (wanted == SensorFit::kAll || *fit == SensorFit::kNone) *fit = wanted;
+  };
+  size_t begin = 0;
+  while (begin <= list.size()) {
+    const size_t end = std::min(list.find(',', begin), list.size());
+    const std::string name = list.substr(begin, end - begin);
+    if (name == "all") {
+      gyro = accel = SensorFit::kAll;
+    } else if (name == "gyro" || name == "gyro-bias") {
+      at_least(&gyro, name == "gyro" ? SensorFit::kAll : SensorFit::kBias);
+    } else if (name == "accel" || name == "accel-bias") {
+      at_least(&accel, name == "accel" ? SensorFit::kAll : SensorFit::kBias);
+    } else {
+      *error =
+          "\"" + name + "\" is not a group to fit (all, gyro, gyro-bias, accel, accel-bias, comma-separated)";
+      return false;
+    }
+    begin = end + 1;
+  }
+  if (gyro == SensorFit::kNone && accel == SensorFit::kNone) {
+    *error = "nothing to fit";
+    return false;
+  }
+  options->gyro_fit = gyro;
+  options->accel_fit = accel;
+  return true;
+}
+
 std::string FitOptions::Validate() const {
   if (gyro_temp_order < 0 || gyro_temp_order > 3) return "the gyro temperature order must be 0..3";
   if (accel_temp_order < 0 || accel_temp_order > 3) return "the accel temperature order must be 0..3";
@@ -324,6 +422,7 @@ std::string FitOptions::Validate() const {
   if (!(distinct_temp_c > 0.0)) return "the distinct-temperature span must be positive";
   if (!(min_excitation_rate_radps > 0.0)) return "the minimum excitation rate must be positive";
   if (!(rank_tolerance > 0.0 && rank_tolerance < 1.0)) return "the rank tolerance must be in (0, 1)";
+  if (gyro_fit == SensorFit::kNone && accel_fit == SensorFit::kNone) return "nothing to fit";
   return "";
 }
 
@@ -394,7 +493,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   gyro.parameters = kGyroParameters;
   gyro.coefficients = kGyroCoefficients;
   gyro.order = options.gyro_temp_order;
-  gyro.with_g_sensitivity = options.fit_g_sensitivity;
+  gyro.with_g_sensitivity = options.Fits(true, kGSensitivityCoefficient);
   SensorProblem accel;
   accel.name = "accel";
   accel.parameters = kAccelParameters;
@@ -423,7 +522,15 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       }
     }
     SetSigmas(is_gyro, sensor);
-    LinearStart(sensor->windows, is_gyro, sensor);
+    const SensorFit mode = is_gyro ? options.gyro_fit : options.accel_fit;
+    const std::vector<double> held = HeldParameters(options, is_gyro, basis);
+    if (mode == SensorFit::kAll) {
+      LinearStart(sensor->windows, is_gyro, sensor);
+    } else {
+      sensor->p0 = held;
+      SetSigmas(is_gyro, sensor);  // the weights at the held scale
+      if (mode == SensorFit::kBias) BiasStart(sensor->windows, is_gyro, sensor);
+    }
     if (!options.closed_form_start) {
       // Keep only the nominal scale factors: the solver must find everything else itself.
       for (int i = 0; i < sensor->parameters; ++i) {
@@ -433,13 +540,15 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
         if (!nominal_scale) sensor->p0[i] = 0.0;
       }
     }
+    for (int i = 0; i < sensor->parameters; ++i) {
+      if (!options.Fits(is_gyro, i / kPolynomialTerms)) sensor->p0[i] = held[i];
+    }
     SetSigmas(is_gyro, sensor);  // the SI figures at the start's scale
     SetSteps(sensor);
     sensor->q.assign(sensor->parameters, 0.0);
     for (int c = 0; c < sensor->coefficients; ++c) {
       for (int k = 0; k < kPolynomialTerms; ++k) {
-        const bool g_sensitivity_off = c >= kGSensitivityCoefficient && !sensor->with_g_sensitivity;
-        if (k > sensor->order || g_sensitivity_off) sensor->held.push_back(c * kPolynomialTerms + k);
+        if (k > sensor->order || !options.Fits(is_gyro, c)) sensor->held.push_back(c * kPolynomialTerms + k);
       }
     }
   }
@@ -463,7 +572,9 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       }
       sensor->blocks.push_back(problem.AddResidualBlock(cost, sensor->loss, sensor->q.data()));
     }
-    if (!sensor->held.empty()) {
+    if (static_cast<int>(sensor->held.size()) == sensor->parameters) {
+      problem.SetParameterBlockConstant(sensor->q.data());  // every group held (SensorFit::kNone)
+    } else if (!sensor->held.empty()) {
       problem.SetManifold(sensor->q.data(), new ceres::SubsetManifold(sensor->parameters, sensor->held));
     }
   }
@@ -489,6 +600,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   };
   if (options.loss != RobustLoss::kNone && solver_summary.termination_type == ceres::CONVERGENCE) {
     for (SensorProblem* sensor : {&gyro, &accel}) {
+      if (sensor->IsFullyHeld()) continue;  // nothing to protect: its residuals move no estimate
       // The robust spread of one residual component; a window's 3-vector norm is compared with
       // loss_scale times it.
       std::vector<double> components;
@@ -518,6 +630,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
 
   // Backstop: the rank of the column-normalised Jacobian at the solution, per sensor.
   for (SensorProblem* sensor : {&gyro, &accel}) {
+    if (sensor->IsFullyHeld()) continue;
     ceres::Problem::EvaluateOptions evaluate;
     evaluate.parameter_blocks = {sensor->q.data()};
     evaluate.residual_blocks = sensor->blocks;
@@ -577,7 +690,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
       out.window = sensor->window_index[w];
       (is_gyro ? out.gyro_radps : out.accel_mps2) = si;
       (is_gyro ? out.gyro_sigma_radps : out.accel_sigma_mps2) = sensor->sigma[w];
-      const bool downweighted = options.loss != RobustLoss::kNone && norms[w] > sensor->loss_threshold;
+      const bool downweighted =
+          options.loss != RobustLoss::kNone && !sensor->IsFullyHeld() && norms[w] > sensor->loss_threshold;
       out.downweighted = out.downweighted || downweighted;
       sum_squares += si.squaredNorm();
       if (!downweighted) {
@@ -601,8 +715,10 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   covariance_options.num_threads = options.num_threads;
   covariance_options.apply_loss_function = true;
   ceres::Covariance covariance(covariance_options);
-  const std::vector<std::pair<const double*, const double*>> covariance_blocks = {
-      {gyro.q.data(), gyro.q.data()}, {accel.q.data(), accel.q.data()}};
+  std::vector<std::pair<const double*, const double*>> covariance_blocks;
+  for (const SensorProblem* sensor : {&gyro, &accel}) {
+    if (!sensor->IsFullyHeld()) covariance_blocks.emplace_back(sensor->q.data(), sensor->q.data());
+  }
   const bool have_covariance = covariance.Compute(covariance_blocks, &problem);
   const std::vector<int> time_blocks = TimeBlocks(fit_windows, options.bias_correlation_s);
   const Eigen::Matrix4d to_reference = RebaseTemperaturePolynomial(basis, TemperatureBasis::Reference());
@@ -612,7 +728,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     const bool is_gyro = sensor == &gyro;
     const std::vector<double> p = sensor->Parameters();
     Eigen::MatrixXd cov_q = Eigen::MatrixXd::Zero(sensor->parameters, sensor->parameters);
-    if (have_covariance) {
+    if (have_covariance && !sensor->IsFullyHeld()) {
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> block(sensor->parameters,
                                                                                    sensor->parameters);
       covariance.GetCovarianceBlock(sensor->q.data(), sensor->q.data(), block.data());
@@ -621,7 +737,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     const double scale2 = is_gyro ? summary.gyro_reduced_chi2 : summary.accel_reduced_chi2;
     cov_q *= scale2;
     const double stability = is_gyro ? options.gyro_bias_stability_radps : options.accel_bias_stability_mps2;
-    if (have_covariance && stability > 0.0) {
+    if (have_covariance && stability > 0.0 && !sensor->IsFullyHeld()) {
       cov_q += BiasStabilityCovariance(*sensor, cov_q / scale2, time_blocks, stability);
     }
     double* model_out = is_gyro ? summary.model.gyro.data() : summary.model.accel.data();

@@ -32,7 +32,16 @@ YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path,
   node["accel_reduced_chi2"] = fit.accel_reduced_chi2;
   node["gyro_temp_order"] = options.gyro_temp_order;
   node["accel_temp_order"] = options.accel_temp_order;
-  node["g_sensitivity_fitted"] = options.fit_g_sensitivity;
+  node["g_sensitivity_fitted"] = options.Fits(true, kGSensitivityCoefficient);
+  // What the fit estimated; the held groups keep their stated values (a prior calibration's, or
+  // scale 1 and 0 otherwise) and a sigma of 0.
+  for (const bool fitted : {true, false}) {
+    const char* key = fitted ? "fitted" : "held";
+    node[key] = YAML::Node(YAML::NodeType::Sequence);
+    for (const std::string& group : options.Groups(fitted)) node[key].push_back(group);
+    node[key].SetStyle(YAML::EmitterStyle::Flow);
+  }
+  if (!options.Groups(false).empty()) node["held_values"] = options.held ? "prior" : "scale 1, others 0";
   node["loss"] = RobustLossName(options.loss);
   node["gyro_bias_stability_radps"] = options.gyro_bias_stability_radps;
   node["accel_bias_stability_mps2"] = options.accel_bias_stability_mps2;

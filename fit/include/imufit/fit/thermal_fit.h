@@ -33,6 +33,7 @@
 #define IMUFIT_FIT_THERMAL_FIT_H_
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,7 +50,22 @@ std::string RobustLossName(RobustLoss loss);
 // Parses a name; on failure returns false and sets `error` to a message listing the names.
 bool ParseRobustLoss(const std::string& name, RobustLoss* loss, std::string* error);
 
+// How much of one sensor's model a fit estimates; the rest is held (FitOptions::held).
+enum class SensorFit {
+  kAll,   // every group
+  kBias,  // the bias only: scale, misalignment (and the gyro g-sensitivity) held
+  kNone,  // nothing: every group held
+};
+
 struct FitOptions {
+  // What is fitted, per sensor (`imufit fit --fit`): a static-only run determines the accelerometer
+  // and the gyro bias but not the gyro scale or misalignment, which need rotation.
+  SensorFit gyro_fit = SensorFit::kAll;
+  SensorFit accel_fit = SensorFit::kAll;
+  // The values of the held groups (reference basis, any order): a prior calibration. Without one,
+  // held scales are 1 (raw already in rad/s, m/s^2) and held biases, misalignments and
+  // g-sensitivities 0.
+  std::optional<SensorModel> held;
   // Order of the temperature polynomial of every gyro / accelerometer coefficient (0..3).
   int gyro_temp_order = 3;
   int accel_temp_order = 3;
@@ -84,7 +100,17 @@ struct FitOptions {
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
+  // Whether coefficient `coefficient` (sensor_model.h layout) of the gyro or the accelerometer is
+  // fitted (true) or held at its stated value (false).
+  bool Fits(bool gyro, int coefficient) const;
+  // Every group, named "gyro.bias", "gyro.scale", "gyro.misalignment", "gyro.g_sensitivity",
+  // "accel.bias", "accel.scale", "accel.misalignment", that is fitted (true) or held (false).
+  std::vector<std::string> Groups(bool fitted) const;
 };
+
+// Parses `imufit fit --fit`: a comma-separated list of "all", "gyro", "gyro-bias", "accel",
+// "accel-bias" (what is not named is held). On failure returns false and sets `error`.
+bool ParseFitGroups(const std::string& list, FitOptions* options, std::string* error);
 
 // The residual of one window after the fit, SI units, body frame.
 struct WindowResidual {
