@@ -99,6 +99,21 @@ const OptionTable<FitRunOptions>& FitOptionTable() {
                 ThrowBadArgument("imufit.fit", error);
             },
             [](const O& o) { return py::cast(RobustLossName(o.fit.loss)); })
+        .Custom(
+            "fit", "what to fit, comma-separated: 'all', 'gyro', 'gyro-bias', 'accel', 'accel-bias' (the rest held)",
+            [](const py::handle& value, O* o) {
+              std::string error;
+              if (!ParseFitGroups(value.cast<std::string>(), &o->fit, &error)) ThrowBadArgument("imufit.fit", error);
+            },
+            [](const O& o) {
+              const auto name = [](SensorFit fit, const char* sensor) -> std::string {
+                if (fit == SensorFit::kNone) return "";
+                return std::string(sensor) + (fit == SensorFit::kBias ? "-bias" : "");
+              };
+              const std::string gyro = name(o.fit.gyro_fit, "gyro"), accel = name(o.fit.accel_fit, "accel");
+              if (gyro == "gyro" && accel == "accel") return py::cast(std::string("all"));
+              return py::cast(gyro + (gyro.empty() || accel.empty() ? "" : ",") + accel);
+            })
         .Field<double>("loss_scale",
                        "where the robust loss acts, in robust spreads of the normalised residuals",
                        [](O& o) -> double& { return o.fit.loss_scale; })

@@ -61,6 +61,20 @@ def test_fit_options_map_onto_the_command(fixtures, tmp_path, run_imufit):
     assert_parameters_close(result.sigma, cli.sigma)
     defaults = imufit.fit_options()
     assert defaults["loss"][0] == "huber" and defaults["gyro_temp_order"][0] == 3
+    assert defaults["fit"][0] == "all"
+
+
+def test_fit_a_subset_holds_the_rest(fixtures, tmp_path, run_imufit):
+    plan, samples = fixtures / "plan_6pos.yaml", fixtures / "mems_6pos_soak.csv.gz"
+    run_imufit("fit", "--plan", plan, "--samples", samples, "-o", tmp_path / "cli.yaml", "-q", "--fit", "gyro-bias,accel")
+    cli = imufit.Calibration.load(tmp_path / "cli.yaml")
+    result = imufit.fit(plan, samples, fit="gyro-bias,accel")
+    cal = result.calibration
+    assert np.all(cal.gyro["scale"][:, 0] == 1) and np.all(cal.gyro["misalignment"] == 0)
+    assert np.all(result.sigma["gyro"]["scale"] == 0)
+    assert_parameters_close({"gyro": cal.gyro, "accel": cal.accel}, {"gyro": cli.gyro, "accel": cli.accel})
+    with pytest.raises(ValueError, match="is not a group to fit"):
+        imufit.fit(plan, samples, fit="magnetometer")
 
 
 def test_simulate_matches_imufit_simulate(fixtures, tmp_path, run_imufit):
