@@ -446,6 +446,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
                            const std::vector<TableSegment>& segments, const FitOptions& options) {
   assert(options.Validate().empty());
   FitSummary summary;
+  summary.gyro_fit = options.gyro_fit;
+  summary.accel_fit = options.accel_fit;
 
   // Truth and temperature basis.
   std::vector<double> temps;
@@ -806,12 +808,14 @@ std::string FitSummary::BriefReport() const {
     case FitStatus::kConverged:
       break;
   }
+  // A sensor held whole was not fitted: its residual says how far the held values are from the run.
+  const char* gyro_note = gyro_fit == SensorFit::kNone ? " (gyro held, not fitted)" : "";
+  const char* accel_note = accel_fit == SensorFit::kNone ? " (accel held, not fitted)" : "";
   std::snprintf(text, sizeof text,
-                "converged in %d iterations; residual RMS gyro %.3g deg/s, accel %.3g mg; %d windows (%d "
-                "down-weighted) "
-                "over %zu temperatures",
-                iterations, gyro_rms_radps * kRadToDeg, accel_rms_mps2 / 9.80665 * 1e3, windows_used,
-                windows_downweighted, distinct_temps_c.size());
+                "converged in %d iterations; residual RMS gyro %.3g deg/s%s, accel %.3g mg%s; %d windows (%d "
+                "down-weighted) over %zu temperatures",
+                iterations, gyro_rms_radps * kRadToDeg, gyro_note, accel_rms_mps2 / 9.80665 * 1e3, accel_note,
+                windows_used, windows_downweighted, distinct_temps_c.size());
   return text;
 }
 

@@ -138,6 +138,10 @@ struct FitSummary {
   double final_cost = -1.0;             // Ceres cost, last pass
   int windows_used = 0;
   int windows_downweighted = 0;
+  // What was fitted per sensor (FitOptions::gyro_fit / accel_fit): the residual RMS of a sensor held
+  // whole measures the held values, not a fit.
+  SensorFit gyro_fit = SensorFit::kAll;
+  SensorFit accel_fit = SensorFit::kAll;
   // What the data do not determine, one readable finding each, with what would determine it.
   std::vector<std::string> undetermined;
   // Why a solved model is refused (kRefused): a scale factor that is negative or changes sign over
