@@ -365,7 +365,9 @@ TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
   const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
   const std::vector<Figure> truth_figures = KeyFigures(truth);
   for (const KeyFigureRow& f : c.figures) {
-    if (f.sigma >= 0.0) EXPECT_EQ(f.expanded, 2.0 * f.sigma) << f.name;
+    if (f.sigma >= 0.0) {
+      EXPECT_EQ(f.expanded, 2.0 * f.sigma) << f.name;
+    }
   }
   const auto figure = [&](const std::string& name) {
     for (const KeyFigureRow& f : c.figures) {

@@ -5,6 +5,7 @@
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
+#include "imufit/model/check.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 #include "imufit/model/temperature_polynomial.h"
@@ -18,6 +19,16 @@ constexpr double kRoundTripRelTol = 1e-12;
 // Central differences: relative step, and the worst-case relative agreement expected.
 constexpr double kFiniteDifferenceStep = 1e-6;
 constexpr double kJacobianRelTol = 1e-6;
+
+// IMUFIT_CHECK is on in every build type (this suite runs in Release): a broken invariant aborts
+// with its location and message instead of running on.
+TEST(CheckDeathTest, AbortsInEveryBuildWithLocationAndMessage) {
+  int evaluated = 0;
+  IMUFIT_CHECK(++evaluated == 1, "evaluated once");
+  EXPECT_EQ(evaluated, 1);
+  EXPECT_DEATH(IMUFIT_CHECK(evaluated == 2, "one Jacobian column per free parameter"),
+               "model_test.cc:[0-9]+: check failed: evaluated == 2 \\(one Jacobian column per free parameter\\)");
+}
 
 TEST(TemperaturePolynomial, RebaseIsExact) {
   const TemperatureBasis fit_basis{12.5, 62.5};

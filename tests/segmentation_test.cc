@@ -382,13 +382,17 @@ TEST(Segmentation, HandSessionWithTurnsThroughKnownAngles) {
     for (size_t i = 0; i < run.samples.size(); ++i) {
       const int label = labeller.Label(run.samples[i].time_s);
       const int truth = run.truth[i];
-      if (truth >= 7) EXPECT_EQ(label, truth) << "turning sample at t = " << run.samples[i].time_s;
+      if (truth >= 7) {
+        EXPECT_EQ(label, truth) << "turning sample at t = " << run.samples[i].time_s;
+      }
       if (truth >= 1 && truth <= 6) {
         ++static_total;
         static_correct += label == truth;
         EXPECT_TRUE(label == truth || label == kTransitionSegment) << "t = " << run.samples[i].time_s;
       }
-      if (label >= 1 && label <= 6) EXPECT_EQ(label, truth) << "t = " << run.samples[i].time_s;
+      if (label >= 1 && label <= 6) {
+        EXPECT_EQ(label, truth) << "t = " << run.samples[i].time_s;
+      }
     }
     EXPECT_GE(static_cast<double>(static_correct) / static_total, kMinLabelledFraction);
     for (const SegmentMatch& match : segmentation.matches) {

@@ -184,14 +184,11 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     const std::string serial_file = UnitSerial(unit_dir);
     outcome.plan_sha256 = Sha256OfFile(plan);
     outcome.samples_sha256 = Sha256OfFile(samples);
-    manifest = {options.fit.software,
-                outcome.plan_sha256,
-                outcome.samples_sha256,
-                shared.limits_sha256,
-                "",
-                "",
-                "",
-                ""};
+    manifest = Manifest{};
+    manifest.software = options.fit.software;
+    manifest.plan_sha256 = outcome.plan_sha256;
+    manifest.samples_sha256 = outcome.samples_sha256;
+    manifest.limits_sha256 = shared.limits_sha256;
 
     // Unchanged since a finished run: take its outcome, redo nothing.
     if (const std::optional<Manifest> previous = ReadManifest(manifest_path);

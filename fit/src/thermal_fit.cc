@@ -1,7 +1,6 @@
 #include "imufit/fit/thermal_fit.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +14,7 @@
 
 #include "coverage.h"
 #include "imufit/fit/window_cost.h"
+#include "imufit/model/check.h"
 
 namespace imufit {
 namespace {
@@ -444,7 +444,8 @@ std::vector<double> DistinctTemperatures(std::vector<double> temps_c, double spa
 
 FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& site,
                            const std::vector<TableSegment>& segments, const FitOptions& options) {
-  assert(options.Validate().empty());
+  const std::string invalid_options = options.Validate();
+  IMUFIT_CHECK(invalid_options.empty(), invalid_options.c_str());
   FitSummary summary;
   summary.gyro_fit = options.gyro_fit;
   summary.accel_fit = options.accel_fit;
@@ -468,15 +469,10 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   for (const Window& w : windows) {
     const auto segment = std::find_if(segments.begin(), segments.end(),
                                       [&](const TableSegment& s) { return s.id == w.segment; });
-    assert(segment != segments.end() && "every window's segment must be in the plan");
+    IMUFIT_CHECK(segment != segments.end(), "every window's segment must be in the plan");
     // A turn's truth is its whole occurrence's mean rate: the window must be that occurrence.
-    if (segment->IsTurn() && !w.whole_occurrence) {
-      // A programmer error (windows built without the plan): always checked, it would bias the fit.
-      std::fprintf(stderr,
-                   "imufit: internal error: a window of turn segment %d is not its whole occurrence\n",
-                   segment->id);
-      std::abort();
-    }
+    // Windows built without the plan would bias the fit.
+    IMUFIT_CHECK(!segment->IsTurn() || w.whole_occurrence, "a window of a turn segment must be its whole occurrence");
     const SegmentTruth truth =
         segment->IsTurn() ? TurnTruth(site, *segment, w.DurationS()) : TruthOf(site, *segment);
     fit_windows.push_back(FitWindow{&w, truth, basis.Argument(w.temp_c), segment->SpecificForceIsKnown()});
@@ -648,7 +644,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     for (int i = 0; i < sensor->parameters; ++i) {
       if (!sensor->IsHeld(i)) free.push_back(i);
     }
-    assert(static_cast<int>(free.size()) == jacobian.cols());
+    IMUFIT_CHECK(static_cast<int>(free.size()) == jacobian.cols(), "one Jacobian column per free parameter");
     sensor->jacobian = jacobian;
     const Eigen::VectorXd column_norm = jacobian.colwise().norm().transpose();
     for (int c = 0; c < jacobian.cols(); ++c) {

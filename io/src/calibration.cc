@@ -1,7 +1,6 @@
 #include "imufit/io/calibration.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -10,6 +9,7 @@
 
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
+#include "imufit/model/check.h"
 #include "imufit/model/rate_table.h"
 #include "yaml_util.h"
 
@@ -171,7 +171,7 @@ Calibration ReadCalibration(const std::string& path) {
 }
 
 std::string CalibrationToYaml(const Calibration& calibration) {
-  assert(calibration.model.basis.half_range_c == 1.0);
+  IMUFIT_CHECK(calibration.model.basis.half_range_c == 1.0, "a calibration is written in powers of dT");
   std::string out;
   out += "format: imufit-calibration\n";
   out += "version: " + std::to_string(kCalibrationFormatVersion) + "\n";

@@ -1,13 +1,13 @@
 #include "imufit/noise/allan.h"
 
 #include <algorithm>
-#include <cassert>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <thread>
 
+#include "imufit/model/check.h"
 #include "imufit/noise/statistics.h"
 
 namespace imufit {
@@ -548,8 +548,7 @@ std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s, 
   std::vector<int64_t> terms;
   for (int64_t m : factors) {
     terms.push_back(EstimatorTerms(estimator, m, n));
-    assert(terms.back() >= 1);
-    if (terms.back() < 1) std::abort();
+    IMUFIT_CHECK(terms.back() >= 1, "every averaging factor leaves at least one term");
   }
   const double* x = phase.data();
   std::vector<long double> sums;
