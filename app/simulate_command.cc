@@ -141,6 +141,13 @@ CommandRunner AddSimulateCommand(CLI::App* root) {
                       "time stamps off their nominal times by up to this much (uniform), s; below half the "
                       "sample interval")
       ->capture_default_str();
+  command
+      ->add_option("--drop-probability", o.drop_probability,
+                   "probability that a sample starts a loss of --drop-burst samples (as a serial link loses "
+                   "frames): the lost samples are not written")
+      ->capture_default_str();
+  command->add_option("--drop-burst", o.drop_burst, "samples lost in a row at each loss")
+      ->capture_default_str();
   command->add_option("--seed", o.seed, "random seed: the same seed gives the same file")->capture_default_str();
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunSimulate(*args); };

@@ -169,6 +169,8 @@ std::string SimulationOptions::Validate() const {
   if (!(time_jitter_s >= 0.0 && time_jitter_s < 0.5 / rate_hz)) {
     return "the time jitter must lie in [0, half the sample interval)";
   }
+  if (!(drop_probability >= 0.0 && drop_probability < 1.0)) return "the drop probability must lie in [0, 1)";
+  if (drop_burst < 1) return "a loss takes at least one sample";
   return "";
 }
 
@@ -213,6 +215,9 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
 
   // A separate generator for the jitter (seeded from the seed), so that jitter moves only the times.
   std::mt19937_64 jitter_engine(options.seed ^ 0x6a09e667f3bcc909ULL);
+  // And one for the losses, so that losing samples changes nothing in the others.
+  std::mt19937_64 drop_engine(options.seed ^ 0xbb67ae8584caa73bULL);
+  int losing = 0;  // samples still to lose in the current loss
   long long k = 0;
   Sample raw;
   for (const Phase& phase : phases) {
@@ -259,6 +264,14 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
       }
       raw.gyro = gyro_m;
       raw.accel = accel_m;
+      if (losing == 0 && options.drop_probability > 0.0 &&
+          static_cast<double>(drop_engine() >> 11) * 0x1.0p-53 < options.drop_probability) {
+        losing = options.drop_burst;
+      }
+      if (losing > 0) {
+        --losing;
+        continue;
+      }
       sink(raw, truth);
     }
   }

@@ -2,14 +2,154 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace imufit {
+
+namespace {
+
+// Acquisition: intervals searched around the median one, and the least resultant (a fraction of
+// the stamps) that is taken for a grid. Uniform jitter of +-0.4 intervals leaves sinc(0.8) = 0.23.
+constexpr double kAcquireSpan = 0.15;        // +- this fraction of the median interval
+constexpr double kAcquireResolution = 0.05;  // cycles of phase drift across the stamps per step
+constexpr double kMinResultant = 0.15;
+
+double Resultant(const std::vector<double>& time_s, double interval_s, double* phase) {
+  double re = 0.0, im = 0.0;
+  for (double t : time_s) {
+    const double angle = 2.0 * M_PI * (t - time_s.front()) / interval_s;
+    re += std::cos(angle);
+    im += std::sin(angle);
+  }
+  if (phase != nullptr) *phase = std::atan2(im, re);
+  return std::hypot(re, im) / static_cast<double>(time_s.size());
+}
+
+}  // namespace
+
+void SampleClock::Update(double slot, double time_s) {
+  // Exponentially weighted Welford update: W = l W + 1, mean += d / W, C = l C + d_k (t - mean_t).
+  constexpr double kDecay = 1.0 - 1.0 / kMemory;
+  weight_ = kDecay * weight_ + 1.0;
+  const double d_slot = slot - mean_slot_;
+  mean_slot_ += d_slot / weight_;
+  mean_time_s_ += (time_s - mean_time_s_) / weight_;
+  slot_variance_ = kDecay * slot_variance_ + d_slot * (slot - mean_slot_);
+  covariance_ = kDecay * covariance_ + d_slot * (time_s - mean_time_s_);
+  slot_ = slot;
+}
+
+void SampleClock::Acquire() {
+  const std::vector<double>& t = acquiring_;
+  std::vector<double> intervals(t.size() - 1);
+  for (size_t i = 1; i < t.size(); ++i) intervals[i - 1] = t[i] - t[i - 1];
+  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
+  const double median_s = intervals[intervals.size() / 2];
+  acquired_ = true;
+  locked_ = false;
+  double best_s = 0.0, best = 0.0;
+  // The grid's slots spanned by the stamps: more than twice as many as stamps would be a grid
+  // that lost most of its samples (the spacing inside a host's bunches, say): none.
+  const double cycles = median_s > 0.0 ? (t.back() - t.front()) / median_s : 0.0;
+  if (cycles > 0.0 && cycles <= 2.0 * static_cast<double>(t.size())) {
+    // A step that drifts the last stamp's phase by kAcquireResolution cycles.
+    const double step_s = median_s * kAcquireResolution / std::max(cycles, 1.0);
+    for (double b = median_s * (1.0 - kAcquireSpan); b <= median_s * (1.0 + kAcquireSpan); b += step_s) {
+      const double r = Resultant(t, b, nullptr);
+      if (r > best) {
+        best = r;
+        best_s = b;
+      }
+    }
+  }
+  if (best >= kMinResultant) {
+    double phase = 0.0;
+    Resultant(t, best_s, &phase);
+    // Slots from the grid, then the line through them; the first stamp's slot is 0.
+    const double start_s = t.front() + best_s * phase / (2.0 * M_PI);
+    const double first = std::round((t.front() - start_s) / best_s);
+    weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0;
+    double previous = -1.0;
+    locked_ = true;
+    for (double time_s : t) {
+      const double slot = std::round((time_s - start_s) / best_s) - first;
+      if (slot <= previous) locked_ = false;  // two stamps in one slot: no grid after all
+      previous = slot;
+      Update(slot, time_s);
+    }
+  }
+  if (!locked_) {  // one slot a stamp, as placed provisionally
+    weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0;
+    for (size_t i = 0; i < t.size(); ++i) Update(static_cast<double>(i), t[i]);
+  }
+  acquiring_.clear();
+  acquiring_.shrink_to_fit();
+}
+
+long long SampleClock::Place(double time_s) {
+  if (!acquired_) {
+    // Provisionally one slot after the last; the line through them for interval_s() meanwhile.
+    if (acquiring_.empty()) weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0;
+    acquiring_.push_back(time_s);
+    Update(static_cast<double>(acquiring_.size() - 1), time_s);
+    on_grid_ = true;
+    if (static_cast<int>(acquiring_.size()) == kAcquire) Acquire();
+    return 1;
+  }
+  const double b = interval_s();
+  // The line's time for a slot, before this stamp moves it.
+  const auto line_s = [&](double k) { return mean_time_s_ + b * (k - mean_slot_); };
+  long long step = 1;
+  if (locked_ && b > 0.0) step = std::max(1LL, 1 + std::llround((time_s - line_s(slot_ + 1.0)) / b));
+  const double slot = slot_ + static_cast<double>(step);
+  on_grid_ = locked_ && b > 0.0 && std::abs(time_s - line_s(slot)) <= kTolerance * b;
+  Update(slot, time_s);
+  off_grid_run_ = on_grid_ ? 0 : off_grid_run_ + 1;
+  // Lost lock (the clock jumped), or none found for a long while: find the grid again.
+  if (off_grid_run_ >= (locked_ ? kRelock : 4 * kAcquire)) {
+    acquired_ = false;
+    off_grid_run_ = 0;
+  }
+  return step;
+}
+
+std::string TimeStampNote(const WindowStats& stats, const WindowOptions& options) {
+  std::string note;
+  const auto add = [&note](const char* format, auto... values) {
+    char line[320];
+    std::snprintf(line, sizeof line, format, values...);
+    note += (note.empty() ? "" : "; ") + std::string(line);
+  };
+  if (!stats.StampsOnGrid()) {
+    add("%lld of %lld time stamps lie off a uniform grid (bunched or irregular): lost samples cannot be told "
+        "from "
+        "jitter%s",
+        stats.off_grid_samples, stats.samples,
+        stats.turns_off_grid > 0 ? ", so in the turns each sample is taken as one interval" : "");
+    return note;
+  }
+  if (stats.lost_samples > 0) {
+    add("%lld sample%s lost in %lld gap%s (longest %.3g s): turns are integrated across them",
+        stats.lost_samples, stats.lost_samples == 1 ? "" : "s", stats.gaps, stats.gaps == 1 ? "" : "s",
+        stats.longest_gap_s);
+  }
+  if (stats.turns_dropped_for_gaps > 0) {
+    add("%d turn%s dropped for a gap longer than %.3g s, which would bias the angle",
+        stats.turns_dropped_for_gaps, stats.turns_dropped_for_gaps == 1 ? "" : "s", options.max_turn_gap_s);
+  }
+  if (stats.turns_off_grid > 0) {
+    add("%d turn%s with a time stamp off the grid: each of its samples taken as one interval",
+        stats.turns_off_grid, stats.turns_off_grid == 1 ? "" : "s");
+  }
+  return note;
+}
 
 std::string WindowOptions::Validate() const {
   if (!(trim_s >= 0.0)) return "the trim time cannot be negative";
   if (!(max_temp_span_c > 0.0)) return "the window temperature span must be positive";
   if (!(max_duration_s >= 0.0)) return "the window duration cannot be negative";
   if (min_samples < 2) return "a window needs at least 2 samples";
+  if (!(max_turn_gap_s >= 0.0)) return "the longest gap allowed in a turn cannot be negative";
   return "";
 }
 
@@ -26,6 +166,18 @@ void WindowBuilder::Add(const Sample& sample) {
   if (stats_.samples == 0) {
     stats_.min_temp_c = stats_.max_temp_c = sample.temp_c;
     stats_.first_time_s = sample.time_s;
+  }
+  // The sample's slot on the run's time grid; empty slots before it are lost samples.
+  slot_ += clock_.Place(sample.time_s);
+  const long long lost = stats_.samples == 0 ? 0 : slot_ - previous_slot_ - 1;
+  const long long slot = slot_;
+  const double gap_s = static_cast<double>(lost) * clock_.interval_s();
+  previous_slot_ = slot;
+  if (!clock_.on_grid()) ++stats_.off_grid_samples;
+  if (lost > 0) {
+    stats_.lost_samples += lost;
+    ++stats_.gaps;
+    stats_.longest_gap_s = std::max(stats_.longest_gap_s, gap_s);
   }
   ++stats_.samples;
   stats_.last_time_s = sample.time_s;
@@ -71,12 +223,20 @@ void WindowBuilder::Add(const Sample& sample) {
     mean_.setZero();
     m2_.setZero();
     second_difference_sum_.setZero();
+    lost_ = 0;
+    longest_gap_s_ = 0.0;
+    off_grid_ = false;
     time_sum_ = 0.0;
     index_time_sum_ = 0.0;
+    turn_slots_.clear();
+    turn_values_.clear();
+  } else if (lost > 0) {  // a gap inside the window
+    lost_ += lost;
+    longest_gap_s_ = std::max(longest_gap_s_, gap_s);
   }
+  off_grid_ = off_grid_ || !clock_.on_grid();
   ++n_;
   end_s_ = sample.time_s;
-  // For the mean sample interval: time against sample index, k = n - 1 (see Close()).
   time_sum_ += sample.time_s - start_s_;
   index_time_sum_ += static_cast<double>(n_ - 1) * (sample.time_s - start_s_);
   const double inv_n = 1.0 / static_cast<double>(n_);
@@ -91,6 +251,50 @@ void WindowBuilder::Add(const Sample& sample) {
   if (n_ >= 3) second_difference_sum_ += (value - 2.0 * previous_[1] + previous_[0]).cwiseAbs2();
   previous_[0] = previous_[1];
   previous_[1] = value;
+  if (whole_occurrence_) {
+    turn_slots_.push_back(slot);
+    turn_values_.push_back(value);
+  }
+}
+
+bool WindowBuilder::CloseTurn(Window* window) {
+  if (off_grid_) {  // one slot a sample (Close()), as if nothing were lost
+    ++stats_.turns_off_grid;
+    return true;
+  }
+  if (window->longest_gap_s > options_.max_turn_gap_s) {
+    ++stats_.turns_dropped_for_gaps;
+    return false;
+  }
+  if (window->lost_samples == 0) return true;  // the running sums hold every slot
+  // The mean over every slot, a lost one counted at the value interpolated linearly between its
+  // neighbours: a gap of g slots adds (g - 1) (x_before + x_after) / 2. Noise from second
+  // differences of three consecutive slots only: across a gap the signal's change would count.
+  Eigen::Matrix<double, 6, 1> slot_sum = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> second_difference_sum = Eigen::Matrix<double, 6, 1>::Zero();
+  long long second_differences = 0;
+  for (size_t i = 0; i < turn_values_.size(); ++i) {
+    slot_sum += turn_values_[i];
+    if (i == 0) continue;
+    const long long step = turn_slots_[i] - turn_slots_[i - 1];
+    slot_sum += static_cast<double>(step - 1) * 0.5 * (turn_values_[i] + turn_values_[i - 1]);
+    if (i >= 2 && step == 1 && turn_slots_[i - 1] - turn_slots_[i - 2] == 1) {
+      second_difference_sum +=
+          (turn_values_[i] - 2.0 * turn_values_[i - 1] + turn_values_[i - 2]).cwiseAbs2();
+      ++second_differences;
+    }
+  }
+  const Eigen::Matrix<double, 6, 1> mean =
+      slot_sum / static_cast<double>(window->samples + window->lost_samples);
+  window->gyro_mean = mean.head<3>();
+  window->accel_mean = mean.tail<3>();
+  if (second_differences > 0) {
+    const Eigen::Matrix<double, 6, 1> noise =
+        (second_difference_sum / (6.0 * static_cast<double>(second_differences))).cwiseSqrt();
+    window->gyro_noise = noise.head<3>();
+    window->accel_noise = noise.tail<3>();
+  }
+  return true;
 }
 
 void WindowBuilder::Close() {
@@ -106,10 +310,19 @@ void WindowBuilder::Close() {
   window.samples = n_;
   window.start_s = start_s_;
   window.end_s = end_s_;
-  // The least-squares slope of time against index: jitter of single time stamps averages out,
+  // The run's grid interval: jitter of single time stamps averages out over the clock's memory,
   // where (end_s - start_s) / (n - 1) would carry the jitter of the two ends whole.
-  const double n = static_cast<double>(n_);
-  window.interval_s = (index_time_sum_ - 0.5 * (n - 1.0) * time_sum_) / (n * (n * n - 1.0) / 12.0);
+  window.interval_s = clock_.interval_s();
+  window.lost_samples = lost_;
+  window.longest_gap_s = longest_gap_s_;
+  if (off_grid_) {
+    // The grid cannot be trusted here: one slot a sample, and the least-squares slope of the
+    // window's stamps against their index.
+    const double n = static_cast<double>(n_);
+    window.interval_s = (index_time_sum_ - 0.5 * (n - 1.0) * time_sum_) / (n * (n * n - 1.0) / 12.0);
+    window.lost_samples = 0;
+    window.longest_gap_s = 0.0;
+  }
   window.temp_c = temp_mean_;
   window.min_temp_c = temp_min_;
   window.max_temp_c = temp_max_;
@@ -125,6 +338,7 @@ void WindowBuilder::Close() {
     window.accel_noise = noise.tail<3>();
   }
   window.whole_occurrence = whole_occurrence_;
+  if (whole_occurrence_ && !CloseTurn(&window)) return;
   windows_.push_back(window);
 }
 

@@ -131,7 +131,8 @@ def simulate(plan: PathLike, truth: Calibration | PathLike, **options: Any) -> d
     start_time_s, gyro_noise_density (rad/s/sqrt(Hz)), accel_noise_density (m/s^2/sqrt(Hz)),
     gyro_random_walk (rad/s^2/sqrt(Hz)), accel_random_walk (m/s^3/sqrt(Hz)),
     gyro_bias_instability (rad/s), accel_bias_instability (m/s^2), bias_correlation_s,
-    time_jitter_s, temp_noise_c, quantize, seed."""
+    time_jitter_s, drop_probability and drop_burst (lost samples: the arrays are then shorter),
+    temp_noise_c, quantize, seed."""
 
 def simulate_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of simulate()."""

@@ -397,6 +397,10 @@ const OptionTable<SimulationOptions>& SimulateOptionTable() {
         .Field<double>("time_jitter_s",
                        "uniform jitter of the time stamps, +- s (less than half the interval)",
                        [](O& o) -> double& { return o.time_jitter_s; })
+        .Field<double>("drop_probability", "probability that a sample starts a loss of drop_burst samples",
+                       [](O& o) -> double& { return o.drop_probability; })
+        .Field<int>("drop_burst", "samples lost in a row at each loss",
+                    [](O& o) -> int& { return o.drop_burst; })
         .Field<double>("temp_noise_c", "white noise of the temperature reading, degC",
                        [](O& o) -> double& { return o.temp_noise_c; })
         .Field<bool>("quantize", "round raw outputs to integer counts",
@@ -430,7 +434,7 @@ py::dict Simulate(const py::object& plan_path, const py::object& truth, const py
     py::gil_scoped_release release;
     SimulateRun(options, plan.site, plan.segments, calibration.model,
                 [&](const Sample& raw, const SegmentTruth& t) {
-                  if (count >= n) return;  // guarded below: SampleCount() is the contract
+                  if (count >= n) return;  // guarded below: SampleCount() is the bound
                   time[count] = raw.time_s;
                   temp[count] = raw.temp_c;
                   seg[count] = raw.segment;
@@ -441,19 +445,21 @@ py::dict Simulate(const py::object& plan_path, const py::object& truth, const py
                   ++count;
                 });
   }
-  if (count != n) {
+  if (count > n || (count < n && options.drop_probability == 0.0)) {
     throw std::logic_error("imufit.simulate: the simulator gave " + std::to_string(count) +
                            " samples, not the " + std::to_string(n) +
                            " SimulationOptions::SampleCount() promised");
   }
+  // Lost samples (drop_probability) leave the arrays' tails unused: views of the samples given.
+  const py::slice given(0, count, 1);
   py::dict samples;
-  samples["time_s"] = time_s;
-  samples["temp_c"] = temp_c;
-  samples["segment"] = segment;
-  samples["gyro"] = gyro;
-  samples["accel"] = accel;
-  samples["omega_true_radps"] = omega_true;
-  samples["a_true_mps2"] = a_true;
+  samples["time_s"] = time_s[given];
+  samples["temp_c"] = temp_c[given];
+  samples["segment"] = segment[given];
+  samples["gyro"] = gyro[given];
+  samples["accel"] = accel[given];
+  samples["omega_true_radps"] = omega_true[given];
+  samples["a_true_mps2"] = a_true[given];
   return samples;
 }
 

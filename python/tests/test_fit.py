@@ -90,6 +90,21 @@ def test_simulate_matches_imufit_simulate(fixtures, tmp_path, run_imufit):
     assert run["a_true_mps2"].tobytes() == cli_truth["accel"].tobytes()
 
 
+def test_simulate_with_lost_samples_matches_imufit_simulate(fixtures, tmp_path, run_imufit):
+    # Lost samples shorten the arrays; the samples kept are those of the run without losses.
+    plan, truth = fixtures / "plan_6pos.yaml", fixtures / "mems_truth.yaml"
+    run_imufit("simulate", "--plan", plan, "--calibration", truth, "-o", tmp_path / "raw.csv",
+               "--drop-probability", 0.01, "--drop-burst", 2, *SOAK_CLI)
+    cli = imufit.read_samples(tmp_path / "raw.csv")
+    run = imufit.simulate(plan, truth, drop_probability=0.01, drop_burst=2, **SOAK)
+    whole = imufit.simulate(plan, truth, **SOAK)
+    assert 0 < len(whole["time_s"]) - len(run["time_s"]) < 0.05 * len(whole["time_s"])
+    for key in ("time_s", "gyro", "accel"):
+        assert run[key].tobytes() == cli[key].tobytes(), key
+    kept = np.isin(whole["time_s"], run["time_s"])
+    assert np.array_equal(whole["gyro"][kept], run["gyro"])
+
+
 def test_fit_of_a_simulated_run_recovers_the_truth(fixtures, tmp_path, run_imufit):
     plan = fixtures / "plan_6pos.yaml"
     truth = imufit.Calibration.load(fixtures / "mems_truth.yaml")

@@ -66,11 +66,16 @@ struct SimulationOptions {
   // [-time_jitter_s, +time_jitter_s] (less than half the sample interval, so times still increase).
   // The deviates come from their own generator: the samples' values are those of the run without jitter.
   double time_jitter_s = 0.0;
+  // Lost samples, as a serial link loses frames: each sample starts a loss of `drop_burst` samples
+  // in a row with probability drop_probability. Lost samples are not written (neither the raw
+  // sample nor its truth); the others keep their values and time stamps, from their own generator.
+  double drop_probability = 0.0;
+  int drop_burst = 1;
   std::uint64_t seed = 1;
 
   // An empty string when the options are usable, else what is wrong.
   std::string Validate() const;
-  // Number of samples the run will have.
+  // Number of samples the run will have (without losses; with drop_probability, at most this many).
   long long SampleCount(size_t segment_count) const;
 };
 

@@ -26,9 +26,10 @@
 // cannot determine the model is refused with a message naming what is missing. After solving,
 // the rank of the column-normalised Jacobian is checked as a backstop.
 //
-// Uncertainty. ceres::Covariance at the solution, scaled per sensor by the measured reduced
-// chi-square, plus (when the unit's bias stability is given) the covariance a bias that wanders
-// between time blocks adds, converted exactly to powers of dT = T - 25 degC.
+// Uncertainty. ceres::Covariance at the solution, inflated per sensor by the measured reduced
+// chi-square when it exceeds 1 (never shrunk: the weights are absolute noise figures), plus (when the unit's
+// bias stability is given) the covariance a bias that wanders between time blocks adds, converted exactly to
+// powers of dT = T - 25 degC.
 #ifndef IMUFIT_FIT_THERMAL_FIT_H_
 #define IMUFIT_FIT_THERMAL_FIT_H_
 
@@ -154,7 +155,7 @@ struct FitSummary {
   // Residual RMS over windows and axes, SI, unweighted.
   double gyro_rms_radps = -1.0;
   double accel_rms_mps2 = -1.0;
-  // Reduced chi-square of the normalised residuals, per sensor (the covariance scale).
+  // Reduced chi-square of the normalised residuals, per sensor (the covariance scale when above 1).
   double gyro_reduced_chi2 = -1.0;
   double accel_reduced_chi2 = -1.0;
   // The fitted model in powers of dT = T - 25 degC, and the 1-sigma of every parameter.
