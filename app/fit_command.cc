@@ -341,6 +341,12 @@ CommandRunner AddFitCommand(CLI::App* root) {
       ->capture_default_str();
   command->add_option("--window-min-samples", w.min_samples, "windows with fewer samples are dropped")
       ->capture_default_str();
+  command
+      ->add_option(
+          "--max-turn-gap", w.max_turn_gap_s,
+          "a turn whose time stamps have a longer gap (lost samples in a row), s, is dropped: integrating "
+          "across it would bias the angle")
+      ->capture_default_str();
   command->add_option("--max-iterations", f.max_iterations, "solver iterations at most, per pass")->capture_default_str();
   command->add_option("--threads", f.num_threads, "solver threads")->capture_default_str();
   command->add_flag("--validate", args->validate,

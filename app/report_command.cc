@@ -82,6 +82,8 @@ CommandRunner AddReportCommand(CLI::App* root) {
                     "certify even when the calibration records other plan/samples hashes than these files' "
                     "(the certificate says so)");
   command->add_option("--trim", args->windows.trim_s, "as imufit fit --trim")->capture_default_str();
+  command->add_option("--max-turn-gap", args->windows.max_turn_gap_s, "as imufit fit --max-turn-gap")
+      ->capture_default_str();
   AddTempOption(command, &args->input);
   AddSegmentationOptions(command, &args->input);
   return [args] { return RunReport(*args); };

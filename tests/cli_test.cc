@@ -1245,6 +1245,73 @@ TEST_F(CliTest, SimulateJitterMustKeepTimesIncreasing) {
 // Done when (issue 9): a hand-rotated session, six faces and a 360 deg turn about each axis, in raw
 // counts, without labels or a thermometer, calibrates end to end through the README's commands, the
 // gyro scale (set by the three turns alone) within its stated sigma.
+TEST_F(CliTest, HandSessionWithLostSamplesKeepsItsGyroScaleAndSaysWhatWasLost) {
+  // A serial link that loses 1 % of the frames, three in a row: the turns are integrated across
+  // the gaps (before, each lost sample took its share of the angle: 0.3 % of scale, 65 sigma).
+  constexpr double kTruthSigmas = 3.5;
+  const std::string plan = Fixture("plan_hand_6faces_3turns.yaml");
+  const std::string raw = Path("lossy.csv");
+  ASSERT_EQ(Run({"simulate",
+                 "--plan",
+                 plan,
+                 "--calibration",
+                 Fixture("mems_truth.yaml"),
+                 "-o",
+                 raw,
+                 "--temps",
+                 "25",
+                 "--rate",
+                 "100",
+                 "--dwell",
+                 "10",
+                 "--transition",
+                 "2",
+                 "--gyro-noise-density",
+                 "8.7e-5",
+                 "--accel-noise-density",
+                 "1.5e-3",
+                 "--quantize",
+                 "--no-segment-column",
+                 "--time-jitter-s",
+                 "0.003",
+                 "--drop-probability",
+                 "0.0033",
+                 "--drop-burst",
+                 "3",
+                 "--seed",
+                 "4",
+                 "-q"})
+                .status,
+            0);
+  const std::string calibration = Path("lossy_cal.yaml");
+  const RunResult fit = Run({"fit", "--plan", plan, "--samples", raw, "--gyro-temp-order", "0",
+                             "--accel-temp-order", "0", "-o", calibration});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  // 33 losses of 3 were simulated; the one among the first 256 stamps (while the time grid is
+  // acquired) goes uncounted.
+  EXPECT_NE(fit.out.find(
+                "time stamps: 96 samples lost in 32 gaps (longest 0.03 s): turns are integrated across them"),
+            std::string::npos)
+      << fit.out;
+  const YAML::Node got = YAML::LoadFile(calibration);
+  const YAML::Node want = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  for (const char* axis : {"x", "y", "z"}) {
+    const double estimate = got["gyro"]["scale"][axis][0].as<double>();
+    const double sigma = got["sigma"]["gyro"]["scale"][axis][0].as<double>();
+    const double true_value = want["gyro"]["scale"][axis][0].as<double>();
+    EXPECT_LE(std::abs(estimate - true_value), kTruthSigmas * sigma)
+        << axis << ": " << estimate << " vs " << true_value << " +- " << sigma;
+  }
+  // A gap longer than --max-turn-gap drops its turn; without the turns nothing sets the gyro scale.
+  const RunResult strict =
+      Run({"fit", "--plan", plan, "--samples", raw, "--gyro-temp-order", "0", "--accel-temp-order", "0",
+           "--max-turn-gap", "0.015", "-o", Path("strict.yaml")});
+  EXPECT_EQ(strict.status, 1) << strict.err;
+  EXPECT_NE(strict.err.find("turns dropped for a gap longer than 0.015 s"), std::string::npos) << strict.err;
+  EXPECT_NE(strict.err.find("gyro scale"), std::string::npos) << strict.err;
+  EXPECT_FALSE(std::filesystem::exists(Path("strict.yaml")));
+}
+
 TEST_F(CliTest, HandSessionWithoutLabelsOrTemperatureCalibratesEndToEnd) {
   // Within this many of its reported sigmas (worst case over the 25 degC coefficients).
   constexpr double kTruthSigmas = 3.5;

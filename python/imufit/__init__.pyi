@@ -115,7 +115,7 @@ def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: 
     "cauchy"), loss_scale, gyro_bias_stability_radps, accel_bias_stability_mps2,
     bias_correlation_s, max_iterations, closed_form_start, threads, distinct_temp_c,
     min_excitation_rate_radps, rank_tolerance, trim_s, window_temp_span_c, window_max_duration_s,
-    window_min_samples, temp_c (degC for a run without a temp_c column), segment_window_s,
+    window_min_samples, max_turn_gap_s, temp_c (degC for a run without a temp_c column), segment_window_s,
     segment_noise_quantile, segment_threshold_factor, min_steady_s, direction_tolerance_deg,
     rate_tolerance (finding the segments of a run without a segment column), validate,
     check_samples, check_plan.

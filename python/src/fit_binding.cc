@@ -100,10 +100,12 @@ const OptionTable<FitRunOptions>& FitOptionTable() {
             },
             [](const O& o) { return py::cast(RobustLossName(o.fit.loss)); })
         .Custom(
-            "fit", "what to fit, comma-separated: 'all', 'gyro', 'gyro-bias', 'accel', 'accel-bias' (the rest held)",
+            "fit",
+            "what to fit, comma-separated: 'all', 'gyro', 'gyro-bias', 'accel', 'accel-bias' (the rest held)",
             [](const py::handle& value, O* o) {
               std::string error;
-              if (!ParseFitGroups(value.cast<std::string>(), &o->fit, &error)) ThrowBadArgument("imufit.fit", error);
+              if (!ParseFitGroups(value.cast<std::string>(), &o->fit, &error))
+                ThrowBadArgument("imufit.fit", error);
             },
             [](const O& o) {
               const auto name = [](SensorFit fit, const char* sensor) -> std::string {
@@ -142,6 +144,9 @@ const OptionTable<FitRunOptions>& FitOptionTable() {
                        [](O& o) -> double& { return o.windows.max_duration_s; })
         .Field<int>("window_min_samples", "windows with fewer samples are dropped",
                     [](O& o) -> int& { return o.windows.min_samples; })
+        .Field<double>("max_turn_gap_s",
+                       "a turn with a longer gap in its time stamps (lost samples), s, is dropped",
+                       [](O& o) -> double& { return o.windows.max_turn_gap_s; })
         .Custom(
             "temp_c",
             "the temperature of every sample, degC, for samples without a temp_c column (None: read it)",
