@@ -1375,5 +1375,109 @@ TEST_F(CliTest, HandRotatedCubeCalibratesAndASignFlipIsRefused) {
   EXPECT_FALSE(fs::exists(Path("out.csv")));
 }
 
+// ------------------------------------------------------------------------------------------ serials
+
+// The serial a file names in a certificate, as the page shows it (data-key="serial").
+std::string CertificateSerial(const std::string& html) {
+  const std::string key = "data-key=\"serial\">";
+  const size_t at = html.find(key);
+  if (at == std::string::npos) return "<no serial element>";
+  const size_t start = at + key.size();
+  return html.substr(start, html.find('<', start) - start);
+}
+
+// issue 10 item 1: simulate --serial writes the serial into the samples' header, where fit, report
+// and batch find it (after --serial and serial.txt, before the plan's); a certificate without a
+// serial says so on stderr as well as on the page.
+TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatch) {
+  const std::string plan = Fixture("plan_6pos.yaml");  // no serial of its own
+  const auto simulate = [&](const std::string& out, const std::vector<std::string>& extra) {
+    // A small run (10 Hz, 3 s dwells, four soaks): enough for a fit, quick to make.
+    std::vector<std::string> args = {"simulate",
+                                     "--plan=" + plan,
+                                     "--calibration=" + Fixture("mems_truth.yaml"),
+                                     "--output=" + out,
+                                     "--rate=10",
+                                     "--dwell=3",
+                                     "--temps=-20,5,30,60",
+                                     "--gyro-noise-density=2e-4",
+                                     "--accel-noise-density=2e-3",
+                                     "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+  };
+  fs::create_directories(work_ / "lot" / "u1");
+  fs::create_directories(work_ / "lot" / "u2");
+  const std::string named = Path("lot/u1/samples.csv");
+  simulate(named, {"--serial", "SN-77", "--truth", Path("truth.csv"), "--seed", "1"});
+  EXPECT_NE(ReadFile(named).find("\n# serial: SN-77\ntime_s,"), std::string::npos);
+  EXPECT_NE(ReadFile(Path("truth.csv")).find("\n# serial: SN-77\ntime_s,"), std::string::npos);
+
+  RunResult r =
+      Run({"fit", "-p", plan, "-s", named, "-o", Path("cal.yaml"), "--report", Path("cal.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(YAML::LoadFile(Path("cal.yaml"))["serial"].as<std::string>(), "SN-77");
+  EXPECT_EQ(CertificateSerial(ReadBytes(Path("cal.html"))), "SN-77");
+  r = Run({"fit", "-p", plan, "-s", named, "-o", Path("cal_override.yaml"), "--serial", "SN-OTHER", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(YAML::LoadFile(Path("cal_override.yaml"))["serial"].as<std::string>(), "SN-OTHER");
+
+  // A calibration without a serial: report takes the samples' serial; without one anywhere the
+  // certificate says "(no serial)" under a warning, and stderr says so too (report and fit --report).
+  YAML::Node unnamed = YAML::LoadFile(Path("cal.yaml"));
+  unnamed["serial"] = "";
+  YAML::Emitter emitter;
+  emitter << unnamed;
+  const std::string unnamed_cal = Write("unnamed.yaml", emitter.c_str());
+  r = Run({"report", "-c", unnamed_cal, "-p", plan, "-s", named, "-o", Path("report.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("no serial"), std::string::npos) << r.err;
+  EXPECT_EQ(CertificateSerial(ReadBytes(Path("report.html"))), "SN-77");
+  const std::string anonymous = Path("anonymous.csv");
+  simulate(anonymous, {"--seed", "2"});
+  r = Run({"fit", "-p", plan, "-s", anonymous, "-o", Path("anonymous.yaml"), "--report",
+           Path("anonymous.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("anonymous.csv: no serial (give --serial"), std::string::npos) << r.err;
+  std::string html = ReadBytes(Path("anonymous.html"));
+  EXPECT_EQ(CertificateSerial(html), "(no serial)");
+  EXPECT_NE(html.find("data-warning=\"no serial"), std::string::npos);
+  r = Run(
+      {"report", "-c", Path("anonymous.yaml"), "-p", plan, "-s", anonymous, "-o", Path("anonymous2.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("anonymous.yaml: no serial (give --serial"), std::string::npos) << r.err;
+  html = ReadBytes(Path("anonymous2.html"));
+  EXPECT_EQ(CertificateSerial(html), "(no serial)");
+  EXPECT_NE(html.find("data-warning=\"no serial"), std::string::npos);
+
+  // batch: u1 by its samples' header; u2's serial.txt wins over its header.
+  simulate(Path("lot/u2/samples.csv"), {"--serial", "SN-HEADER", "--seed", "3"});
+  Write("lot/u2/serial.txt", "SN-FILE\n");
+  r = Run({"batch", Path("lot"), "--plan", plan, "-o", Path("out"), "--no-report", "--jobs", "1"});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const Table summary = ReadTable(Path("out/lot_summary.csv"));
+  ASSERT_EQ(summary.rows.size(), 2u);
+  EXPECT_EQ(summary.rows[0][summary.Column("serial")], "SN-77");
+  EXPECT_EQ(summary.rows[1][summary.Column("serial")], "SN-FILE");
+  EXPECT_EQ(YAML::LoadFile(Path("out/u1/calibration.yaml"))["serial"].as<std::string>(), "SN-77");
+
+  // Bad serials: exit 2 at their place, nothing written.
+  r = Run(
+      {"simulate", "-p", plan, "-c", Fixture("mems_truth.yaml"), "-o", Path("bad.csv"), "--serial", "SN\n1"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--serial: the serial \"SN\\x0a1\" holds a control character"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("bad.csv")));
+  std::string two = ReadFile(named);
+  two.insert(two.find("time_s,"), "#   serial: SN-78\n");
+  r = Run({"fit", "-p", plan, "-s", Write("two.csv", two), "-o", Path("two.yaml")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("two.csv:3:13: a second serial \"SN-78\" after \"SN-77\""), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("two.yaml")));
+}
+
 }  // namespace
 }  // namespace imufit

@@ -1,7 +1,10 @@
 #include "imufit/io/samples.h"
 
+#include <algorithm>
 #include <sstream>
+#include <string_view>
 
+#include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
 
 namespace imufit {
@@ -9,6 +12,7 @@ namespace {
 
 constexpr const char* kGyroNames[3] = {"gyro_x", "gyro_y", "gyro_z"};
 constexpr const char* kAccelNames[3] = {"accel_x", "accel_y", "accel_z"};
+constexpr std::string_view kSerialKey = "serial:";
 
 }  // namespace
 
@@ -69,6 +73,36 @@ void SamplesReader::Fail(const std::string& column, const std::string& message) 
   const std::optional<int> index = csv_.FindColumn(column);
   if (!index) csv_.FailRow(message);
   csv_.Fail(*index, message);
+}
+
+std::string ReadSamplesSerial(const std::string& path) {
+  const CsvReader csv(path);
+  std::string serial;
+  for (const CsvReader::Comment& comment : csv.header_comments()) {
+    if (comment.text.compare(0, kSerialKey.size(), kSerialKey) != 0) continue;
+    const size_t first = comment.text.find_first_not_of(" \t", kSerialKey.size());
+    const long column = comment.column + static_cast<long>(std::min(first, comment.text.size()));
+    if (first == std::string::npos) throw InputError(path, comment.line, column, "an empty serial");
+    const std::string found = comment.text.substr(first);
+    if (!serial.empty() && found != serial) {
+      // Two units in one file, or a header pasted onto another unit's log: certify neither.
+      throw InputError(path, comment.line, column,
+                       "a second serial " + QuoteForMessage(found) + " after " + QuoteForMessage(serial));
+    }
+    serial = found;
+  }
+  return serial;
+}
+
+std::string SerialComment(const std::string& serial, const std::string& source) {
+  if (serial.empty()) throw InputError(source, "the serial is empty");
+  for (const char c : serial) {
+    // A newline would end the comment line; other control characters have no place in a serial.
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      throw InputError(source, "the serial " + QuoteForMessage(serial) + " holds a control character");
+    }
+  }
+  return std::string(kSerialKey) + " " + serial;
 }
 
 SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment)

@@ -50,6 +50,16 @@ class SamplesReader {
   double last_time_s_ = 0.0;
 };
 
+// The unit's serial as a samples file's header states it: a comment line `# serial: SN0001`
+// before the column names (what `imufit simulate --serial` writes, and a logger can). Returns the
+// text after "serial:", trimmed, or "" when no such line exists. Reads the file only up to its
+// header. Throws InputError for an unreadable file, an empty serial, or two different serials.
+std::string ReadSamplesSerial(const std::string& path);
+
+// The comment text (without the '#') that states `serial` in a samples header, for SamplesWriter.
+// Throws InputError (naming `source`) when the serial is empty or holds a control character.
+std::string SerialComment(const std::string& serial, const std::string& source);
+
 // The optional columns a SamplesWriter writes.
 struct SampleColumns {
   bool segment = true;
