@@ -1477,6 +1477,14 @@ TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatc
   EXPECT_NE(r.err.find("two.csv:3:13: a second serial \"SN-78\" after \"SN-77\""), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(Path("two.yaml")));
+  std::string bell = ReadFile(named);
+  bell.replace(bell.find("SN-77"), 5, "SN\a77");
+  r = Run({"apply", "-c", Path("cal.yaml"), "-s", Write("bell.csv", bell), "-o", Path("bell_out.csv")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bell.csv:2:11: the serial \"SN\\x0777\" holds a control character"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("bell_out.csv")));
 }
 
 // ------------------------------------------------------------------------------------------ allan

@@ -38,7 +38,7 @@ CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* 
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
                                      const std::string& output_path, std::optional<double> temp_c) {
   SamplesReader reader(samples_path, /*require_segment=*/false, temp_c);
-  SamplesWriter writer(output_path, reader.has_segment());
+  SamplesWriter writer(output_path, reader.has_segment(), SerialComment(reader.serial(), samples_path));
   const CorrectFileReport report =
       CorrectSamples(calibration, &reader, [&writer](const Sample& corrected) { writer.Write(corrected); });
   writer.Commit();

@@ -31,6 +31,8 @@ class SamplesReader {
   bool Next(Sample* sample);
 
   bool has_segment() const { return segment_column_ >= 0; }
+  // The unit's serial from the header's `# serial:` line (ReadSamplesSerial), or "".
+  const std::string& serial() const { return serial_; }
   bool has_temp() const { return temp_column_ >= 0; }
   // Throws an InputError located at the current row and the column called `column`.
   [[noreturn]] void Fail(const std::string& column, const std::string& message) const;
@@ -44,6 +46,7 @@ class SamplesReader {
   int temp_column_ = -1;
   double fixed_temp_c_ = 0.0;  // without a temp_c column
   int segment_column_ = -1;
+  std::string serial_;
   int gyro_columns_[3];
   int accel_columns_[3];
   bool first_ = true;
@@ -56,8 +59,9 @@ class SamplesReader {
 // header. Throws InputError for an unreadable file, an empty serial, or two different serials.
 std::string ReadSamplesSerial(const std::string& path);
 
-// The comment text (without the '#') that states `serial` in a samples header, for SamplesWriter.
-// Throws InputError (naming `source`) when the serial is empty or holds a control character.
+// The comment text (without the '#') that states `serial` in a samples header, for SamplesWriter;
+// "" for an empty serial (no line). Throws InputError (naming `source`) when the serial holds a
+// control character. Commands that write samples from samples (apply, segment) carry it over.
 std::string SerialComment(const std::string& serial, const std::string& source);
 
 // The optional columns a SamplesWriter writes.
