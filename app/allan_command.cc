@@ -9,6 +9,8 @@
 
 #include "commands.h"
 #include "imufit/factory/allan_plot.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/correct_file.h"
 #include "imufit/io/error.h"
 #include "imufit/io/noise_file.h"
 #include "imufit/io/output_file.h"
@@ -33,6 +35,8 @@ struct AllanArguments {
   std::string plot_units = "si";
   std::string time_unit = "s";
   double scale = 1.0;
+  std::string calibration;      // correct the raw samples through it first (as imufit apply does)
+  SamplesInputArguments input;  // --temp-c, for a raw log without temp_c
   double confidence = 0.683;
   double time_tolerance = 0.1;
   double min_clusters = 8.0;
@@ -80,10 +84,20 @@ void PlausibilityWarnings(const AllanArguments& args, const UniformSeries& serie
     const bool gyro = r.kind == ColumnKind::kGyro && mean > kImplausibleGyroMeanRadps;
     const bool accel = r.kind == ColumnKind::kAccel && mean > kImplausibleAccelMeanMps2;
     if (!gyro && !accel) continue;
+    if (!args.calibration.empty()) {
+      // Corrected and still implausible: the calibration is not this unit's (or not for raw counts).
+      std::fprintf(
+          stderr,
+          "imufit: warning: %s: %s has a mean of %s %s after correction with %s, implausible for a %s "
+          "at rest: is it this unit's calibration, and are the columns what it was fitted to?\n",
+          args.samples.c_str(), r.name.c_str(), Number(r.curve.mean).c_str(), SiUnit(r.kind),
+          args.calibration.c_str(), gyro ? "gyro" : "accelerometer");
+      continue;
+    }
     std::fprintf(stderr,
                  "imufit: warning: %s: %s has a mean of %s %s, implausible for a %s at rest in SI units: are "
-                 "these raw counts (or deg/s, g)? Correct the file with imufit apply, or give --scale (raw "
-                 "per %s)\n",
+                 "these raw counts (or deg/s, g)? Give the unit's calibration (--calibration CAL.yaml), or "
+                 "--scale (raw per %s)\n",
                  args.samples.c_str(), r.name.c_str(), Number(r.curve.mean).c_str(), SiUnit(r.kind),
                  gyro ? "gyro" : "accelerometer", SiUnit(r.kind));
   }
@@ -175,7 +189,7 @@ int RunAllan(const AllanArguments& args) {
   if (!args.noise_yaml.empty()) outputs.push_back(args.noise_yaml);
   if (!args.plot.empty()) outputs.push_back(args.plot);
   for (size_t i = 0; i < outputs.size(); ++i) {
-    RefuseToOverwriteInputs(outputs[i], {args.samples});
+    RefuseToOverwriteInputs(outputs[i], {args.samples, args.calibration});
     for (size_t j = 0; j < i; ++j) {
       if (outputs[i] == outputs[j]) throw InputError(outputs[i], "named for two outputs");
     }
@@ -200,7 +214,17 @@ int RunAllan(const AllanArguments& args) {
   UniformSeriesOptions series_options;
   series_options.time_tolerance = args.time_tolerance;
   series_options.bridge_gaps = args.gaps == "bridge";
-  UniformSeries series = ReadUniformSeries(args.samples, args.columns, series_options);
+  UniformSeries series;
+  if (args.calibration.empty()) {
+    series = ReadUniformSeries(args.samples, args.columns, series_options);
+  } else {
+    // The samples imufit apply would write, without the file: a raw log analysed directly.
+    const Calibration calibration = ReadCalibration(args.calibration);
+    CorrectFileReport correction;
+    series = ReadCorrectedSeries(args.samples, calibration, args.input.Get().temp_c, args.columns,
+                                 series_options, &correction);
+    WarnOutsideFitTempRange(calibration, correction);
+  }
   series.sample_interval_s *= seconds_per_unit;
   series.start_time_s *= seconds_per_unit;
   series.end_time_s *= seconds_per_unit;
@@ -251,7 +275,9 @@ CommandRunner AddAllanCommand(CLI::App* root) {
       "allan",
       "Allan deviation of columns of a samples file, with confidence intervals, the IEEE 952 noise terms "
       "(quantization, random walk, bias instability, rate random walk, ramp) and Kalibr noise densities. "
-      "Columns are rates in SI units (a corrected file: gyro rad/s, accel m/s^2). Writes "
+      "Columns are rates in SI units (a corrected file: gyro rad/s, accel m/s^2), or raw counts corrected on "
+      "the "
+      "way in with --calibration. Writes "
       "column,estimator,tau_s,terms,dev,dev_lo,dev_hi.");
   command->add_option("--samples,-s", args->samples, "samples CSV (or .csv.gz) with time_s and the columns")
       ->required();
@@ -289,10 +315,19 @@ CommandRunner AddAllanCommand(CLI::App* root) {
                       "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
   command->add_option("--plot-units", args->plot_units, "si (default) or dph: gyro panels in deg/h");
   command->add_option("--time-unit", args->time_unit, "unit of the time_s column: s (default), ms, us or ns");
-  command->add_option(
+  CLI::Option* scale = command->add_option(
       "--scale", args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "
       "columns are raw counts (default 1)");
+  CLI::Option* calibration =
+      command
+          ->add_option(
+              "--calibration", args->calibration,
+              "the unit's calibration YAML: correct the raw samples through it first, as imufit apply "
+              "does (then the columns are among gyro_*, accel_* and temp_c)")
+          ->excludes(scale);
+  AddTempOption(command, &args->input);
+  args->input.temp_c_option->needs(calibration);  // a temperature only matters to the correction
   command->add_option("--threads", args->threads, "worker threads (default 0: all cores)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
   return [args] { return RunAllan(*args); };

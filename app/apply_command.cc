@@ -22,15 +22,7 @@ int RunApply(const ApplyArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
   const Calibration calibration = ReadCalibration(args.calibration);
   const CorrectFileReport report = CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().temp_c);
-  if (report.outside_temp_range > 0) {
-    std::fprintf(stderr,
-                 "imufit: warning: %lld of %lld samples (%.1f %%) lie outside the calibration's fit "
-                 "temperature range [%g, %g] degC (the run spans [%g, %g] degC): their correction is "
-                 "an extrapolation\n",
-                 report.outside_temp_range, report.samples, 100.0 * report.outside_temp_range / report.samples,
-                 calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1], report.min_temp_c,
-                 report.max_temp_c);
-  }
+  WarnOutsideFitTempRange(calibration, report);
   if (!args.quiet) {
     std::printf("corrected %lld samples -> %s\n", report.samples, args.output.c_str());
   }
@@ -38,6 +30,17 @@ int RunApply(const ApplyArguments& args) {
 }
 
 }  // namespace
+
+void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report) {
+  if (report.outside_temp_range == 0) return;
+  std::fprintf(stderr,
+               "imufit: warning: %lld of %lld samples (%.1f %%) lie outside the calibration's fit "
+               "temperature range [%g, %g] degC (the run spans [%g, %g] degC): their correction is "
+               "an extrapolation\n",
+               report.outside_temp_range, report.samples, 100.0 * report.outside_temp_range / report.samples,
+               calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1], report.min_temp_c,
+               report.max_temp_c);
+}
 
 CommandRunner AddApplyCommand(CLI::App* root) {
   auto args = std::make_shared<ApplyArguments>();

@@ -42,6 +42,17 @@ void AddTempOption(CLI::App* command, SamplesInputArguments* args);
 // --segment-window, --min-steady, --direction-tolerance, --rate-tolerance.
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
 
+struct Calibration;
+struct CorrectFileReport;
+// Warns once, with a count, when corrected samples lay outside the calibration's fit temperature
+// range (an extrapolation): apply_command.cc; apply and allan --calibration share it.
+void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report);
+
+struct Certificate;
+// A certificate that names no unit says "(no serial)" (under a warning on the page); this says so
+// on stderr too, naming `file` (report_command.cc; fit --report and report share it).
+void WarnIfNoSerial(const Certificate& certificate, const std::string& file);
+
 // Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).
 inline constexpr int kExitFailedLimits = 3;

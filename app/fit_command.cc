@@ -36,7 +36,7 @@ struct FitArguments {
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
   std::string report;  // certificate HTML to write
   std::string store;   // results store to record the fit in
-  std::string serial;  // the unit's serial; empty: the plan's
+  std::string serial;  // the unit's serial; empty: the samples header's, else the plan's
   double gyro_bias_stability_dph = 0.0;
   double accel_bias_stability_ug = 0.0;
   FitOptions fit;
@@ -133,6 +133,7 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
                       {"samples", args.samples, samples_sha256},
                       {"limits", args.limits, ""}};
     certificate = MakeCertificate(sources);
+    WarnIfNoSerial(*certificate, args.samples);
   }
   std::optional<Verdict> verdict;
   if (limits) {
@@ -356,7 +357,9 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   command->add_option("--limits,-l", args->limits,
                       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
-  command->add_option("--serial", args->serial, "the unit's serial (default: the plan's serial)");
+  command->add_option(
+      "--serial", args->serial,
+      "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial)");
   command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
   command->add_option("--store", args->store, "record the fit in this results store (SQLite; created when missing)");
   return [args] { return RunFit(*args); };

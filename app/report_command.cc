@@ -9,6 +9,7 @@
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
+#include "imufit/io/samples.h"
 
 namespace imufit {
 namespace {
@@ -32,6 +33,8 @@ int RunReport(const ReportArguments& args) {
   CertificateSources sources;
   sources.calibration = ReadCalibration(args.calibration);
   if (!args.serial.empty()) sources.calibration.serial = args.serial;
+  // A calibration fitted without a serial: the unit's own log may still name it.
+  if (sources.calibration.serial.empty()) sources.calibration.serial = ReadSamplesSerial(args.samples);
   if (!args.limits.empty()) sources.limits = ReadLimits(args.limits);
   // A certificate of a calibration for another run's data would certify nothing.
   const std::vector<std::string> mismatches = InputMismatches(sources.calibration, args.plan, args.samples);
@@ -51,11 +54,7 @@ int RunReport(const ReportArguments& args) {
                     {"samples", args.samples, ""},
                     {"limits", args.limits, ""}};
   const Certificate certificate = MakeCertificate(sources);
-  if (certificate.serial.empty()) {
-    std::fprintf(stderr,
-                 "imufit: warning: %s: no serial (give --serial): the certificate says \"(no serial)\"\n",
-                 args.calibration.c_str());
-  }
+  WarnIfNoSerial(certificate, args.calibration);
   WriteCertificate(args.output, certificate);
   const std::optional<Verdict>& verdict = certificate.verdict;
   std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
@@ -64,6 +63,14 @@ int RunReport(const ReportArguments& args) {
 }
 
 }  // namespace
+
+void WarnIfNoSerial(const Certificate& certificate, const std::string& file) {
+  if (!certificate.serial.empty()) return;
+  std::fprintf(stderr,
+               "imufit: warning: %s: no serial (give --serial, or a '# serial:' line in the samples header): "
+               "the certificate says \"(no serial)\"\n",
+               file.c_str());
+}
 
 CommandRunner AddReportCommand(CLI::App* root) {
   auto args = std::make_shared<ReportArguments>();
@@ -77,7 +84,8 @@ CommandRunner AddReportCommand(CLI::App* root) {
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz) of the run")->required();
   command->add_option("--limits,-l", args->limits, "acceptance limits YAML");
   command->add_option("--output,-o", args->output, "HTML file to write")->required();
-  command->add_option("--serial", args->serial, "the unit's serial (default: the calibration's)");
+  command->add_option("--serial", args->serial,
+                      "the unit's serial (default: the calibration's, else the samples header's)");
   command->add_flag("--allow-mismatch", args->allow_mismatch,
                     "certify even when the calibration records other plan/samples hashes than these files' "
                     "(the certificate says so)");

@@ -23,6 +23,7 @@ struct SimulateArguments {
   std::string truth_output;
   std::vector<double> soak_temps_c;
   std::vector<double> ramp_c;
+  std::string serial;  // written into both files' header comments (empty: none)
   bool quiet = false;
   bool no_segment_column = false;  // an unlabelled log (the truth file keeps the labels)
   bool no_temp_column = false;     // a log without a thermometer
@@ -56,14 +57,17 @@ int RunSimulate(SimulateArguments args) {
   const Plan plan = ReadPlan(args.plan);
   const Calibration truth = ReadCalibration(args.calibration);
 
+  // The serial as a unit's logger states it, so that fit, report and batch find it (samples.h).
+  const std::string serial_line = args.serial.empty() ? "" : "\n" + SerialComment(args.serial, "--serial");
   std::ostringstream comment;
   comment << "simulated by " << SoftwareVersion() << " from plan " << args.plan << " and calibration "
-          << args.calibration << ", seed " << options.seed;
+          << args.calibration << ", seed " << options.seed << serial_line;
   SamplesWriter samples(args.output, SampleColumns{!args.no_segment_column, !args.no_temp_column}, comment.str());
   std::optional<SamplesWriter> truth_samples;
   if (!args.truth_output.empty()) {
-    truth_samples.emplace(args.truth_output, true,
-                          "true angular rate (rad/s) and specific force (m/s^2) of " + args.output);
+    truth_samples.emplace(
+        args.truth_output, true,
+        "true angular rate (rad/s) and specific force (m/s^2) of " + args.output + serial_line);
   }
   long long count = 0;
   SimulateRun(options, plan.site, plan.segments, truth.model, [&](const Sample& raw, const SegmentTruth& truth_of) {
@@ -148,6 +152,9 @@ CommandRunner AddSimulateCommand(CLI::App* root) {
       ->capture_default_str();
   command->add_option("--drop-burst", o.drop_burst, "samples lost in a row at each loss")
       ->capture_default_str();
+  command->add_option("--serial", args->serial,
+                      "the unit's serial, written into the header of the samples (and --truth) as "
+                      "'# serial: SERIAL', where fit, report and batch find it");
   command->add_option("--seed", o.seed, "random seed: the same seed gives the same file")->capture_default_str();
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunSimulate(*args); };

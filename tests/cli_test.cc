@@ -1442,5 +1442,223 @@ TEST_F(CliTest, HandRotatedCubeCalibratesAndASignFlipIsRefused) {
   EXPECT_FALSE(fs::exists(Path("out.csv")));
 }
 
+// ------------------------------------------------------------------------------------------ serials
+
+// The serial a file names in a certificate, as the page shows it (data-key="serial").
+std::string CertificateSerial(const std::string& html) {
+  const std::string key = "data-key=\"serial\">";
+  const size_t at = html.find(key);
+  if (at == std::string::npos) return "<no serial element>";
+  const size_t start = at + key.size();
+  return html.substr(start, html.find('<', start) - start);
+}
+
+// issue 10 item 1: simulate --serial writes the serial into the samples' header, where fit, report
+// and batch find it (after --serial and serial.txt, before the plan's); a certificate without a
+// serial says so on stderr as well as on the page.
+TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatch) {
+  const std::string plan = Fixture("plan_6pos.yaml");  // no serial of its own
+  const auto simulate = [&](const std::string& out, const std::vector<std::string>& extra) {
+    // A small run (10 Hz, 3 s dwells, four soaks): enough for a fit, quick to make.
+    std::vector<std::string> args = {"simulate",
+                                     "--plan=" + plan,
+                                     "--calibration=" + Fixture("mems_truth.yaml"),
+                                     "--output=" + out,
+                                     "--rate=10",
+                                     "--dwell=3",
+                                     "--temps=-20,5,30,60",
+                                     "--gyro-noise-density=2e-4",
+                                     "--accel-noise-density=2e-3",
+                                     "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+  };
+  fs::create_directories(work_ / "lot" / "u1");
+  fs::create_directories(work_ / "lot" / "u2");
+  const std::string named = Path("lot/u1/samples.csv");
+  simulate(named, {"--serial", "SN-77", "--truth", Path("truth.csv"), "--seed", "1"});
+  EXPECT_NE(ReadFile(named).find("\n# serial: SN-77\ntime_s,"), std::string::npos);
+  EXPECT_NE(ReadFile(Path("truth.csv")).find("\n# serial: SN-77\ntime_s,"), std::string::npos);
+
+  RunResult r =
+      Run({"fit", "-p", plan, "-s", named, "-o", Path("cal.yaml"), "--report", Path("cal.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(YAML::LoadFile(Path("cal.yaml"))["serial"].as<std::string>(), "SN-77");
+  EXPECT_EQ(CertificateSerial(ReadBytes(Path("cal.html"))), "SN-77");
+  r = Run({"fit", "-p", plan, "-s", named, "-o", Path("cal_override.yaml"), "--serial", "SN-OTHER", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(YAML::LoadFile(Path("cal_override.yaml"))["serial"].as<std::string>(), "SN-OTHER");
+
+  // A calibration without a serial: report takes the samples' serial; without one anywhere the
+  // certificate says "(no serial)" under a warning, and stderr says so too (report and fit --report).
+  YAML::Node unnamed = YAML::LoadFile(Path("cal.yaml"));
+  unnamed["serial"] = "";
+  YAML::Emitter emitter;
+  emitter << unnamed;
+  const std::string unnamed_cal = Write("unnamed.yaml", emitter.c_str());
+  r = Run({"report", "-c", unnamed_cal, "-p", plan, "-s", named, "-o", Path("report.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("no serial"), std::string::npos) << r.err;
+  EXPECT_EQ(CertificateSerial(ReadBytes(Path("report.html"))), "SN-77");
+  const std::string anonymous = Path("anonymous.csv");
+  simulate(anonymous, {"--seed", "2"});
+  r = Run({"fit", "-p", plan, "-s", anonymous, "-o", Path("anonymous.yaml"), "--report",
+           Path("anonymous.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("anonymous.csv: no serial (give --serial"), std::string::npos) << r.err;
+  std::string html = ReadBytes(Path("anonymous.html"));
+  EXPECT_EQ(CertificateSerial(html), "(no serial)");
+  EXPECT_NE(html.find("data-warning=\"no serial"), std::string::npos);
+  r = Run(
+      {"report", "-c", Path("anonymous.yaml"), "-p", plan, "-s", anonymous, "-o", Path("anonymous2.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("anonymous.yaml: no serial (give --serial"), std::string::npos) << r.err;
+  html = ReadBytes(Path("anonymous2.html"));
+  EXPECT_EQ(CertificateSerial(html), "(no serial)");
+  EXPECT_NE(html.find("data-warning=\"no serial"), std::string::npos);
+
+  // batch: u1 by its samples' header; u2's serial.txt wins over its header.
+  simulate(Path("lot/u2/samples.csv"), {"--serial", "SN-HEADER", "--seed", "3"});
+  Write("lot/u2/serial.txt", "SN-FILE\n");
+  r = Run({"batch", Path("lot"), "--plan", plan, "-o", Path("out"), "--no-report", "--jobs", "1"});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const Table summary = ReadTable(Path("out/lot_summary.csv"));
+  ASSERT_EQ(summary.rows.size(), 2u);
+  EXPECT_EQ(summary.rows[0][summary.Column("serial")], "SN-77");
+  EXPECT_EQ(summary.rows[1][summary.Column("serial")], "SN-FILE");
+  EXPECT_EQ(YAML::LoadFile(Path("out/u1/calibration.yaml"))["serial"].as<std::string>(), "SN-77");
+
+  // Bad serials: exit 2 at their place, nothing written.
+  r = Run(
+      {"simulate", "-p", plan, "-c", Fixture("mems_truth.yaml"), "-o", Path("bad.csv"), "--serial", "SN\n1"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--serial: the serial \"SN\\x0a1\" holds a control character"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("bad.csv")));
+  std::string two = ReadFile(named);
+  two.insert(two.find("time_s,"), "#   serial: SN-78\n");
+  r = Run({"fit", "-p", plan, "-s", Write("two.csv", two), "-o", Path("two.yaml")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("two.csv:3:13: a second serial \"SN-78\" after \"SN-77\""), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("two.yaml")));
+  std::string bell = ReadFile(named);
+  bell.replace(bell.find("SN-77"), 5, "SN\a77");
+  r = Run({"apply", "-c", Path("cal.yaml"), "-s", Write("bell.csv", bell), "-o", Path("bell_out.csv")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bell.csv:2:11: the serial \"SN\\x0777\" holds a control character"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("bell_out.csv")));
+}
+
+// ------------------------------------------------------------------------------------------ allan
+
+// The angle random walk a summary of `imufit allan` prints for `column`, deg/sqrt(h) (NaN if none).
+double PrintedArw(const std::string& summary, const std::string& column) {
+  const size_t at = summary.find(column + " (gyro");
+  const std::string label = "angle random walk";
+  const size_t line = at == std::string::npos ? std::string::npos : summary.find(label, at);
+  return line == std::string::npos ? std::nan("") : std::stod(summary.substr(line + label.size()));
+}
+
+// issue 10 item 5: `imufit allan --calibration` analyses a raw-count log through the shared
+// correction, with the result of `imufit apply` then `imufit allan` to the last bit, and the
+// simulated noise density comes back.
+TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
+  const std::string plan = Write("static.yaml",
+                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+                                 "  - {id: 1, up: [0, 0, 1]}\n");
+  const std::string truth = Fixture("mems_truth.yaml");
+  constexpr double kGyroNoiseDensity = 8.7e-5;  // rad/s/sqrt(Hz); ARW = N * 180/pi * 60 deg/sqrt(h)
+  // 300 s at 100 Hz fix the ARW to about 1 % (one sigma); not quantised, so the white noise is
+  // the simulated one alone.
+  constexpr double kArwRelativeTolerance = 0.05;
+  RunResult r = Run({"simulate",
+                     "-p",
+                     plan,
+                     "-c",
+                     truth,
+                     "-o",
+                     Path("raw.csv.gz"),
+                     "--rate",
+                     "100",
+                     "--dwell",
+                     "300",
+                     "--temps",
+                     "40",
+                     "--gyro-noise-density",
+                     "8.7e-5",
+                     "--accel-noise-density",
+                     "1.5e-3",
+                     "--seed",
+                     "11",
+                     "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+
+  // Raw counts without a calibration: the warning names the cure.
+  r = Run({"allan", "-s", Path("raw.csv.gz"), "-c", "gyro_x", "-o", Path("raw_allan.csv"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("gyro_x has a mean of"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--calibration CAL.yaml"), std::string::npos) << r.err;
+
+  r = Run({"allan", "-s", Path("raw.csv.gz"), "--calibration", truth, "-o", Path("direct.csv"),
+           "--noise-yaml", Path("direct.yaml")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // corrected: nothing implausible, inside the fit range
+  const std::string direct_summary = r.out;
+  ASSERT_EQ(Run({"apply", "-c", truth, "-s", Path("raw.csv.gz"), "-o", Path("corrected.csv"), "-q"}).status,
+            0);
+  r = Run({"allan", "-s", Path("corrected.csv"), "-o", Path("applied.csv"), "--noise-yaml",
+           Path("applied.yaml")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  // Every deviation, bound and noise term bit for bit (the files differ only in the input named).
+  EXPECT_EQ(ReadBytes(Path("direct.csv")), ReadBytes(Path("applied.csv")));
+  std::string direct_yaml = ReadBytes(Path("direct.yaml"));
+  const std::string applied_yaml = ReadBytes(Path("applied.yaml"));
+  direct_yaml.replace(direct_yaml.find(Path("raw.csv.gz")), Path("raw.csv.gz").size(), Path("corrected.csv"));
+  EXPECT_EQ(direct_yaml, applied_yaml);
+  const auto summary_body = [](const std::string& summary) { return summary.substr(summary.find('\n')); };
+  EXPECT_EQ(summary_body(direct_summary), summary_body(r.out));
+  const double expected_arw = kGyroNoiseDensity * 180.0 / M_PI * 60.0;
+  for (const char* column : {"gyro_x", "gyro_y", "gyro_z"}) {
+    const double arw = PrintedArw(direct_summary, column);
+    EXPECT_NEAR(arw, expected_arw, kArwRelativeTolerance * expected_arw) << column << "\n" << direct_summary;
+  }
+
+  // A log without temp_c needs --temp-c, as apply does; --temp-c alone, --scale with
+  // --calibration and a column no calibration corrects are bad invocations; nothing is written.
+  r = Run({"simulate", "-p", plan, "-c", truth, "-o", Path("no_temp.csv"), "--rate", "100", "--dwell", "30",
+           "--no-temp-column", "--no-segment-column", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Run({"allan", "-s", Path("no_temp.csv"), "--calibration", truth, "-o", Path("x.csv")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no column \"temp_c\""), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--temp-c"), std::string::npos) << r.err;
+  r = Run({"allan", "-s", Path("no_temp.csv"), "--calibration", truth, "--temp-c", "25", "-c",
+           "gyro_z,temp_c", "-o", Path("no_temp_allan.csv"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(ReadBytes(Path("no_temp_allan.csv")).find("\ntemp_c,oadev,0.01,"), std::string::npos);
+  r = Run({"allan", "-s", Path("no_temp.csv"), "--calibration", truth, "--temp-c", "125", "-c", "gyro_z",
+           "-o", Path("hot.csv"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("lie outside the calibration's fit temperature range"), std::string::npos) << r.err;
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"--temp-c", "25"},
+        {"--calibration", truth, "--scale", "939.65"},
+        {"--calibration", truth, "--temp-c", "25", "-c", "gyro_x,segment"},
+        {"--calibration", Path("x.csv"), "--temp-c", "25"}}) {
+    std::vector<std::string> args = {"allan", "-s", Path("no_temp.csv"), "-o", Path("x.csv")};
+    args.insert(args.end(), bad.begin(), bad.end());
+    r = Run(args);
+    EXPECT_EQ(r.status, 2) << bad[0] << " " << bad[1] << ": " << r.err;
+    EXPECT_FALSE(fs::exists(Path("x.csv"))) << bad[0];
+  }
+}
+
 }  // namespace
 }  // namespace imufit

@@ -213,8 +213,7 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     fit_options.plan_sha256 = outcome.plan_sha256;
     fit_options.samples_sha256 = outcome.samples_sha256;
     FitRunResult result = FitRun(plan, samples, fit_options);
-    if (!result.plan.serial.empty()) outcome.serial = result.plan.serial;
-    if (!serial_file.empty()) outcome.serial = serial_file;
+    if (!result.serial.empty()) outcome.serial = result.serial;  // serial.txt, the samples', the plan's
     if (result.fit.status == FitStatus::kUndetermined) {
       outcome.status = "not-fitted";
       outcome.message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");

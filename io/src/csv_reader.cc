@@ -165,7 +165,16 @@ CsvReader::CsvReader(std::string path) : path_(std::move(path)) {
   std::string_view line;
   while (NextLine(&line)) {
     if (line_number_ == 1) SkipByteOrderMark(&line);
-    if (Trim(line).empty() || line.front() == '#') continue;
+    if (Trim(line).empty()) continue;
+    if (line.front() == '#') {
+      if (header_comments_.size() < kMaxHeaderComments) {
+        const std::string_view text = Trim(line.substr(1));
+        const long column = static_cast<long>(text.data() - line.data()) + 1;
+        header_comments_.push_back(
+            {line_number_, column, std::string(text.substr(0, kMaxHeaderCommentBytes))});
+      }
+      continue;
+    }
     SplitLine(line);
     header_line_ = line_number_;
     std::unordered_set<std::string_view> seen;  // views into header_, reserved so they stay valid

@@ -1,7 +1,10 @@
 #include "imufit/io/samples.h"
 
+#include <algorithm>
 #include <sstream>
+#include <string_view>
 
+#include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
 
 namespace imufit {
@@ -9,11 +12,42 @@ namespace {
 
 constexpr const char* kGyroNames[3] = {"gyro_x", "gyro_y", "gyro_z"};
 constexpr const char* kAccelNames[3] = {"accel_x", "accel_y", "accel_z"};
+constexpr std::string_view kSerialKey = "serial:";
+
+// A newline would end a comment line; other control characters have no place in a serial.
+bool HasControlCharacter(const std::string& text) {
+  return std::any_of(text.begin(), text.end(),
+                     [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
+
+// The serial of ReadSamplesSerial, from a reader that has read the header.
+std::string SerialInHeader(const CsvReader& csv) {
+  const std::string& path = csv.path();
+  std::string serial;
+  for (const CsvReader::Comment& comment : csv.header_comments()) {
+    if (comment.text.compare(0, kSerialKey.size(), kSerialKey) != 0) continue;
+    const size_t first = comment.text.find_first_not_of(" \t", kSerialKey.size());
+    const long column = comment.column + static_cast<long>(std::min(first, comment.text.size()));
+    if (first == std::string::npos) throw InputError(path, comment.line, column, "an empty serial");
+    const std::string found = comment.text.substr(first);
+    if (!serial.empty() && found != serial) {
+      // Two units in one file, or a header pasted onto another unit's log: certify neither.
+      throw InputError(path, comment.line, column,
+                       "a second serial " + QuoteForMessage(found) + " after " + QuoteForMessage(serial));
+    }
+    if (HasControlCharacter(found)) {
+      throw InputError(path, comment.line, column,
+                       "the serial " + QuoteForMessage(found) + " holds a control character");
+    }
+    serial = found;
+  }
+  return serial;
+}
 
 }  // namespace
 
 SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c)
-    : csv_(std::move(path)) {
+    : csv_(std::move(path)), serial_(SerialInHeader(csv_)) {
   time_column_ = csv_.RequireColumn("time_s");
   if (!temp_c) {
     try {
@@ -69,6 +103,16 @@ void SamplesReader::Fail(const std::string& column, const std::string& message) 
   const std::optional<int> index = csv_.FindColumn(column);
   if (!index) csv_.FailRow(message);
   csv_.Fail(*index, message);
+}
+
+std::string ReadSamplesSerial(const std::string& path) { return SerialInHeader(CsvReader(path)); }
+
+std::string SerialComment(const std::string& serial, const std::string& source) {
+  if (serial.empty()) return "";
+  if (HasControlCharacter(serial)) {
+    throw InputError(source, "the serial " + QuoteForMessage(serial) + " holds a control character");
+  }
+  return std::string(kSerialKey) + " " + serial;
 }
 
 SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment)

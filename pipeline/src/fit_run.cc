@@ -2,6 +2,7 @@
 
 #include <set>
 
+#include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 
 namespace imufit {
@@ -73,6 +74,10 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
                     const FitRunOptions& options) {
   FitRunResult result;
   result.plan = ReadPlan(plan_path);
+  // The most specific source first: the caller's, the unit's own log, then the (possibly shared) plan.
+  result.serial = options.serial;
+  if (result.serial.empty()) result.serial = ReadSamplesSerial(samples_path);
+  if (result.serial.empty()) result.serial = result.plan.serial;
   result.run = ReadRunWindows(result.plan, samples_path, options.windows, options.input);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   std::vector<Window> check_windows;
@@ -86,7 +91,7 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   if (!result.fit.IsSolutionUsable()) return result;
 
   Calibration calibration;
-  calibration.serial = options.serial.empty() ? result.plan.serial : options.serial;
+  calibration.serial = result.serial;
   calibration.created_utc = UtcNow();
   calibration.software = options.software;
   calibration.fit_temp_range_c = result.fit.temp_range_c;

@@ -35,7 +35,8 @@ Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_pat
 LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
                                         const std::string& output_path, const SamplesInput& input) {
   SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
-  SamplesWriter writer(output_path, SampleColumns{true, reader.has_temp() || input.temp_c.has_value()});
+  SamplesWriter writer(output_path, SampleColumns{true, reader.has_temp() || input.temp_c.has_value()},
+                       SerialComment(reader.serial(), samples_path));
   LabelledFileReport report;
   report.input_had_segment = reader.has_segment();
   Labeller labeller(segmentation);

@@ -26,7 +26,7 @@ namespace imufit {
 // One unit's outcome.
 struct UnitOutcome {
   std::string unit;     // the folder name
-  std::string serial;   // the plan's serial, else the unit folder name
+  std::string serial;   // serial.txt's, the samples header's, the plan's, else the unit folder name
   std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
   std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
   std::string message;  // the failed criteria, or why it was not fitted

@@ -1,16 +1,21 @@
-// imufit — correcting a whole samples file with a calibration (`imufit apply`).
+// imufit — correcting a whole samples file with a calibration (`imufit apply`, `imufit allan
+// --calibration`).
 //
-// Streams `samples_path` row by row through the shared model (SensorModel::Correct: the
-// accelerometer first, then the gyro with the corrected specific force of the same row) and
-// writes the corrected layout of docs/spec.md (time_s, temp_c, segment if the input had it, gyro in
-// rad/s, accel in m/s^2) to `output_path`, atomically.
+// Streams the samples row by row through the shared model (SensorModel::Correct: the
+// accelerometer first, then the gyro with the corrected specific force of the same row).
+// CorrectSamplesFile writes the corrected layout of docs/spec.md (time_s, temp_c, segment if the
+// input had it, gyro in rad/s, accel in m/s^2) to `output_path`, atomically; CorrectSamples hands
+// each corrected sample to a caller, so that what `imufit allan --calibration` analyses is, bit
+// for bit, what `imufit apply` writes.
 #ifndef IMUFIT_IO_CORRECT_FILE_H_
 #define IMUFIT_IO_CORRECT_FILE_H_
 
+#include <functional>
 #include <optional>
 #include <string>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/samples.h"
 
 namespace imufit {
 
@@ -21,6 +26,12 @@ struct CorrectFileReport {
   double min_temp_c = 0.0;
   double max_temp_c = 0.0;
 };
+
+// Reads every sample of `reader`, corrects it and calls `sink` with the corrected sample (time_s,
+// temp_c and segment as read). Throws InputError, located at the row, when a correction is not a
+// finite number (a temperature far outside the fit range overflows the polynomials).
+CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
+                                 const std::function<void(const Sample& corrected)>& sink);
 
 // `temp_c`: the temperature of every sample of a file without a temp_c column (written to the output).
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,

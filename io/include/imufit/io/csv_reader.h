@@ -26,6 +26,10 @@ class CsvReader {
   // file that is not a CSV of samples (a binary, /dev/zero, one huge line) costs bounded memory.
   static constexpr size_t kMaxLineBytes = 1 << 20;
   static constexpr size_t kMaxColumns = 10000;
+  // Comment lines before the header that are kept (header_comments()), and their length kept:
+  // a file of endless comments still costs bounded memory.
+  static constexpr size_t kMaxHeaderComments = 256;
+  static constexpr size_t kMaxHeaderCommentBytes = 1024;
 
   // Opens `path` (gzip when it ends in ".gz") and reads its header. Throws InputError.
   explicit CsvReader(std::string path);
@@ -34,6 +38,16 @@ class CsvReader {
   CsvReader& operator=(const CsvReader&) = delete;
 
   const std::vector<std::string>& header() const { return header_; }
+  // A comment line before the header: its line number, its text after the '#', trimmed, and the
+  // 1-based character column where that text starts (the
+  // first kMaxHeaderComments, each cut to kMaxHeaderCommentBytes). Loggers put what describes
+  // the whole file there (`# serial: SN0001`, samples.h).
+  struct Comment {
+    long line;
+    long column;
+    std::string text;
+  };
+  const std::vector<Comment>& header_comments() const { return header_comments_; }
   // The index of the column called `name`, if there is one.
   std::optional<int> FindColumn(std::string_view name) const;
   // The index of the column called `name`; throws InputError naming the header line if absent.
@@ -76,6 +90,7 @@ class CsvReader {
   long header_line_ = 0;  // line number of the header, for errors about columns
   long long bytes_read_ = 0;
   std::vector<std::string> header_;
+  std::vector<Comment> header_comments_;
   void AddField(std::string_view field) {
     if (field_count_ == fields_.size()) {
       if (field_count_ >= kMaxColumns) TooManyFields();

@@ -31,6 +31,8 @@ class SamplesReader {
   bool Next(Sample* sample);
 
   bool has_segment() const { return segment_column_ >= 0; }
+  // The unit's serial from the header's `# serial:` line (ReadSamplesSerial), or "".
+  const std::string& serial() const { return serial_; }
   bool has_temp() const { return temp_column_ >= 0; }
   // Throws an InputError located at the current row and the column called `column`.
   [[noreturn]] void Fail(const std::string& column, const std::string& message) const;
@@ -44,11 +46,23 @@ class SamplesReader {
   int temp_column_ = -1;
   double fixed_temp_c_ = 0.0;  // without a temp_c column
   int segment_column_ = -1;
+  std::string serial_;
   int gyro_columns_[3];
   int accel_columns_[3];
   bool first_ = true;
   double last_time_s_ = 0.0;
 };
+
+// The unit's serial as a samples file's header states it: a comment line `# serial: SN0001`
+// before the column names (what `imufit simulate --serial` writes, and a logger can). Returns the
+// text after "serial:", trimmed, or "" when no such line exists. Reads the file only up to its
+// header. Throws InputError for an unreadable file, an empty serial, or two different serials.
+std::string ReadSamplesSerial(const std::string& path);
+
+// The comment text (without the '#') that states `serial` in a samples header, for SamplesWriter;
+// "" for an empty serial (no line). Throws InputError (naming `source`) when the serial holds a
+// control character. Commands that write samples from samples (apply, segment) carry it over.
+std::string SerialComment(const std::string& serial, const std::string& source);
 
 // The optional columns a SamplesWriter writes.
 struct SampleColumns {

@@ -15,8 +15,12 @@
 #define IMUFIT_IO_SERIES_READER_H_
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "imufit/io/calibration.h"
+#include "imufit/io/correct_file.h"
 
 namespace imufit {
 
@@ -43,6 +47,16 @@ struct UniformSeries {
 // number, a time that does not increase, a gap or jitter, or fewer than two samples.
 UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::string>& columns,
                                 const UniformSeriesOptions& options);
+
+// The same series of a raw samples file corrected through `calibration` first, sample by sample
+// with CorrectSamples (correct_file.h): the values are those `imufit apply` writes, bit for bit.
+// `columns` are among gyro_x..z (rad/s), accel_x..z (m/s^2) and temp_c (when empty: the six
+// rates); `temp_c` is the temperature of a file without a temp_c column, as for SamplesReader.
+// `report` receives the correction's counts (samples outside the fit temperature range).
+// Throws InputError as ReadUniformSeries does, and for a column the calibration does not correct.
+UniformSeries ReadCorrectedSeries(const std::string& path, const Calibration& calibration,
+                                  std::optional<double> temp_c, const std::vector<std::string>& columns,
+                                  const UniformSeriesOptions& options, CorrectFileReport* report);
 
 }  // namespace imufit
 

@@ -34,7 +34,8 @@ struct FitRunOptions {
   std::string check_plan;
   // Written into the calibration's `software` key, e.g. "imufit 0.1.0".
   std::string software;
-  // The unit's serial (--serial); empty: the plan's `serial`.
+  // The unit's serial (--serial); empty: the samples header's `# serial:` line, else the plan's
+  // `serial`.
   std::string serial;
   // SHA-256 of the plan and samples files, recorded in the calibration's `fit:` block so that a
   // certificate can tell that a calibration and a run belong together; computed when empty.
@@ -46,6 +47,9 @@ struct FitRunOptions {
 };
 
 struct FitRunResult {
+  // The unit's serial as FitRunOptions::serial resolves it (also when the fit fails); empty when
+  // nothing names the unit.
+  std::string serial;
   Plan plan;
   RunWindows run;
   FitSummary fit;
