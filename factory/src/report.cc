@@ -643,6 +643,49 @@ PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
   return OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230);
 }
 
+// The lots of a results store: their yields as a table and bars, then the key figures' lot means;
+// the plots are svgs[first...] (LotHistoryPlots' order).
+void AcrossLots(Html* h, const LotHistory& history, const std::vector<Svg>& svgs, size_t first,
+                const std::string& failure) {
+  h->Open("div", {{"class", "keep"}, {"data-key", "history"}});
+  h->Element("h2", "Across lots");
+  h->Element("p",
+             "Every lot in the results store " + history.store_path +
+                 " (each unit by its latest fit), oldest first" +
+                 (history.current >= 0 ? "; this lot in orange." : "."),
+             {{"class", "note"}});
+  h->Open("table").Open("thead");
+  Row(h, {"lot", "units", "passed", "failed", "not fitted", "yield"}, "th");
+  h->Close("thead").Open("tbody");
+  for (size_t i = 0; i < history.lots.size(); ++i) {
+    const LotYield& y = history.lots[i];
+    HtmlAttributes row = {{"data-history-lot", y.lot}};
+    if (static_cast<int>(i) == history.current) row.push_back({"class", "current"});
+    h->Open("tr", row).Element("td", y.lot);
+    Num(h, Count(y.units));
+    Num(h, Count(y.passed));
+    Num(h, Count(y.failed));
+    Num(h, Count(y.not_fitted));
+    Num(h, Fmt("%.1f %%", history.yield_pct[i]), {{"data-yield", FormatDouble(history.yield_pct[i])}});
+    h->Close("tr");
+  }
+  h->Close("tbody").Close("table");
+  Plots(h, svgs, first, first + 1, failure);
+  h->Close("div");
+  h->Element("h3", "Key figures across lots");
+  Plots(h, svgs, first + 1, svgs.size(), failure, "plots2");
+}
+
+// Draws `figures` in one gnuplot run; `failure` says why not.
+std::vector<Svg> TryDraw(const std::vector<PlotFigure>& figures, std::string* failure) {
+  try {
+    return DrawSvg(figures);
+  } catch (const std::exception& e) {
+    *failure = e.what();
+    return {};
+  }
+}
+
 }  // namespace
 
 std::vector<PlotFigure> LotPlots(const LotSummary& lot) {
@@ -798,13 +841,8 @@ std::string LotPageHtml(const LotSummary& lot) {
   if (lot.history) {
     for (PlotFigure& f : LotHistoryPlots(*lot.history)) figures.push_back(std::move(f));
   }
-  std::vector<Svg> svgs;
   std::string failure;
-  try {
-    svgs = DrawSvg(figures);
-  } catch (const std::exception& e) {
-    failure = e.what();
-  }
+  const std::vector<Svg> svgs = TryDraw(figures, &failure);
   h.Element("h2", "Distributions");
   h.Element("p",
             "One point per fitted unit, in the order of the units table. Red square: the unit failed its "
@@ -813,35 +851,20 @@ std::string LotPageHtml(const LotSummary& lot) {
             {{"class", "note"}});
   Plots(&h, svgs, 0, strips, failure, "plots2");
 
-  if (lot.history) {
-    const LotHistory& history = *lot.history;
-    h.Open("div", {{"class", "keep"}, {"data-key", "history"}});
-    h.Element("h2", "Across lots");
-    h.Element("p",
-              "Every lot in the results store " + history.store_path +
-                  " (each unit by its latest fit), oldest first; this lot in orange.",
-              {{"class", "note"}});
-    h.Open("table").Open("thead");
-    Row(&h, {"lot", "units", "passed", "failed", "not fitted", "yield"}, "th");
-    h.Close("thead").Open("tbody");
-    for (size_t i = 0; i < history.lots.size(); ++i) {
-      const LotYield& y = history.lots[i];
-      HtmlAttributes row = {{"data-history-lot", y.lot}};
-      if (static_cast<int>(i) == history.current) row.push_back({"class", "current"});
-      h.Open("tr", row).Element("td", y.lot);
-      Num(&h, Count(y.units));
-      Num(&h, Count(y.passed));
-      Num(&h, Count(y.failed));
-      Num(&h, Count(y.not_fitted));
-      Num(&h, Fmt("%.1f %%", history.yield_pct[i]), {{"data-yield", FormatDouble(history.yield_pct[i])}});
-      h.Close("tr");
-    }
-    h.Close("tbody").Close("table");
-    Plots(&h, svgs, strips, strips + 1, failure);
-    h.Close("div");
-    h.Element("h3", "Key figures across lots");
-    Plots(&h, svgs, strips + 1, svgs.size(), failure.empty() ? "" : " ", "plots2");
-  }
+  if (lot.history) AcrossLots(&h, *lot.history, svgs, strips, failure);
+  h.Close("body").Close("html");
+  return h.Finish();
+}
+
+std::string LotHistoryHtml(const LotHistory& history) {
+  const std::string title = "Lots in " + history.store_path;
+  Html h;
+  h.Open("html", {{"lang", "en"}}).Open("head").Void("meta", {{"charset", "utf-8"}});
+  h.Element("title", title).Style(kStyle).PageStyle(title, "", "auto");
+  h.Close("head").Open("body").Element("h1", title);
+  std::string failure;
+  const std::vector<Svg> svgs = TryDraw(LotHistoryPlots(history), &failure);
+  AcrossLots(&h, history, svgs, 0, failure);
   h.Close("body").Close("html");
   return h.Finish();
 }

@@ -30,6 +30,8 @@ std::vector<PlotFigure> LotPlots(const LotSummary& lot);
 // means with their sigma.
 std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history);
 std::string LotPageHtml(const LotSummary& lot);
+// The lots of a results store on a page of their own (`imufit history DB --lot --html`).
+std::string LotHistoryHtml(const LotHistory& history);
 
 }  // namespace imufit
 
