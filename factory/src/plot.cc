@@ -256,12 +256,14 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
       gp << "set label " << object++ << " " << Quote(plot.labels[l].text) << " at graph 0.03, graph " << y
          << " left front\n";
     }
+    gp << "set style textbox opaque noborder margins 0.5, 0.5\n";
     for (const PlotNote& n : plot.notes) {
       gp << "set label " << object++ << " " << Quote(n.text) << " at first " << n.x << ", first " << n.y
          << (n.align == PlotNote::Align::kLeft     ? " left"
              : n.align == PlotNote::Align::kCenter ? " center"
                                                    : " right")
-         << " front textcolor rgb '" << n.color << "' offset character " << n.dx_chars << ", " << n.dy_chars;
+         << (n.opaque ? " boxed" : "") << " front textcolor rgb '" << n.color << "' offset character "
+         << n.dx_chars << ", " << n.dy_chars;
       if (n.point_type >= 0)
         gp << " point pt " << n.point_type << " ps " << n.point_size << " lc rgb '" << n.color << "'";
       gp << "\n";

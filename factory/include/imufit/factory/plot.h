@@ -67,6 +67,7 @@ struct PlotNote {
   Align align = Align::kLeft;
   int point_type = -1;
   double point_size = 1.0;
+  bool opaque = false;  // the text on a white ground, over the lines behind it
 };
 
 struct Plot {
