@@ -32,7 +32,7 @@ struct AllanArguments {
   std::string gaps = "error";
   std::string noise_yaml;
   std::string plot;
-  std::string plot_units = "si";
+  std::string plot_units = "native";
   std::string time_unit = "s";
   double scale = 1.0;
   std::string calibration;      // correct the raw samples through it first (as imufit apply does)
@@ -196,8 +196,10 @@ int RunAllan(const AllanArguments& args) {
   }
   const double seconds_per_unit = SecondsPer(args.time_unit);
   if (!(args.scale > 0.0) || !std::isfinite(args.scale)) BadInvocation("--scale must be a positive number");
-  if (args.plot_units != "si" && args.plot_units != "dph") {
-    BadInvocation("--plot-units " + QuoteForMessage(args.plot_units) + " is not one of: si, dph");
+  AllanPlotUnits plot_units = AllanPlotUnits::kNative;
+  if (!ParseAllanPlotUnits(args.plot_units, &plot_units)) {
+    BadInvocation("--plot-units " + QuoteForMessage(args.plot_units) +
+                  " is not one of: " + AllanPlotUnitsNames());
   }
   if (!args.plot.empty()) {
     if (!HasSuffix(args.plot, ".svg") && !HasSuffix(args.plot, ".png")) {
@@ -260,7 +262,7 @@ int RunAllan(const AllanArguments& args) {
     std::snprintf(title, sizeof title, "%s: %s, tau0 = %g s, %lld samples, %.3g %% confidence",
                   args.samples.c_str(), ToString(results.front().curve.estimator), series.sample_interval_s,
                   static_cast<long long>(n), 100.0 * args.confidence);
-    DrawFile(AllanPlot(results, title, args.plot_units == "dph"), args.plot);
+    DrawFile(AllanPlot(results, title, plot_units), args.plot);
   }
   written.Commit();
   if (!args.quiet) PrintSummary(args, series, n, results);
@@ -313,7 +315,9 @@ CommandRunner AddAllanCommand(CLI::App* root) {
                       "write the noise terms as YAML (top-level key noise:)");
   command->add_option("--plot", args->plot,
                       "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
-  command->add_option("--plot-units", args->plot_units, "si (default) or dph: gyro panels in deg/h");
+  command->add_option("--plot-units", args->plot_units,
+                      "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
+                      "corrected file), rad/s, deg/s or deg/h");
   command->add_option("--time-unit", args->time_unit, "unit of the time_s column: s (default), ms, us or ns");
   CLI::Option* scale = command->add_option(
       "--scale", args->scale,

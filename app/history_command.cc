@@ -1,12 +1,17 @@
 // imufit history — what the results store knows: a serial's calibrations, lots' yield, a
-// coefficient's trend over time. Printed tables, or CSV with --csv.
+// coefficient's trend over time. Printed tables, or CSV with --csv; the lots as an HTML page of
+// charts with --lot --html (factory/lot_history.h, report.h).
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "commands.h"
 #include "imufit/factory/batch.h"
+#include "imufit/factory/lot_history.h"
+#include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/error.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 
 namespace imufit {
@@ -19,14 +24,31 @@ struct HistoryArguments {
   bool lot_given = false;
   std::string trend;
   bool csv = false;
+  std::string html;    // --lot: the lots as a page of charts
+  std::string limits;  // drawn on those charts
 };
 
+// The lots of the store as a page: every lot's yield and key figures, `lot` highlighted.
+int WriteLotHistoryPage(const HistoryArguments& args, ResultsStore* store) {
+  RefuseToOverwriteInputs(args.html, {args.store, args.limits});
+  std::optional<Limits> limits;
+  if (!args.limits.empty()) limits = ReadLimits(args.limits);
+  const LotHistory history = MakeLotHistory(store, args.lot, limits ? &*limits : nullptr);
+  if (!args.lot.empty() && history.current < 0)
+    throw InputError(args.store, "no lot named " + QuoteForMessage(args.lot) + " to highlight");
+  WriteFileAtomically(args.html, LotHistoryHtml(history));
+  return 0;
+}
+
 int RunHistory(const HistoryArguments& args) {
+  if ((!args.html.empty() || !args.limits.empty()) && !args.lot_given)
+    throw InputError("imufit history", "--html and --limits draw the lots: give them with --lot [NAME]");
   const int queries = (args.lot_given ? 1 : 0) + (args.trend.empty() ? 0 : 1) +
                       (!args.serial.empty() && args.trend.empty() ? 1 : 0);
   if (queries != 1)
     throw InputError("imufit history", "give one of --serial S, --lot [NAME], --trend FIGURE [--serial S]");
   ResultsStore store(args.store);
+  if (args.lot_given && !args.html.empty()) return WriteLotHistoryPage(args, &store);
   if (args.lot_given) {
     const std::vector<LotYield> yields = store.Yield(args.lot);
     if (args.csv) {
@@ -116,6 +138,10 @@ CommandRunner AddHistoryCommand(CLI::App* root) {
       command->add_option("--lot", args->lot, "yield of this lot (no name: of every lot)")->expected(0, 1);
   command->add_option("--trend", args->trend, "a key figure over time");
   command->add_flag("--csv", args->csv, "print CSV instead of a table");
+  command->add_option("--html", args->html,
+                      "with --lot: write every lot's yield and key figures as charts to this HTML page "
+                      "(NAME highlighted)");
+  command->add_option("--limits", args->limits, "with --html: draw these acceptance limits on the charts");
   return [args, lot] {
     args->lot_given = lot->count() > 0;
     return RunHistory(*args);

@@ -282,6 +282,23 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   r = Run({"history", Path("store.db"), "--trend", "gyro.bias.x", "--csv"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(ReadCsv(r.out).size(), 4u);  // the four fitted units
+  // With a store, the lot page compares the lot with every lot recorded (here: itself), and
+  // `history --lot --html` draws the store's lots on a page of their own.
+  EXPECT_NE(lot.find("<tr data-history-lot=\"LOT-A\" class=\"current\">"), std::string::npos);
+  r = Run({"history", Path("store.db"), "--lot", "LOT-A", "--html", Path("lots.html"), "--limits",
+           Path("limits.yaml")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string lots = ReadBytes(dir_ / "lots.html");
+  EXPECT_NE(lots.find("<tr data-history-lot=\"LOT-A\" class=\"current\">"), std::string::npos);
+  EXPECT_NE(lots.find("data-yield=\"60\""), std::string::npos);
+  EXPECT_NE(lots.find("<svg"), std::string::npos);
+  r = Run({"history", Path("store.db"), "--lot", "LOT-Z", "--html", Path("lots_z.html")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("no lot named \"LOT-Z\""), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "lots_z.html"));
+  r = Run({"history", Path("store.db"), "--html", Path("lots_z.html")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("give them with --lot"), std::string::npos) << r.err;
 
   // Again: nothing changed, nothing redone, same summary, no new rows.
   const std::string first_summary = ReadBytes(dir_ / "out" / "lot_summary.csv");

@@ -679,6 +679,21 @@ TEST_F(AllanCliTest, PlotsWithGnuplotOrSaysItIsMissing) {
   ASSERT_EQ(Run("allan -q -s '" + samples + "' -o '" + Path("b.csv") + "' --plot '" + Path("a.svg") + "'"), 0)
       << error_;
   EXPECT_NE(Read(Path("a.svg")).find("<svg"), std::string::npos);
+  // In deg/h: tau written as the letter, the white noise's ARW annotated on the plot.
+  ASSERT_EQ(Run("allan -q -s '" + samples + "' -c gyro_x -o '" + Path("c.csv") + "' --plot '" +
+                Path("c.svg") + "' --plot-units deg/h"),
+            0)
+      << error_;
+  const std::string svg = Read(Path("c.svg"));
+  EXPECT_NE(svg.find("averaging time \xcf\x84 (s)"), std::string::npos);
+  EXPECT_NE(svg.find("overlapping Allan deviation (\xc2\xb0/h)"), std::string::npos);
+  EXPECT_NE(svg.find(">ARW "), std::string::npos);
+  EXPECT_EQ(Run("allan -q -s '" + samples + "' -o '" + Path("d.csv") + "' --plot '" + Path("d.svg") +
+                "' --plot-units dph"),
+            2);
+  EXPECT_NE(error_.find("--plot-units \"dph\" is not one of: native, rad/s, deg/s, deg/h"), std::string::npos)
+      << error_;
+  EXPECT_FALSE(fs::exists(Path("d.csv")));
 }
 
 }  // namespace

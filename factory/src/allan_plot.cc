@@ -6,11 +6,91 @@
 #include <cstdio>
 
 #include "imufit/io/noise_file.h"
+#include "imufit/io/units.h"
 
 namespace imufit {
+namespace {
 
-PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::string& title, bool in_dph) {
-  constexpr int kModelPoints = 120;
+constexpr int kModelPoints = 120;  // taus at which the model and its terms are drawn
+// A term is drawn where its deviation is at least this share of the model's (a hundredth of the
+// variance): beyond, its line only stretches the axis.
+constexpr double kTermShownShare = 0.1;
+// The deviation axis reaches whole decades, at least this factor below the lowest point (room for
+// the bias-instability labels under the floor) and above the highest.
+constexpr double kRoomBelow = 4.0, kRoomAbove = 1.5;
+const char* kKeyGrey = "#555555";
+
+// A unit as a plot shows it: "deg/sqrt(h)" -> "°/√h", "micro-g" -> "µg", "m/s^2" -> "m/s²".
+std::string Pretty(std::string unit) {
+  const std::array<std::array<const char*, 2>, 4> replacements = {
+      {{"sqrt(h)", "\xe2\x88\x9ah"}, {"deg", "\xc2\xb0"}, {"micro-g", "\xc2\xb5g"}, {"^2", "\xc2\xb2"}}};
+  for (const auto& [from, to] : replacements) {
+    for (size_t at = unit.find(from); at != std::string::npos; at = unit.find(from, at + 1))
+      unit.replace(at, std::string(from).size(), to);
+  }
+  return unit;
+}
+
+const char* LongName(AllanEstimator estimator) {
+  switch (estimator) {
+    case AllanEstimator::kAdev:
+      return "Allan deviation";
+    case AllanEstimator::kOadev:
+      return "overlapping Allan deviation";
+    case AllanEstimator::kMdev:
+      return "modified Allan deviation";
+    case AllanEstimator::kTdev:
+      return "time deviation";
+    case AllanEstimator::kHdev:
+      return "Hadamard deviation";
+    case AllanEstimator::kOhdev:
+      return "overlapping Hadamard deviation";
+    case AllanEstimator::kTotdev:
+      return "total deviation";
+  }
+  return "deviation";
+}
+
+// Plot units per SI unit, and their name, for a panel of `kind`.
+double Scale(ColumnKind kind, AllanPlotUnits units) {
+  if (kind != ColumnKind::kGyro || units == AllanPlotUnits::kNative) return 1.0;
+  return units == AllanPlotUnits::kDegPerHour ? DphFromRadps(1.0) : DpsFromRadps(1.0);
+}
+std::string UnitName(ColumnKind kind, AllanPlotUnits units) {
+  if (kind != ColumnKind::kGyro || units == AllanPlotUnits::kNative) return Pretty(SiUnit(kind));
+  return units == AllanPlotUnits::kDegPerHour ? "\xc2\xb0/h" : "\xc2\xb0/s";
+}
+
+// "ARW 0.299 ± 0.0004 °/√h" in the term's engineer units (SI for other columns).
+std::string TermText(const ColumnAnalysis& r, int term, const char* name) {
+  const NoiseTermUnits& u = UnitsOf(r.kind, term);
+  const bool engineer = *u.engineer_key != '\0';
+  const double scale = engineer ? u.engineer_per_si : 1.0;
+  char text[160];
+  std::snprintf(text, sizeof text, "%s %.3g \xc2\xb1 %.2g %s", name, r.fit.value[term] * scale,
+                r.fit.sigma[term] * scale, Pretty(engineer ? u.engineer_unit : u.si_unit).c_str());
+  return text;
+}
+
+}  // namespace
+
+bool ParseAllanPlotUnits(const std::string& text, AllanPlotUnits* units) {
+  if (text == "native" || text == "rad/s") {
+    *units = AllanPlotUnits::kNative;
+  } else if (text == "deg/s") {
+    *units = AllanPlotUnits::kDegPerSecond;
+  } else if (text == "deg/h") {
+    *units = AllanPlotUnits::kDegPerHour;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* AllanPlotUnitsNames() { return "native, rad/s, deg/s, deg/h"; }
+
+PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::string& title,
+                     AllanPlotUnits units) {
   std::vector<ColumnKind> kinds;
   for (const ColumnAnalysis& r : results) {
     if (std::find(kinds.begin(), kinds.end(), r.kind) == kinds.end()) kinds.push_back(r.kind);
@@ -18,95 +98,158 @@ PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::stri
   PlotFigure figure;
   figure.title = title;
   figure.cols = static_cast<int>(kinds.size());
-  figure.width_px = kinds.size() > 1 ? 1600 : 1100;
-  figure.height_px = 760;
+  figure.width_px = kinds.size() > 1 ? 1400 : 900;
+  figure.height_px = 620;
+  const AllanEstimator estimator = results.empty() ? AllanEstimator::kOadev : results.front().curve.estimator;
+  // The IEEE 952 model is the Allan variance's: drawn (and read off) over Allan-variance curves only.
+  const bool draw_model = estimator == AllanEstimator::kOadev || estimator == AllanEstimator::kAdev ||
+                          estimator == AllanEstimator::kTotdev;
   for (ColumnKind kind : kinds) {
-    const bool dph = in_dph && kind == ColumnKind::kGyro;
-    const double scale = dph ? UnitsOf(ColumnKind::kGyro, kBiasInstability).engineer_per_si : 1.0;
-    const AllanEstimator estimator = results.front().curve.estimator;
+    const double scale = Scale(kind, units);
     Plot plot;
     plot.log_x = plot.log_y = true;
-    plot.x_label = "averaging time tau, s";
-    const std::string unit = dph ? "deg/h" : SiUnit(kind);
-    plot.y_label = std::string(ToString(estimator)) + " (" + unit +
-                   (estimator == AllanEstimator::kTdev ? " s" : "") + ")";
-    plot.title = std::string(ToString(kind)) + " columns";
+    plot.x_label = "averaging time \xcf\x84 (s)";
+    plot.y_label = std::string(LongName(estimator)) + " (" + UnitName(kind, units) +
+                   (estimator == AllanEstimator::kTdev ? "\xc2\xb7s" : "") + ")";
+    plot.title = kind == ColumnKind::kGyro    ? "Gyro"
+                 : kind == ColumnKind::kAccel ? "Accelerometer"
+                                              : "Other columns";
     plot.labels_at_bottom = true;
-    // The IEEE 952 model is the Allan variance's: drawn over Allan-variance curves only.
-    const bool draw_model = estimator == AllanEstimator::kOadev || estimator == AllanEstimator::kAdev ||
-                            estimator == AllanEstimator::kTotdev;
+    const char* random_walk = kind == ColumnKind::kAccel ? "VRW" : "ARW";
+    int in_panel = 0;
+    for (const ColumnAnalysis& r : results) in_panel += r.kind == kind ? 1 : 0;
+    double lowest = INFINITY, highest = 0.0;
+    int column = 0;                     // this column's place in the panel: its labels stack in that order
+    std::vector<PlotNote> floor_words;  // the bias instabilities in words
     for (size_t c = 0; c < results.size(); ++c) {
       const ColumnAnalysis& r = results[c];
       if (r.kind != kind) continue;
-      const int color = static_cast<int>(c);
+      const std::string who = in_panel > 1 ? r.name + " " : "";
       PlotSeries curve;
       curve.style = PlotSeries::Style::kErrorBars;
       curve.title = r.name;
-      curve.color = PlotColor(color);
+      curve.color = PlotColor(static_cast<int>(c));
       curve.point_size = 0.7;
       for (const AllanPoint& p : r.curve.points) {
         if (!(p.dev > 0.0)) continue;  // a constant column has nothing to show on a log scale
         curve.x.push_back(p.tau_s);
         curve.y.push_back(p.dev * scale);
-        curve.lo.push_back((std::isfinite(p.dev_lo) ? p.dev_lo : p.dev) * scale);
+        curve.lo.push_back((std::isfinite(p.dev_lo) && p.dev_lo > 0.0 ? p.dev_lo : p.dev) * scale);
         curve.hi.push_back((std::isfinite(p.dev_hi) ? p.dev_hi : p.dev) * scale);
+        lowest = std::min(lowest, curve.lo.back());
+        highest = std::max(highest, curve.hi.back());
       }
       plot.series.push_back(curve);
-      if (!r.fit.fitted || !draw_model || curve.x.empty()) continue;
+      if (!r.fit.fitted) {
+        plot.labels.push_back({r.name + ": no noise fit (" + r.fit.message + ")"});
+        ++column;
+        continue;
+      }
+      const bool arw = IsResolved(r.fit, kRandomWalk), bias = IsResolved(r.fit, kBiasInstability);
+      if (!draw_model || curve.x.empty()) {
+        // The terms belong to the overlapping Allan deviation, not to this curve: words only.
+        plot.labels.push_back(
+            {r.name + ": " + (arw ? TermText(r, kRandomWalk, random_walk) : "ARW not resolved") + ", " +
+             (bias ? TermText(r, kBiasInstability, "bias instability") : "bias instability not resolved") +
+             " (IEEE 952 fit to oadev)"});
+        ++column;
+        continue;
+      }
       PlotSeries model;
-      model.title = r.name + " model";
       model.color = curve.color;
       model.line_width = 2;
       std::array<PlotSeries, kNoiseTerms> terms;
       const double first = curve.x.front(), last = curve.x.back();
+      double floor_tau = first, floor_dev = INFINITY;
       for (int i = 0; i <= kModelPoints; ++i) {
         const double tau = first * std::pow(last / first, static_cast<double>(i) / kModelPoints);
+        const double dev = r.fit.ModelDeviation(tau);
         model.x.push_back(tau);
-        model.y.push_back(r.fit.ModelDeviation(tau) * scale);
+        model.y.push_back(dev * scale);
+        if (dev < floor_dev) floor_tau = tau, floor_dev = dev;
         for (int k = 0; k < kNoiseTerms; ++k) {
+          const double term = r.fit.TermDeviation(k, tau);
           terms[k].x.push_back(tau);
-          terms[k].y.push_back(r.fit.TermDeviation(k, tau) * scale);
+          terms[k].y.push_back(term >= kTermShownShare * dev ? term * scale : NAN);  // NaN: a gap
         }
       }
       plot.series.push_back(model);
       for (int k = 0; k < kNoiseTerms; ++k) {
-        if (!(r.fit.variance[k] > 0.0)) continue;
+        if (!IsResolved(r.fit, k)) continue;  // a term within its noise is no line to read
         terms[k].color = curve.color;
         terms[k].dashed = true;
         terms[k].line_width = 1;
         plot.series.push_back(terms[k]);
       }
-      PlotSeries readout;
-      readout.style = PlotSeries::Style::kPoints;
-      readout.color = curve.color;
-      readout.point_type = 6;
-      readout.point_size = 2.2;
-      if (std::isfinite(r.fit.readout_random_walk)) {
-        readout.x.push_back(1.0);
-        readout.y.push_back(r.fit.readout_random_walk * scale);
+      // N where it is read: the -1/2 line at tau = 1 s (at the curve's end when 1 s is beyond it).
+      if (arw) {
+        PlotNote n;
+        n.x = std::clamp(1.0, first, last);
+        n.y = r.fit.TermDeviation(kRandomWalk, n.x) * scale;
+        n.text = who + TermText(r, kRandomWalk, random_walk);
+        n.color = curve.color;
+        n.point_type = 7;
+        n.point_size = 1.3;
+        n.opaque = true;
+        n.dx_chars = 1.5;
+        n.dy_chars = 1.2 + 1.4 * (in_panel - 1 - column);  // the first column on top
+        plot.notes.push_back(n);
+      } else {
+        plot.labels.push_back({r.name + ": " + random_walk + " not resolved"});
       }
-      if (std::isfinite(r.fit.readout_bias_instability)) {
-        readout.x.push_back(r.fit.readout_bias_tau_s);
-        readout.y.push_back(0.664 * r.fit.readout_bias_instability * scale);
+      // The bias-instability floor, 0.664 B, marked at the model's minimum; its words are stacked
+      // below the panel's lowest floor (after the loop), so that they cross no floor line.
+      if (bias) {
+        PlotNote b;
+        b.x = floor_tau;
+        b.y = r.fit.TermDeviation(kBiasInstability, floor_tau) * scale;
+        b.color = curve.color;
+        b.point_type = 13;
+        b.point_size = 1.6;
+        plot.notes.push_back(b);
+        b.point_type = -1;
+        b.text = who + TermText(r, kBiasInstability, "bias instability");
+        b.opaque = true;
+        floor_words.push_back(b);
+        lowest = std::min(lowest, b.y);
+      } else {
+        plot.labels.push_back({r.name + ": bias instability not resolved"});
       }
-      if (std::isfinite(r.fit.readout_rate_random_walk)) {
-        readout.x.push_back(3.0);
-        readout.y.push_back(r.fit.readout_rate_random_walk * scale);
+      ++column;
+    }
+    if (!floor_words.empty()) {
+      // Anchored at the lowest floor, under the rightmost mark; towards the middle of the panel.
+      double x = 0.0, y = INFINITY, taus_lo = INFINITY, taus_hi = 0.0;
+      for (const PlotNote& b : floor_words) x = std::max(x, b.x), y = std::min(y, b.y);
+      for (const PlotSeries& s : plot.series) {
+        if (!s.x.empty()) taus_lo = std::min(taus_lo, s.x.front()), taus_hi = std::max(taus_hi, s.x.back());
       }
-      plot.series.push_back(readout);
-      const NoiseTermUnits& n = UnitsOf(kind, kRandomWalk);
-      const NoiseTermUnits& b = UnitsOf(kind, kBiasInstability);
-      const bool engineer = *n.engineer_key != '\0';
-      const auto term_text = [&](int k, const NoiseTermUnits& u) {
-        if (!IsResolved(r.fit, k)) return std::string("not resolved");
-        char text[96];
-        std::snprintf(text, sizeof text, "%.3g %s", r.fit.value[k] * (engineer ? u.engineer_per_si : 1.0),
-                      engineer ? u.engineer_unit : u.si_unit);
-        return std::string(text);
-      };
-      plot.labels.push_back({r.name + ": " + (kind == ColumnKind::kAccel ? "VRW " : "ARW ") +
-                             term_text(kRandomWalk, n) + ", bias instability " +
-                             term_text(kBiasInstability, b)});
+      const bool right_half = x > std::sqrt(taus_lo * taus_hi);
+      for (size_t i = 0; i < floor_words.size(); ++i) {
+        PlotNote& b = floor_words[i];
+        b.x = x;
+        b.y = y;
+        b.align = right_half ? PlotNote::Align::kRight : PlotNote::Align::kLeft;
+        b.dx_chars = right_half ? 1.0 : -1.0;
+        b.dy_chars = -1.4 - 1.4 * i;
+        plot.notes.push_back(b);
+      }
+    }
+    if (draw_model) {
+      // Key entries for what the lines are (series without points draw nothing but their key).
+      PlotSeries fit_key, term_key;
+      fit_key.title = "IEEE 952 fit";
+      term_key.title = "its terms";
+      fit_key.color = term_key.color = kKeyGrey;
+      fit_key.line_width = 2;
+      term_key.dashed = true;
+      term_key.line_width = 1;
+      plot.series.push_back(fit_key);
+      plot.series.push_back(term_key);
+    }
+    if (highest > 0.0 && std::isfinite(lowest) && lowest > 0.0) {
+      plot.y_range = std::array<double, 2>{std::pow(10.0, std::floor(std::log10(lowest / kRoomBelow))),
+                                           std::pow(10.0, std::ceil(std::log10(highest * kRoomAbove)))};
     }
     figure.panels.push_back(plot);
   }

@@ -411,8 +411,11 @@ BatchResult RunBatch(const BatchOptions& options) {
     if (options.write_reports) {
       std::optional<Limits> limits;
       if (!options.limits_path.empty()) limits = ReadLimits(options.limits_path);
-      WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(),
-                          LotPageHtml(MakeLotSummary(shared.lot, result, options.fit.software, limits)));
+      LotSummary summary = MakeLotSummary(shared.lot, result, options.fit.software, limits);
+      // With a results store, the page compares this lot with every lot recorded there.
+      if (shared.store)
+        summary.history = MakeLotHistory(shared.store.get(), shared.lot, limits ? &*limits : nullptr);
+      WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), LotPageHtml(summary));
     }
   }
   return result;

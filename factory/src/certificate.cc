@@ -1,6 +1,7 @@
 #include "imufit/factory/certificate.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -475,6 +476,34 @@ std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std:
   return scores;
 }
 
+namespace {
+
+// The longest prefix every name shares, cut back to a boundary (after a character that is not a
+// letter or digit, or between a letter and a digit) and leaving every name at least one character:
+// "unit-01", "unit-02" -> "unit-"; "SN1001", "SN1002" -> "SN"; "a", "b" -> "".
+std::string SharedPrefix(const std::vector<std::string>& names) {
+  if (names.size() < 2) return "";
+  size_t length = names.front().size();
+  for (const std::string& n : names) {
+    length = std::min(length, n.size() - (n.empty() ? 0 : 1));
+    size_t i = 0;
+    while (i < length && n[i] == names.front()[i]) ++i;
+    length = i;
+  }
+  const std::string& first = names.front();
+  const auto alnum = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
+  const auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
+  while (length > 0) {
+    const char before = first[length - 1];
+    const char after = first[length];
+    if (!alnum(before) || (!digit(before) && digit(after))) break;
+    --length;
+  }
+  return first.substr(0, length);
+}
+
+}  // namespace
+
 LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, const std::string& software,
                           const std::optional<Limits>& limits) {
   LotSummary s;
@@ -482,57 +511,54 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
   s.written_utc = UtcNow();
   s.software = software;
   s.git_revision = IMUFIT_GIT_REVISION;
+  if (limits) s.limits_name = limits->name.empty() ? limits->path : limits->name;
   s.units = static_cast<int>(batch.units.size());
   s.passed = batch.passed;
   s.failed = batch.failed;
   s.not_fitted = batch.not_fitted;
   s.errors = batch.errors;
   s.yield_pct = s.units > 0 ? 100.0 * batch.passed / s.units : 0.0;
+  std::vector<std::string> names;
+  for (const UnitOutcome& u : batch.units) names.push_back(u.unit);
+  s.unit_prefix = SharedPrefix(names);
   for (const UnitOutcome& u : batch.units) {
-    s.rows.push_back({u.unit, u.serial, u.status, u.verdict, u.message, u.status == "fitted"});
+    s.rows.push_back({u.unit, u.serial, u.status, u.verdict, u.message, u.status == "fitted",
+                      u.unit.substr(s.unit_prefix.size())});
   }
   for (const std::string& name : kSummaryFigures) {
     LotFigure f;
     f.name = name;
-    for (const UnitOutcome& u : batch.units) {
+    if (limits) f.limits = FigureLimits(name, *limits);
+    for (size_t row = 0; row < batch.units.size(); ++row) {
+      const UnitOutcome& u = batch.units[row];
       const Figure* figure = FindFigure(u.figures, name);
       if (figure == nullptr) continue;
       f.unit = figure->unit;
       f.units.push_back(u.unit);
+      f.row.push_back(static_cast<int>(row));
       f.value.push_back(figure->value);
       f.sigma.push_back(figure->sigma);
-      f.jitter.push_back((f.value.size() % 5) * 0.15);  // spread the dots of a strip plot vertically
       f.failed.push_back(u.verdict == "FAIL");
+      f.outside_limits.push_back(f.limits && ((f.limits->lower && !(figure->value > *f.limits->lower)) ||
+                                              (f.limits->upper && !(figure->value < *f.limits->upper))));
     }
     if (f.value.empty()) continue;
     f.z = RobustZScores(f.value, f.sigma);
-    double sum = 0.0, squares = 0.0;
-    for (double v : f.value) sum += v;
-    f.mean = sum / f.value.size();
-    for (double v : f.value) squares += (v - f.mean) * (v - f.mean);
-    f.stdev = f.value.size() > 1 ? std::sqrt(squares / (f.value.size() - 1)) : 0.0;
-    if (limits) {
-      const std::string quantity = name.substr(0, name.find('.'));
-      const std::string axis = name.find('.') == std::string::npos ? "" : name.substr(name.find('.') + 1);
-      for (const LimitCriterion& criterion : limits->criteria) {
-        if (criterion.quantity != quantity || criterion.kind == LimitKind::kCoverage ||
-            criterion.statistic == LimitStatistic::kSigma) {
-          continue;
-        }
-        if (!axis.empty() &&
-            std::find(criterion.axes.begin(), criterion.axes.end(), axis) == criterion.axes.end())
-          continue;
-        if (!f.limit || criterion.max_abs < *f.limit) f.limit = criterion.max_abs;
-      }
+    const MeanSigma m = MeanAndSigma(f.value);
+    f.mean = m.mean;
+    f.stdev = m.sigma;
+    f.three_sigma = {f.mean - 3.0 * f.stdev, f.mean + 3.0 * f.stdev};
+    f.stdev_within = WithinSigma(f.value);
+    if (f.limits) {
+      f.ppk = Capability(f.mean, f.stdev, *f.limits);
+      f.cpk = Capability(f.mean, f.stdev_within, *f.limits);
     }
-    if (f.limit && f.stdev > 0.0) f.ppk = std::min(*f.limit - f.mean, f.mean + *f.limit) / (3.0 * f.stdev);
+    const auto [low, high] = std::minmax_element(f.value.begin(), f.value.end());
+    f.view = ViewWithLimits(std::min(*low, f.three_sigma[0]), std::max(*high, f.three_sigma[1]), f.limits);
     for (size_t i = 0; i < f.value.size(); ++i) {
       if (!f.z[i].outlier) continue;
-      const UnitOutcome* owner = nullptr;
-      for (const UnitOutcome& u : batch.units) {
-        if (u.unit == f.units[i]) owner = &u;
-      }
-      s.outliers.push_back({f.units[i], owner ? owner->serial : "", name, f.unit, f.value[i], f.z[i].z});
+      const UnitOutcome& owner = batch.units[f.row[i]];
+      s.outliers.push_back({f.units[i], owner.serial, name, f.unit, f.value[i], f.z[i].z});
     }
     s.figures.push_back(std::move(f));
   }

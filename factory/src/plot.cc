@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -76,6 +77,9 @@ std::string With(const PlotSeries& s) {
     case PlotSeries::Style::kErrorBars:
       w << "using 1:2:3:4 with yerrorbars pt " << s.point_type << " ps " << s.point_size << " " << color;
       break;
+    case PlotSeries::Style::kBoxes:
+      w << "using 1:2:(0.7) with boxes fs solid 0.75 noborder " << color;
+      break;
   }
   w << " " << (s.title.empty() ? "notitle" : "title " + Quote(s.title));
   return w.str();
@@ -118,6 +122,51 @@ struct TempFolder {
 
 }  // namespace
 
+AxisScale NiceAxis(double lo, double hi, int tics) {
+  if (!(hi > lo)) {  // one value (or none): a small range around it
+    const double pad = lo != 0.0 && std::isfinite(lo) ? 0.01 * std::abs(lo) : 1.0;
+    if (!std::isfinite(lo)) lo = 0.0;
+    hi = lo + pad;
+    lo -= pad;
+  }
+  // A point on the frame is hard to see: 3 % of the range to spare on each side first.
+  const double pad = 0.03 * (hi - lo);
+  lo -= pad;
+  hi += pad;
+  // The step of about `tics` steps over the range, rounded up to 1, 2 or 5 times a power of 10.
+  const double raw = (hi - lo) / std::max(tics, 1);
+  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+  const double fraction = raw / magnitude;
+  const double step = (fraction <= 1.0   ? 1.0
+                       : fraction <= 2.0 ? 2.0
+                       : fraction <= 5.0 ? 5.0
+                                         : 10.0) *
+                      magnitude;
+  AxisScale scale;
+  scale.step = step;
+  scale.lo = std::floor(lo / step) * step;
+  scale.hi = std::ceil(hi / step) * step;
+  // Decimals: as many as the step's first significant digit needs (0.05 -> 2, 20 -> 0).
+  const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
+  scale.format = "%." + std::to_string(decimals) + "f";
+  return scale;
+}
+
+CategoryAxis CategoryTics(const std::vector<std::string>& labels, int max_labels, int width_chars) {
+  CategoryAxis axis;
+  const size_t n = labels.size();
+  axis.range = {-0.5, std::max<double>(n, 1) - 0.5};
+  const size_t every =
+      n <= static_cast<size_t>(std::max(max_labels, 1)) ? 1 : (n + max_labels - 1) / max_labels;
+  size_t chars = 0;
+  for (size_t i = 0; i < n; i += every) {
+    axis.tics.push_back({static_cast<double>(i), labels[i]});
+    chars += labels[i].size() + 2;  // two spaces between neighbours
+  }
+  if (chars > static_cast<size_t>(std::max(width_chars, 0))) axis.rotate_deg = 90;
+  return axis;
+}
+
 const char* PlotColor(int index) {
   static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
                                         "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
@@ -127,6 +176,10 @@ const char* PlotColor(int index) {
 std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal, const std::string& output) {
   std::ostringstream gp;
   gp.precision(12);
+  // Text is UTF-8 (tau, sigma, degree signs) and drawn as it is (noenhanced). Enhanced text's
+  // {/Symbol t} asks for the Symbol font: pngcairo maps it to a tau, but the SVG names font-family
+  // "Symbol" with a Latin t, which browsers and librsvg draw as "t".
+  gp << "set encoding utf8\n";
   const std::string size = std::to_string(figure.width_px) + "," + std::to_string(figure.height_px);
   if (terminal == "png") {
     gp << "set terminal pngcairo size " << size
@@ -161,20 +214,36 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
     else
       gp << "set format y '%g'\n";
     if (!plot.y_tics) gp << "unset ytics\n";
+    if (plot.y_tics && plot.y_tic_step > 0.0) gp << "set ytics " << plot.y_tic_step << "\n";
+    if (!plot.y_format.empty()) gp << "set format y " << Quote(plot.y_format) << "\n";
+    if (!plot.x_tics.empty()) {
+      gp << "set xtics (";
+      for (size_t t = 0; t < plot.x_tics.size(); ++t) {
+        gp << (t ? ", " : "") << Quote(plot.x_tics[t].label) << " " << plot.x_tics[t].value;
+      }
+      gp << ")"
+         << (plot.x_tic_rotate_deg ? " rotate by " + std::to_string(plot.x_tic_rotate_deg) + " right" : "")
+         << "\n";
+    }
     if (plot.x_range) gp << "set xrange [" << (*plot.x_range)[0] << ":" << (*plot.x_range)[1] << "]\n";
     if (plot.y_range) gp << "set yrange [" << (*plot.y_range)[0] << ":" << (*plot.y_range)[1] << "]\n";
     if (!plot.x_range) gp << "set offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n";
     gp << (plot.key ? "set key outside right top samplen 2\n" : "unset key\n");
     int object = 1;
+    size_t right_label = 0;  // the longest label of a horizontal marker, right of the panel
+    for (const PlotMarker& m : plot.markers) {
+      if (!m.vertical) right_label = std::max(right_label, m.label.size());
+    }
+    if (right_label > 0 && !plot.key) gp << "set rmargin " << right_label + 3 << "\n";
     for (const PlotMarker& m : plot.markers) {
       if (m.vertical) {
         gp << "set arrow " << object << " from first " << m.value << ", graph 0 to first " << m.value
-           << ", graph 1 nohead dt 2 lw 1.5 lc rgb '" << m.color << "'\n";
+           << ", graph 1 nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
         gp << "set label " << object << " " << Quote(m.label) << " at first " << m.value
            << ", graph 1.02 center textcolor rgb '" << m.color << "'\n";
       } else {
         gp << "set arrow " << object << " from graph 0, first " << m.value << " to graph 1, first " << m.value
-           << " nohead dt 2 lw 1.5 lc rgb '" << m.color << "'\n";
+           << " nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
         gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first " << m.value
            << " left textcolor rgb '" << m.color << "'\n";
       }
@@ -186,6 +255,18 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
           plot.labels_at_bottom ? 0.05 + kLabelStep * (plot.labels.size() - 1 - l) : 0.94 - kLabelStep * l;
       gp << "set label " << object++ << " " << Quote(plot.labels[l].text) << " at graph 0.03, graph " << y
          << " left front\n";
+    }
+    gp << "set style textbox opaque noborder margins 0.5, 0.5\n";
+    for (const PlotNote& n : plot.notes) {
+      gp << "set label " << object++ << " " << Quote(n.text) << " at first " << n.x << ", first " << n.y
+         << (n.align == PlotNote::Align::kLeft     ? " left"
+             : n.align == PlotNote::Align::kCenter ? " center"
+                                                   : " right")
+         << (n.opaque ? " boxed" : "") << " front textcolor rgb '" << n.color << "' offset character "
+         << n.dx_chars << ", " << n.dy_chars;
+      if (n.point_type >= 0)
+        gp << " point pt " << n.point_type << " ps " << n.point_size << " lc rgb '" << n.color << "'";
+      gp << "\n";
     }
     gp << "plot ";
     if (plot.series.empty()) gp << "NaN notitle";

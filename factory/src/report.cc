@@ -37,7 +37,7 @@ thead { display: table-header-group; } td:first-child { white-space: nowrap; } t
 .keep { break-inside: avoid; page-break-inside: avoid; }
 .warn { background: #fff4d6; border: 1px solid #e0b000; padding: 4px 8px; margin: 6px 0; }
 .note { color: #555; font-size: 11px; }
-.outlier { color: #b00; } .failed-unit { color: #b00; font-weight: bold; }
+.outlier { color: #b00; } .failed-unit { color: #b00; font-weight: bold; } tr.current td { background: #ffe9d6; font-weight: bold; }
 h2, h3 { break-after: avoid; page-break-after: avoid; }
 .sign td { height: 28px; min-width: 180px; }
 @media print { body { margin: 0; max-width: none; font-size: 10.5px; } .page-break { break-before: page; } }
@@ -541,40 +541,210 @@ void WriteCertificate(const std::string& path, const Certificate& certificate) {
 
 // ---------------------------------------------------------------- the lot page
 
+namespace {
+
+constexpr int kMaxCategoryLabels = 40;      // unit or lot names under a plot; more are thinned out
+constexpr int kPlotWidthChars = 64;         // characters of tick labels side by side under a small plot
+constexpr int kSmallPlotWidthPx = 540;      // two to a row on the page: text stays legible when scaled
+constexpr size_t kMaxBarNotes = 24;         // yields printed on their bars up to this many lots
+constexpr double kNoteInsideBarPct = 15.0;  // a yield note goes inside its bar from this yield up
+const char* kHighlight = "#ff7f0e";         // this lot, an outlier's ring
+const char* kFailRed = "#c00000";
+// The mean and the 3-sigma lines differ in colour as well as in dash: gnuplot 5.4's SVG terminal
+// joins a dotted line to the solid one before it when they share a colour, and draws both solid.
+const char* kMeanGrey = "#444444";
+const char* kSigmaGrey = "#8a8a8a";
+
+PlotFigure OnePanel(const Plot& plot, int width_px, int height_px) {
+  PlotFigure figure = Figure(1, 1, width_px, height_px);
+  figure.panels.push_back(plot);
+  return figure;
+}
+
+// What the limits allow, in words: "|value| < 5", "16.1 .. 16.9", "< 0.05".
+std::string LimitsText(const std::optional<LimitInterval>& limits) {
+  if (!limits) return "\xe2\x80\x93";
+  if (limits->symmetric && limits->upper) return "|value| < " + Fmt("%g", *limits->upper);
+  if (limits->lower && limits->upper)
+    return Fmt("%.6g", *limits->lower) + " .. " + Fmt("%.6g", *limits->upper);
+  return limits->upper ? "< " + Fmt("%g", *limits->upper) : "> " + Fmt("%g", *limits->lower);
+}
+
+// Dashed lines at the sides of `limits` in view; the x label notes the sides beyond the scale.
+void LimitLines(const std::optional<LimitInterval>& limits, const FigureView& view, Plot* plot) {
+  if (!limits) return;
+  if (limits->lower && view.lower_in_view)
+    plot->markers.push_back({*limits->lower, Fmt("%g", *limits->lower), kFailRed});
+  if (limits->upper && view.upper_in_view)
+    plot->markers.push_back({*limits->upper, Fmt("%g", *limits->upper), kFailRed});
+  if ((limits->lower && !view.lower_in_view) || (limits->upper && !view.upper_in_view))
+    plot->x_label += "; limit " + LimitsText(limits) + " beyond this scale";
+}
+
+void NiceY(const FigureView& view, Plot* plot) {
+  const AxisScale y = NiceAxis(view.range[0], view.range[1]);
+  plot->y_range = std::array<double, 2>{y.lo, y.hi};
+  plot->y_tic_step = y.step;
+  plot->y_format = y.format;
+}
+
+void CategoryX(const std::vector<std::string>& labels, Plot* plot) {
+  const CategoryAxis axis = CategoryTics(labels, kMaxCategoryLabels, kPlotWidthChars);
+  plot->x_tics = axis.tics;
+  plot->x_tic_rotate_deg = axis.rotate_deg;
+  plot->x_range = axis.range;
+}
+
+std::string Capabilities(const std::optional<double>& ppk, const std::optional<double>& cpk) {
+  return (ppk ? Fmt(", Ppk %.3g", *ppk) : "") + (cpk ? Fmt(", Cpk %.3g", *cpk) : "");
+}
+
+// A strip plot of one figure over the lot: a point per unit at its row, the limits, the mean and
+// mean -+ 3 sigma; a failed unit as a square (filled when this figure is outside its limits), an
+// outlier ringed.
+PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
+  std::vector<std::string> labels;
+  for (const LotUnitRow& r : lot.rows) labels.push_back(r.label);
+  Plot plot = Panel(f.name + ": mean " + Fmt("%.6g", f.mean) + ", \xcf\x83 " + Fmt("%.2g", f.stdev) +
+                        Capabilities(f.ppk, f.cpk),
+                    lot.unit_prefix.empty() ? "unit" : "unit (" + lot.unit_prefix + "\xe2\x80\xa6)", f.unit);
+  plot.key = false;
+  CategoryX(labels, &plot);
+  NiceY(f.view, &plot);
+  PlotSeries normal = Series(PlotSeries::Style::kPoints, "", 0, {}, {});
+  PlotSeries failed_elsewhere = normal, failed_here = normal, outlier = normal;
+  normal.point_size = 0.8;
+  failed_elsewhere.color = failed_here.color = kFailRed;
+  failed_elsewhere.point_type = 4;  // open square: failed on another criterion
+  failed_here.point_type = 5;       // filled square: this figure is outside its limits
+  failed_elsewhere.point_size = failed_here.point_size = 1.0;
+  outlier.color = kHighlight;
+  outlier.point_type = 6;  // a ring around the point
+  outlier.point_size = 2.0;
+  for (size_t i = 0; i < f.value.size(); ++i) {
+    PlotSeries& s = f.outside_limits[i] ? failed_here : f.failed[i] ? failed_elsewhere : normal;
+    s.x.push_back(f.row[i]);
+    s.y.push_back(f.value[i]);
+    if (f.z[i].outlier) {
+      outlier.x.push_back(f.row[i]);
+      outlier.y.push_back(f.value[i]);
+    }
+  }
+  plot.series = {normal, failed_elsewhere, failed_here, outlier};
+  plot.markers.push_back({f.mean, "mean", kMeanGrey, false, 1});
+  if (f.stdev > 0.0) {
+    plot.markers.push_back({f.three_sigma[0],
+                            "\xe2\x88\x92"
+                            "3\xcf\x83",
+                            kSigmaGrey, false, 3});
+    plot.markers.push_back({f.three_sigma[1], "+3\xcf\x83", kSigmaGrey, false, 3});
+  }
+  LimitLines(f.limits, f.view, &plot);
+  return OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230);
+}
+
+// The lots of a results store: their yields as a table and bars, then the key figures' lot means;
+// the plots are svgs[first...] (LotHistoryPlots' order).
+void AcrossLots(Html* h, const LotHistory& history, const std::vector<Svg>& svgs, size_t first,
+                const std::string& failure) {
+  h->Open("div", {{"class", "keep"}, {"data-key", "history"}});
+  h->Element("h2", "Across lots");
+  h->Element("p",
+             "Every lot in the results store " + history.store_path +
+                 " (each unit by its latest fit), oldest first" +
+                 (history.current >= 0 ? "; this lot in orange." : "."),
+             {{"class", "note"}});
+  h->Open("table").Open("thead");
+  Row(h, {"lot", "units", "passed", "failed", "not fitted", "yield"}, "th");
+  h->Close("thead").Open("tbody");
+  for (size_t i = 0; i < history.lots.size(); ++i) {
+    const LotYield& y = history.lots[i];
+    HtmlAttributes row = {{"data-history-lot", y.lot}};
+    if (static_cast<int>(i) == history.current) row.push_back({"class", "current"});
+    h->Open("tr", row).Element("td", y.lot);
+    Num(h, Count(y.units));
+    Num(h, Count(y.passed));
+    Num(h, Count(y.failed));
+    Num(h, Count(y.not_fitted));
+    Num(h, Fmt("%.1f %%", history.yield_pct[i]), {{"data-yield", FormatDouble(history.yield_pct[i])}});
+    h->Close("tr");
+  }
+  h->Close("tbody").Close("table");
+  Plots(h, svgs, first, first + 1, failure);
+  h->Close("div");
+  h->Element("h3", "Key figures across lots");
+  Plots(h, svgs, first + 1, svgs.size(), failure, "plots2");
+}
+
+// Draws `figures` in one gnuplot run; `failure` says why not.
+std::vector<Svg> TryDraw(const std::vector<PlotFigure>& figures, std::string* failure) {
+  try {
+    return DrawSvg(figures);
+  } catch (const std::exception& e) {
+    *failure = e.what();
+    return {};
+  }
+}
+
+}  // namespace
+
 std::vector<PlotFigure> LotPlots(const LotSummary& lot) {
   std::vector<PlotFigure> figures;
-  for (const LotFigure& f : lot.figures) {
-    PlotFigure figure;
-    figure.width_px = 640;
-    figure.height_px = 200;
-    Plot plot;
-    plot.title = f.name + " (" + f.unit + ")";
-    plot.y_tics = false;
+  for (const LotFigure& f : lot.figures) figures.push_back(StripFigure(lot, f));
+  return figures;
+}
+
+std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
+  std::vector<std::string> names;
+  for (const LotYield& y : history.lots) names.push_back(y.lot);
+  std::vector<PlotFigure> figures;
+  Plot yield = Panel("Yield per lot (units that passed their limits)", "lot", "yield, %");
+  yield.key = false;
+  CategoryX(names, &yield);
+  yield.y_range = std::array<double, 2>{0.0, 100.0};
+  yield.y_tic_step = 20.0;
+  yield.y_format = "%.0f";
+  PlotSeries others = Series(PlotSeries::Style::kBoxes, "", 0, {}, {});
+  PlotSeries current = others;
+  current.color = kHighlight;
+  for (size_t i = 0; i < history.lots.size(); ++i) {
+    PlotSeries& s = static_cast<int>(i) == history.current ? current : others;
+    s.x.push_back(i);
+    s.y.push_back(history.yield_pct[i]);
+    if (history.lots.size() <= kMaxBarNotes) {
+      PlotNote note;
+      note.x = i;
+      note.y = history.yield_pct[i];
+      note.text = Fmt("%.0f %%", history.yield_pct[i]) + " of " + Count(history.lots[i].units);
+      const bool inside = history.yield_pct[i] >= kNoteInsideBarPct;
+      note.dy_chars = inside ? -0.9 : 0.7;
+      note.color = inside ? "#ffffff" : note.color;
+      note.align = PlotNote::Align::kCenter;
+      yield.notes.push_back(note);
+    }
+  }
+  yield.series = {others, current};
+  figures.push_back(OnePanel(yield, 900, yield.x_tic_rotate_deg ? 300 : 240));
+  for (const LotTrend& t : history.trends) {
+    Plot plot = Panel(t.name + ": lot mean \xc2\xb1 1 \xcf\x83 of its units", "lot", t.unit);
     plot.key = false;
-    plot.y_range = std::array<double, 2>{-0.3, 0.9};
-    PlotSeries normal = Series(PlotSeries::Style::kPoints, "", 0, {}, {});
-    PlotSeries outlier = Series(PlotSeries::Style::kPoints, "outlier", 1, {}, {});
-    PlotSeries failed = Series(PlotSeries::Style::kPoints, "failed limits", 1, {}, {});
-    normal.point_size = outlier.point_size = failed.point_size = 0.9;
-    outlier.point_type = 6;  // open circle: an outlier
-    outlier.point_size = 1.6;
-    failed.point_type = 5;  // filled square: a unit that failed its limits
-    for (size_t i = 0; i < f.value.size(); ++i) {
-      PlotSeries& s = f.failed[i] ? failed : normal;
-      s.x.push_back(f.value[i]);
-      s.y.push_back(f.jitter[i]);
-      if (f.z[i].outlier) {
-        outlier.x.push_back(f.value[i]);
-        outlier.y.push_back(f.jitter[i]);
-      }
+    CategoryX(names, &plot);
+    NiceY(t.view, &plot);
+    PlotSeries lots = Series(PlotSeries::Style::kErrorBars, "", 0, {}, {});
+    lots.point_size = 0.8;
+    PlotSeries this_lot = lots;
+    this_lot.color = kHighlight;
+    this_lot.point_size = 1.2;
+    for (size_t i = 0; i < t.mean.size(); ++i) {
+      if (t.count[i] == 0) continue;
+      PlotSeries& s = static_cast<int>(i) == history.current ? this_lot : lots;
+      s.x.push_back(i);
+      s.y.push_back(t.mean[i]);
+      s.error.push_back(t.sigma[i]);
     }
-    plot.series = {normal, failed, outlier};
-    if (f.limit) {
-      plot.markers.push_back({*f.limit, "limit", "#b00000", true});
-      plot.markers.push_back({-*f.limit, "-limit", "#b00000", true});
-    }
-    figure.panels.push_back(plot);
-    figures.push_back(figure);
+    plot.series = {lots, this_lot};
+    LimitLines(t.limits, t.view, &plot);
+    figures.push_back(OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230));
   }
   return figures;
 }
@@ -584,7 +754,8 @@ std::string LotPageHtml(const LotSummary& lot) {
   h.Open("html", {{"lang", "en"}}).Open("head").Void("meta", {{"charset", "utf-8"}});
   h.Element("title", "Lot " + lot.lot).Style(kStyle).PageStyle("Lot " + lot.lot, lot.written_utc, "auto");
   h.Close("head").Open("body");
-  h.Open("h1").Text("Lot ").Element("span", lot.lot, {{"data-key", "lot"}}).Close("h1");
+  h.Open("h1").Text("Lot ").Element("span", lot.lot, {{"data-key", "lot"}});
+  h.Text(" \xe2\x80\x94 calibration results").Close("h1");
   h.Open("table");
   h.Open("tr").Element("td", "units").Open("td").Element("span", Count(lot.units), {{"data-key", "units"}});
   h.Close("td").Close("tr");
@@ -598,6 +769,7 @@ std::string LotPageHtml(const LotSummary& lot) {
       .Open("td")
       .Element("span", Fmt("%.1f", lot.yield_pct), {{"data-key", "yield"}});
   h.Text(" %").Close("td").Close("tr");
+  Row(&h, {"acceptance limits", lot.limits_name.empty() ? "none given" : lot.limits_name});
   Row(&h, {"written", lot.written_utc + " by " + lot.software + ", git " + lot.git_revision});
   h.Close("table");
 
@@ -642,36 +814,57 @@ std::string LotPageHtml(const LotSummary& lot) {
     h.Close("tbody").Close("table");
   }
 
-  h.Element("h2", "Key figures at 25 degC over the lot");
+  h.Open("div", {{"class", "keep"}}).Element("h2", "Key figures at 25 degC over the lot");
+  h.Element("p",
+            "\xcf\x83: the units' standard deviation; \xcf\x83 within: the mean moving range of consecutive "
+            "units / 1.128. Ppk = min(upper - mean, mean - lower) / 3\xcf\x83; Cpk the same with \xcf\x83 "
+            "within (Cpk well above Ppk: the lot drifts from unit to unit).",
+            {{"class", "note"}});
   h.Open("table").Open("thead");
-  Row(&h, {"figure", "units", "mean", "sigma", "limit (|value| <)", "Ppk"}, "th");
+  Row(&h, {"figure", "units", "mean", "\xcf\x83", "\xcf\x83 within", "limits", "Ppk", "Cpk"}, "th");
   h.Close("thead").Open("tbody");
   for (const LotFigure& f : lot.figures) {
     h.Open("tr", {{"data-lot-figure", f.name}}).Element("td", f.name + " (" + f.unit + ")");
     Num(&h, Count(static_cast<long long>(f.value.size())));
-    Num(&h, Fmt("%.6g", f.mean));
-    Num(&h, Fmt("%.3g", f.stdev));
-    Num(&h, f.limit ? Fmt("%g", *f.limit) : "\xe2\x80\x93");
+    Num(&h, Fmt("%.6g", f.mean), {{"data-mean", FormatDouble(f.mean)}});
+    Num(&h, Fmt("%.3g", f.stdev), {{"data-sigma", FormatDouble(f.stdev)}});
+    Num(&h, Fmt("%.3g", f.stdev_within));
+    Num(&h, LimitsText(f.limits));
     Num(&h, f.ppk ? Fmt("%.2f", *f.ppk) : "\xe2\x80\x93", {{"data-ppk", f.ppk ? FormatDouble(*f.ppk) : ""}});
+    Num(&h, f.cpk ? Fmt("%.2f", *f.cpk) : "\xe2\x80\x93", {{"data-cpk", f.cpk ? FormatDouble(*f.cpk) : ""}});
     h.Close("tr");
   }
-  h.Close("tbody").Close("table");
+  h.Close("tbody").Close("table").Close("div");
 
-  h.Element("h2", "Distributions");
-  h.Element(
-      "p",
-      "One dot per fitted unit; filled square: the unit failed its limits; open circle: outlier; dashed: "
-      "the limit.",
-      {{"class", "note"}});
-  const std::vector<PlotFigure> figures = LotPlots(lot);
-  if (!figures.empty()) {
-    try {
-      const std::vector<Svg> svgs = DrawSvg(figures);
-      Plots(&h, svgs, 0, svgs.size(), "", "plots2");
-    } catch (const std::exception& e) {
-      Plots(&h, {}, 0, 0, e.what());
-    }
+  std::vector<PlotFigure> figures = LotPlots(lot);
+  const size_t strips = figures.size();
+  if (lot.history) {
+    for (PlotFigure& f : LotHistoryPlots(*lot.history)) figures.push_back(std::move(f));
   }
+  std::string failure;
+  const std::vector<Svg> svgs = TryDraw(figures, &failure);
+  h.Element("h2", "Distributions");
+  h.Element("p",
+            "One point per fitted unit, in the order of the units table. Red square: the unit failed its "
+            "limits (filled: on this figure); orange ring: outlier; grey: the lot's mean (solid) and mean "
+            "\xc2\xb1 3\xcf\x83 (dotted); red dashed: the limits.",
+            {{"class", "note"}});
+  Plots(&h, svgs, 0, strips, failure, "plots2");
+
+  if (lot.history) AcrossLots(&h, *lot.history, svgs, strips, failure);
+  h.Close("body").Close("html");
+  return h.Finish();
+}
+
+std::string LotHistoryHtml(const LotHistory& history) {
+  const std::string title = "Lots in " + history.store_path;
+  Html h;
+  h.Open("html", {{"lang", "en"}}).Open("head").Void("meta", {{"charset", "utf-8"}});
+  h.Element("title", title).Style(kStyle).PageStyle(title, "", "auto");
+  h.Close("head").Open("body").Element("h1", title);
+  std::string failure;
+  const std::vector<Svg> svgs = TryDraw(LotHistoryPlots(history), &failure);
+  AcrossLots(&h, history, svgs, 0, failure);
   h.Close("body").Close("html");
   return h.Finish();
 }

@@ -218,4 +218,20 @@ std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std
   return points;
 }
 
+std::vector<LotValue> ResultsStore::LotValues(const std::string& figure) {
+  Statement query(
+      db_,
+      "SELECT f.lot, f.unit, g.value, g.sigma, g.unit FROM fits f JOIN figures g ON g.fit_id = f.id "
+      "WHERE f.id = (SELECT max(id) FROM fits h WHERE h.lot = f.lot AND h.unit = f.unit) "
+      "AND f.lot != '' AND f.status = 'fitted' AND (g.name = ?1 OR g.coefficient = ?1) "
+      "ORDER BY f.lot, f.unit");
+  if (!query.ok()) Fail("querying a figure per lot");
+  query.Bind(1, figure);
+  std::vector<LotValue> values;
+  while (query.Step() == SQLITE_ROW) {
+    values.push_back({query.Text(0), query.Text(1), query.Double(2), query.Double(3), query.Text(4)});
+  }
+  return values;
+}
+
 }  // namespace imufit

@@ -1,4 +1,15 @@
 // imufit — the Allan deviation plot of analysed columns, as a figure of the plotting module.
+//
+// One log-log panel per kind of column (gyro, accelerometer, other: their units differ). In each,
+// per column: the curve with its confidence bars, and over Allan-variance curves (adev, oadev,
+// totdev: the IEEE 952 model is the Allan variance's) the fitted model (solid) and its terms
+// (dashed, where they carry at least a hundredth of the model's variance), annotated:
+//   - the angle (velocity) random walk N where it is read, on the -1/2 slope line at tau = 1 s
+//     (sigma(1 s) = N; a filled point), labelled "ARW 0.299 ± 0.0004 °/√h";
+//   - the bias-instability floor: the flat term sqrt(2 ln 2 / pi) B = 0.664 B at the model's
+//     minimum (a diamond), labelled "bias instability 2.99 ± 0.39 °/h" (B, not the floor's height).
+// A term the fit does not resolve is said in words at the panel's foot. Labels carry the column's
+// name when a panel has more than one column.
 #ifndef IMUFIT_FACTORY_ALLAN_PLOT_H_
 #define IMUFIT_FACTORY_ALLAN_PLOT_H_
 
@@ -10,11 +21,20 @@
 
 namespace imufit {
 
-// `imufit allan --plot`: one panel per kind of column (they have different units); in each, per
-// column the curve with its confidence bars, the fitted IEEE 952 model (solid), its terms (dashed)
-// and the read-out points (open circles); ARW and bias instability printed on the plot. `in_dph`
-// shows gyro panels in deg/h instead of rad/s.
-PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::string& title, bool in_dph);
+// The unit of the gyro panels' deviation axis (other kinds keep their column's own unit).
+enum class AllanPlotUnits {
+  kNative,        // "native" or "rad/s": the columns' own unit (rad/s for a corrected file)
+  kDegPerSecond,  // "deg/s"
+  kDegPerHour,    // "deg/h": the unit bias instability is quoted in
+};
+// Parses "native", "rad/s", "deg/s", "deg/h"; false (and `units` untouched) for anything else.
+bool ParseAllanPlotUnits(const std::string& text, AllanPlotUnits* units);
+// "native, rad/s, deg/s, deg/h", for messages and help.
+const char* AllanPlotUnitsNames();
+
+// `imufit allan --plot`: the figure described above, titled `title`.
+PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::string& title,
+                     AllanPlotUnits units = AllanPlotUnits::kNative);
 
 }  // namespace imufit
 

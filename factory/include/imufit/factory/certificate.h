@@ -19,6 +19,7 @@
 
 #include "imufit/factory/acceptance.h"
 #include "imufit/factory/batch.h"
+#include "imufit/factory/lot_history.h"
 #include "imufit/fit/validation.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
@@ -207,17 +208,23 @@ std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std:
 struct LotUnitRow {
   std::string unit, serial, status, verdict, message;
   bool has_report = false;
+  std::string label;  // the unit without the prefix all units share ("unit-07" -> "07"): axis labels
 };
 
 struct LotFigure {
   std::string name, unit;
   std::vector<std::string> units;  // per point: the unit folder
-  std::vector<double> value, sigma, jitter;
+  std::vector<int> row;            // per point: the unit's index in LotSummary::rows (a strip plot's x)
+  std::vector<double> value, sigma;
   std::vector<RobustZ> z;
-  std::vector<bool> failed;  // the unit failed its limits
+  std::vector<bool> failed;          // the unit failed its limits (any criterion)
+  std::vector<bool> outside_limits;  // this value itself lies outside this figure's limits
   double mean = 0.0, stdev = 0.0;
-  std::optional<double> limit;  // the max_abs of a limit on this figure
-  std::optional<double> ppk;    // min(limit - mean, mean + limit) / (3 stdev)
+  std::array<double, 2> three_sigma{0.0, 0.0};  // mean -+ 3 stdev: where the lot's units fall
+  double stdev_within = 0.0;                    // mean moving range / 1.128 (lot_history.h)
+  std::optional<LimitInterval> limits;          // what the limits allow this figure; nullopt: no limit on it
+  std::optional<double> ppk, cpk;               // against `limits` (lot_history.h)
+  FigureView view;  // what a strip plot shows: the values, mean +- 3 sigma, the limits in reach
 };
 
 struct LotOutlier {
@@ -227,11 +234,14 @@ struct LotOutlier {
 
 struct LotSummary {
   std::string lot, written_utc, software, git_revision;
+  std::string limits_name;  // the limits file's name, or its path; empty without limits
   int units = 0, passed = 0, failed = 0, not_fitted = 0, errors = 0;
   double yield_pct = 0.0;
   std::vector<LotUnitRow> rows;
+  std::string unit_prefix;  // what every unit's name starts with and the labels leave out
   std::vector<LotFigure> figures;
   std::vector<LotOutlier> outliers;
+  std::optional<LotHistory> history;  // every lot of the results store, when the batch had one
 };
 
 LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, const std::string& software,

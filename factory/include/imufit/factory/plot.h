@@ -20,7 +20,8 @@ namespace imufit {
 const char* PlotColor(int index);
 
 struct PlotSeries {
-  enum class Style { kLines, kPoints, kLinesPoints, kBand, kErrorBars };
+  // kBoxes: bars from 0 to y, 0.7 x units wide (categories at x = 0, 1, 2, ...).
+  enum class Style { kLines, kPoints, kLinesPoints, kBand, kErrorBars, kBoxes };
   Style style = Style::kLines;
   std::string title;  // "" leaves the series out of the key
   std::string color = "#1f77b4";
@@ -40,11 +41,33 @@ struct PlotMarker {
   std::string label;
   std::string color = "#b00000";
   bool vertical = false;
+  int dash_type = 2;  // gnuplot's: 1 solid, 2 dashed, 3 dotted
 };
 
 // A line of text inside the panel; labels stack from the top left (or the bottom left).
 struct PlotLabel {
   std::string text;
+};
+
+// A tick mark of the x axis with its own text (a unit's or a lot's name at its category).
+struct PlotTic {
+  double value = 0.0;
+  std::string label;
+};
+
+// Text at a point of the data (a value read off a curve, a bar's height), with a point drawn there
+// when point_type >= 0. The text starts at the point (is centred on it, ends there), moved by
+// character widths and heights, so that notes stack without knowing the axes' scales.
+struct PlotNote {
+  enum class Align { kLeft, kCenter, kRight };
+  double x = 0.0, y = 0.0;  // data coordinates
+  std::string text;
+  std::string color = "#222222";
+  double dx_chars = 0.0, dy_chars = 0.0;
+  Align align = Align::kLeft;
+  int point_type = -1;
+  double point_size = 1.0;
+  bool opaque = false;  // the text on a white ground, over the lines behind it
 };
 
 struct Plot {
@@ -57,7 +80,34 @@ struct Plot {
   std::vector<PlotSeries> series;
   std::vector<PlotMarker> markers;
   std::vector<PlotLabel> labels;
+  // A linear y axis: tick marks every y_tic_step from the range's start, printed with y_format
+  // (printf, e.g. "%.4f"); 0 and "" leave them to gnuplot. NiceAxis() picks range, step and format.
+  double y_tic_step = 0.0;
+  std::string y_format;
+  std::vector<PlotTic> x_tics;  // replace gnuplot's x tick marks; empty: gnuplot's own
+  int x_tic_rotate_deg = 0;     // 90: labels read bottom to top (many or long labels)
+  std::vector<PlotNote> notes;
 };
+
+// A linear axis that shows [lo, hi] with 3 % to spare each side: widened to whole steps of 1, 2 or
+// 5 x 10^k, about `tics` steps in all, with the printf format of the fewest decimals that tell neighbouring
+// ticks apart
+// ("%.0f" for steps of 1 and more). A zero-width range is widened around its value.
+struct AxisScale {
+  double lo = 0.0, hi = 1.0, step = 0.2;
+  std::string format = "%.1f";
+};
+AxisScale NiceAxis(double lo, double hi, int tics = 5);
+
+// An x axis of categories 0, 1, 2, ... named `labels` (units, lots): every label while at most
+// `max_labels`, else every k-th from the first so that at most max_labels show; turned upright
+// (rotate_deg 90) when the labels shown would not fit side by side in `width_chars` characters.
+struct CategoryAxis {
+  std::vector<PlotTic> tics;
+  int rotate_deg = 0;
+  std::array<double, 2> range{-0.5, 0.5};  // half a category beyond the first and the last
+};
+CategoryAxis CategoryTics(const std::vector<std::string>& labels, int max_labels, int width_chars);
 
 struct PlotFigure {
   std::string title;  // above the grid ("" = none)

@@ -24,9 +24,14 @@ std::string CertificateHtml(const Certificate& certificate);
 // Writes it atomically.
 void WriteCertificate(const std::string& path, const Certificate& certificate);
 
-// The lot page's strip plots, one per key figure, with the limits drawn.
+// The lot page's strip plots, one per key figure: a point per unit, the limits, mean and 3 sigma.
 std::vector<PlotFigure> LotPlots(const LotSummary& lot);
+// Across lots: the yield per lot (bars, this lot highlighted), then per trend figure the lots'
+// means with their sigma.
+std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history);
 std::string LotPageHtml(const LotSummary& lot);
+// The lots of a results store on a page of their own (`imufit history DB --lot --html`).
+std::string LotHistoryHtml(const LotHistory& history);
 
 }  // namespace imufit
 

@@ -57,6 +57,15 @@ struct TrendPoint {
   std::string unit;
 };
 
+// One key figure of one unit of a lot.
+struct LotValue {
+  std::string lot;
+  std::string unit;
+  double value = 0.0;
+  double sigma = -1.0;
+  std::string figure_unit;  // "deg/s", ...
+};
+
 class ResultsStore {
  public:
   // Opens the database at `path`, creating it (and its schema) when it does not exist.
@@ -64,6 +73,8 @@ class ResultsStore {
   ~ResultsStore();
   ResultsStore(const ResultsStore&) = delete;
   ResultsStore& operator=(const ResultsStore&) = delete;
+
+  const std::string& path() const { return path_; }
 
   // Records one fit in one transaction; returns its id.
   int64_t Record(const StoredFit& fit);
@@ -75,6 +86,9 @@ class ResultsStore {
   // One key figure (a Figure name such as "gyro_bias_dps.x" or coefficient path "gyro.bias.x")
   // over time, oldest first; optionally of one serial.
   std::vector<TrendPoint> Trend(const std::string& figure, const std::string& serial);
+  // One key figure (name or coefficient path, as Trend) of every unit of every lot, each unit by
+  // its latest fit in the lot (the fit Yield() counts), fitted units only; by lot, then unit.
+  std::vector<LotValue> LotValues(const std::string& figure);
 
  private:
   void Open();  // pragmas, schema, version check

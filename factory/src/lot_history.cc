@@ -1,0 +1,156 @@
+#include "imufit/factory/lot_history.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "imufit/io/units.h"
+
+namespace imufit {
+namespace {
+
+// d2 of a moving range of two: E|x_i - x_(i-1)| = 1.128 sigma for normal x.
+constexpr double kMovingRangeD2 = 1.128;
+
+// The intersection of two intervals (each side the tighter one).
+LimitInterval Intersect(const LimitInterval& a, const LimitInterval& b) {
+  LimitInterval both;
+  both.lower = !a.lower ? b.lower : !b.lower ? a.lower : std::max(*a.lower, *b.lower);
+  both.upper = !a.upper ? b.upper : !b.upper ? a.upper : std::min(*a.upper, *b.upper);
+  both.symmetric = a.symmetric && b.symmetric;
+  return both;
+}
+
+// The nominal scale of a scale figure in the figure's unit (raw/(deg/s), raw/g); 0 without one.
+double NominalScale(const std::string& quantity, const Limits& limits) {
+  if (quantity == "gyro_scale_per_dps") return limits.nominal_gyro_scale / kRadToDeg;
+  if (quantity == "accel_scale_per_g") return limits.nominal_accel_scale * kStandardGravityMps2;
+  return 0.0;
+}
+
+}  // namespace
+
+const std::vector<std::string> kLotTrendFigures = {
+    "gyro_bias_dps.x", "gyro_bias_dps.y", "gyro_bias_dps.z",       "accel_bias_mg.x",
+    "accel_bias_mg.y", "accel_bias_mg.z", "gyro_residual_rms_dps", "accel_residual_rms_mg"};
+
+std::optional<LimitInterval> FigureLimits(const std::string& figure, const Limits& limits) {
+  const size_t dot = figure.find('.');
+  const std::string quantity = figure.substr(0, dot);
+  const std::string axis = dot == std::string::npos ? "" : figure.substr(dot + 1);
+  // "gyro_scale_per_dps" is judged by "gyro_scale_error_ppm" and "_pct": |S / nominal - 1| < limit.
+  const size_t scale_at = quantity.find("_scale_per_");
+  const std::string scale_error =
+      scale_at == std::string::npos ? "" : quantity.substr(0, scale_at) + "_scale_error_";
+  const double nominal = NominalScale(quantity, limits);
+  std::optional<LimitInterval> interval;
+  for (const LimitCriterion& criterion : limits.criteria) {
+    if (criterion.kind == LimitKind::kCoverage || criterion.statistic == LimitStatistic::kSigma) continue;
+    if (!axis.empty() &&
+        std::find(criterion.axes.begin(), criterion.axes.end(), axis) == criterion.axes.end())
+      continue;
+    LimitInterval allowed;
+    if (criterion.quantity == quantity && criterion.kind == LimitKind::kFigure) {
+      allowed.upper = criterion.max_abs;  // a residual RMS: one-sided
+    } else if (criterion.quantity == quantity) {
+      allowed = {-criterion.max_abs, criterion.max_abs, true};
+    } else if (!scale_error.empty() && nominal > 0.0 && criterion.quantity.rfind(scale_error, 0) == 0) {
+      const bool ppm =
+          criterion.quantity.size() > 4 && criterion.quantity.substr(criterion.quantity.size() - 4) == "_ppm";
+      const double fraction = criterion.max_abs * (ppm ? 1e-6 : 1e-2);
+      allowed = {nominal * (1.0 - fraction), nominal * (1.0 + fraction), false};
+    } else {
+      continue;
+    }
+    interval = interval ? Intersect(*interval, allowed) : allowed;
+  }
+  return interval;
+}
+
+FigureView ViewWithLimits(double lo, double hi, const std::optional<LimitInterval>& limits) {
+  FigureView view;
+  view.range = {lo, hi};
+  if (!limits) return view;
+  const double reach = kLimitViewReach * (hi - lo);
+  if (limits->lower && *limits->lower >= lo - reach) {
+    view.lower_in_view = true;
+    view.range[0] = std::min(lo, *limits->lower);
+  }
+  if (limits->upper && *limits->upper <= hi + reach) {
+    view.upper_in_view = true;
+    view.range[1] = std::max(hi, *limits->upper);
+  }
+  return view;
+}
+
+MeanSigma MeanAndSigma(const std::vector<double>& values) {
+  MeanSigma m;
+  m.count = static_cast<int>(values.size());
+  if (values.empty()) return m;
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  m.mean = sum / m.count;
+  double squares = 0.0;
+  for (double v : values) squares += (v - m.mean) * (v - m.mean);
+  m.sigma = m.count > 1 ? std::sqrt(squares / (m.count - 1)) : 0.0;
+  return m;
+}
+
+double WithinSigma(const std::vector<double>& values) {
+  if (values.size() < 2) return 0.0;
+  double ranges = 0.0;
+  for (size_t i = 1; i < values.size(); ++i) ranges += std::abs(values[i] - values[i - 1]);
+  return ranges / (values.size() - 1) / kMovingRangeD2;
+}
+
+std::optional<double> Capability(double mean, double sigma, const LimitInterval& limits) {
+  if (!(sigma > 0.0) || (!limits.lower && !limits.upper)) return std::nullopt;
+  double margin = INFINITY;
+  if (limits.upper) margin = std::min(margin, *limits.upper - mean);
+  if (limits.lower) margin = std::min(margin, mean - *limits.lower);
+  return margin / (3.0 * sigma);
+}
+
+LotHistory MakeLotHistory(ResultsStore* store, const std::string& current_lot, const Limits* limits,
+                          const std::vector<std::string>& figures) {
+  LotHistory h;
+  h.store_path = store->path();
+  h.lots = store->Yield("");
+  std::map<std::string, size_t> index;
+  for (size_t i = 0; i < h.lots.size(); ++i) {
+    const LotYield& y = h.lots[i];
+    index[y.lot] = i;
+    h.yield_pct.push_back(y.units > 0 ? 100.0 * y.passed / y.units : 0.0);
+    if (y.lot == current_lot) h.current = static_cast<int>(i);
+  }
+  for (const std::string& name : figures) {
+    std::vector<std::vector<double>> per_lot(h.lots.size());
+    LotTrend trend;
+    trend.name = name;
+    for (const LotValue& v : store->LotValues(name)) {
+      const auto lot = index.find(v.lot);
+      if (lot == index.end()) continue;
+      per_lot[lot->second].push_back(v.value);
+      trend.unit = v.figure_unit;
+    }
+    if (trend.unit.empty()) continue;  // no lot has it
+    for (const std::vector<double>& values : per_lot) {
+      const MeanSigma m = MeanAndSigma(values);
+      trend.count.push_back(m.count);
+      trend.mean.push_back(m.count > 0 ? m.mean : NAN);
+      trend.sigma.push_back(m.count > 0 ? m.sigma : NAN);
+    }
+    if (limits != nullptr) trend.limits = FigureLimits(name, *limits);
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < trend.mean.size(); ++i) {
+      if (trend.count[i] == 0) continue;
+      lo = std::min(lo, trend.mean[i] - trend.sigma[i]);
+      hi = std::max(hi, trend.mean[i] + trend.sigma[i]);
+    }
+    trend.view = ViewWithLimits(lo, hi, trend.limits);
+    h.trends.push_back(std::move(trend));
+  }
+  return h;
+}
+
+}  // namespace imufit

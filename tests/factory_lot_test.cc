@@ -1,0 +1,293 @@
+// Tests of the lot page's numbers (part of factory_test): a figure's limit interval, capability
+// (Ppk, moving-range Cpk), the LotSummary of a hand-made batch (unit labels, failed and outlying
+// units, what a strip plot shows), and lots compared across a results store (LotHistory), with the
+// page that draws them.
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "imufit/factory/certificate.h"
+#include "imufit/factory/lot_history.h"
+#include "imufit/factory/plot.h"
+#include "imufit/factory/report.h"
+#include "imufit/factory/store.h"
+#include "imufit/io/limits.h"
+#include "imufit/io/units.h"
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Absolute tolerance of sums and ratios of a few numbers of order 1 recomputed by hand.
+constexpr double kArithmeticAbsolute = 1e-12;
+
+class LotTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("imufit_factory_lot_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  Limits WriteLimits(const std::string& text) const {
+    const std::string path = (dir_ / "limits.yaml").string();
+    std::ofstream(path) << "format: imufit-limits\nversion: 1\n" << text;
+    return ReadLimits(path);
+  }
+  fs::path dir_;
+};
+
+Figure MakeFigure(const std::string& name, const std::string& unit, double value, double sigma) {
+  return {name, "", unit, value, sigma};
+}
+
+TEST_F(LotTest, FigureLimitsAreTheTightestIntervalTheValueCriteriaAllow) {
+  const Limits limits = WriteLimits(
+      "nominal: {gyro_scale: 939.65, accel_scale: 208.838}\n"
+      "criteria:\n"
+      "  - {quantity: gyro_bias_dps, max_abs: 5}\n"
+      "  - {quantity: gyro_bias_dps, max_abs: 2, axes: [x]}\n"
+      "  - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.001}\n"
+      "  - {quantity: gyro_scale_error_ppm, max_abs: 20000}\n"
+      "  - {quantity: gyro_scale_error_pct, max_abs: 1, axes: [z]}\n"
+      "  - {quantity: accel_scale_error_pct, max_abs: 2}\n"
+      "  - {quantity: gyro_residual_rms_dps, max_abs: 0.05}\n"
+      "  - {quantity: fit_temp_range_c, covers: [-20, 60]}\n");
+  const std::optional<LimitInterval> x = FigureLimits("gyro_bias_dps.x", limits);
+  ASSERT_TRUE(x && x->lower && x->upper);
+  EXPECT_EQ(*x->lower, -2.0);  // the axis-specific criterion is tighter; the sigma one bounds no value
+  EXPECT_EQ(*x->upper, 2.0);
+  EXPECT_TRUE(x->symmetric);
+  EXPECT_EQ(*FigureLimits("gyro_bias_dps.y", limits)->upper, 5.0);
+  // Scale: |S / nominal - 1| < 2 % (ppm), 1 % on z, around the nominal in raw per deg/s.
+  const double nominal_per_dps = 939.65 / kRadToDeg;
+  const std::optional<LimitInterval> sy = FigureLimits("gyro_scale_per_dps.y", limits);
+  ASSERT_TRUE(sy && sy->lower && sy->upper);
+  EXPECT_NEAR(*sy->lower, nominal_per_dps * 0.98, kArithmeticAbsolute);
+  EXPECT_NEAR(*sy->upper, nominal_per_dps * 1.02, kArithmeticAbsolute);
+  EXPECT_FALSE(sy->symmetric);
+  EXPECT_NEAR(*FigureLimits("gyro_scale_per_dps.z", limits)->upper, nominal_per_dps * 1.01,
+              kArithmeticAbsolute);
+  EXPECT_NEAR(*FigureLimits("accel_scale_per_g.x", limits)->lower, 208.838 * kStandardGravityMps2 * 0.98,
+              kArithmeticAbsolute);
+  // A residual RMS: one-sided.
+  const std::optional<LimitInterval> rms = FigureLimits("gyro_residual_rms_dps", limits);
+  ASSERT_TRUE(rms);
+  EXPECT_FALSE(rms->lower);
+  EXPECT_EQ(*rms->upper, 0.05);
+  EXPECT_FALSE(FigureLimits("accel_bias_mg.x", limits));
+  EXPECT_FALSE(FigureLimits("gyro_g_sensitivity_dpsg.xx", limits));
+}
+
+TEST(LotCapability, PpkFromTheSpreadCpkFromTheMovingRange) {
+  const std::vector<double> values = {1.0, 2.0, 3.0, 4.0, 5.0};
+  const MeanSigma m = MeanAndSigma(values);
+  EXPECT_EQ(m.count, 5);
+  EXPECT_EQ(m.mean, 3.0);
+  EXPECT_NEAR(m.sigma, std::sqrt(2.5), kArithmeticAbsolute);           // sum of squares 10 over n - 1 = 4
+  EXPECT_NEAR(WithinSigma(values), 1.0 / 1.128, kArithmeticAbsolute);  // every moving range is 1
+  const LimitInterval symmetric{-10.0, 10.0, true};
+  EXPECT_NEAR(*Capability(m.mean, m.sigma, symmetric), 7.0 / (3.0 * std::sqrt(2.5)), kArithmeticAbsolute);
+  LimitInterval lower_only;
+  lower_only.lower = -10.0;
+  EXPECT_NEAR(*Capability(m.mean, 1.0, lower_only), 13.0 / 3.0, kArithmeticAbsolute);
+  EXPECT_FALSE(Capability(m.mean, 0.0, symmetric));        // no spread: no capability
+  EXPECT_FALSE(Capability(m.mean, 1.0, LimitInterval()));  // no limits: none either
+  EXPECT_EQ(MeanAndSigma({4.0}).sigma, 0.0);
+  EXPECT_EQ(WithinSigma({4.0}), 0.0);
+}
+
+// Five units: unit-03 failed another criterion, unit-04 could not be read, unit-05 is outside the
+// gyro bias limit and far from the others.
+BatchResult FiveUnits() {
+  BatchResult batch;
+  const double bias[] = {0.10, 0.11, 0.09, 0.0, 0.50};
+  for (int i = 0; i < 5; ++i) {
+    UnitOutcome u;
+    u.unit = "unit-0" + std::to_string(i + 1);
+    u.serial = "SN" + std::to_string(i + 1);
+    u.status = i == 3 ? "error" : "fitted";
+    u.verdict = i == 3 ? "" : (i == 2 || i == 4) ? "FAIL" : "PASS";
+    if (i != 3) {
+      u.figures = {MakeFigure("gyro_bias_dps.x", "deg/s", bias[i], 0.001),
+                   MakeFigure("accel_bias_mg.x", "mg", 10.0 + 0.1 * i, 0.01)};
+    }
+    batch.units.push_back(u);
+  }
+  batch.passed = 2;
+  batch.failed = 2;
+  batch.errors = 1;
+  return batch;
+}
+
+TEST_F(LotTest, LotSummaryMarksFailedAndOutlyingUnitsAndChoosesWhatAStripPlotShows) {
+  const Limits limits = WriteLimits(
+      "name: bench limits\ncriteria:\n"
+      "  - {quantity: gyro_bias_dps, max_abs: 0.3}\n"
+      "  - {quantity: accel_bias_mg, max_abs: 1000}\n");
+  const LotSummary s = MakeLotSummary("LOT-1", FiveUnits(), "imufit test", limits);
+  EXPECT_EQ(s.limits_name, "bench limits");
+  EXPECT_EQ(s.unit_prefix, "unit-");  // cut where a word ends, not inside the number
+  ASSERT_EQ(s.rows.size(), 5u);
+  EXPECT_EQ(s.rows[0].label, "01");
+  EXPECT_EQ(s.rows[4].label, "05");
+  EXPECT_DOUBLE_EQ(s.yield_pct, 40.0);
+  ASSERT_EQ(s.figures.size(), 2u);
+
+  const LotFigure& bias = s.figures[0];
+  EXPECT_EQ(bias.name, "gyro_bias_dps.x");
+  EXPECT_EQ(bias.row, (std::vector<int>{0, 1, 2, 4}));  // the unit that was not read leaves its row empty
+  EXPECT_EQ(bias.failed, (std::vector<bool>{false, false, true, true}));
+  EXPECT_EQ(bias.outside_limits, (std::vector<bool>{false, false, false, true}));
+  const MeanSigma m = MeanAndSigma({0.10, 0.11, 0.09, 0.50});
+  EXPECT_DOUBLE_EQ(bias.mean, m.mean);
+  EXPECT_DOUBLE_EQ(bias.stdev, m.sigma);
+  EXPECT_DOUBLE_EQ(bias.three_sigma[1], m.mean + 3.0 * m.sigma);
+  EXPECT_DOUBLE_EQ(*bias.ppk, (0.3 - m.mean) / (3.0 * m.sigma));
+  EXPECT_DOUBLE_EQ(*bias.cpk, (0.3 - m.mean) / (3.0 * WithinSigma({0.10, 0.11, 0.09, 0.50})));
+  // The limits lie within the values' spread: both drawn, and the view holds them.
+  EXPECT_TRUE(bias.view.lower_in_view && bias.view.upper_in_view);
+  EXPECT_LE(bias.view.range[0], -0.3);
+  EXPECT_GE(bias.view.range[1], 0.5);
+  // unit-05 is an outlier (far by the spread and by its own sigma), listed with its serial.
+  ASSERT_EQ(s.outliers.size(), 1u);
+  EXPECT_EQ(s.outliers[0].unit, "unit-05");
+  EXPECT_EQ(s.outliers[0].serial, "SN5");
+
+  // +-1000 mg is far beyond 10.0 .. 10.4 mg: out of view, so the values are not squashed into a line.
+  const LotFigure& accel = s.figures[1];
+  EXPECT_FALSE(accel.view.lower_in_view || accel.view.upper_in_view);
+  EXPECT_GT(accel.view.range[0], 9.0);
+  EXPECT_LT(accel.view.range[1], 11.0);
+
+  // The strip plot draws what the struct says: points at the units' rows, a filled square for the
+  // unit outside its limit, an open one for the unit that failed elsewhere, a ring for the outlier,
+  // the mean, 3 sigma and both limits.
+  const std::vector<PlotFigure> plots = LotPlots(s);
+  ASSERT_EQ(plots.size(), 2u);
+  const Plot& strip = plots[0].panels.at(0);
+  ASSERT_EQ(strip.series.size(), 4u);
+  EXPECT_EQ(strip.series[0].x, (std::vector<double>{0, 1}));
+  EXPECT_EQ(strip.series[1].x, (std::vector<double>{2}));
+  EXPECT_EQ(strip.series[2].x, (std::vector<double>{4}));
+  EXPECT_EQ(strip.series[3].x, (std::vector<double>{4}));
+  EXPECT_EQ(strip.markers.size(), 5u);
+  EXPECT_EQ(strip.x_tics.size(), 5u);
+  EXPECT_EQ(strip.x_tics[4].label, "05");
+  EXPECT_EQ(plots[1].panels.at(0).markers.size(), 3u);  // mean and 3 sigma; the limits off scale
+  EXPECT_NE(plots[1].panels.at(0).x_label.find("beyond this scale"), std::string::npos);
+}
+
+// Records one unit's fit of `lot` with a gyro bias x of `bias_dps`.
+void Record(ResultsStore* store, const std::string& lot, const std::string& unit, const std::string& time,
+            const std::string& status, const std::string& verdict, double bias_dps) {
+  StoredFit fit;
+  fit.serial = lot + "/" + unit;
+  fit.unit = unit;
+  fit.lot = lot;
+  fit.time_utc = time;
+  fit.software = "imufit test";
+  fit.status = status;
+  fit.verdict = verdict;
+  if (status == "fitted") fit.figures = {MakeFigure("gyro_bias_dps.x", "deg/s", bias_dps, 0.01)};
+  store->Record(fit);
+}
+
+TEST_F(LotTest, LotHistoryHasEveryLotsYieldAndMeans) {
+  ResultsStore store((dir_ / "store.db").string());
+  Record(&store, "lot-a", "u1", "2026-01-01T00:00:00Z", "fitted", "PASS", 1.0);
+  Record(&store, "lot-a", "u2", "2026-01-01T00:01:00Z", "fitted", "PASS", 1.2);
+  // lot-b: u1 failed, was refitted and passed: its latest fit counts, in the yield and the mean.
+  Record(&store, "lot-b", "u1", "2026-02-01T00:00:00Z", "fitted", "FAIL", 9.0);
+  Record(&store, "lot-b", "u2", "2026-02-01T00:01:00Z", "fitted", "PASS", 2.2);
+  Record(&store, "lot-b", "u3", "2026-02-01T00:02:00Z", "fitted", "PASS", 2.4);
+  Record(&store, "lot-b", "u1", "2026-02-02T00:00:00Z", "fitted", "PASS", 2.0);
+  // lot-c: one unit not fitted (no figures), one that passed.
+  Record(&store, "lot-c", "u1", "2026-03-01T00:00:00Z", "not-fitted", "", 0.0);
+  Record(&store, "lot-c", "u2", "2026-03-01T00:01:00Z", "fitted", "PASS", 3.0);
+  Record(&store, "", "single", "2026-03-02T00:00:00Z", "fitted", "PASS", 50.0);  // imufit fit: no lot
+
+  const Limits limits = WriteLimits("criteria:\n  - {quantity: gyro_bias_dps, max_abs: 4}\n");
+  const LotHistory h = MakeLotHistory(&store, "lot-b", &limits, {"gyro_bias_dps.x", "accel_bias_mg.x"});
+  ASSERT_EQ(h.lots.size(), 3u);
+  EXPECT_EQ(h.lots[0].lot, "lot-a");
+  EXPECT_EQ(h.lots[2].lot, "lot-c");
+  EXPECT_EQ(h.current, 1);
+  EXPECT_EQ(h.yield_pct, (std::vector<double>{100.0, 100.0, 50.0}));
+  EXPECT_EQ(h.lots[2].not_fitted, 1);
+  ASSERT_EQ(h.trends.size(), 1u);  // no lot has accel_bias_mg.x
+  const LotTrend& t = h.trends[0];
+  EXPECT_EQ(t.unit, "deg/s");
+  EXPECT_EQ(t.count, (std::vector<int>{2, 3, 1}));
+  EXPECT_NEAR(t.mean[0], 1.1, kArithmeticAbsolute);
+  EXPECT_NEAR(t.mean[1], 2.2, kArithmeticAbsolute);
+  EXPECT_NEAR(t.sigma[1], 0.2, kArithmeticAbsolute);
+  EXPECT_EQ(t.mean[2], 3.0);
+  EXPECT_EQ(t.sigma[2], 0.0);
+  ASSERT_TRUE(t.limits);
+  EXPECT_EQ(*t.limits->upper, 4.0);
+  EXPECT_TRUE(t.view.upper_in_view);
+  EXPECT_EQ(MakeLotHistory(&store, "lot-z", nullptr).current, -1);
+
+  // The plots: yield bars with this lot apart, then the lot means with their sigmas.
+  const std::vector<PlotFigure> plots = LotHistoryPlots(h);
+  ASSERT_EQ(plots.size(), 2u);
+  const Plot& yield = plots[0].panels.at(0);
+  ASSERT_EQ(yield.series.size(), 2u);
+  EXPECT_EQ(yield.series[0].style, PlotSeries::Style::kBoxes);
+  EXPECT_EQ(yield.series[0].y, (std::vector<double>{100.0, 50.0}));
+  EXPECT_EQ(yield.series[1].x, (std::vector<double>{1.0}));
+  EXPECT_EQ(yield.x_tics.at(2).label, "lot-c");
+  const Plot& trend = plots[1].panels.at(0);
+  EXPECT_EQ(trend.series[1].y.size(), 1u);
+  EXPECT_NEAR(trend.series[1].error.at(0), 0.2, kArithmeticAbsolute);
+
+  // The lot page of lot-b carries the section, its table and (with gnuplot) the charts.
+  LotSummary summary = MakeLotSummary("lot-b", FiveUnits(), "imufit test", limits);
+  summary.history = h;
+  const std::string page = LotPageHtml(summary);
+  EXPECT_NE(page.find("data-key=\"history\""), std::string::npos);
+  EXPECT_NE(page.find("<tr data-history-lot=\"lot-b\" class=\"current\">"), std::string::npos);
+  EXPECT_NE(page.find("data-yield=\"50\""), std::string::npos);
+  if (GnuplotAvailable()) {
+    size_t svgs = 0;
+    for (size_t at = page.find("<svg"); at != std::string::npos; at = page.find("<svg", at + 1)) ++svgs;
+    EXPECT_EQ(svgs, LotPlots(summary).size() + plots.size());
+  }
+}
+
+TEST(PlotAxes, NiceTicksAndCategoryLabels) {
+  const AxisScale a = NiceAxis(16.5507, 16.5516);
+  EXPECT_NEAR(a.step, 0.0002, 1e-15);
+  EXPECT_EQ(a.format, "%.4f");
+  EXPECT_LE(a.lo, 16.5507);
+  EXPECT_GE(a.hi, 16.5516);
+  EXPECT_EQ(NiceAxis(0.0, 100.0).format, "%.0f");
+  const AxisScale flat = NiceAxis(2.0, 2.0);  // one value: a small range around it
+  EXPECT_LT(flat.lo, 2.0);
+  EXPECT_GT(flat.hi, 2.0);
+
+  std::vector<std::string> few = {"01", "02", "03"}, many;
+  for (int i = 0; i < 100; ++i) many.push_back("SN24011" + std::to_string(1000 + i));
+  const CategoryAxis flat_axis = CategoryTics(few, 40, 64);
+  EXPECT_EQ(flat_axis.tics.size(), 3u);
+  EXPECT_EQ(flat_axis.rotate_deg, 0);
+  EXPECT_EQ(flat_axis.range[1], 2.5);
+  const CategoryAxis upright = CategoryTics(many, 40, 64);
+  EXPECT_EQ(upright.tics.size(), 34u);  // every third of 100
+  EXPECT_EQ(upright.tics[1].value, 3.0);
+  EXPECT_EQ(upright.rotate_deg, 90);
+}
+
+}  // namespace
+}  // namespace imufit
