@@ -18,9 +18,11 @@
 #include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
+#include "imufit/fit/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
@@ -402,6 +404,94 @@ TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
   ASSERT_EQ(plots.size(), c.curves.size() + 2);
   EXPECT_EQ(plots[3].panels.size(), 9u);
   EXPECT_EQ(plots[0].panels[0].series[1].y, c.curves[0].curves[0].value);
+  // The window estimates are drawn over the band and the line.
+  ASSERT_FALSE(c.curves[0].curves[0].points.empty());
+  EXPECT_EQ(plots[0].panels[0].series[2].style, PlotSeries::Style::kErrorBars);
+  EXPECT_EQ(plots[0].panels[0].series[2].y.size(), c.curves[0].curves[0].points.size());
+  EXPECT_EQ(plots[0].panels[0].series[2].error[0], c.curves[0].curves[0].points[0].sigma);
+}
+
+// The window estimates of every coefficient on a run with white noise only, simulated from the
+// fixture truth: they scatter about the true coefficient and about the fitted polynomial by their
+// own 1-sigma error bars (normalised RMS near 1), and not less (points taken from the curve
+// would have none of the data's scatter).
+TEST_F(CertificateTest, WindowEstimatesScatterAboutTheTruthByTheirOwnNoise) {
+  const Plan plan = ReadPlan(kFixtures + "/plan_6pos.yaml");
+  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  SimulationOptions options;
+  options.soak_temps_c = {-40.0, -10.0, 25.0, 55.0, 85.0};
+  options.rate_hz = 50.0;
+  options.dwell_s = 5.0;
+  options.transition_s = 1.0;
+  options.gyro_noise_density = 8.7e-5;
+  options.accel_noise_density = 1.5e-3;
+  options.seed = 21;
+  const std::string samples = (dir_ / "white.csv").string();
+  SamplesWriter writer(samples, true);
+  SimulateRun(options, plan.site, plan.segments, truth.model,
+              [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+  writer.Commit();
+  const FitRunResult fit = FitRun(kFixtures + "/plan_6pos.yaml", samples, FitRunOptions());
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  CertificateSources sources;
+  sources.calibration = *fit.calibration;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  const Certificate c = MakeCertificate(sources);
+
+  // The groups in certificate order: sensor, first coefficient, whether stated as a scale change.
+  struct GroupKind {
+    Sensor sensor;
+    int first;
+    bool scale_change;
+  };
+  const GroupKind kinds[] = {
+      {Sensor::kGyro, kBiasCoefficient, false},         {Sensor::kGyro, kScaleCoefficient, true},
+      {Sensor::kGyro, kMisalignmentCoefficient, false}, {Sensor::kGyro, kGSensitivityCoefficient, false},
+      {Sensor::kAccel, kBiasCoefficient, false},        {Sensor::kAccel, kScaleCoefficient, true},
+      {Sensor::kAccel, kMisalignmentCoefficient, false}};
+  ASSERT_EQ(c.curves.size(), std::size(kinds));
+  const auto value = [](const SensorModel& model, const GroupKind& kind, int i, double temp_c) {
+    return kind.scale_change
+               ? ScaleChangePpm(model, nullptr, kind.sensor, i, temp_c).value
+               : EngineeringCoefficient(model, nullptr, kind.sensor, kind.first + i, temp_c).value;
+  };
+  // Normalised RMS over a group's points (60 to 180 of them): 1 for errors of exactly the stated
+  // sigma; the bounds allow the sampling spread of that many points and the fit's own error.
+  // Against the fit the RMS is lower, about sqrt(1 - terms / points) (4 polynomial terms from 10 to
+  // 30 points per coefficient, shared with the other coefficients of the row): at least
+  // kLowestFitRms, where points computed from the curve would give 0.
+  constexpr double kLowestRms = 0.6, kHighestRms = 1.5, kLowestFitRms = 0.5;
+  constexpr double kWorstPointSigmas = 5.0;  // worst case over all ~700 points
+  constexpr size_t kFewestPoints = 10;       // per coefficient: 2 positions or rates x 5 temperatures
+  for (size_t g = 0; g < c.curves.size(); ++g) {
+    double truth_squares = 0.0, fit_squares = 0.0;
+    size_t count = 0;
+    for (size_t i = 0; i < c.curves[g].curves.size(); ++i) {
+      const CoefficientCurve& curve = c.curves[g].curves[i];
+      EXPECT_GE(curve.points.size(), kFewestPoints) << c.curves[g].title << " " << curve.axis;
+      for (const CoefficientPoint& p : curve.points) {
+        ASSERT_GT(p.sigma, 0.0);
+        const double z_truth =
+            (p.value - value(truth.model, kinds[g], static_cast<int>(i), p.temp_c)) / p.sigma;
+        const double z_fit =
+            (p.value - value(fit.calibration->model, kinds[g], static_cast<int>(i), p.temp_c)) / p.sigma;
+        EXPECT_LT(std::abs(z_truth), kWorstPointSigmas)
+            << c.curves[g].title << " " << curve.axis << " at " << p.temp_c << " degC, segment " << p.segment;
+        truth_squares += z_truth * z_truth;
+        fit_squares += z_fit * z_fit;
+        ++count;
+      }
+    }
+    ASSERT_GT(count, 0u) << c.curves[g].title;
+    const double truth_rms = std::sqrt(truth_squares / count), fit_rms = std::sqrt(fit_squares / count);
+    std::printf("%-48s %4zu points: normalised RMS against the truth %.2f, against the fit %.2f\n",
+                c.curves[g].title.c_str(), count, truth_rms, fit_rms);
+    EXPECT_GT(truth_rms, kLowestRms) << c.curves[g].title;
+    EXPECT_LT(truth_rms, kHighestRms) << c.curves[g].title;
+    EXPECT_GT(fit_rms, kLowestFitRms) << c.curves[g].title << ": the points do not carry the data's scatter";
+    EXPECT_LT(fit_rms, kHighestRms) << c.curves[g].title;
+  }
 }
 
 TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {

@@ -74,7 +74,8 @@ std::string With(const PlotSeries& s) {
       w << "using 1:3:4 with filledcurves fs transparent solid 0.18 noborder " << color;
       break;
     case PlotSeries::Style::kErrorBars:
-      w << "using 1:2:3:4 with yerrorbars pt " << s.point_type << " ps " << s.point_size << " " << color;
+      w << "using 1:2:3:4 with yerrorbars lw " << s.line_width << " pt " << s.point_type << " ps "
+        << s.point_size << " " << color;
       break;
   }
   w << " " << (s.title.empty() ? "notitle" : "title " + Quote(s.title));
@@ -150,6 +151,7 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
   for (size_t p = 0; p < figure.panels.size(); ++p) {
     const Plot& plot = figure.panels[p];
     gp << "reset\nset encoding utf8\nset grid lc rgb '#dddddd'\nset border lc rgb '#444444'\n";
+    gp << "set bars small\n";
     gp << "set title " << Quote(plot.title) << "\n";
     gp << "set xlabel " << Quote(plot.x_label) << "\nset ylabel " << Quote(plot.y_label) << "\n";
     if (plot.log_x)

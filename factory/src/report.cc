@@ -107,8 +107,20 @@ PlotFigure CoefficientFigure(const CoefficientGroup& g) {
     band.hi = c.hi;
     plot->series.push_back(band);
     PlotSeries line = Series(PlotSeries::Style::kLines, g.grid ? "" : c.axis, color, c.temp_c, c.value);
-    line.line_width = 2;
+    line.line_width = 1.5;
     plot->series.push_back(line);
+    // The windows' own estimates over the curve: open circles with their 1-sigma bars (a bar
+    // shorter than the circle is hidden by it).
+    PlotSeries points = Series(PlotSeries::Style::kErrorBars, "", color, {}, {});
+    for (const CoefficientPoint& p : c.points) {
+      points.x.push_back(p.temp_c);
+      points.y.push_back(p.value);
+      points.error.push_back(p.sigma);
+    }
+    points.point_type = 6;
+    points.point_size = 0.45;
+    points.line_width = 1;
+    plot->series.push_back(points);
   };
   if (g.grid) {
     figure.rows = figure.cols = 3;
@@ -144,6 +156,7 @@ PlotFigure ResidualFigure(const WindowResiduals& r) {
                             axis, r.temp_c, values[axis]);
       if (noise) s.error = (*noise)[axis];
       s.point_size = 0.4;
+      s.line_width = 1;
       plot.series.push_back(s);
     }
     figure.panels.push_back(plot);

@@ -14,7 +14,9 @@ std::vector<WindowError> PredictWindows(const SensorModel& model, const std::vec
     const auto segment = std::find_if(segments.begin(), segments.end(),
                                       [&](const TableSegment& s) { return s.id == window.segment; });
     if (segment == segments.end()) continue;
-    const SegmentTruth truth = TruthOf(site, *segment);
+    // As the fit takes it: a turn's truth is its mean rate over the whole occurrence.
+    const SegmentTruth truth =
+        segment->IsTurn() ? TurnTruth(site, *segment, window.DurationS()) : TruthOf(site, *segment);
     WindowError error;
     error.window = static_cast<int>(w);
     error.segment = window.segment;
@@ -24,6 +26,9 @@ std::vector<WindowError> PredictWindows(const SensorModel& model, const std::vec
     model.Correct(window.temp_c, window.gyro_mean, window.accel_mean, &omega_hat, &a_hat);
     error.gyro_radps = omega_hat - truth.omega_radps;
     error.accel_mps2 = a_hat - truth.a_mps2;
+    error.omega_true_radps = truth.omega_radps;
+    error.a_true_mps2 = truth.a_mps2;
+    error.specific_force_known = segment->SpecificForceIsKnown();
     errors.push_back(error);
   }
   return errors;

@@ -62,10 +62,24 @@ struct KeyFigureRow {
   double expanded = -1.0;  // k = 2; < 0: none
 };
 
-// One coefficient against temperature: the polynomial with its 1-sigma band.
+// One window's own estimate of a coefficient at the window's temperature T_w: the value of that
+// one coefficient that explains the window's mean output exactly on the coefficient's row, every
+// other coefficient at its fitted value (a partial residual; equations in certificate.cc). It
+// scatters about the polynomial by the window's noise alone, so the points show what the data say
+// where the curve only shows what the fit made of them.
+struct CoefficientPoint {
+  double temp_c = 0.0;
+  double value = 0.0;  // in the group's unit
+  double sigma = 0.0;  // 1-sigma from the window mean's own noise (no fit uncertainty in it)
+  int segment = -1;
+};
+
+// One coefficient against temperature: the polynomial with its 1-sigma band, and the windows'
+// own estimates.
 struct CoefficientCurve {
   std::string axis;  // "x", "xy", ...
   std::vector<double> temp_c, value, lo, hi;
+  std::vector<CoefficientPoint> points;
 };
 struct CoefficientGroup {
   std::string title;  // "Gyro bias"

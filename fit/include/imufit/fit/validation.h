@@ -29,6 +29,12 @@ struct WindowError {
   double temp_c = 0.0;
   Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+  // The truth the errors are taken against (a turn's: its mean rate over the whole occurrence).
+  Eigen::Vector3d omega_true_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d a_true_mps2 = Eigen::Vector3d::Zero();
+  // False where gravity turns in the body frame (a turn, a rate about a non-vertical axis): the
+  // specific force is then not constant, and accel_mps2 is against its value at the start.
+  bool specific_force_known = true;
 };
 
 // Errors aggregated over the windows of one segment (or of one held-out group).
