@@ -9,6 +9,7 @@
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
+#include "imufit/io/station.h"
 
 namespace imufit {
 namespace {
@@ -20,19 +21,22 @@ struct ReportArguments {
   std::string limits;
   std::string output;
   std::string serial;
+  std::string station;  // station file: where and by whom
   bool allow_mismatch = false;
   WindowOptions windows;
   SamplesInputArguments input;  // --temp-c and the segmentation options, as imufit fit has them
 };
 
 int RunReport(const ReportArguments& args) {
-  RefuseToOverwriteInputs(args.output, {args.calibration, args.plan, args.samples, args.limits});
+  RefuseToOverwriteInputs(args.output,
+                          {args.calibration, args.plan, args.samples, args.limits, args.station});
   if (const std::string problem = args.windows.Validate(); !problem.empty())
     throw InputError("imufit report", problem);
   CertificateSources sources;
   sources.calibration = ReadCalibration(args.calibration);
   if (!args.serial.empty()) sources.calibration.serial = args.serial;
   if (!args.limits.empty()) sources.limits = ReadLimits(args.limits);
+  if (!args.station.empty()) sources.station = ReadStation(args.station);
   // A certificate of a calibration for another run's data would certify nothing.
   const std::vector<std::string> mismatches = InputMismatches(sources.calibration, args.plan, args.samples);
   if (!mismatches.empty() && !args.allow_mismatch) {
@@ -49,7 +53,8 @@ int RunReport(const ReportArguments& args) {
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
                     {"samples", args.samples, ""},
-                    {"limits", args.limits, ""}};
+                    {"limits", args.limits, ""},
+                    {"station", args.station, ""}};
   const Certificate certificate = MakeCertificate(sources);
   if (certificate.serial.empty()) {
     std::fprintf(stderr,
@@ -78,6 +83,9 @@ CommandRunner AddReportCommand(CLI::App* root) {
   command->add_option("--limits,-l", args->limits, "acceptance limits YAML");
   command->add_option("--output,-o", args->output, "HTML file to write")->required();
   command->add_option("--serial", args->serial, "the unit's serial (default: the calibration's)");
+  command->add_option(
+      "--station", args->station,
+      "station file (format imufit-station: station, operator, equipment) shown on the certificate");
   command->add_flag("--allow-mismatch", args->allow_mismatch,
                     "certify even when the calibration records other plan/samples hashes than these files' "
                     "(the certificate says so)");

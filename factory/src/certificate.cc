@@ -21,9 +21,15 @@ constexpr int kModelCurvePoints = 80;        // taus at which the fitted Allan m
 constexpr double kHistogramHalfWidth = 5.0;  // normalised errors binned over [-5, 5]
 constexpr int kHistogramBins = 20;
 
-std::string Vector3Text(const Eigen::Vector3d& v) {
+// "+z" for a body axis, else "[x, y, z]".
+std::string DirectionText(const Eigen::Vector3d& v) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(std::abs(v(axis)) - 1.0) < 1e-12 && std::abs(v.norm() - 1.0) < 1e-12) {
+      return std::string(v(axis) > 0 ? "+" : "-") + "xyz"[axis];
+    }
+  }
   char text[96];
-  std::snprintf(text, sizeof text, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  std::snprintf(text, sizeof text, "[%.3g, %.3g, %.3g]", v.x(), v.y(), v.z());
   return text;
 }
 
@@ -348,7 +354,7 @@ std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<Windo
     ResidualRow row;
     row.segment = s.segment;
     if (const TableSegment* seg = s.segment < 0 ? nullptr : plan.Find(s.segment)) {
-      row.up = Vector3Text(seg->up);
+      row.up = DirectionText(seg->up);
       row.rate_dps = DpsFromRadps(seg->rate_radps);
     }
     row.windows = s.windows;
@@ -360,6 +366,30 @@ std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<Windo
     row.accel_max_mg = MgFromMps2(s.accel_max_mps2);
     rows.push_back(row);
   }
+  return rows;
+}
+
+// The rows the certificate prints (Certificate::residual_table_printed).
+std::vector<ResidualRow> PrintedResidualRows(const std::vector<ResidualRow>& table, int* omitted) {
+  *omitted = 0;
+  const int segments = static_cast<int>(table.size()) - 1;  // the last row is "all"
+  if (segments <= kMostResidualRowsPrinted) return table;
+  const ResidualRow& all = table.back();
+  const auto relative = [&](const ResidualRow& r) {
+    return std::max(all.gyro_rms_dps > 0.0 ? r.gyro_rms_dps / all.gyro_rms_dps : 0.0,
+                    all.accel_rms_mg > 0.0 ? r.accel_rms_mg / all.accel_rms_mg : 0.0);
+  };
+  std::vector<size_t> order(segments);
+  for (int i = 0; i < segments; ++i) order[i] = i;
+  const int kept = kMostResidualRowsPrinted - 1;
+  std::partial_sort(order.begin(), order.begin() + kept, order.end(),
+                    [&](size_t a, size_t b) { return relative(table[a]) > relative(table[b]); });
+  order.resize(kept);
+  std::sort(order.begin(), order.end());
+  std::vector<ResidualRow> rows;
+  for (size_t i : order) rows.push_back(table[i]);
+  rows.push_back(all);
+  *omitted = segments - kept;
   return rows;
 }
 
@@ -465,6 +495,19 @@ void CoverageWarnings(const Plan& plan, const RunWindows& run, std::vector<std::
   }
 }
 
+// The station's reference equipment must have been within its calibration when the unit was
+// calibrated (ISO dates compare as text).
+void StationWarnings(const Station& station, const std::string& calibrated_utc,
+                     const std::string& written_utc, std::vector<std::string>* warnings) {
+  if (station.reference_calibration_due.empty()) return;
+  const std::string when = (calibrated_utc.size() >= 10 ? calibrated_utc : written_utc).substr(0, 10);
+  if (station.reference_calibration_due < when) {
+    warnings->push_back("the station's reference equipment was due for calibration on " +
+                        station.reference_calibration_due + ", before this unit was calibrated (" + when +
+                        ")");
+  }
+}
+
 }  // namespace
 
 Certificate MakeCertificate(const CertificateSources& sources) {
@@ -478,7 +521,12 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   c.report_software = cal.software;
   c.git_revision = IMUFIT_GIT_REVISION;
   c.reference_temp_c = cal.model.basis.center_c;
-  for (ReportInput input : sources.inputs) {
+  std::vector<ReportInput> inputs = sources.inputs;
+  if (sources.station && std::none_of(inputs.begin(), inputs.end(),
+                                      [](const ReportInput& in) { return in.role == "station"; })) {
+    inputs.push_back({"station", sources.station->path, ""});
+  }
+  for (ReportInput input : inputs) {
     if (input.path.empty()) continue;
     if (input.sha256.empty()) input.sha256 = Sha256OfFile(input.path);
     c.inputs.push_back(input);
@@ -487,6 +535,8 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     c.warnings.push_back("no serial: neither the calibration, the plan nor --serial names the unit");
   }
   for (const std::string& w : sources.warnings) c.warnings.push_back(w);
+  c.station = sources.station;
+  if (c.station) StationWarnings(*c.station, c.calibrated_utc, c.written_utc, &c.warnings);
   CoverageWarnings(sources.plan, sources.run, &c.warnings);
   c.run = SummariseRun(cal, sources.plan, sources.run);
   c.settings = Settings(cal, sources.windows);
@@ -504,6 +554,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
       PredictWindows(ScaleOnly(cal), sources.run.windows, sources.plan.site, sources.plan.segments);
   c.residuals = Residuals(cal, sources.plan, sources.run.windows, after, before);
   c.residual_table = ResidualTable(sources.plan, after, before);
+  c.residual_table_printed = PrintedResidualRows(c.residual_table, &c.residual_rows_omitted);
 
   c.noise.why_not = "no samples file given";
   for (const ReportInput& in : c.inputs) {
@@ -572,7 +623,7 @@ std::vector<std::string> InputMismatches(const Calibration& calibration, const s
 
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
                             const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const WindowOptions& windows) {
+                            const WindowOptions& windows, const std::optional<Station>& station) {
   const FitRunResult& fit = *unit.fit;
   CertificateSources sources;
   sources.unit = unit.unit;
@@ -588,6 +639,7 @@ Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_p
                     {"plan", unit.plan_path, unit.plan_sha256},
                     {"samples", unit.samples_path, unit.samples_sha256},
                     {"limits", limits_path, ""}};
+  sources.station = station;
   return MakeCertificate(sources);
 }
 

@@ -23,6 +23,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/station.h"
 #include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
@@ -52,6 +53,9 @@ struct CertificateSources {
   std::optional<Limits> limits;
   std::vector<ReportInput> inputs;    // files to hash and list
   std::vector<std::string> warnings;  // from the caller (e.g. a mismatch the user allowed)
+  // Where and by whom (a station file, --station): listed among the inputs (role "station") when
+  // the caller has not.
+  std::optional<Station> station;
 };
 
 struct KeyFigureRow {
@@ -102,9 +106,13 @@ struct WindowResiduals {
   double normalised_gyro_rms = 0.0, normalised_accel_rms = 0.0;  // ~1 when the model explains the run
 };
 
+// A plan with more segments than this prints only the segments with the largest errors after
+// correction (the certificate stays within its pages); the complete table is in the struct.
+inline constexpr int kMostResidualRowsPrinted = 20;
+
 struct ResidualRow {
   int segment = -1;  // -1: all
-  std::string up;    // "[0, 0, 1]"
+  std::string up;    // "+z", or "[0.6, 0, 0.8]" when not along an axis
   double rate_dps = 0.0;
   int windows = 0;
   double gyro_rms_before_dps = 0.0, gyro_rms_dps = 0.0, gyro_max_dps = 0.0;
@@ -176,6 +184,7 @@ struct Certificate {
   double reference_temp_c = 25.0;
   std::vector<ReportInput> inputs;  // with their hashes
   std::vector<std::string> warnings;
+  std::optional<Station> station;  // none: the signers fill in where and by whom
   RunSummary run;
   FitSettings settings;
   std::optional<Verdict> verdict;
@@ -183,6 +192,11 @@ struct Certificate {
   std::vector<CoefficientGroup> curves;
   WindowResiduals residuals;
   std::vector<ResidualRow> residual_table;  // per segment, then all
+  // The rows printed: all of residual_table, or (more than kMostResidualRowsPrinted segments) the
+  // kMostResidualRowsPrinted - 1 segments whose larger of gyro and accel RMS after correction,
+  // each over the run's, is largest, in segment order, then all; residual_rows_omitted counts the others.
+  std::vector<ResidualRow> residual_table_printed;
+  int residual_rows_omitted = 0;
   NoiseSection noise;
   std::vector<ValidationRow> validation;  // empty: not run
 };
@@ -193,7 +207,8 @@ Certificate MakeCertificate(const CertificateSources& sources);
 // From a batch unit just fitted (its FitRunResult is in unit.fit).
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
                             const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const WindowOptions& windows = WindowOptions());
+                            const WindowOptions& windows = WindowOptions(),
+                            const std::optional<Station>& station = std::nullopt);
 
 // The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
 std::vector<Figure> MeasuredFigures(const Certificate& certificate);
