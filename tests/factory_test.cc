@@ -22,6 +22,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
@@ -494,6 +495,54 @@ TEST_F(CertificateTest, WindowEstimatesScatterAboutTheTruthByTheirOwnNoise) {
     EXPECT_GT(fit_rms, kLowestFitRms) << c.curves[g].title << ": the points do not carry the data's scatter";
     EXPECT_LT(fit_rms, kHighestRms) << c.curves[g].title;
   }
+}
+
+// A hand session (six faces, a 360 deg turn about each axis) at one temperature: a turn's window is
+// judged against its mean rate, and the accelerometer is not judged where gravity turned in the
+// body frame (the turns about x and y).
+TEST_F(CertificateTest, AHandSessionsTurnsAreJudgedAgainstTheirMeanRate) {
+  const std::string plan_path = kFixtures + "/plan_hand_6faces_3turns.yaml";
+  const Plan plan = ReadPlan(plan_path);
+  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  SimulationOptions options;
+  options.rate_hz = 100.0;
+  options.dwell_s = 10.0;
+  options.transition_s = 2.0;
+  options.gyro_noise_density = 8.7e-5;
+  options.accel_noise_density = 1.5e-3;
+  options.seed = 4;
+  const std::string samples = (dir_ / "hand.csv").string();
+  SamplesWriter writer(samples, true);
+  SimulateRun(options, plan.site, plan.segments, truth.model,
+              [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+  writer.Commit();
+  FitRunOptions fit_options;
+  fit_options.fit.gyro_temp_order = fit_options.fit.accel_temp_order = 0;
+  const FitRunResult fit = FitRun(plan_path, samples, fit_options);
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  CertificateSources sources;
+  sources.calibration = *fit.calibration;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  const Certificate c = MakeCertificate(sources);
+  ASSERT_EQ(c.residual_table.size(), plan.segments.size() + 1);
+  int turns = 0;
+  for (const ResidualRow& row : c.residual_table) {
+    const TableSegment* segment = row.segment < 0 ? nullptr : plan.Find(row.segment);
+    if (segment == nullptr || !segment->IsTurn()) continue;
+    ++turns;
+    EXPECT_EQ(row.motion.rfind("turn 360 deg about ", 0), 0u) << row.motion;
+    // Against its mean rate the turn's error is noise (about 1e-4 deg/s), not its 36 deg/s.
+    constexpr double kTurnErrorDps = 0.01;
+    EXPECT_LT(row.gyro_rms_dps, kTurnErrorDps) << row.motion;
+    EXPECT_EQ(row.accel_windows, segment->AxisIsVertical() ? 1 : 0) << row.motion;
+  }
+  EXPECT_EQ(turns, 3);
+  // The normalised errors are noise: the turns' accelerometer means are not in them.
+  constexpr double kMostNormalisedRms = 3.0;
+  EXPECT_LT(c.residuals.normalised_gyro_rms, kMostNormalisedRms);
+  EXPECT_LT(c.residuals.normalised_accel_rms, kMostNormalisedRms);
+  EXPECT_LT(c.residual_table.back().accel_rms_mg, 1.0);
 }
 
 TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {

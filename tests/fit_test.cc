@@ -641,6 +641,13 @@ TEST(Turns, PredictWindowsTakesATurnsMeanRateAsItsTruth) {
     if (turn) EXPECT_GT(e.omega_true_radps.norm(), 0.1) << "segment " << e.segment;
   }
   EXPECT_EQ(turns, 3);
+  // The accelerometer's figures leave out the turns about x and y, where gravity turns in the body
+  // frame: what is left is exact.
+  const ErrorStats all = SummariseErrors(errors);
+  EXPECT_EQ(all.windows, 9);
+  EXPECT_EQ(all.accel_windows, 7);
+  constexpr double kNoiseFreeAccelErrorMps2 = 1e-9;
+  EXPECT_LT(all.accel_max_mps2, kNoiseFreeAccelErrorMps2);
 }
 
 TEST(ScaleSign, ASignFlippedTurnIsRefusedWithTheConventionToCheck) {

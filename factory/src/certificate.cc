@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <utility>
@@ -31,6 +32,19 @@ std::string DirectionText(const Eigen::Vector3d& v) {
   char text[96];
   std::snprintf(text, sizeof text, "[%.3g, %.3g, %.3g]", v.x(), v.y(), v.z());
   return text;
+}
+
+// What the table did in a segment: "static", "+100 deg/s" (with " about +x" when the axis is not
+// up), "turn 360 deg about +x".
+std::string MotionText(const TableSegment& segment) {
+  char text[64];
+  if (segment.IsTurn()) {
+    std::snprintf(text, sizeof text, "turn %g deg about ", *segment.angle_rad * kRadToDeg);
+    return text + DirectionText(segment.RotationAxis());
+  }
+  if (segment.IsStatic()) return "static";
+  std::snprintf(text, sizeof text, "%+g deg/s", DpsFromRadps(segment.rate_radps));
+  return segment.axis && !segment.AxisIsVertical() ? text + (" about " + DirectionText(*segment.axis)) : text;
 }
 
 // A number from the calibration's `fit:` block, when there.
@@ -314,11 +328,14 @@ WindowResiduals Residuals(const Calibration& cal, const Plan& plan, const std::v
       r.gyro_dps[axis].push_back(DpsFromRadps(e.gyro_radps(axis)));
       r.gyro_before_dps[axis].push_back(DpsFromRadps(before[i].gyro_radps(axis)));
       r.gyro_noise_dps[axis].push_back(gyro_noise);
-      r.accel_mg[axis].push_back(MgFromMps2(e.accel_mps2(axis)));
-      r.accel_before_mg[axis].push_back(MgFromMps2(before[i].accel_mps2(axis)));
+      const double unknown = std::numeric_limits<double>::quiet_NaN();
+      r.accel_mg[axis].push_back(e.specific_force_known ? MgFromMps2(e.accel_mps2(axis)) : unknown);
+      r.accel_before_mg[axis].push_back(e.specific_force_known ? MgFromMps2(before[i].accel_mps2(axis))
+                                                               : unknown);
       r.accel_noise_mg[axis].push_back(accel_noise);
       if (gyro_noise > 0.0) gyro_normalised.push_back(r.gyro_dps[axis].back() / gyro_noise);
-      if (accel_noise > 0.0) accel_normalised.push_back(r.accel_mg[axis].back() / accel_noise);
+      if (accel_noise > 0.0 && e.specific_force_known)
+        accel_normalised.push_back(r.accel_mg[axis].back() / accel_noise);
     }
   }
   const double bin = 2.0 * kHistogramHalfWidth / kHistogramBins;
@@ -356,8 +373,10 @@ std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<Windo
     if (const TableSegment* seg = s.segment < 0 ? nullptr : plan.Find(s.segment)) {
       row.up = DirectionText(seg->up);
       row.rate_dps = DpsFromRadps(seg->rate_radps);
+      row.motion = MotionText(*seg);
     }
     row.windows = s.windows;
+    row.accel_windows = s.accel_windows;
     row.gyro_rms_before_dps = DpsFromRadps(b.gyro_rms_radps);
     row.gyro_rms_dps = DpsFromRadps(s.gyro_rms_radps);
     row.gyro_max_dps = DpsFromRadps(s.gyro_max_radps);

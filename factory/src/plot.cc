@@ -237,6 +237,11 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
         lo = y_axis && plot.y_from_zero ? 0.0 : lo - margin;
         hi += margin;
       }
+      if (!fixed && !(hi > lo)) {  // one value (a run at one temperature): a unit either side
+        const double half = std::max(1.0, 0.01 * std::abs(lo));
+        lo -= half;
+        hi += half;
+      }
       const double step = TickStep(lo, hi, most);
       if (!(step > 0.0)) continue;
       const char* axis = y_axis ? "y" : "x";

@@ -433,7 +433,7 @@ void ResidualTable(Html* h, const Certificate& c) {
              "outputs divided by the unit's 25 degC scale factors only.",
              {{"class", "note"}});
   h->Open("table").Open("thead").Open("tr");
-  for (const char* title : {"segment", "up", "rate, deg/s", "windows"}) {
+  for (const char* title : {"segment", "up", "motion", "windows"}) {
     h->Element("th", title, {{"rowspan", "2"}});
   }
   h->Element("th", "gyro, deg/s", {{"colspan", "3"}}).Element("th", "accelerometer, mg", {{"colspan", "3"}});
@@ -442,15 +442,18 @@ void ResidualTable(Html* h, const Certificate& c) {
   h->Close("thead").Open("tbody");
   for (const ResidualRow& r : c.residual_table_printed) {
     h->Open("tr", r.segment < 0 ? HtmlAttributes{{"data-key", "residual_all"}} : HtmlAttributes{});
-    h->Element("td", r.segment < 0 ? "all" : Count(r.segment)).Element("td", r.up);
-    Num(h, r.segment < 0 ? "" : Fmt("%g", r.rate_dps));
+    h->Element("td", r.segment < 0 ? "all" : Count(r.segment)).Element("td", r.up).Element("td", r.motion);
     Num(h, Count(r.windows));
     Num(h, Fmt("%.4f", r.gyro_rms_before_dps));
     Num(h, Fmt("%.5f", r.gyro_rms_dps));
     Num(h, Fmt("%.5f", r.gyro_max_dps));
-    Num(h, Fmt("%.3f", r.accel_rms_before_mg));
-    Num(h, Fmt("%.4f", r.accel_rms_mg));
-    Num(h, Fmt("%.4f", r.accel_max_mg));
+    if (r.accel_windows == 0) {
+      h->Element("td", "specific force not constant", {{"colspan", "3"}, {"class", "note"}});
+    } else {
+      Num(h, Fmt("%.3f", r.accel_rms_before_mg));
+      Num(h, Fmt("%.4f", r.accel_rms_mg));
+      Num(h, Fmt("%.4f", r.accel_max_mg));
+    }
     h->Close("tr");
   }
   h->Close("tbody").Close("table").Close("div");

@@ -41,15 +41,15 @@ ErrorStats SummariseErrors(const std::vector<WindowError>& errors) {
   for (const WindowError& e : errors) {
     ++stats.windows;
     gyro_sum += e.gyro_radps.squaredNorm();
-    accel_sum += e.accel_mps2.squaredNorm();
     stats.gyro_max_radps = std::max(stats.gyro_max_radps, e.gyro_radps.cwiseAbs().maxCoeff());
+    if (!e.specific_force_known) continue;  // its accel error is against a specific force that turned
+    ++stats.accel_windows;
+    accel_sum += e.accel_mps2.squaredNorm();
     stats.accel_max_mps2 = std::max(stats.accel_max_mps2, e.accel_mps2.cwiseAbs().maxCoeff());
   }
-  if (stats.windows > 0) {
-    // RMS per axis component.
-    stats.gyro_rms_radps = std::sqrt(gyro_sum / (3.0 * stats.windows));
-    stats.accel_rms_mps2 = std::sqrt(accel_sum / (3.0 * stats.windows));
-  }
+  // RMS per axis component.
+  if (stats.windows > 0) stats.gyro_rms_radps = std::sqrt(gyro_sum / (3.0 * stats.windows));
+  if (stats.accel_windows > 0) stats.accel_rms_mps2 = std::sqrt(accel_sum / (3.0 * stats.accel_windows));
   return stats;
 }
 

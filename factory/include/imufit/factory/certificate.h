@@ -93,7 +93,9 @@ struct CoefficientGroup {
 };
 
 // Per window, signed per-axis errors (corrected - true) before and after correction, in deg/s and
-// mg, with the window mean's own noise (1-sigma from the samples' spread) for the band.
+// mg, with the window mean's own noise (1-sigma from the samples' spread) for the band. The accel
+// values of a window whose specific force is not known (a turn, a rate about a non-vertical axis)
+// are NaN: not drawn, not in the histogram.
 struct WindowResiduals {
   std::vector<double> time_s, temp_c;
   std::vector<int> segment;
@@ -111,10 +113,12 @@ struct WindowResiduals {
 inline constexpr int kMostResidualRowsPrinted = 20;
 
 struct ResidualRow {
-  int segment = -1;  // -1: all
-  std::string up;    // "+z", or "[0.6, 0, 0.8]" when not along an axis
+  int segment = -1;    // -1: all
+  std::string up;      // "+z", or "[0.6, 0, 0.8]" when not along an axis
+  std::string motion;  // "static", "+100 deg/s" (about +x when not about up), "turn 360 deg about +x"
   double rate_dps = 0.0;
   int windows = 0;
+  int accel_windows = 0;  // with a known specific force: the accel figures are over these (0: none)
   double gyro_rms_before_dps = 0.0, gyro_rms_dps = 0.0, gyro_max_dps = 0.0;
   double accel_rms_before_mg = 0.0, accel_rms_mg = 0.0, accel_max_mg = 0.0;
 };

@@ -38,9 +38,12 @@ struct WindowError {
 };
 
 // Errors aggregated over the windows of one segment (or of one held-out group).
+// The accelerometer's figures leave out windows whose specific force is not known (a turn or a rate
+// about a non-vertical axis: WindowError::specific_force_known).
 struct ErrorStats {
   int segment = -1;  // -1 for "all"
   int windows = 0;
+  int accel_windows = 0;  // of `windows`, those with a known specific force
   double gyro_rms_radps = 0.0;
   double gyro_max_radps = 0.0;
   double accel_rms_mps2 = 0.0;
