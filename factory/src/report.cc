@@ -41,6 +41,7 @@ thead { display: table-header-group; } td:first-child { white-space: nowrap; } t
 h2, h3 { break-after: avoid; page-break-after: avoid; }
 .sign { width: 100%; margin-top: 6px; } .sign td { height: 26px; } .sign td:first-child { width: 22%; }
 .sign td:nth-child(2) { width: 30%; } .sign td:nth-child(3) { width: 30%; } table.fill { width: 100%; }
+table.fill td:first-child { width: 35%; }
 @media print { body { margin: 0; max-width: none; font-size: 10px; } td, th { padding: 0 5px; } h2 { margin: 10px 0 4px 0; }
   table { line-height: 1.1; }
   .page-break { break-before: page; } }
@@ -205,9 +206,7 @@ PlotFigure ErrorFigure(const Certificate& c) {
 }
 
 PlotFigure AllanFigure(const NoiseSection& noise) {
-  PlotFigure figure;
-  figure.width_px = 760;
-  figure.height_px = 330;
+  PlotFigure figure = Figure(1, 1, kFullWidthPx, 280);
   Plot plot;
   plot.title = "Gyro overlapping Allan deviation, segment " + Count(noise.segment) +
                Fmt(", %.0f s", noise.duration_s) + Fmt(" at %.1f degC", noise.temp_c);
