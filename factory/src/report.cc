@@ -568,21 +568,21 @@ std::string CertificateHtml(const Certificate& c) {
   KeyFigures(&h, c);
 
   // Coefficients against temperature, two to a row (the heading stays with the first row), then
-  // the g-sensitivity grid.
+  // the g-sensitivity grid. Figure i of CertificatePlots() is group i.
   const size_t groups = c.curves.size();
-  std::vector<size_t> pairs;
+  std::vector<std::vector<size_t>> rows;
   size_t grid = groups;
   for (size_t g = 0; g < groups; ++g) {
     if (c.curves[g].grid) {
       grid = g;
-    } else {
-      pairs.push_back(g);
+      continue;
     }
+    if (rows.empty() || rows.back().size() == 2) rows.emplace_back();
+    rows.back().push_back(g);
   }
-  const auto plot_row = [&](size_t row) {
+  const auto plot_row = [&](const std::vector<size_t>& row) {
     h.Open("div", {{"class", "plots2 keep"}});
-    for (size_t i = row * 2; i < row * 2 + 2 && i < pairs.size(); ++i)
-      Plots(&h, svgs, pairs[i], pairs[i] + 1, "");
+    for (size_t g : row) Plots(&h, svgs, g, g + 1, "");
     h.Close("div");
   };
   h.Open("div", {{"class", "keep"}}).Element("h2", "Coefficients against temperature");
@@ -593,11 +593,11 @@ std::string CertificateHtml(const Certificate& c) {
             {{"class", "note"}});
   if (!failure.empty()) {
     Plots(&h, svgs, 0, 0, failure);
-  } else if (!pairs.empty()) {
-    plot_row(0);
+  } else if (!rows.empty()) {
+    plot_row(rows.front());
   }
   h.Close("div");
-  for (size_t row = 1; row * 2 < pairs.size() && failure.empty(); ++row) plot_row(row);
+  for (size_t r = 1; r < rows.size() && failure.empty(); ++r) plot_row(rows[r]);
   if (grid < groups && failure.empty()) Plots(&h, svgs, grid, grid + 1, "");
 
   h.Open("div", {{"class", "keep"}}).Element("h2", "Errors before and after correction");
