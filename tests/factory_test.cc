@@ -4,10 +4,12 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -543,6 +545,42 @@ TEST_F(CertificateTest, AHandSessionsTurnsAreJudgedAgainstTheirMeanRate) {
   EXPECT_LT(c.residuals.normalised_gyro_rms, kMostNormalisedRms);
   EXPECT_LT(c.residuals.normalised_accel_rms, kMostNormalisedRms);
   EXPECT_LT(c.residual_table.back().accel_rms_mg, 1.0);
+}
+
+// A plan of many segments (the 24-position tactical soak: 36 segments) prints the segments with
+// the largest errors after correction, in segment order, then all; the struct keeps every row.
+TEST_F(CertificateTest, ManySegmentsPrintTheWorstOnly) {
+  const std::string plan_path = kFixtures + "/plan_24pos.yaml";
+  const FitRunResult fit = FitRun(plan_path, kFixtures + "/tactical_24pos_soak.csv.gz", FitRunOptions());
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  CertificateSources sources;
+  sources.calibration = *fit.calibration;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  const Certificate c = MakeCertificate(sources);
+  const size_t segments = fit.plan.segments.size();
+  ASSERT_GT(segments, static_cast<size_t>(kMostResidualRowsPrinted));
+  ASSERT_EQ(c.residual_table.size(), segments + 1);
+  ASSERT_EQ(c.residual_table_printed.size(), static_cast<size_t>(kMostResidualRowsPrinted));
+  EXPECT_EQ(c.residual_rows_omitted, static_cast<int>(segments) - (kMostResidualRowsPrinted - 1));
+  EXPECT_EQ(c.residual_table_printed.back().segment, -1);
+  const ResidualRow& all = c.residual_table.back();
+  const auto relative = [&](const ResidualRow& r) {
+    return std::max(r.gyro_rms_dps / all.gyro_rms_dps, r.accel_rms_mg / all.accel_rms_mg);
+  };
+  double least_printed = 1e300;
+  std::set<int> printed;
+  for (size_t i = 0; i + 1 < c.residual_table_printed.size(); ++i) {
+    const ResidualRow& r = c.residual_table_printed[i];
+    if (i > 0) EXPECT_LT(c.residual_table_printed[i - 1].segment, r.segment);  // in segment order
+    least_printed = std::min(least_printed, relative(r));
+    printed.insert(r.segment);
+  }
+  for (size_t i = 0; i + 1 < c.residual_table.size(); ++i) {
+    if (printed.count(c.residual_table[i].segment) == 0) {
+      EXPECT_LE(relative(c.residual_table[i]), least_printed) << "segment " << c.residual_table[i].segment;
+    }
+  }
 }
 
 TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {
