@@ -356,6 +356,23 @@ class CertificateTest : public FactoryTest {
         InputMismatches(sources.calibration, plan_path, kFixtures + "/mems_6pos_noiseless.csv.gz").empty());
     return MakeCertificate(sources);
   }
+  // The certificate of a fit from its run alone (no limits, no files to hash).
+  static Certificate CertificateOf(const FitRunResult& fit) {
+    CertificateSources sources;
+    sources.calibration = *fit.calibration;
+    sources.plan = fit.plan;
+    sources.run = fit.run;
+    return MakeCertificate(sources);
+  }
+  // Simulates `plan` for the fixture truth into `name` (with its segment column); returns the path.
+  std::string Simulate(const Plan& plan, const SimulationOptions& options, const std::string& name) const {
+    const std::string path = (dir_ / name).string();
+    SamplesWriter writer(path, true);
+    SimulateRun(options, plan.site, plan.segments, ReadCalibration(kFixtures + "/mems_truth.yaml").model,
+                [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+    writer.Commit();
+    return path;
+  }
 };
 
 TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
@@ -431,18 +448,10 @@ TEST_F(CertificateTest, WindowEstimatesScatterAboutTheTruthByTheirOwnNoise) {
   options.gyro_noise_density = 8.7e-5;
   options.accel_noise_density = 1.5e-3;
   options.seed = 21;
-  const std::string samples = (dir_ / "white.csv").string();
-  SamplesWriter writer(samples, true);
-  SimulateRun(options, plan.site, plan.segments, truth.model,
-              [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
-  writer.Commit();
-  const FitRunResult fit = FitRun(kFixtures + "/plan_6pos.yaml", samples, FitRunOptions());
+  const FitRunResult fit =
+      FitRun(kFixtures + "/plan_6pos.yaml", Simulate(plan, options, "white.csv"), FitRunOptions());
   ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
-  CertificateSources sources;
-  sources.calibration = *fit.calibration;
-  sources.plan = fit.plan;
-  sources.run = fit.run;
-  const Certificate c = MakeCertificate(sources);
+  const Certificate c = CertificateOf(fit);
 
   // The groups in certificate order: sensor, first coefficient, whether stated as a scale change.
   struct GroupKind {
@@ -505,7 +514,6 @@ TEST_F(CertificateTest, WindowEstimatesScatterAboutTheTruthByTheirOwnNoise) {
 TEST_F(CertificateTest, AHandSessionsTurnsAreJudgedAgainstTheirMeanRate) {
   const std::string plan_path = kFixtures + "/plan_hand_6faces_3turns.yaml";
   const Plan plan = ReadPlan(plan_path);
-  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
   SimulationOptions options;
   options.rate_hz = 100.0;
   options.dwell_s = 10.0;
@@ -513,20 +521,11 @@ TEST_F(CertificateTest, AHandSessionsTurnsAreJudgedAgainstTheirMeanRate) {
   options.gyro_noise_density = 8.7e-5;
   options.accel_noise_density = 1.5e-3;
   options.seed = 4;
-  const std::string samples = (dir_ / "hand.csv").string();
-  SamplesWriter writer(samples, true);
-  SimulateRun(options, plan.site, plan.segments, truth.model,
-              [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
-  writer.Commit();
   FitRunOptions fit_options;
   fit_options.fit.gyro_temp_order = fit_options.fit.accel_temp_order = 0;
-  const FitRunResult fit = FitRun(plan_path, samples, fit_options);
+  const FitRunResult fit = FitRun(plan_path, Simulate(plan, options, "hand.csv"), fit_options);
   ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
-  CertificateSources sources;
-  sources.calibration = *fit.calibration;
-  sources.plan = fit.plan;
-  sources.run = fit.run;
-  const Certificate c = MakeCertificate(sources);
+  const Certificate c = CertificateOf(fit);
   ASSERT_EQ(c.residual_table.size(), plan.segments.size() + 1);
   int turns = 0;
   for (const ResidualRow& row : c.residual_table) {
@@ -553,11 +552,7 @@ TEST_F(CertificateTest, ManySegmentsPrintTheWorstOnly) {
   const std::string plan_path = kFixtures + "/plan_24pos.yaml";
   const FitRunResult fit = FitRun(plan_path, kFixtures + "/tactical_24pos_soak.csv.gz", FitRunOptions());
   ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
-  CertificateSources sources;
-  sources.calibration = *fit.calibration;
-  sources.plan = fit.plan;
-  sources.run = fit.run;
-  const Certificate c = MakeCertificate(sources);
+  const Certificate c = CertificateOf(fit);
   const size_t segments = fit.plan.segments.size();
   ASSERT_GT(segments, static_cast<size_t>(kMostResidualRowsPrinted));
   ASSERT_EQ(c.residual_table.size(), segments + 1);
@@ -572,7 +567,9 @@ TEST_F(CertificateTest, ManySegmentsPrintTheWorstOnly) {
   std::set<int> printed;
   for (size_t i = 0; i + 1 < c.residual_table_printed.size(); ++i) {
     const ResidualRow& r = c.residual_table_printed[i];
-    if (i > 0) EXPECT_LT(c.residual_table_printed[i - 1].segment, r.segment);  // in segment order
+    if (i > 0) {
+      EXPECT_LT(c.residual_table_printed[i - 1].segment, r.segment);  // in segment order
+    }
     least_printed = std::min(least_printed, relative(r));
     printed.insert(r.segment);
   }

@@ -638,7 +638,9 @@ TEST(Turns, PredictWindowsTakesATurnsMeanRateAsItsTruth) {
     EXPECT_LT(e.gyro_radps.norm(), kNoiseFreeRateErrorRadps) << "segment " << e.segment;
     EXPECT_EQ(e.specific_force_known, !turn || e.segment == 12)
         << "segment " << e.segment;  // 12: about z (up)
-    if (turn) EXPECT_GT(e.omega_true_radps.norm(), 0.1) << "segment " << e.segment;
+    if (turn) {
+      EXPECT_GT(e.omega_true_radps.norm(), 0.1) << "segment " << e.segment;
+    }
   }
   EXPECT_EQ(turns, 3);
   // The accelerometer's figures leave out the turns about x and y, where gravity turns in the body
