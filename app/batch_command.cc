@@ -86,6 +86,9 @@ CommandRunner AddBatchCommand(CLI::App* root) {
   command->add_option("--limits,-l", b.limits_path, "acceptance limits YAML (format imufit-limits)");
   command->add_option("--plan,-p", b.shared_plan, "plan for units without their own plan.yaml");
   command->add_option("--store", b.store_path, "results store (SQLite) to record every fit in");
+  command->add_option(
+      "--station", b.station_path,
+      "station file (format imufit-station: station, operator, equipment) shown on every certificate");
   command->add_option("--lot", b.lot, "the lot's name in the store (default: the units folder's name)");
   command->add_option("--jobs,-j", b.jobs, "units fitted in parallel (0: all cores)")->capture_default_str();
   command

@@ -15,6 +15,7 @@
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/io/station.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
 
@@ -36,7 +37,8 @@ struct FitArguments {
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
   std::string report;  // certificate HTML to write
   std::string store;   // results store to record the fit in
-  std::string serial;  // the unit's serial; empty: the samples header's, else the plan's
+  std::string serial;   // the unit's serial; empty: the samples header's, else the plan's
+  std::string station;  // station file shown on the certificate (with --report)
   double gyro_bias_stability_dph = 0.0;
   double accel_bias_stability_ug = 0.0;
   FitOptions fit;
@@ -109,7 +111,8 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 
 // --limits, --report, --store: the factory additions, after the calibration is written.
 // Returns the exit status: 0, or kExitFailedLimits.
-int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits, const FitRunResult& result,
+int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
+                  const std::optional<Station>& station, const FitRunResult& result,
                   OutputTransaction* outputs) {
   const Calibration& calibration = *result.calibration;
   std::string plan_sha256, samples_sha256;
@@ -131,7 +134,9 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
     sources.inputs = {{"calibration", args.output, Sha256Hex(CalibrationToYaml(calibration))},
                       {"plan", args.plan, plan_sha256},
                       {"samples", args.samples, samples_sha256},
-                      {"limits", args.limits, ""}};
+                      {"limits", args.limits, ""},
+                      {"station", args.station, ""}};
+    sources.station = station;
     certificate = MakeCertificate(sources);
     WarnIfNoSerial(*certificate, args.samples);
   }
@@ -168,11 +173,17 @@ int RunFit(FitArguments args) {
   RefuseToOverwriteInputs(
       args.output, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits, args.prior});
   if (!args.report.empty()) {
-    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits, args.output});
+    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples,
+                                          args.limits, args.output, args.station});
   }
-  // A bad limits file is reported before any work.
+  // A bad limits or station file is reported before any work.
   std::optional<Limits> limits;
   if (!args.limits.empty()) limits = ReadLimits(args.limits);
+  std::optional<Station> station;
+  if (!args.station.empty()) {
+    if (args.report.empty()) throw InputError("--station", "is shown on the certificate: give --report too");
+    station = ReadStation(args.station);
+  }
   std::string error;
   if (!ParseRobustLoss(args.loss, &args.fit.loss, &error)) throw InputError("--loss", error);
   args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
@@ -236,7 +247,7 @@ int RunFit(FitArguments args) {
   OutputTransaction outputs;
   WriteCalibration(args.output, *result.calibration);
 
-  if (args.quiet) return FinishFactory(args, limits, result, &outputs);
+  if (args.quiet) return FinishFactory(args, limits, station, result, &outputs);
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
   std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
@@ -285,7 +296,7 @@ int RunFit(FitArguments args) {
   if (!result.check_errors.empty()) {
     PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
   }
-  return FinishFactory(args, limits, result, &outputs);
+  return FinishFactory(args, limits, station, result, &outputs);
 }
 
 }  // namespace
@@ -361,6 +372,9 @@ CommandRunner AddFitCommand(CLI::App* root) {
       "--serial", args->serial,
       "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial)");
   command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
+  command->add_option(
+      "--station", args->station,
+      "station file (format imufit-station: station, operator, equipment) shown on the certificate");
   command->add_option("--store", args->store, "record the fit in this results store (SQLite; created when missing)");
   return [args] { return RunFit(*args); };
 }

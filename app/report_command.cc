@@ -10,6 +10,7 @@
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
+#include "imufit/io/station.h"
 
 namespace imufit {
 namespace {
@@ -21,13 +22,15 @@ struct ReportArguments {
   std::string limits;
   std::string output;
   std::string serial;
+  std::string station;  // station file: where and by whom
   bool allow_mismatch = false;
   WindowOptions windows;
   SamplesInputArguments input;  // --temp-c and the segmentation options, as imufit fit has them
 };
 
 int RunReport(const ReportArguments& args) {
-  RefuseToOverwriteInputs(args.output, {args.calibration, args.plan, args.samples, args.limits});
+  RefuseToOverwriteInputs(args.output,
+                          {args.calibration, args.plan, args.samples, args.limits, args.station});
   if (const std::string problem = args.windows.Validate(); !problem.empty())
     throw InputError("imufit report", problem);
   CertificateSources sources;
@@ -36,6 +39,7 @@ int RunReport(const ReportArguments& args) {
   // A calibration fitted without a serial: the unit's own log may still name it.
   if (sources.calibration.serial.empty()) sources.calibration.serial = ReadSamplesSerial(args.samples);
   if (!args.limits.empty()) sources.limits = ReadLimits(args.limits);
+  if (!args.station.empty()) sources.station = ReadStation(args.station);
   // A certificate of a calibration for another run's data would certify nothing.
   const std::vector<std::string> mismatches = InputMismatches(sources.calibration, args.plan, args.samples);
   if (!mismatches.empty() && !args.allow_mismatch) {
@@ -52,7 +56,8 @@ int RunReport(const ReportArguments& args) {
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
                     {"samples", args.samples, ""},
-                    {"limits", args.limits, ""}};
+                    {"limits", args.limits, ""},
+                    {"station", args.station, ""}};
   const Certificate certificate = MakeCertificate(sources);
   WarnIfNoSerial(certificate, args.calibration);
   WriteCertificate(args.output, certificate);
@@ -86,6 +91,9 @@ CommandRunner AddReportCommand(CLI::App* root) {
   command->add_option("--output,-o", args->output, "HTML file to write")->required();
   command->add_option("--serial", args->serial,
                       "the unit's serial (default: the calibration's, else the samples header's)");
+  command->add_option(
+      "--station", args->station,
+      "station file (format imufit-station: station, operator, equipment) shown on the certificate");
   command->add_flag("--allow-mismatch", args->allow_mismatch,
                     "certify even when the calibration records other plan/samples hashes than these files' "
                     "(the certificate says so)");

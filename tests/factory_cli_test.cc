@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -41,6 +42,8 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitNotDone = 1;
 constexpr int kExitFailedLimits = 3;
 constexpr int kUnits = 5;
+// Issue 10: a passing unit's certificate prints on at most about 4 pages.
+constexpr int kMostPagesOfAPassingCertificate = 4;
 
 constexpr const char* kLimits = R"(format: imufit-limits
 version: 1
@@ -53,6 +56,18 @@ criteria:
   - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.05}
   - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}
   - {quantity: fit_temp_range_c, covers: [-20, 60]}
+)";
+
+constexpr const char* kStation = R"(format: imufit-station
+version: 1
+station: Rate table bench 2
+station_id: CB-02
+location: Building 4, room 112
+operator: J. Smith
+rate_table: {model: Acutronic AC1120S, serial: RT-2291}
+chamber: {model: Espec SU-262, serial: CH-0117}
+reference_calibration_due: 2099-12-31
+notes: Rate table calibrated by the national lab, certificate NL-2026-0412.
 )";
 
 std::string ReadBytes(const fs::path& path) { return testing::ReadBytes(path.string()); }
@@ -183,6 +198,72 @@ class FactoryCliTest : public ::testing::Test {
     return {"batch",   Path("units"),    "--limits", Path("limits.yaml"),
             "-o",      Path(out),        "--plan",   kFixtures + "/plan_6pos.yaml",
             "--store", Path("store.db"), "--lot",    "LOT-A"};
+  }
+
+  // Prints `html` to PDF with headless Chromium on paper `size` ("A4", "letter"; the printer's page
+  // size: an @page rule added to a copy), rasterises every page with pdftoppm and checks it: not
+  // blank, "page x of y" in its footer, text no smaller than kMinimumWordHeightPt. Returns the
+  // number of pages (0 when the tools are missing: the caller skips). `readable`: check the text size.
+  int PrintToPdf(const std::string& html, const std::string& name, const std::string& size,
+                 bool readable = true) {
+    for (const char* tool : {"/usr/bin/chromium", "/usr/bin/pdftoppm", "/usr/bin/pdfinfo",
+                             "/usr/bin/pdftotext", "/usr/bin/timeout"}) {
+      if (!fs::exists(tool)) return 0;
+    }
+    std::string text = ReadBytes(html);
+    const size_t head = text.find("</head>");
+    EXPECT_NE(head, std::string::npos) << html;
+    text.insert(head, "<style>@page { size: " + size + "; }</style>");
+    const std::string copy = (fs::path(html).parent_path() / (name + ".html")).string();
+    std::ofstream(copy, std::ios::binary) << text;  // beside the original: its links still resolve
+    const std::string pdf = Path(name + ".pdf");
+    const RunResult p =
+        RunProgram("/usr/bin/timeout", {"120", "/usr/bin/chromium", "--headless", "--no-sandbox",
+                                        "--disable-gpu", "--disable-quic", "--no-first-run",
+                                        "--disable-background-networking", "--disable-component-update",
+                                        "--disable-sync", "--user-data-dir=" + Path("chromium-" + name),
+                                        "--no-pdf-header-footer", "--print-to-pdf=" + pdf, "file://" + copy});
+    EXPECT_EQ(p.status, 0) << p.err;
+    const RunResult info = RunProgram("/usr/bin/pdfinfo", {pdf});
+    std::smatch match;
+    int pages = 0;
+    if (std::regex_search(info.out, match, std::regex("Pages:\\s+(\\d+)"))) pages = std::stoi(match[1]);
+    EXPECT_NE(info.out.find(size == "A4" ? "(A4)" : "(letter)"), std::string::npos) << info.out;
+    EXPECT_EQ(RunProgram("/usr/bin/pdftoppm", {"-r", "30", "-png", pdf, Path(name + "-page")}).status, 0);
+    for (int page = 1; page <= pages; ++page) {
+      // pdftoppm numbers pages with as many digits as the last one needs.
+      const std::string png =
+          Path(name + "-page-" + (pages >= 10 && page < 10 ? "0" : "") + std::to_string(page) + ".png");
+      const std::string image = ReadBytes(png);
+      EXPECT_EQ(image.substr(1, 3), "PNG") << png;
+      // A page with text and plots compresses to far more than a blank one (about 1 kB at 30 dpi).
+      constexpr size_t kMinimumPrintedPagePngBytes = 4000;
+      EXPECT_GT(image.size(), kMinimumPrintedPagePngBytes) << png;
+      const RunResult words = RunProgram("/usr/bin/pdftotext", {"-f", std::to_string(page), "-l",
+                                                                std::to_string(page), pdf, Path("page.txt")});
+      EXPECT_EQ(words.status, 0);
+      EXPECT_NE(
+          ReadBytes(Path("page.txt")).find("page " + std::to_string(page) + " of " + std::to_string(pages)),
+          std::string::npos)
+          << name << " page " << page;
+    }
+    // Readable in print: the word boxes pdftotext reports are the font's height (ascent to
+    // descent, about 1.03 x its size); 95 % of the words at least kMinimumWordHeightPt, i.e. a
+    // 7.3 pt font (tables print at 7.5 pt, plot labels at about 8.4 pt). A page wider than the
+    // paper (a long path that cannot wrap) is shrunk by the browser and fails this.
+    constexpr double kMinimumWordHeightPt = 7.5;
+    EXPECT_EQ(RunProgram("/usr/bin/pdftotext", {"-bbox", pdf, Path("bbox.html")}).status, 0);
+    const std::string boxes = ReadBytes(Path("bbox.html"));
+    const std::regex word("yMin=\"([0-9.]+)\" xMax=\"[0-9.]+\" yMax=\"([0-9.]+)\"");
+    std::vector<double> heights;
+    for (std::sregex_iterator it(boxes.begin(), boxes.end(), word), end; it != end; ++it)
+      heights.push_back(std::stod((*it)[2]) - std::stod((*it)[1]));
+    EXPECT_GT(heights.size(), 100u) << name;
+    if (readable && !heights.empty()) {
+      std::sort(heights.begin(), heights.end());
+      EXPECT_GE(heights[heights.size() / 20], kMinimumWordHeightPt) << name;
+    }
+    return pages;
   }
 
   std::map<std::string, std::map<std::string, std::string>> Summary(const std::string& out) const {
@@ -504,13 +585,12 @@ TEST_F(FactoryCliTest, AllanWarnsOnRawCountsAndMillisecondTimestamps) {
 }
 
 // The certificate and the lot page as a quality engineer prints them: a lot with one failing, one
-// corrupt and one incomplete unit, printed to PDF by headless Chromium, each page rasterised by
-// pdftoppm and checked: page count, "page x of y" and the serial in the running header, no blank page.
+// corrupt and one incomplete unit, printed to PDF by headless Chromium on A4 and on Letter, each
+// page rasterised by pdftoppm and checked (PrintToPdf): page count, "page x of y" and the serial
+// in the running header, no blank page, readable text.
 TEST_F(FactoryCliTest, CertificatesAndLotPagePrintToPdf) {
-  const std::string chromium = "/usr/bin/chromium";
-  for (const char* tool : {"/usr/bin/chromium", "/usr/bin/pdftoppm", "/usr/bin/pdfinfo", "/usr/bin/pdftotext",
-                           "/usr/bin/timeout"}) {
-    if (!fs::exists(tool)) GTEST_SKIP() << "no " << tool << " (Debian: chromium poppler-utils)";
+  if (!fs::exists("/usr/bin/chromium") || !fs::exists("/usr/bin/pdftoppm")) {
+    GTEST_SKIP() << "no chromium or pdftoppm (Debian: chromium poppler-utils)";
   }
   // unit-06: a run cut short after its second temperature (the rig stopped).
   fs::create_directories(dir_ / "units" / "unit-06");
@@ -525,53 +605,110 @@ TEST_F(FactoryCliTest, CertificatesAndLotPagePrintToPdf) {
   EXPECT_EQ(summary["unit-05"]["status"], "error");
   EXPECT_EQ(summary["unit-06"]["status"], "not-fitted") << summary["unit-06"]["message"];
 
-  const auto print = [&](const std::string& html, const std::string& name) {
-    const std::string pdf = Path(name + ".pdf");
-    const RunResult p =
-        RunProgram("/usr/bin/timeout",
-                   {"120", chromium, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                    "--no-first-run", "--disable-background-networking", "--disable-component-update",
-                    "--disable-sync", "--user-data-dir=" + Path("chromium-" + name), "--no-pdf-header-footer",
-                    "--print-to-pdf=" + pdf, "file://" + html});
-    EXPECT_EQ(p.status, 0) << p.err;
-    const RunResult info = RunProgram("/usr/bin/pdfinfo", {pdf});
-    std::smatch match;
-    int pages = 0;
-    if (std::regex_search(info.out, match, std::regex("Pages:\\s+(\\d+)"))) pages = std::stoi(match[1]);
-    EXPECT_EQ(RunProgram("/usr/bin/pdftoppm", {"-r", "30", "-png", pdf, Path(name + "-page")}).status, 0);
-    for (int page = 1; page <= pages; ++page) {
-      // pdftoppm numbers pages with as many digits as the last one needs.
-      const std::string png =
-          Path(name + "-page-" + (pages >= 10 && page < 10 ? "0" : "") + std::to_string(page) + ".png");
-      const std::string image = ReadBytes(png);
-      EXPECT_EQ(image.substr(1, 3), "PNG") << png;
-      // A page with text and plots compresses to far more than a blank one (about 1 kB at 30 dpi).
-      constexpr size_t kMinimumPrintedPagePngBytes = 4000;
-      EXPECT_GT(image.size(), kMinimumPrintedPagePngBytes) << png;
-      const RunResult text = RunProgram("/usr/bin/pdftotext", {"-f", std::to_string(page), "-l",
-                                                               std::to_string(page), pdf, Path("page.txt")});
-      EXPECT_EQ(text.status, 0);
-      const std::string words = ReadBytes(Path("page.txt"));
-      EXPECT_NE(words.find("page " + std::to_string(page) + " of " + std::to_string(pages)),
-                std::string::npos)
-          << name << " page " << page;
-    }
-    return pages;
-  };
-  // A passing unit fits on a handful of pages; every page says whose certificate it is.
-  constexpr int kMostPagesOfACertificate = 6;
-  const int passing = print(Path("out/unit-01/report.html"), "unit-01");
-  EXPECT_GE(passing, 2);
-  EXPECT_LE(passing, kMostPagesOfACertificate);
-  EXPECT_EQ(
-      RunProgram("/usr/bin/pdftotext", {"-f", "2", "-l", "2", Path("unit-01.pdf"), Path("p2.txt")}).status,
-      0);
-  EXPECT_NE(ReadBytes(Path("p2.txt")).find("IMU calibration certificate SN-01"), std::string::npos);
-  const int failing = print(Path("out/unit-04/report.html"), "unit-04");
-  EXPECT_LE(failing, kMostPagesOfACertificate);
+  // A passing unit prints on at most kMostPagesOfAPassingCertificate pages of either paper size;
+  // every page says whose certificate it is.
+  for (const char* size : {"A4", "letter"}) {
+    const int passing = PrintToPdf(Path("out/unit-01/report.html"), std::string("unit-01-") + size, size);
+    EXPECT_GE(passing, 2) << size;
+    EXPECT_LE(passing, kMostPagesOfAPassingCertificate) << size;
+    EXPECT_EQ(
+        RunProgram("/usr/bin/pdftotext",
+                   {"-f", "2", "-l", "2", Path(std::string("unit-01-") + size + ".pdf"), Path("p2.txt")})
+            .status,
+        0);
+    EXPECT_NE(ReadBytes(Path("p2.txt")).find("IMU calibration certificate SN-01"), std::string::npos);
+  }
+  const int failing = PrintToPdf(Path("out/unit-04/report.html"), "unit-04", "A4");
+  EXPECT_LE(failing, kMostPagesOfAPassingCertificate + 1);
   EXPECT_EQ(RunProgram("/usr/bin/pdftotext", {"-l", "1", Path("unit-04.pdf"), Path("p1.txt")}).status, 0);
   EXPECT_NE(ReadBytes(Path("p1.txt")).find("FAIL"), std::string::npos);
-  EXPECT_GE(print(Path("out/lot.html"), "lot"), 1);
+  EXPECT_GE(PrintToPdf(Path("out/lot.html"), "lot", "letter", /*readable=*/false), 1);
+}
+
+// The standard simulated 6-position soak (fixtures/mems_6pos_soak.csv.gz: 18 segments at five
+// temperatures), fitted with validation and certified with limits and a station file: a passing
+// unit on at most kMostPagesOfAPassingCertificate pages of A4 and of Letter.
+TEST_F(FactoryCliTest, StandardSoakCertificatePrintsOnFourPages) {
+  if (!fs::exists("/usr/bin/chromium") || !fs::exists("/usr/bin/pdftoppm")) {
+    GTEST_SKIP() << "no chromium or pdftoppm (Debian: chromium poppler-utils)";
+  }
+  const RunResult r =
+      Run({"fit", "-p", kFixtures + "/plan_6pos.yaml", "-s", kFixtures + "/mems_6pos_soak.csv.gz", "-o",
+           Path("soak.yaml"), "--serial", "SN-SOAK", "--validate", "--limits", Path("limits.yaml"),
+           "--station", Write("station.yaml", kStation), "--report", Path("soak.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  for (const char* size : {"A4", "letter"}) {
+    const int pages = PrintToPdf(Path("soak.html"), std::string("soak-") + size, size);
+    std::printf("standard soak certificate: %d pages on %s\n", pages, size);
+    EXPECT_GE(pages, 3) << size;  // not shrunk into nothing
+    EXPECT_LE(pages, kMostPagesOfAPassingCertificate) << size;
+  }
+}
+
+// The station file: on the certificate of fit --report, report and batch, hashed among the inputs;
+// a bad one is exit 2 with its location before any work; --station without --report is refused.
+TEST_F(FactoryCliTest, StationFileIsShownHashedAndChecked) {
+  const std::string station = Write("station.yaml", kStation);
+  const std::string plan = Path("units/unit-01/plan.yaml"), samples = Path("units/unit-01/samples.csv.gz");
+  RunResult r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal1.yaml"), "--station", station,
+                     "--report", Path("unit1.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string sha = Sha256OfFile(station);
+  for (const std::string& html : {Path("unit1.html"), Path("unit1_report.html")}) {
+    if (html == Path("unit1_report.html")) {
+      r = Run(
+          {"report", "-c", Path("cal1.yaml"), "-p", plan, "-s", samples, "--station", station, "-o", html});
+      ASSERT_EQ(r.status, 0) << r.err;
+    }
+    const std::string report = ReadBytes(html);
+    EXPECT_NE(report.find("data-sha256=\"station\">" + sha + "<"), std::string::npos) << html;
+    EXPECT_NE(report.find("data-key=\"station\">Rate table bench 2 (CB-02)<"), std::string::npos) << html;
+    EXPECT_NE(report.find("data-key=\"calibrated_by\">J. Smith<"), std::string::npos) << html;
+    EXPECT_NE(report.find("data-key=\"rate_table\">Acutronic AC1120S, serial RT-2291<"), std::string::npos);
+    EXPECT_NE(report.find("Reviewed by (quality)"), std::string::npos);
+  }
+  // Reference equipment out of its calibration when the unit was calibrated: a warning.
+  std::string overdue = kStation;
+  overdue = std::regex_replace(overdue, std::regex("2099-12-31"), "2020-01-31");
+  r = Run({"report", "-c", Path("cal1.yaml"), "-p", plan, "-s", samples, "--station",
+           Write("overdue.yaml", overdue), "-o", Path("overdue.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(ReadBytes(Path("overdue.html")).find("due for calibration on 2020-01-31"), std::string::npos);
+
+  // A bad station file: exit 2 with file:line:column, nothing written.
+  const std::string bad = Write("bad_station.yaml", std::string(kStation) + "operater: A. Typo\n");
+  r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal_bad.yaml"), "--station", bad, "--report",
+           Path("bad.html")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("bad_station.yaml:11:1: unknown key \"operater\""), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("cal_bad.yaml")));
+  EXPECT_FALSE(fs::exists(Path("bad.html")));
+  r = Run({"report", "-c", Path("cal1.yaml"), "-p", plan, "-s", samples, "--station", bad, "-o",
+           Path("bad.html")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_FALSE(fs::exists(Path("bad.html")));
+  r = Run(std::vector<std::string>{"batch", Path("units"), "--station", bad, "-o", Path("out_bad")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("bad_station.yaml:11:1"), std::string::npos) << r.err;
+  r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal_no_report.yaml"), "--station", station});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("--report"), std::string::npos) << r.err;
+
+  // batch: every certificate shows the station; the manifest records its hash, and another station
+  // file redoes the units (their certificates would change).
+  std::vector<std::string> args = BatchArgs("out");
+  args.insert(args.end(), {"--station", station});
+  r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.err;
+  EXPECT_NE(ReadBytes(dir_ / "out" / "unit-02" / "report.html").find("data-sha256=\"station\">" + sha + "<"),
+            std::string::npos);
+  EXPECT_NE(ReadBytes(dir_ / "out" / "unit-02" / "manifest.yaml").find("station_sha256: \"" + sha + "\""),
+            std::string::npos);
+  r = Run(args);
+  EXPECT_NE(r.out.find("5 unchanged and skipped"), std::string::npos) << r.out;
+  args.back() = Write("station2.yaml", std::string(kStation) + "# another bench\n");
+  r = Run(args);
+  EXPECT_NE(r.out.find("0 unchanged and skipped"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -4,10 +4,12 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -18,9 +20,12 @@
 #include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
+#include "imufit/fit/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/plan.h"
+#include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
@@ -351,6 +356,23 @@ class CertificateTest : public FactoryTest {
         InputMismatches(sources.calibration, plan_path, kFixtures + "/mems_6pos_noiseless.csv.gz").empty());
     return MakeCertificate(sources);
   }
+  // The certificate of a fit from its run alone (no limits, no files to hash).
+  static Certificate CertificateOf(const FitRunResult& fit) {
+    CertificateSources sources;
+    sources.calibration = *fit.calibration;
+    sources.plan = fit.plan;
+    sources.run = fit.run;
+    return MakeCertificate(sources);
+  }
+  // Simulates `plan` for the fixture truth into `name` (with its segment column); returns the path.
+  std::string Simulate(const Plan& plan, const SimulationOptions& options, const std::string& name) const {
+    const std::string path = (dir_ / name).string();
+    SamplesWriter writer(path, true);
+    SimulateRun(options, plan.site, plan.segments, ReadCalibration(kFixtures + "/mems_truth.yaml").model,
+                [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+    writer.Commit();
+    return path;
+  }
 };
 
 TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
@@ -401,9 +423,161 @@ TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
   EXPECT_FALSE(c.verdict.has_value());
   // The plots hold the certificate's data.
   const std::vector<PlotFigure> plots = CertificatePlots(c);
-  ASSERT_EQ(plots.size(), c.curves.size() + 2);
+  ASSERT_EQ(plots.size(), c.curves.size() + 1);  // the coefficient groups, then the errors
   EXPECT_EQ(plots[3].panels.size(), 9u);
   EXPECT_EQ(plots[0].panels[0].series[1].y, c.curves[0].curves[0].value);
+  // The window estimates are drawn over the band and the line.
+  ASSERT_FALSE(c.curves[0].curves[0].points.empty());
+  EXPECT_EQ(plots[0].panels[0].series[2].style, PlotSeries::Style::kErrorBars);
+  EXPECT_EQ(plots[0].panels[0].series[2].y.size(), c.curves[0].curves[0].points.size());
+  EXPECT_EQ(plots[0].panels[0].series[2].error[0], c.curves[0].curves[0].points[0].sigma);
+}
+
+// The window estimates of every coefficient on a run with white noise only, simulated from the
+// fixture truth: they scatter about the true coefficient and about the fitted polynomial by their
+// own 1-sigma error bars (normalised RMS near 1), and not less (points taken from the curve
+// would have none of the data's scatter).
+TEST_F(CertificateTest, WindowEstimatesScatterAboutTheTruthByTheirOwnNoise) {
+  const Plan plan = ReadPlan(kFixtures + "/plan_6pos.yaml");
+  const Calibration truth = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  SimulationOptions options;
+  options.soak_temps_c = {-40.0, -10.0, 25.0, 55.0, 85.0};
+  options.rate_hz = 50.0;
+  options.dwell_s = 5.0;
+  options.transition_s = 1.0;
+  options.gyro_noise_density = 8.7e-5;
+  options.accel_noise_density = 1.5e-3;
+  options.seed = 21;
+  const FitRunResult fit =
+      FitRun(kFixtures + "/plan_6pos.yaml", Simulate(plan, options, "white.csv"), FitRunOptions());
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  const Certificate c = CertificateOf(fit);
+
+  // The groups in certificate order: sensor, first coefficient, whether stated as a scale change.
+  struct GroupKind {
+    Sensor sensor;
+    int first;
+    bool scale_change;
+  };
+  const GroupKind kinds[] = {
+      {Sensor::kGyro, kBiasCoefficient, false},         {Sensor::kGyro, kScaleCoefficient, true},
+      {Sensor::kGyro, kMisalignmentCoefficient, false}, {Sensor::kGyro, kGSensitivityCoefficient, false},
+      {Sensor::kAccel, kBiasCoefficient, false},        {Sensor::kAccel, kScaleCoefficient, true},
+      {Sensor::kAccel, kMisalignmentCoefficient, false}};
+  ASSERT_EQ(c.curves.size(), std::size(kinds));
+  const auto value = [](const SensorModel& model, const GroupKind& kind, int i, double temp_c) {
+    return kind.scale_change
+               ? ScaleChangePpm(model, nullptr, kind.sensor, i, temp_c).value
+               : EngineeringCoefficient(model, nullptr, kind.sensor, kind.first + i, temp_c).value;
+  };
+  // Normalised RMS over a group's points (60 to 180 of them): 1 for errors of exactly the stated
+  // sigma; the bounds allow the sampling spread of that many points and the fit's own error.
+  // Against the fit the RMS is lower, about sqrt(1 - terms / points) (4 polynomial terms from 10 to
+  // 30 points per coefficient, shared with the other coefficients of the row): at least
+  // kLowestFitRms, where points computed from the curve would give 0.
+  constexpr double kLowestRms = 0.6, kHighestRms = 1.5, kLowestFitRms = 0.5;
+  constexpr double kWorstPointSigmas = 5.0;  // worst case over all ~700 points
+  constexpr size_t kFewestPoints = 10;       // per coefficient: 2 positions or rates x 5 temperatures
+  for (size_t g = 0; g < c.curves.size(); ++g) {
+    double truth_squares = 0.0, fit_squares = 0.0;
+    size_t count = 0;
+    for (size_t i = 0; i < c.curves[g].curves.size(); ++i) {
+      const CoefficientCurve& curve = c.curves[g].curves[i];
+      EXPECT_GE(curve.points.size(), kFewestPoints) << c.curves[g].title << " " << curve.axis;
+      for (const CoefficientPoint& p : curve.points) {
+        ASSERT_GT(p.sigma, 0.0);
+        const double z_truth =
+            (p.value - value(truth.model, kinds[g], static_cast<int>(i), p.temp_c)) / p.sigma;
+        const double z_fit =
+            (p.value - value(fit.calibration->model, kinds[g], static_cast<int>(i), p.temp_c)) / p.sigma;
+        EXPECT_LT(std::abs(z_truth), kWorstPointSigmas)
+            << c.curves[g].title << " " << curve.axis << " at " << p.temp_c << " degC, segment " << p.segment;
+        truth_squares += z_truth * z_truth;
+        fit_squares += z_fit * z_fit;
+        ++count;
+      }
+    }
+    ASSERT_GT(count, 0u) << c.curves[g].title;
+    const double truth_rms = std::sqrt(truth_squares / count), fit_rms = std::sqrt(fit_squares / count);
+    std::printf("%-48s %4zu points: normalised RMS against the truth %.2f, against the fit %.2f\n",
+                c.curves[g].title.c_str(), count, truth_rms, fit_rms);
+    EXPECT_GT(truth_rms, kLowestRms) << c.curves[g].title;
+    EXPECT_LT(truth_rms, kHighestRms) << c.curves[g].title;
+    EXPECT_GT(fit_rms, kLowestFitRms) << c.curves[g].title << ": the points do not carry the data's scatter";
+    EXPECT_LT(fit_rms, kHighestRms) << c.curves[g].title;
+  }
+}
+
+// A hand session (six faces, a 360 deg turn about each axis) at one temperature: a turn's window is
+// judged against its mean rate, and the accelerometer is not judged where gravity turned in the
+// body frame (the turns about x and y).
+TEST_F(CertificateTest, AHandSessionsTurnsAreJudgedAgainstTheirMeanRate) {
+  const std::string plan_path = kFixtures + "/plan_hand_6faces_3turns.yaml";
+  const Plan plan = ReadPlan(plan_path);
+  SimulationOptions options;
+  options.rate_hz = 100.0;
+  options.dwell_s = 10.0;
+  options.transition_s = 2.0;
+  options.gyro_noise_density = 8.7e-5;
+  options.accel_noise_density = 1.5e-3;
+  options.seed = 4;
+  FitRunOptions fit_options;
+  fit_options.fit.gyro_temp_order = fit_options.fit.accel_temp_order = 0;
+  const FitRunResult fit = FitRun(plan_path, Simulate(plan, options, "hand.csv"), fit_options);
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  const Certificate c = CertificateOf(fit);
+  ASSERT_EQ(c.residual_table.size(), plan.segments.size() + 1);
+  int turns = 0;
+  for (const ResidualRow& row : c.residual_table) {
+    const TableSegment* segment = row.segment < 0 ? nullptr : plan.Find(row.segment);
+    if (segment == nullptr || !segment->IsTurn()) continue;
+    ++turns;
+    EXPECT_EQ(row.motion.rfind("turn 360 deg about ", 0), 0u) << row.motion;
+    // Against its mean rate the turn's error is noise (about 1e-4 deg/s), not its 36 deg/s.
+    constexpr double kTurnErrorDps = 0.01;
+    EXPECT_LT(row.gyro_rms_dps, kTurnErrorDps) << row.motion;
+    EXPECT_EQ(row.accel_windows, segment->AxisIsVertical() ? 1 : 0) << row.motion;
+  }
+  EXPECT_EQ(turns, 3);
+  // The normalised errors are noise: the turns' accelerometer means are not in them.
+  constexpr double kMostNormalisedRms = 3.0;
+  EXPECT_LT(c.residuals.normalised_gyro_rms, kMostNormalisedRms);
+  EXPECT_LT(c.residuals.normalised_accel_rms, kMostNormalisedRms);
+  EXPECT_LT(c.residual_table.back().accel_rms_mg, 1.0);
+}
+
+// A plan of many segments (the 24-position tactical soak: 36 segments) prints the segments with
+// the largest errors after correction, in segment order, then all; the struct keeps every row.
+TEST_F(CertificateTest, ManySegmentsPrintTheWorstOnly) {
+  const std::string plan_path = kFixtures + "/plan_24pos.yaml";
+  const FitRunResult fit = FitRun(plan_path, kFixtures + "/tactical_24pos_soak.csv.gz", FitRunOptions());
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  const Certificate c = CertificateOf(fit);
+  const size_t segments = fit.plan.segments.size();
+  ASSERT_GT(segments, static_cast<size_t>(kMostResidualRowsPrinted));
+  ASSERT_EQ(c.residual_table.size(), segments + 1);
+  ASSERT_EQ(c.residual_table_printed.size(), static_cast<size_t>(kMostResidualRowsPrinted));
+  EXPECT_EQ(c.residual_rows_omitted, static_cast<int>(segments) - (kMostResidualRowsPrinted - 1));
+  EXPECT_EQ(c.residual_table_printed.back().segment, -1);
+  const ResidualRow& all = c.residual_table.back();
+  const auto relative = [&](const ResidualRow& r) {
+    return std::max(r.gyro_rms_dps / all.gyro_rms_dps, r.accel_rms_mg / all.accel_rms_mg);
+  };
+  double least_printed = 1e300;
+  std::set<int> printed;
+  for (size_t i = 0; i + 1 < c.residual_table_printed.size(); ++i) {
+    const ResidualRow& r = c.residual_table_printed[i];
+    if (i > 0) {
+      EXPECT_LT(c.residual_table_printed[i - 1].segment, r.segment);  // in segment order
+    }
+    least_printed = std::min(least_printed, relative(r));
+    printed.insert(r.segment);
+  }
+  for (size_t i = 0; i + 1 < c.residual_table.size(); ++i) {
+    if (printed.count(c.residual_table[i].segment) == 0) {
+      EXPECT_LE(relative(c.residual_table[i]), least_printed) << "segment " << c.residual_table[i].segment;
+    }
+  }
 }
 
 TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {

@@ -836,6 +836,40 @@ TEST(Turns, AQuarterTurnAboutAHorizontalAxisIsExactWithoutNoise) {
   }
 }
 
+// PredictWindows takes a turn's truth as the fit does (its mean rate over the whole occurrence),
+// so the truth calibration predicts a noise-free turn's window to rounding, not by the turn's rate.
+TEST(Turns, PredictWindowsTakesATurnsMeanRateAsItsTruth) {
+  const SensorModel truth = testing::RandomMemsModel(8);
+  const std::vector<TableSegment> plan = FacesAndTurns();
+  SimulationOptions simulation = OneTemperature(1);
+  simulation.gyro_noise_density = 0.0;
+  simulation.accel_noise_density = 0.0;
+  simulation.quantize = false;
+  const std::vector<Window> windows = Simulate(simulation, plan, truth, WindowOptions(), NoLatitude());
+  const std::vector<WindowError> errors = PredictWindows(truth, windows, NoLatitude(), plan);
+  ASSERT_EQ(errors.size(), windows.size());
+  constexpr double kNoiseFreeRateErrorRadps = 1e-6;  // a turn's summed rate x dt against its angle
+  int turns = 0;
+  for (const WindowError& e : errors) {
+    const bool turn = e.segment >= 10;
+    turns += turn ? 1 : 0;
+    EXPECT_LT(e.gyro_radps.norm(), kNoiseFreeRateErrorRadps) << "segment " << e.segment;
+    EXPECT_EQ(e.specific_force_known, !turn || e.segment == 12)
+        << "segment " << e.segment;  // 12: about z (up)
+    if (turn) {
+      EXPECT_GT(e.omega_true_radps.norm(), 0.1) << "segment " << e.segment;
+    }
+  }
+  EXPECT_EQ(turns, 3);
+  // The accelerometer's figures leave out the turns about x and y, where gravity turns in the body
+  // frame: what is left is exact.
+  const ErrorStats all = SummariseErrors(errors);
+  EXPECT_EQ(all.windows, 9);
+  EXPECT_EQ(all.accel_windows, 7);
+  constexpr double kNoiseFreeAccelErrorMps2 = 1e-9;
+  EXPECT_LT(all.accel_max_mps2, kNoiseFreeAccelErrorMps2);
+}
+
 TEST(ScaleSign, ASignFlippedTurnIsRefusedWithTheConventionToCheck) {
   // The unit turned +360 degrees about x, the plan says -360: the fitted gyro x scale is negative.
   const SensorModel truth = testing::RandomMemsModel(2026);

@@ -18,6 +18,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/io/station.h"
 #include "test_models.h"
 
 namespace imufit {
@@ -60,6 +61,75 @@ class IoTest : public ::testing::Test {
 
   fs::path dir_;
 };
+
+// ---------------------------------------------------------------- station
+
+constexpr const char* kStation = R"(format: imufit-station
+version: 1
+station: "Rate table bench 2"
+station_id: CB-02
+location: "Building 4, room 112"
+operator: J. Smith
+rate_table: {model: Acutronic AC1120S, serial: RT-2291}
+chamber: {model: Espec SU-262}
+reference_calibration_due: 2028-02-29
+notes: "Rate table calibrated by the national lab, certificate NL-2026-0412."
+)";
+
+TEST_F(IoTest, StationFileIsRead) {
+  const Station station = ReadStation(Write("station.yaml", kStation));
+  EXPECT_EQ(station.name, "Rate table bench 2");
+  EXPECT_EQ(station.id, "CB-02");
+  EXPECT_EQ(station.location, "Building 4, room 112");
+  EXPECT_EQ(station.operator_name, "J. Smith");
+  EXPECT_EQ(station.rate_table.model, "Acutronic AC1120S");
+  EXPECT_EQ(station.rate_table.serial, "RT-2291");
+  EXPECT_EQ(station.chamber.model, "Espec SU-262");
+  EXPECT_EQ(station.chamber.serial, "");
+  EXPECT_EQ(station.reference_calibration_due, "2028-02-29");  // a leap day
+  EXPECT_NE(station.notes.find("NL-2026-0412"), std::string::npos);
+  // Only the name is required.
+  const Station minimal =
+      ReadStation(Write("minimal.yaml", "format: imufit-station\nversion: 1\nstation: B2\n"));
+  EXPECT_EQ(minimal.name, "B2");
+  EXPECT_TRUE(minimal.operator_name.empty());
+}
+
+TEST_F(IoTest, StationFileErrorsNameFileLineAndColumn) {
+  const std::string head = "format: imufit-station\nversion: 1\nstation: B2\n";
+  const struct {
+    std::string text;
+    std::string expected;  // part of the message, from ":line:column: " on
+  } cases[] = {
+      {head + "operater: J. Smith\n", ":4:1: unknown key \"operater\""},
+      {head + "operator: A\noperator: B\n", ":5:1: key \"operator\" appears twice"},
+      {head + "operator: [J. Smith]\n", ":4:11: operator: expected a text value"},
+      {head + "rate_table: RT-2291\n", ":4:13: rate_table: expected a mapping"},
+      {head + "rate_table: {model: X, serial: Y, due: 2027-01-01}\n",
+       ":4:35: rate_table: unknown key \"due\""},
+      {head + "chamber: {serial: {id: 1}}\n", ":4:19: chamber.serial: expected a text value"},
+      {head + "reference_calibration_due: 2027-02-29\n",
+       ":4:28: reference_calibration_due: \"2027-02-29\" is not a date"},
+      {head + "reference_calibration_due: 31.03.2027\n",
+       ":4:28: reference_calibration_due: \"31.03.2027\" is not a date"},
+      {head + "location: \"\"\n", ":4:11: location: is empty"},
+      {head + "notes: \"two\\nlines\"\n", ":4:8: notes: must be one line"},
+      {head + "notes: " + std::string(kMaxStationTextBytes + 1, 'n') + "\n",
+       ":4:8: notes: is 501 bytes long"},
+      {"format: imufit-station\nversion: 1\n", ":1: station: missing (required)"},
+      {"format: imufit-limits\nversion: 1\nstation: B2\n",
+       ":1:9: format: \"imufit-limits\" is not \"imufit-station\""},
+      {"format: imufit-station\nversion: 2\nstation: B2\n", ":2:10: version: version 2 is not supported"},
+      {"format: imufit-station\nversion: 1\nstation: [\n", ":4:1: YAML syntax"},
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    const std::string path = Write("station" + std::to_string(n++) + ".yaml", c.text);
+    const InputError e = Catch([&] { ReadStation(path); });
+    EXPECT_NE(std::string(e.what()).find(path + c.expected), std::string::npos)
+        << "got: " << e.what() << "\nexpected: " << c.expected;
+  }
+}
 
 // ---------------------------------------------------------------- calibration
 

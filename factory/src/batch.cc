@@ -22,6 +22,7 @@
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/io/station.h"
 
 namespace imufit {
 
@@ -51,6 +52,7 @@ struct Manifest {
   std::string software, plan_sha256, samples_sha256, limits_sha256;
   std::string serial, status, verdict, message;
   std::string calibration_sha256;  // of the calibration written (fitted units)
+  std::string station_sha256;      // "" without a station file
 };
 
 std::optional<Manifest> ReadManifest(const std::string& path) {
@@ -66,6 +68,7 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
                           "serial",   "status",      "verdict",        "message"};
     for (int i = 0; i < 8; ++i) *fields[i] = node[keys[i]].as<std::string>();
     if (node["calibration_sha256"]) m.calibration_sha256 = node["calibration_sha256"].as<std::string>();
+    if (node["station_sha256"]) m.station_sha256 = node["station_sha256"].as<std::string>();
     return m;
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the unit is done again
@@ -84,7 +87,8 @@ void WriteManifest(const std::string& path, const Manifest& m) {
                                                                {"status", &m.status},
                                                                {"verdict", &m.verdict},
                                                                {"message", &m.message},
-                                                               {"calibration_sha256", &m.calibration_sha256}};
+                                                               {"calibration_sha256", &m.calibration_sha256},
+                                                               {"station_sha256", &m.station_sha256}};
   for (const auto& [key, value] : fields)
     out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
   out << YAML::EndMap;
@@ -134,6 +138,8 @@ struct Shared {
   const BatchOptions* options;
   std::optional<Limits> limits;
   std::string limits_sha256;
+  std::optional<Station> station;
+  std::string station_sha256;
   std::unique_ptr<ResultsStore> store;
   std::string lot;
   std::mutex store_mutex;
@@ -189,6 +195,7 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     manifest.plan_sha256 = outcome.plan_sha256;
     manifest.samples_sha256 = outcome.samples_sha256;
     manifest.limits_sha256 = shared.limits_sha256;
+    manifest.station_sha256 = shared.station_sha256;
 
     // Unchanged since a finished run: take its outcome, redo nothing.
     if (const std::optional<Manifest> previous = ReadManifest(manifest_path);
@@ -196,6 +203,7 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
         previous->plan_sha256 == manifest.plan_sha256 &&
         previous->samples_sha256 == manifest.samples_sha256 &&
         previous->limits_sha256 == manifest.limits_sha256 &&
+        previous->station_sha256 == manifest.station_sha256 &&
         (previous->status != "fitted" || fs::exists(calibration_path))) {
       outcome.skipped = true;
       outcome.serial = previous->serial;
@@ -231,8 +239,8 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     }
     outcome.fit = std::move(result);
     if (outcome.status == "fitted" && options.write_reports) {
-      const Certificate certificate =
-          MakeCertificate(outcome, options.limits_path, shared.limits, calibration_path, options.fit.windows);
+      const Certificate certificate = MakeCertificate(outcome, options.limits_path, shared.limits,
+                                                      calibration_path, options.fit.windows, shared.station);
       // The certificate judges with the noise it measured itself: its verdict is the unit's.
       if (certificate.verdict) {
         outcome.verdict_detail = *certificate.verdict;
@@ -337,6 +345,10 @@ BatchResult RunBatch(const BatchOptions& options) {
   if (!options.limits_path.empty()) {
     shared.limits = ReadLimits(options.limits_path);
     shared.limits_sha256 = Sha256OfFile(options.limits_path);
+  }
+  if (!options.station_path.empty()) {
+    shared.station = ReadStation(options.station_path);
+    shared.station_sha256 = Sha256OfFile(options.station_path);
   }
   if (!options.shared_plan.empty()) ReadPlan(options.shared_plan);  // a bad shared plan is the lot's error
   std::error_code error;

@@ -4,8 +4,10 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
+#include <utility>
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
@@ -21,10 +23,29 @@ constexpr int kModelCurvePoints = 80;        // taus at which the fitted Allan m
 constexpr double kHistogramHalfWidth = 5.0;  // normalised errors binned over [-5, 5]
 constexpr int kHistogramBins = 20;
 
-std::string Vector3Text(const Eigen::Vector3d& v) {
+// "+z" for a body axis, else "[x, y, z]".
+std::string DirectionText(const Eigen::Vector3d& v) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(std::abs(v(axis)) - 1.0) < 1e-12 && std::abs(v.norm() - 1.0) < 1e-12) {
+      return std::string(v(axis) > 0 ? "+" : "-") + "xyz"[axis];
+    }
+  }
   char text[96];
-  std::snprintf(text, sizeof text, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  std::snprintf(text, sizeof text, "[%.3g, %.3g, %.3g]", v.x(), v.y(), v.z());
   return text;
+}
+
+// What the table did in a segment: "static", "+100 deg/s" (with " about +x" when the axis is not
+// up), "turn 360 deg about +x".
+std::string MotionText(const TableSegment& segment) {
+  char text[64];
+  if (segment.IsTurn()) {
+    std::snprintf(text, sizeof text, "turn %g deg about ", *segment.angle_rad * kRadToDeg);
+    return text + DirectionText(segment.RotationAxis());
+  }
+  if (segment.IsStatic()) return "static";
+  std::snprintf(text, sizeof text, "%+g deg/s", DpsFromRadps(segment.rate_radps));
+  return segment.axis && !segment.AxisIsVertical() ? text + (" about " + DirectionText(*segment.axis)) : text;
 }
 
 // A number from the calibration's `fit:` block, when there.
@@ -96,7 +117,142 @@ RunSummary SummariseRun(const Calibration& calibration, const Plan& plan, const 
   return r;
 }
 
-std::vector<CoefficientGroup> CoefficientCurves(const Calibration& cal) {
+// ---------------------------------------------------------------- window estimates
+//
+// A window w at temperature T_w, corrected through the shared model (validation.h: accelerometer
+// first, the gyro's g-sensitivity from the corrected specific force a^), leaves the error
+// e = corrected - truth (SI) and, mapped to raw units as the fit weighs it (fit/window_cost.h),
+//
+//   r = diag(S) inv(M) e = B - V - H a^ - diag(S) inv(M) truth           (raw; H = 0 for accel)
+//
+// with every coefficient at its fitted value at T_w. The window's own estimate of one coefficient
+// is the value that zeroes the residual of its row i with all others held, solved exactly: r_i is
+// affine in V_i, S_i and H_ij, and the corrected output's row i, corrected_i = sum_k M_ik u_k with
+// u = inv(M) corrected = diag(1/S) (B - V - H a^), is affine in M_ij:
+//
+//   bias           V_i  + r_i                    1-sigma  n_i
+//   scale          S_i  + r_i / x_i,             x = inv(M) truth          n_i / |x_i|
+//   g-sensitivity  H_ij + r_i / a^_j                                        n_i / |a^_j|
+//   misalignment   M_ij - e_i / u_j                                         sqrt(sum_k (M_ik n_k / S_k)^2) /
+//   |u_j|
+//
+// n: the noise of the window's mean, raw, per axis (windows.h), propagated to first order. The
+// estimate is stated in the group's unit by the same factor as the polynomial at T_w (io/units.h).
+// Windows used: the truth must be exact (the accelerometer: a constant specific force); biases and
+// g-sensitivity from static windows only (in a rate window the rate times the scale factor's own
+// error would dominate); and a slope (x_i, a^_j, u_j) at least kPointRegressorFraction of its
+// largest magnitude in the run, so that no point's error bar is more than 1 / fraction of the best.
+
+constexpr double kPointRegressorFraction = 0.25;
+
+// One window as one sensor saw it.
+struct SensorWindow {
+  int segment = -1;
+  double temp_c = 0.0;
+  bool is_static = false;
+  SensorCoefficients<double> c;         // the calibration's coefficients at temp_c
+  Eigen::Vector3d truth;                // omega_true (rad/s) or a_true (m/s^2), body frame
+  Eigen::Vector3d error;                // e = corrected - truth, SI
+  Eigen::Vector3d raw_residual;         // r = diag(S) inv(M) e, raw
+  Eigen::Vector3d sensor_frame;         // u = inv(M) corrected
+  Eigen::Vector3d specific_force_mps2;  // a^: the corrected accelerometer mean
+  Eigen::Vector3d noise_raw;            // n: the noise of the window's mean, raw
+};
+
+std::vector<SensorWindow> SensorWindows(const Calibration& cal, const Plan& plan,
+                                        const std::vector<Window>& windows,
+                                        const std::vector<WindowError>& errors, Sensor sensor) {
+  const bool gyro = sensor == Sensor::kGyro;
+  std::vector<SensorWindow> result;
+  for (const WindowError& e : errors) {
+    if (!gyro && !e.specific_force_known) continue;  // the accelerometer's truth is not constant there
+    const Window& w = windows[e.window];
+    const TableSegment* segment = plan.Find(e.segment);
+    SensorWindow s;
+    s.segment = e.segment;
+    s.temp_c = w.temp_c;
+    s.is_static = segment != nullptr && segment->IsStatic();
+    s.c = CoefficientsAt(gyro ? cal.model.gyro.data() : cal.model.accel.data(),
+                         gyro ? kGyroCoefficients : kAccelCoefficients, cal.model.basis.Argument(w.temp_c));
+    s.truth = gyro ? e.omega_true_radps : e.a_true_mps2;
+    s.error = gyro ? e.gyro_radps : e.accel_mps2;
+    const Eigen::PartialPivLU<Eigen::Matrix3d> misalignment(s.c.misalignment);
+    s.raw_residual = s.c.scale.cwiseProduct(misalignment.solve(s.error));
+    s.sensor_frame = misalignment.solve(Eigen::Vector3d(s.truth + s.error));
+    s.specific_force_mps2 = e.a_true_mps2 + e.accel_mps2;
+    s.noise_raw = w.NoiseOfMean(gyro);
+    result.push_back(s);
+  }
+  return result;
+}
+
+// The slope of the row's residual in the coefficient (the regressor), and whether the window may
+// estimate it at all (the table above).
+double Regressor(const SensorWindow& w, int coefficient) {
+  if (coefficient < kScaleCoefficient) return 1.0;
+  if (coefficient < kMisalignmentCoefficient) {
+    const int i = coefficient - kScaleCoefficient;
+    return w.c.misalignment.partialPivLu().solve(w.truth)(i);
+  }
+  if (coefficient < kGSensitivityCoefficient) {
+    return w.sensor_frame(kMisalignmentCol[coefficient - kMisalignmentCoefficient]);
+  }
+  return w.specific_force_mps2((coefficient - kGSensitivityCoefficient) % 3);
+}
+
+bool StaticOnly(int coefficient) {
+  return coefficient < kScaleCoefficient || coefficient >= kGSensitivityCoefficient;
+}
+
+// The window's estimate minus the fitted value at T_w, raw, and its 1-sigma (the table above).
+std::pair<double, double> WindowEstimate(const SensorWindow& w, int coefficient, double regressor) {
+  if (coefficient < kGSensitivityCoefficient && coefficient >= kMisalignmentCoefficient) {
+    const int m = coefficient - kMisalignmentCoefficient;
+    const int i = kMisalignmentRow[m];
+    double variance = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double term = w.c.misalignment(i, k) * w.noise_raw(k) / w.c.scale(k);
+      variance += term * term;
+    }
+    return {-w.error(i) / regressor, std::sqrt(variance) / std::abs(regressor)};
+  }
+  const int i = coefficient < kScaleCoefficient          ? coefficient
+                : coefficient < kMisalignmentCoefficient ? coefficient - kScaleCoefficient
+                                                         : (coefficient - kGSensitivityCoefficient) / 3;
+  return {w.raw_residual(i) / regressor, w.noise_raw(i) / std::abs(regressor)};
+}
+
+// The window estimates of one coefficient, in the group's unit (ppm of the scale change when
+// `scale_change`).
+std::vector<CoefficientPoint> WindowPoints(const Calibration& cal, const std::vector<SensorWindow>& windows,
+                                           Sensor sensor, int coefficient, bool scale_change) {
+  double largest = 0.0;
+  for (const SensorWindow& w : windows) {
+    if (StaticOnly(coefficient) && !w.is_static) continue;
+    largest = std::max(largest, std::abs(Regressor(w, coefficient)));
+  }
+  std::vector<CoefficientPoint> points;
+  if (!(largest > 0.0)) return points;
+  for (const SensorWindow& w : windows) {
+    if (StaticOnly(coefficient) && !w.is_static) continue;
+    const double regressor = Regressor(w, coefficient);
+    if (std::abs(regressor) < kPointRegressorFraction * largest) continue;
+    const auto [delta_raw, sigma_raw] = WindowEstimate(w, coefficient, regressor);
+    if (!(sigma_raw > 0.0)) continue;  // no noise measured: no error bar to draw
+    const int axis = coefficient - kScaleCoefficient;
+    const double curve =
+        scale_change ? ScaleChangePpm(cal.model, nullptr, sensor, axis, w.temp_c).value
+                     : EngineeringCoefficient(cal.model, nullptr, sensor, coefficient, w.temp_c).value;
+    const double factor = scale_change ? ScaleChangePpmPerRaw(cal.model, sensor, axis)
+                                       : EngineeringFactor(cal.model, sensor, coefficient, w.temp_c);
+    points.push_back({w.temp_c, curve + factor * delta_raw, std::abs(factor) * sigma_raw, w.segment});
+  }
+  return points;
+}
+
+std::vector<CoefficientGroup> CoefficientCurves(const Calibration& cal,
+                                                const std::vector<SensorWindow>& gyro_windows,
+                                                const std::vector<SensorWindow>& accel_windows) {
   const double lo = cal.fit_temp_range_c[0], hi = cal.fit_temp_range_c[1];
   const SensorModel* sigma = cal.sigma ? &*cal.sigma : nullptr;
   std::vector<CoefficientGroup> groups;
@@ -120,6 +276,8 @@ std::vector<CoefficientGroup> CoefficientCurves(const Calibration& cal) {
         curve.lo.push_back(v.value - s);
         curve.hi.push_back(v.value + s);
       }
+      curve.points = WindowPoints(cal, sensor == Sensor::kGyro ? gyro_windows : accel_windows, sensor,
+                                  first + i, scale_change);
       g.curves.push_back(std::move(curve));
     }
     groups.push_back(std::move(g));
@@ -159,23 +317,26 @@ WindowResiduals Residuals(const Calibration& cal, const Plan& plan, const std::v
     r.temp_c.push_back(e.temp_c);
     r.segment.push_back(e.segment);
     r.is_static.push_back(segment != nullptr && segment->IsStatic());
-    const double root_n = std::sqrt(static_cast<double>(std::max<long long>(w.samples, 1)));
+    const Eigen::Vector3d gyro_noise_raw = w.NoiseOfMean(true), accel_noise_raw = w.NoiseOfMean(false);
     const double x = cal.model.basis.Argument(w.temp_c);
     for (int axis = 0; axis < 3; ++axis) {
       const double gyro_scale = EvaluateTemperaturePolynomial(
           cal.model.gyro.data() + (kScaleCoefficient + axis) * kPolynomialTerms, x);
       const double accel_scale = EvaluateTemperaturePolynomial(
           cal.model.accel.data() + (kScaleCoefficient + axis) * kPolynomialTerms, x);
-      const double gyro_noise = DpsFromRadps(w.gyro_std(axis) / root_n / std::abs(gyro_scale));
-      const double accel_noise = MgFromMps2(w.accel_std(axis) / root_n / std::abs(accel_scale));
+      const double gyro_noise = DpsFromRadps(gyro_noise_raw(axis) / std::abs(gyro_scale));
+      const double accel_noise = MgFromMps2(accel_noise_raw(axis) / std::abs(accel_scale));
       r.gyro_dps[axis].push_back(DpsFromRadps(e.gyro_radps(axis)));
       r.gyro_before_dps[axis].push_back(DpsFromRadps(before[i].gyro_radps(axis)));
       r.gyro_noise_dps[axis].push_back(gyro_noise);
-      r.accel_mg[axis].push_back(MgFromMps2(e.accel_mps2(axis)));
-      r.accel_before_mg[axis].push_back(MgFromMps2(before[i].accel_mps2(axis)));
+      const double unknown = std::numeric_limits<double>::quiet_NaN();
+      r.accel_mg[axis].push_back(e.specific_force_known ? MgFromMps2(e.accel_mps2(axis)) : unknown);
+      r.accel_before_mg[axis].push_back(e.specific_force_known ? MgFromMps2(before[i].accel_mps2(axis))
+                                                               : unknown);
       r.accel_noise_mg[axis].push_back(accel_noise);
       if (gyro_noise > 0.0) gyro_normalised.push_back(r.gyro_dps[axis].back() / gyro_noise);
-      if (accel_noise > 0.0) accel_normalised.push_back(r.accel_mg[axis].back() / accel_noise);
+      if (accel_noise > 0.0 && e.specific_force_known)
+        accel_normalised.push_back(r.accel_mg[axis].back() / accel_noise);
     }
   }
   const double bin = 2.0 * kHistogramHalfWidth / kHistogramBins;
@@ -211,10 +372,12 @@ std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<Windo
     ResidualRow row;
     row.segment = s.segment;
     if (const TableSegment* seg = s.segment < 0 ? nullptr : plan.Find(s.segment)) {
-      row.up = Vector3Text(seg->up);
+      row.up = DirectionText(seg->up);
       row.rate_dps = DpsFromRadps(seg->rate_radps);
+      row.motion = MotionText(*seg);
     }
     row.windows = s.windows;
+    row.accel_windows = s.accel_windows;
     row.gyro_rms_before_dps = DpsFromRadps(b.gyro_rms_radps);
     row.gyro_rms_dps = DpsFromRadps(s.gyro_rms_radps);
     row.gyro_max_dps = DpsFromRadps(s.gyro_max_radps);
@@ -223,6 +386,30 @@ std::vector<ResidualRow> ResidualTable(const Plan& plan, const std::vector<Windo
     row.accel_max_mg = MgFromMps2(s.accel_max_mps2);
     rows.push_back(row);
   }
+  return rows;
+}
+
+// The rows the certificate prints (Certificate::residual_table_printed).
+std::vector<ResidualRow> PrintedResidualRows(const std::vector<ResidualRow>& table, int* omitted) {
+  *omitted = 0;
+  const int segments = static_cast<int>(table.size()) - 1;  // the last row is "all"
+  if (segments <= kMostResidualRowsPrinted) return table;
+  const ResidualRow& all = table.back();
+  const auto relative = [&](const ResidualRow& r) {
+    return std::max(all.gyro_rms_dps > 0.0 ? r.gyro_rms_dps / all.gyro_rms_dps : 0.0,
+                    all.accel_rms_mg > 0.0 ? r.accel_rms_mg / all.accel_rms_mg : 0.0);
+  };
+  std::vector<size_t> order(segments);
+  for (int i = 0; i < segments; ++i) order[i] = i;
+  const int kept = kMostResidualRowsPrinted - 1;
+  std::partial_sort(order.begin(), order.begin() + kept, order.end(),
+                    [&](size_t a, size_t b) { return relative(table[a]) > relative(table[b]); });
+  order.resize(kept);
+  std::sort(order.begin(), order.end());
+  std::vector<ResidualRow> rows;
+  for (size_t i : order) rows.push_back(table[i]);
+  rows.push_back(all);
+  *omitted = segments - kept;
   return rows;
 }
 
@@ -328,6 +515,19 @@ void CoverageWarnings(const Plan& plan, const RunWindows& run, std::vector<std::
   }
 }
 
+// The station's reference equipment must have been within its calibration when the unit was
+// calibrated (ISO dates compare as text).
+void StationWarnings(const Station& station, const std::string& calibrated_utc,
+                     const std::string& written_utc, std::vector<std::string>* warnings) {
+  if (station.reference_calibration_due.empty()) return;
+  const std::string when = (calibrated_utc.size() >= 10 ? calibrated_utc : written_utc).substr(0, 10);
+  if (station.reference_calibration_due < when) {
+    warnings->push_back("the station's reference equipment was due for calibration on " +
+                        station.reference_calibration_due + ", before this unit was calibrated (" + when +
+                        ")");
+  }
+}
+
 }  // namespace
 
 Certificate MakeCertificate(const CertificateSources& sources) {
@@ -341,7 +541,12 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   c.report_software = cal.software;
   c.git_revision = IMUFIT_GIT_REVISION;
   c.reference_temp_c = cal.model.basis.center_c;
-  for (ReportInput input : sources.inputs) {
+  std::vector<ReportInput> inputs = sources.inputs;
+  if (sources.station && std::none_of(inputs.begin(), inputs.end(),
+                                      [](const ReportInput& in) { return in.role == "station"; })) {
+    inputs.push_back({"station", sources.station->path, ""});
+  }
+  for (ReportInput input : inputs) {
     if (input.path.empty()) continue;
     if (input.sha256.empty()) input.sha256 = Sha256OfFile(input.path);
     c.inputs.push_back(input);
@@ -350,6 +555,8 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     c.warnings.push_back("no serial: neither the calibration, the plan nor --serial names the unit");
   }
   for (const std::string& w : sources.warnings) c.warnings.push_back(w);
+  c.station = sources.station;
+  if (c.station) StationWarnings(*c.station, c.calibrated_utc, c.written_utc, &c.warnings);
   CoverageWarnings(sources.plan, sources.run, &c.warnings);
   c.run = SummariseRun(cal, sources.plan, sources.run);
   c.settings = Settings(cal, sources.windows);
@@ -358,13 +565,16 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     c.figures.push_back(
         {f.name, f.unit, f.value, f.sigma, f.sigma >= 0.0 ? kCoverageFactor * f.sigma : -1.0});
   }
-  c.curves = CoefficientCurves(cal);
   const std::vector<WindowError> after =
       PredictWindows(cal.model, sources.run.windows, sources.plan.site, sources.plan.segments);
+  c.curves =
+      CoefficientCurves(cal, SensorWindows(cal, sources.plan, sources.run.windows, after, Sensor::kGyro),
+                        SensorWindows(cal, sources.plan, sources.run.windows, after, Sensor::kAccel));
   const std::vector<WindowError> before =
       PredictWindows(ScaleOnly(cal), sources.run.windows, sources.plan.site, sources.plan.segments);
   c.residuals = Residuals(cal, sources.plan, sources.run.windows, after, before);
   c.residual_table = ResidualTable(sources.plan, after, before);
+  c.residual_table_printed = PrintedResidualRows(c.residual_table, &c.residual_rows_omitted);
 
   c.noise.why_not = "no samples file given";
   for (const ReportInput& in : c.inputs) {
@@ -433,7 +643,7 @@ std::vector<std::string> InputMismatches(const Calibration& calibration, const s
 
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
                             const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const WindowOptions& windows) {
+                            const WindowOptions& windows, const std::optional<Station>& station) {
   const FitRunResult& fit = *unit.fit;
   CertificateSources sources;
   sources.unit = unit.unit;
@@ -449,6 +659,7 @@ Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_p
                     {"plan", unit.plan_path, unit.plan_sha256},
                     {"samples", unit.samples_path, unit.samples_sha256},
                     {"limits", limits_path, ""}};
+  sources.station = station;
   return MakeCertificate(sources);
 }
 

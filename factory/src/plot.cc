@@ -75,7 +75,8 @@ std::string With(const PlotSeries& s) {
       w << "using 1:3:4 with filledcurves fs transparent solid 0.18 noborder " << color;
       break;
     case PlotSeries::Style::kErrorBars:
-      w << "using 1:2:3:4 with yerrorbars pt " << s.point_type << " ps " << s.point_size << " " << color;
+      w << "using 1:2:3:4 with yerrorbars lw " << s.line_width << " pt " << s.point_type << " ps "
+        << s.point_size << " " << color;
       break;
     case PlotSeries::Style::kBoxes:
       w << "using 1:2:(0.7) with boxes fs solid 0.75 noborder " << color;
@@ -119,6 +120,50 @@ struct TempFolder {
     fs::remove_all(path, ignored);
   }
 };
+
+// Margins around the data, as fractions of its extent, so that no point sits on the frame.
+constexpr double kXMargin = 0.04, kYMargin = 0.06;
+
+// The extent of the panel's data along x or y (y: the intervals of bands and error bars too);
+// false when it holds no finite value.
+bool DataExtent(const Plot& plot, bool y_axis, double* lo, double* hi) {
+  *lo = INFINITY;
+  *hi = -INFINITY;
+  const auto take = [&](double v) {
+    if (!std::isfinite(v)) return;
+    *lo = std::min(*lo, v);
+    *hi = std::max(*hi, v);
+  };
+  for (const PlotSeries& s : plot.series) {
+    if (!y_axis) {
+      for (double v : s.x) take(v);
+      continue;
+    }
+    if (s.style != PlotSeries::Style::kBand) {
+      for (double v : s.y) take(v);
+    }
+    for (double v : s.lo) take(v);
+    for (double v : s.hi) take(v);
+    for (size_t i = 0; i < s.error.size() && i < s.y.size(); ++i) {
+      take(s.y[i] - s.error[i]);
+      take(s.y[i] + s.error[i]);
+    }
+  }
+  return *lo <= *hi;
+}
+
+// A tick step of 1, 2, 2.5 or 5 times a power of ten that puts at most `most` tick labels on
+// [lo, hi]; 0 when the extent is empty.
+double TickStep(double lo, double hi, int most) {
+  const double span = hi - lo;
+  if (!(span > 0.0) || most < 2) return 0.0;
+  const double raw = span / (most - 1);
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0}) {
+    if (m * power >= raw) return m * power;
+  }
+  return 10.0 * power;
+}
 
 }  // namespace
 
@@ -203,6 +248,7 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
   for (size_t p = 0; p < figure.panels.size(); ++p) {
     const Plot& plot = figure.panels[p];
     gp << "reset\nset encoding utf8\nset grid lc rgb '#dddddd'\nset border lc rgb '#444444'\n";
+    gp << "set bars small\n";
     gp << "set title " << Quote(plot.title) << "\n";
     gp << "set xlabel " << Quote(plot.x_label) << "\nset ylabel " << Quote(plot.y_label) << "\n";
     if (plot.log_x)
@@ -227,8 +273,44 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
     }
     if (plot.x_range) gp << "set xrange [" << (*plot.x_range)[0] << ":" << (*plot.x_range)[1] << "]\n";
     if (plot.y_range) gp << "set yrange [" << (*plot.y_range)[0] << ":" << (*plot.y_range)[1] << "]\n";
-    if (!plot.x_range) gp << "set offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n";
-    gp << (plot.key ? "set key outside right top samplen 2\n" : "unset key\n");
+    if (!plot.x_range) {
+      gp << "set offsets graph " << kXMargin << ", graph " << kXMargin << ", graph " << kYMargin << ", graph "
+         << (plot.y_from_zero ? 0.0 : kYMargin) << "\n";
+    }
+    if (plot.y_from_zero && !plot.y_range) gp << "set yrange [0:*]\n";
+    if (!plot.key) {
+      gp << "unset key\n";
+    } else {
+      gp << (plot.key_above ? "set key outside center top horizontal samplen 1.5 spacing 0.9\n"
+                            : "set key outside right top samplen 1.5 spacing 0.9\n");
+    }
+    for (const bool y_axis : {false, true}) {
+      const int most = y_axis ? plot.max_y_tics : plot.max_x_tics;
+      const bool log = y_axis ? plot.log_y : plot.log_x;
+      const bool fixed = y_axis ? plot.y_range.has_value() : plot.x_range.has_value();
+      double lo = 0.0, hi = 0.0;
+      if (most <= 1 || log || (y_axis && !plot.y_tics) || !DataExtent(plot, y_axis, &lo, &hi)) continue;
+      if (fixed) {
+        lo = (y_axis ? *plot.y_range : *plot.x_range)[0];
+        hi = (y_axis ? *plot.y_range : *plot.x_range)[1];
+      } else {
+        // The axis ends where the data end (with the margins of the offsets above), not at the next
+        // tick: a few labels on a small panel must not leave half of it empty.
+        const double margin = (hi - lo) * (y_axis ? kYMargin : kXMargin);
+        lo = y_axis && plot.y_from_zero ? 0.0 : lo - margin;
+        hi += margin;
+      }
+      if (!fixed && !(hi > lo)) {  // one value (a run at one temperature): a unit either side
+        const double half = std::max(1.0, 0.01 * std::abs(lo));
+        lo -= half;
+        hi += half;
+      }
+      const double step = TickStep(lo, hi, most);
+      if (!(step > 0.0)) continue;
+      const char* axis = y_axis ? "y" : "x";
+      gp << "set " << axis << "tics " << step << "\n";
+      if (!fixed) gp << "set " << axis << "range [" << lo << ":" << hi << "]\n";
+    }
     int object = 1;
     size_t right_label = 0;  // the longest label of a horizontal marker, right of the panel
     for (const PlotMarker& m : plot.markers) {

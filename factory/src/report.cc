@@ -26,7 +26,7 @@ body { font-family: "DejaVu Sans", Helvetica, Arial, sans-serif; font-size: 12px
 h1 { font-size: 20px; margin: 0 0 6px 0; } h2 { font-size: 15px; border-bottom: 1px solid #999; margin: 16px 0 6px 0; }
 h3 { font-size: 13px; margin: 10px 0 4px 0; }
 table { border-collapse: collapse; margin: 4px 0; } td, th { border: 1px solid #bbb; padding: 1px 6px; text-align: left; vertical-align: top; }
-th { background: #eee; } td.num { text-align: right; font-variant-numeric: tabular-nums; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
+th { background: #eee; } .path { overflow-wrap: anywhere; } td.num { text-align: right; font-variant-numeric: tabular-nums; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
 thead { display: table-header-group; } td:first-child { white-space: nowrap; } tr { break-inside: avoid; page-break-inside: avoid; }
 .hash { font-family: "DejaVu Sans Mono", monospace; font-size: 10px; word-break: break-all; }
 .PASS { color: #06642a; font-weight: bold; } .FAIL { color: #b00; font-weight: bold; }
@@ -39,8 +39,12 @@ thead { display: table-header-group; } td:first-child { white-space: nowrap; } t
 .note { color: #555; font-size: 11px; }
 .outlier { color: #b00; } .failed-unit { color: #b00; font-weight: bold; } tr.current td { background: #ffe9d6; font-weight: bold; }
 h2, h3 { break-after: avoid; page-break-after: avoid; }
-.sign td { height: 28px; min-width: 180px; }
-@media print { body { margin: 0; max-width: none; font-size: 10.5px; } .page-break { break-before: page; } }
+.sign { width: 100%; margin-top: 6px; } .sign td { height: 26px; } .sign td:first-child { width: 22%; }
+.sign td:nth-child(2) { width: 30%; } .sign td:nth-child(3) { width: 30%; } table.fill { width: 100%; }
+table.fill td:first-child { width: 35%; }
+@media print { body { margin: 0; max-width: none; font-size: 10px; } td, th { padding: 0 5px; } h2 { margin: 10px 0 4px 0; }
+  table { line-height: 1.1; }
+  .page-break { break-before: page; } }
 )css";
 
 // A table row of cells (each text escaped).
@@ -99,6 +103,11 @@ PlotSeries Series(PlotSeries::Style style, const std::string& title, int color, 
   return s;
 }
 
+// Figure widths in CSS pixels at print (A4 less its margins is about 695 px, Letter 718 px): drawn
+// at the size they are printed, so gnuplot's 10 pt labels stay 10 pt on paper.
+constexpr int kFullWidthPx = 700;
+constexpr int kHalfWidthPx = 345;
+
 PlotFigure CoefficientFigure(const CoefficientGroup& g) {
   PlotFigure figure;
   const auto panel = [&](const CoefficientCurve& c, int color, Plot* plot) {
@@ -107,84 +116,97 @@ PlotFigure CoefficientFigure(const CoefficientGroup& g) {
     band.hi = c.hi;
     plot->series.push_back(band);
     PlotSeries line = Series(PlotSeries::Style::kLines, g.grid ? "" : c.axis, color, c.temp_c, c.value);
-    line.line_width = 2;
+    line.line_width = 1.5;
     plot->series.push_back(line);
+    // The windows' own estimates over the curve: open circles with their 1-sigma bars (a bar
+    // shorter than the circle is hidden by it).
+    PlotSeries points = Series(PlotSeries::Style::kErrorBars, "", color, {}, {});
+    for (const CoefficientPoint& p : c.points) {
+      points.x.push_back(p.temp_c);
+      points.y.push_back(p.value);
+      points.error.push_back(p.sigma);
+    }
+    points.point_type = 6;
+    points.point_size = 0.45;
+    points.line_width = 1;
+    plot->series.push_back(points);
   };
   if (g.grid) {
-    figure.rows = figure.cols = 3;
-    figure.width_px = 760;
-    figure.height_px = 400;
-    figure.title = g.title + " (" + g.unit + ") against temperature, degC; 1-sigma band";
+    figure = Figure(3, 3, kFullWidthPx, 320);
+    figure.title = g.title + " (" + g.unit + ") against temperature, degC";
     for (const CoefficientCurve& c : g.curves) {
       Plot plot;
-      plot.title = c.axis;
+      plot.labels.push_back({c.axis});  // inside the panel: no title line
       plot.key = false;
+      plot.max_x_tics = 7;
+      plot.max_y_tics = 4;
       panel(c, 0, &plot);
       figure.panels.push_back(plot);
     }
     return figure;
   }
-  figure.width_px = 480;
-  figure.height_px = 240;
-  Plot plot = Panel(g.title + ", 1-sigma band", "temperature, degC", g.unit);
+  figure = Figure(1, 1, kHalfWidthPx, 160);
+  Plot plot = Panel(g.title, "temperature, degC", g.unit);
+  plot.max_x_tics = 7;
+  plot.max_y_tics = 5;
   for (size_t i = 0; i < g.curves.size(); ++i) panel(g.curves[i], static_cast<int>(i), &plot);
   figure.panels.push_back(plot);
   return figure;
 }
 
-PlotFigure ResidualFigure(const WindowResiduals& r) {
-  PlotFigure figure = Figure(2, 2, 900, 560);
-  const char* axes[] = {"x", "y", "z"};
-  const auto panel = [&](const std::string& title, const std::string& unit,
-                         const std::array<std::vector<double>, 3>& values,
+// The errors of every window before and after correction, against temperature and time, with the
+// run's temperature and the histogram of the normalised errors: one 3 x 3 grid.
+PlotFigure ErrorFigure(const Certificate& c) {
+  const WindowResiduals& r = c.residuals;
+  PlotFigure figure = Figure(3, 3, kFullWidthPx, 480);
+  const char* axes[] = {"x", "y", "z"};  // keyed in the section's note, so the panels keep their width
+  const auto panel = [&](const std::string& title, const std::vector<double>& x, const std::string& x_label,
+                         const std::string& unit, const std::array<std::vector<double>, 3>& values,
                          const std::array<std::vector<double>, 3>* noise) {
-    Plot plot = Panel(title, "temperature, degC", unit);
+    Plot plot = Panel(title, x_label, unit);
+    plot.key = false;
+    plot.max_x_tics = 7;
+    plot.max_y_tics = 5;
     for (int axis = 0; axis < 3; ++axis) {
       PlotSeries s = Series(noise ? PlotSeries::Style::kErrorBars : PlotSeries::Style::kPoints, axes[axis],
-                            axis, r.temp_c, values[axis]);
+                            axis, x, values[axis]);
       if (noise) s.error = (*noise)[axis];
-      s.point_size = 0.4;
+      s.point_size = 0.3;
+      s.line_width = 1;
       plot.series.push_back(s);
     }
     figure.panels.push_back(plot);
   };
-  panel("Gyro error after correction, per window (bars: the window's own noise)", "deg/s", r.gyro_dps,
-        &r.gyro_noise_dps);
-  panel("Accelerometer error after correction, per window", "mg", r.accel_mg, &r.accel_noise_mg);
-  panel("Gyro error before (25 degC scale factor only)", "deg/s", r.gyro_before_dps, nullptr);
-  panel("Accelerometer error before (25 degC scale factor only)", "mg", r.accel_before_mg, nullptr);
-  return figure;
-}
-
-PlotFigure RunFigure(const Certificate& c) {
-  PlotFigure figure = Figure(1, 3, 900, 260);
-  Plot temp = Panel("Temperature against time (window means)", "time, s", "degC");
-  temp.key = false;
-  temp.series.push_back(Series(PlotSeries::Style::kPoints, "", 3, c.run.time_s, c.run.window_temp_c));
-  figure.panels.push_back(temp);
-  Plot time = Panel("Gyro error after correction against time", "time, s", "deg/s");
-  const char* axes[] = {"x", "y", "z"};
-  for (int axis = 0; axis < 3; ++axis) {
-    PlotSeries s =
-        Series(PlotSeries::Style::kPoints, axes[axis], axis, c.residuals.time_s, c.residuals.gyro_dps[axis]);
-    s.point_size = 0.4;
-    time.series.push_back(s);
-  }
-  figure.panels.push_back(time);
-  Plot histogram = Panel("Normalised errors (error / window noise)", "normalised error", "windows x axes");
-  PlotSeries gyro = Series(PlotSeries::Style::kLinesPoints, "gyro", 0, c.residuals.histogram_center,
-                           c.residuals.gyro_histogram);
-  PlotSeries accel = Series(PlotSeries::Style::kLinesPoints, "accel", 1, c.residuals.histogram_center,
-                            c.residuals.accel_histogram);
+  panel("Gyro error after correction", r.temp_c, "temperature, degC", "deg/s", r.gyro_dps, &r.gyro_noise_dps);
+  panel("Accel error after correction", r.temp_c, "temperature, degC", "mg", r.accel_mg, &r.accel_noise_mg);
+  Plot histogram = Panel("Normalised errors after", "error / window noise", "windows x axes");
+  histogram.key = false;
+  histogram.max_x_tics = 11;
+  histogram.max_y_tics = 5;
+  histogram.y_from_zero = true;
+  PlotSeries gyro = Series(PlotSeries::Style::kLinesPoints, "gyro", 0, r.histogram_center, r.gyro_histogram);
+  PlotSeries accel =
+      Series(PlotSeries::Style::kLinesPoints, "accel", 1, r.histogram_center, r.accel_histogram);
+  gyro.point_size = accel.point_size = 0.4;
   histogram.series = {gyro, accel};
   figure.panels.push_back(histogram);
+  panel("Gyro error after, against time", r.time_s, "time, s", "deg/s", r.gyro_dps, nullptr);
+  panel("Accel error after, against time", r.time_s, "time, s", "mg", r.accel_mg, nullptr);
+  Plot temp = Panel("Temperature (window means)", "time, s", "degC");
+  temp.key = false;
+  temp.max_x_tics = 7;
+  temp.max_y_tics = 5;
+  PlotSeries temps = Series(PlotSeries::Style::kPoints, "", 3, c.run.time_s, c.run.window_temp_c);
+  temps.point_size = 0.3;
+  temp.series.push_back(temps);
+  figure.panels.push_back(temp);
+  panel("Gyro error before", r.temp_c, "temperature, degC", "deg/s", r.gyro_before_dps, nullptr);
+  panel("Accel error before", r.temp_c, "temperature, degC", "mg", r.accel_before_mg, nullptr);
   return figure;
 }
 
 PlotFigure AllanFigure(const NoiseSection& noise) {
-  PlotFigure figure;
-  figure.width_px = 760;
-  figure.height_px = 330;
+  PlotFigure figure = Figure(1, 1, kFullWidthPx, 280);
   Plot plot;
   plot.title = "Gyro overlapping Allan deviation, segment " + Count(noise.segment) +
                Fmt(", %.0f s", noise.duration_s) + Fmt(" at %.1f degC", noise.temp_c);
@@ -218,6 +240,50 @@ PlotFigure AllanFigure(const NoiseSection& noise) {
 
 // ---------------------------------------------------------------- certificate sections
 
+// A piece of equipment as "model, serial S".
+std::string EquipmentText(const StationEquipment& e) {
+  if (e.serial.empty()) return e.model;
+  return (e.model.empty() ? "" : e.model + ", ") + "serial " + e.serial;
+}
+
+// Where and by whom, from the station file; without one, lines to fill in by hand.
+void Station(Html* h, const Certificate& c) {
+  h->Open("div").Open("table", {{"class", "fill"}});
+  if (!c.station) {
+    for (const char* field :
+         {"station", "location", "rate table", "chamber", "reference equipment calibrated until"})
+      Row(h, {field, ""});
+    h->Close("table").Close("div");
+    return;
+  }
+  const imufit::Station& s = *c.station;
+  const auto field = [&](const char* name, const std::string& value, const char* key) {
+    if (value.empty()) return;
+    h->Open("tr").Element("td", name).Element("td", value, {{"data-key", key}}).Close("tr");
+  };
+  field("station", s.name + (s.id.empty() ? "" : " (" + s.id + ")"), "station");
+  field("location", s.location, "location");
+  field("operator", s.operator_name, "operator");
+  field("rate table", EquipmentText(s.rate_table), "rate_table");
+  field("chamber", EquipmentText(s.chamber), "chamber");
+  field("reference equipment calibrated until", s.reference_calibration_due, "reference_calibration_due");
+  field("notes", s.notes, "station_notes");
+  h->Close("table").Close("div");
+}
+
+// The lines a quality engineer signs: who calibrated the unit (the station's operator, when known)
+// and who reviewed the certificate.
+void Signatures(Html* h, const Certificate& c) {
+  h->Open("table", {{"class", "sign"}}).Open("thead");
+  Row(h, {"", "name", "signature", "date"}, "th");
+  h->Close("thead").Open("tbody");
+  h->Open("tr").Element("td", "Calibrated by");
+  h->Element("td", c.station ? c.station->operator_name : "", {{"data-key", "calibrated_by"}});
+  h->Element("td", "").Element("td", "").Close("tr");
+  Row(h, {"Reviewed by (quality)", "", "", ""});
+  h->Close("tbody").Close("table");
+}
+
 void Identification(Html* h, const Certificate& c) {
   const std::string serial = c.serial.empty() ? "(no serial)" : c.serial;
   h->Open("h1")
@@ -239,7 +305,7 @@ void Identification(Html* h, const Certificate& c) {
     h->Open("div", {{"class", "warn"}, {"data-warning", w}}).Text("Warning: " + w).Close("div");
   }
   h->Open("div", {{"class", "cols"}});
-  h->Open("div").Open("table");
+  h->Open("div").Open("table", {{"class", "fill"}});
   Row(h, {"unit serial", serial});
   if (!c.unit.empty()) Row(h, {"unit folder", c.unit});
   Row(h, {"calibrated (UTC)", c.calibrated_utc});
@@ -251,20 +317,16 @@ void Identification(Html* h, const Certificate& c) {
   Row(h, {"certificate software", c.report_software + ", git " + c.git_revision});
   Row(h, {"reference temperature of the coefficients", Fmt("%g degC", c.reference_temp_c)});
   h->Close("table").Close("div");
-  h->Open("div").Open("table", {{"class", "sign"}});
-  Row(h, {"calibrated by", ""});
-  Row(h, {"checked by (quality)", ""});
-  Row(h, {"date, signature", ""});
-  h->Close("table").Close("div");
+  Station(h, c);
   h->Close("div");
-
+  Signatures(h, c);
   h->Open("div", {{"class", "keep"}});
   h->Element("h2", "Input files");
   h->Open("table").Open("thead");
   Row(h, {"role", "file", "SHA-256"}, "th");
   h->Close("thead").Open("tbody");
   for (const ReportInput& in : c.inputs) {
-    h->Open("tr").Element("td", in.role).Element("td", in.path);
+    h->Open("tr").Element("td", in.role).Element("td", in.path, {{"class", "path"}});
     h->Element("td", in.sha256, {{"class", "hash"}, {"data-sha256", in.role}}).Close("tr");
   }
   h->Close("tbody").Close("table").Close("div");
@@ -275,7 +337,7 @@ void RunAndSettings(Html* h, const Certificate& c) {
   h->Open("div").Element("h2", "Plan and run").Open("table");
   std::string rates;
   for (double r : c.run.rates_dps) rates += (rates.empty() ? "" : ", ") + Fmt("%g", r);
-  Row(h, {"plan", c.run.plan_path});
+  h->Open("tr").Element("td", "plan").Element("td", c.run.plan_path, {{"class", "path"}}).Close("tr");
   Row(h, {"segments", Count(c.run.segments) + " (" + Count(c.run.static_segments) + " static; rates " +
                           (rates.empty() ? "none" : rates + " deg/s") + ")"});
   Row(h, {"local gravity", Fmt("%.6g m/s\xc2\xb2", c.run.gravity_mps2)});
@@ -332,12 +394,14 @@ void Acceptance(Html* h, const Verdict& verdict) {
 }
 
 void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
+  // The sensor's prefix is the table's heading, so that two tables fit side by side on A4.
+  const std::string prefix = gyro ? "gyro_" : "accel_";
   h->Open("table").Open("thead");
-  Row(h, {"coefficient", "value", "1-sigma", "U (k = 2)", "unit"}, "th");
+  Row(h, {gyro ? "gyro" : "accelerometer", "value", "1-sigma", "U (k = 2)", "unit"}, "th");
   h->Close("thead").Open("tbody");
   for (const KeyFigureRow& f : figures) {
     if ((f.name.rfind("gyro", 0) == 0) != gyro) continue;
-    h->Open("tr").Element("td", f.name);
+    h->Open("tr").Element("td", f.name.rfind(prefix, 0) == 0 ? f.name.substr(prefix.size()) : f.name);
     Num(h, Fmt("%+.6g", f.value), {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
     Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
     Num(h, f.expanded >= 0.0 ? Fmt("%.3g", f.expanded) : "\xe2\x80\x93");
@@ -347,6 +411,7 @@ void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
 }
 
 void KeyFigures(Html* h, const Certificate& c) {
+  h->Open("div", {{"class", "keep"}});
   h->Element("h2", "Coefficients at 25 degC");
   h->Element("p",
              "1-sigma from the fit's covariance; U is the expanded uncertainty at k = 2 (about 95 % for a "
@@ -357,40 +422,48 @@ void KeyFigures(Html* h, const Certificate& c) {
   FigureTable(h, c.figures, true);
   h->Close("div").Open("div");
   FigureTable(h, c.figures, false);
-  h->Close("div").Close("div");
+  h->Close("div").Close("div").Close("div");
 }
 
 void ResidualTable(Html* h, const Certificate& c) {
-  h->Element(
-      "p",
-      "Per window, |corrected - true|; before: the raw outputs divided by the unit's 25 degC scale factors "
-      "only.",
-      {{"class", "note"}});
-  h->Open("table").Open("thead");
-  Row(h,
-      {"segment", "up", "rate, deg/s", "windows", "gyro RMS before, deg/s", "gyro RMS, deg/s",
-       "gyro max, deg/s", "accel RMS before, mg", "accel RMS, mg", "accel max, mg"},
-      "th");
+  h->Open("div", {{"class", "keep"}}).Element("h2", "Errors per segment");
+  h->Element("p",
+             "Per window, |corrected - true|, RMS and largest over the segment's windows; before: the raw "
+             "outputs divided by the unit's 25 degC scale factors only.",
+             {{"class", "note"}});
+  h->Open("table").Open("thead").Open("tr");
+  for (const char* title : {"segment", "up", "motion", "windows"}) {
+    h->Element("th", title, {{"rowspan", "2"}});
+  }
+  h->Element("th", "gyro, deg/s", {{"colspan", "3"}}).Element("th", "accelerometer, mg", {{"colspan", "3"}});
+  h->Close("tr");
+  Row(h, {"RMS before", "RMS after", "max after", "RMS before", "RMS after", "max after"}, "th");
   h->Close("thead").Open("tbody");
-  for (const ResidualRow& r : c.residual_table) {
+  for (const ResidualRow& r : c.residual_table_printed) {
     h->Open("tr", r.segment < 0 ? HtmlAttributes{{"data-key", "residual_all"}} : HtmlAttributes{});
-    h->Element("td", r.segment < 0 ? "all" : Count(r.segment)).Element("td", r.up);
-    Num(h, r.segment < 0 ? "" : Fmt("%g", r.rate_dps));
+    h->Element("td", r.segment < 0 ? "all" : Count(r.segment)).Element("td", r.up).Element("td", r.motion);
     Num(h, Count(r.windows));
     Num(h, Fmt("%.4f", r.gyro_rms_before_dps));
     Num(h, Fmt("%.5f", r.gyro_rms_dps));
     Num(h, Fmt("%.5f", r.gyro_max_dps));
-    Num(h, Fmt("%.3f", r.accel_rms_before_mg));
-    Num(h, Fmt("%.4f", r.accel_rms_mg));
-    Num(h, Fmt("%.4f", r.accel_max_mg));
+    if (r.accel_windows == 0) {
+      h->Element("td", "specific force not constant", {{"colspan", "3"}, {"class", "note"}});
+    } else {
+      Num(h, Fmt("%.3f", r.accel_rms_before_mg));
+      Num(h, Fmt("%.4f", r.accel_rms_mg));
+      Num(h, Fmt("%.4f", r.accel_max_mg));
+    }
     h->Close("tr");
   }
-  h->Close("tbody").Close("table");
-  h->Element("p",
-             "RMS of the normalised errors (1 when the errors are the windows' own noise): gyro " +
-                 Fmt("%.2f", c.residuals.normalised_gyro_rms) + ", accelerometer " +
-                 Fmt("%.2f", c.residuals.normalised_accel_rms) + ".",
-             {{"class", "note"}});
+  h->Close("tbody").Close("table").Close("div");
+  std::string note = "RMS of the normalised errors (1 when the errors are the windows' own noise): gyro " +
+                     Fmt("%.2f", c.residuals.normalised_gyro_rms) + ", accelerometer " +
+                     Fmt("%.2f", c.residuals.normalised_accel_rms) + ".";
+  if (c.residual_rows_omitted > 0) {
+    note += " The " + Count(c.residual_rows_omitted) +
+            " segments with the smallest errors after correction are not listed (all: every segment).";
+  }
+  h->Element("p", note, {{"class", "note"}});
 }
 
 void NoiseTable(Html* h, const NoiseSection& noise) {
@@ -424,9 +497,9 @@ void NoiseTable(Html* h, const NoiseSection& noise) {
 }
 
 void Validation(Html* h, const Certificate& c) {
-  h->Element("h2", "Validation (leave one temperature out)");
+  h->Open("div", {{"class", "keep"}}).Element("h2", "Validation (leave one temperature out)");
   if (c.validation.empty()) {
-    h->Element("p", "Not run (imufit fit --validate runs it).", {{"class", "note"}});
+    h->Element("p", "Not run (imufit fit --validate runs it).", {{"class", "note"}}).Close("div");
     return;
   }
   h->Open("table").Open("thead");
@@ -458,6 +531,7 @@ void Validation(Html* h, const Certificate& c) {
                   v.temp_c, v.gyro_temp_order, v.accel_temp_order);
     h->Element("p", text, {{"class", "note"}});
   }
+  h->Close("div");
 }
 
 }  // namespace
@@ -465,8 +539,7 @@ void Validation(Html* h, const Certificate& c) {
 std::vector<PlotFigure> CertificatePlots(const Certificate& c) {
   std::vector<PlotFigure> figures;
   for (const CoefficientGroup& g : c.curves) figures.push_back(CoefficientFigure(g));
-  figures.push_back(ResidualFigure(c.residuals));
-  figures.push_back(RunFigure(c));
+  figures.push_back(ErrorFigure(c));
   if (c.noise.computed) figures.push_back(AllanFigure(c.noise));
   return figures;
 }
@@ -494,27 +567,46 @@ std::string CertificateHtml(const Certificate& c) {
   if (c.verdict) Acceptance(&h, *c.verdict);
   KeyFigures(&h, c);
 
+  // Coefficients against temperature, two to a row (the heading stays with the first row), then
+  // the g-sensitivity grid. Figure i of CertificatePlots() is group i.
   const size_t groups = c.curves.size();
-  h.Element("h2", "Coefficients against temperature");
-  h.Element("p",
-            "Lines: the fitted polynomial; bands: 1-sigma from each term's own sigma (correlations between "
-            "terms not drawn).",
-            {{"class", "note"}});
-  // The g-sensitivity grid is the group drawn as a grid; the others two to a row.
+  std::vector<std::vector<size_t>> rows;
   size_t grid = groups;
   for (size_t g = 0; g < groups; ++g) {
-    if (c.curves[g].grid) grid = g;
+    if (c.curves[g].grid) {
+      grid = g;
+      continue;
+    }
+    if (rows.empty() || rows.back().size() == 2) rows.emplace_back();
+    rows.back().push_back(g);
   }
-  h.Open("div", {{"class", "plots2"}});
-  for (size_t g = 0; g < groups && failure.empty(); ++g) {
-    if (g != grid) Plots(&h, svgs, g, g + 1, "");
+  const auto plot_row = [&](const std::vector<size_t>& row) {
+    h.Open("div", {{"class", "plots2 keep"}});
+    for (size_t g : row) Plots(&h, svgs, g, g + 1, "");
+    h.Close("div");
+  };
+  h.Open("div", {{"class", "keep"}}).Element("h2", "Coefficients against temperature");
+  h.Element("p",
+            "Lines: the fitted polynomial; bands: its 1-sigma (each term's own, correlations not drawn); "
+            "circles: each window's own estimate (the coefficient that explains that window, all others as "
+            "fitted) with its noise as 1-sigma bars.",
+            {{"class", "note"}});
+  if (!failure.empty()) {
+    Plots(&h, svgs, 0, 0, failure);
+  } else if (!rows.empty()) {
+    plot_row(rows.front());
   }
   h.Close("div");
-  if (grid < groups) Plots(&h, svgs, grid, grid + 1, "");
-  if (!failure.empty()) Plots(&h, svgs, 0, 0, failure);
+  for (size_t r = 1; r < rows.size() && failure.empty(); ++r) plot_row(rows[r]);
+  if (grid < groups && failure.empty()) Plots(&h, svgs, grid, grid + 1, "");
 
   h.Open("div", {{"class", "keep"}}).Element("h2", "Errors before and after correction");
-  Plots(&h, svgs, groups, groups + 2, failure.empty() ? "" : " ");
+  h.Element("p",
+            "Per window, corrected - true for axis x (blue), y (red), z (green); after correction with the "
+            "window's noise as bars (1-sigma), before: the raw outputs over the 25 degC scale factors only. "
+            "Histogram: gyro (blue), accelerometer (red).",
+            {{"class", "note"}});
+  Plots(&h, svgs, groups, groups + 1, failure);
   h.Close("div");
   ResidualTable(&h, c);
 
@@ -522,7 +614,7 @@ std::string CertificateHtml(const Certificate& c) {
   if (!c.noise.computed) {
     h.Element("p", "Not drawn: " + c.noise.why_not + ".", {{"class", "note"}});
   } else {
-    Plots(&h, svgs, groups + 2, groups + 3, "");
+    Plots(&h, svgs, groups + 1, groups + 2, failure);
     NoiseTable(&h, c.noise);
   }
   h.Close("div");

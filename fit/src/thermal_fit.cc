@@ -78,16 +78,8 @@ const Eigen::Vector3d& TruthFor(const FitWindow& w, bool gyro) {
 const Eigen::Vector3d& RawFor(const FitWindow& w, bool gyro) {
   return gyro ? w.window->gyro_mean : w.window->accel_mean;
 }
-// The noise of a window's mean, raw units: the per-sample spread over sqrt(samples). Where the
-// truth is constant over the window, the sample standard deviation (it also holds the table's
-// rate ripple and slow noise); in a turn, whose rate varies, the second-difference figure, which
-// sees the noise and not the rate profile (windows.h).
-Eigen::Vector3d RawSigmaFor(const FitWindow& w, bool gyro) {
-  const Window& window = *w.window;
-  const Eigen::Vector3d& spread = window.whole_occurrence ? (gyro ? window.gyro_noise : window.accel_noise)
-                                                          : (gyro ? window.gyro_std : window.accel_std);
-  return spread / std::sqrt(static_cast<double>(window.samples));
-}
+// The noise of a window's mean, raw units (windows.h).
+Eigen::Vector3d RawSigmaFor(const FitWindow& w, bool gyro) { return w.window->NoiseOfMean(gyro); }
 
 // The closed-form start of one sensor: raw_i = sum_j K_ij(x) truth_j + V_i(x) + sum_j H_ij(x) a_j
 // by weighted linear least squares per axis, then S and M from K^-1 = M diag(1/S).

@@ -14,7 +14,9 @@ std::vector<WindowError> PredictWindows(const SensorModel& model, const std::vec
     const auto segment = std::find_if(segments.begin(), segments.end(),
                                       [&](const TableSegment& s) { return s.id == window.segment; });
     if (segment == segments.end()) continue;
-    const SegmentTruth truth = TruthOf(site, *segment);
+    // As the fit takes it: a turn's truth is its mean rate over the whole occurrence.
+    const SegmentTruth truth =
+        segment->IsTurn() ? TurnTruth(site, *segment, window.DurationS()) : TruthOf(site, *segment);
     WindowError error;
     error.window = static_cast<int>(w);
     error.segment = window.segment;
@@ -24,6 +26,9 @@ std::vector<WindowError> PredictWindows(const SensorModel& model, const std::vec
     model.Correct(window.temp_c, window.gyro_mean, window.accel_mean, &omega_hat, &a_hat);
     error.gyro_radps = omega_hat - truth.omega_radps;
     error.accel_mps2 = a_hat - truth.a_mps2;
+    error.omega_true_radps = truth.omega_radps;
+    error.a_true_mps2 = truth.a_mps2;
+    error.specific_force_known = segment->SpecificForceIsKnown();
     errors.push_back(error);
   }
   return errors;
@@ -36,15 +41,15 @@ ErrorStats SummariseErrors(const std::vector<WindowError>& errors) {
   for (const WindowError& e : errors) {
     ++stats.windows;
     gyro_sum += e.gyro_radps.squaredNorm();
-    accel_sum += e.accel_mps2.squaredNorm();
     stats.gyro_max_radps = std::max(stats.gyro_max_radps, e.gyro_radps.cwiseAbs().maxCoeff());
+    if (!e.specific_force_known) continue;  // its accel error is against a specific force that turned
+    ++stats.accel_windows;
+    accel_sum += e.accel_mps2.squaredNorm();
     stats.accel_max_mps2 = std::max(stats.accel_max_mps2, e.accel_mps2.cwiseAbs().maxCoeff());
   }
-  if (stats.windows > 0) {
-    // RMS per axis component.
-    stats.gyro_rms_radps = std::sqrt(gyro_sum / (3.0 * stats.windows));
-    stats.accel_rms_mps2 = std::sqrt(accel_sum / (3.0 * stats.windows));
-  }
+  // RMS per axis component.
+  if (stats.windows > 0) stats.gyro_rms_radps = std::sqrt(gyro_sum / (3.0 * stats.windows));
+  if (stats.accel_windows > 0) stats.accel_rms_mps2 = std::sqrt(accel_sum / (3.0 * stats.accel_windows));
   return stats;
 }
 

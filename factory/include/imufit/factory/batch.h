@@ -5,7 +5,7 @@
 // unit each, one solver thread per unit); a unit's failure never stops the others. For each unit
 // OUT_DIR/<unit>/ receives, each file atomically and in this order: calibration.yaml (when
 // fitted), report.html (with write_reports), then manifest.yaml last. The manifest
-// holds the SHA-256 of the unit's inputs (plan, samples, limits) and the software version;
+// holds the SHA-256 of the unit's inputs (plan, samples, limits, station) and the software version;
 // a re-run skips a unit whose manifest matches, so a batch killed half way and run again redoes
 // only the units that had not finished. The lot summary OUT_DIR/lot_summary.csv is written at the
 // end from every unit's outcome (fitted now or before).
@@ -53,10 +53,11 @@ struct BatchProgress {
 struct BatchOptions {
   std::string units_dir;
   std::string output_dir;
-  std::string limits_path;  // empty: no verdicts
-  std::string shared_plan;  // used by units without their own plan.yaml
-  std::string store_path;   // empty: no results store
-  std::string lot;          // the lot's name in the store; empty: the units folder's name
+  std::string limits_path;   // empty: no verdicts
+  std::string shared_plan;   // used by units without their own plan.yaml
+  std::string store_path;    // empty: no results store
+  std::string station_path;  // station file shown on every certificate; empty: none
+  std::string lot;           // the lot's name in the store; empty: the units folder's name
   // Worker threads; 0: all cores.
   int jobs = 0;
   // Stop after this many units have been fitted in this run (0: no limit) — for tests of resuming.

@@ -24,6 +24,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/station.h"
 #include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
@@ -53,6 +54,9 @@ struct CertificateSources {
   std::optional<Limits> limits;
   std::vector<ReportInput> inputs;    // files to hash and list
   std::vector<std::string> warnings;  // from the caller (e.g. a mismatch the user allowed)
+  // Where and by whom (a station file, --station): listed among the inputs (role "station") when
+  // the caller has not.
+  std::optional<Station> station;
 };
 
 struct KeyFigureRow {
@@ -63,10 +67,24 @@ struct KeyFigureRow {
   double expanded = -1.0;  // k = 2; < 0: none
 };
 
-// One coefficient against temperature: the polynomial with its 1-sigma band.
+// One window's own estimate of a coefficient at the window's temperature T_w: the value of that
+// one coefficient that explains the window's mean output exactly on the coefficient's row, every
+// other coefficient at its fitted value (a partial residual; equations in certificate.cc). It
+// scatters about the polynomial by the window's noise alone, so the points show what the data say
+// where the curve only shows what the fit made of them.
+struct CoefficientPoint {
+  double temp_c = 0.0;
+  double value = 0.0;  // in the group's unit
+  double sigma = 0.0;  // 1-sigma from the window mean's own noise (no fit uncertainty in it)
+  int segment = -1;
+};
+
+// One coefficient against temperature: the polynomial with its 1-sigma band, and the windows'
+// own estimates.
 struct CoefficientCurve {
   std::string axis;  // "x", "xy", ...
   std::vector<double> temp_c, value, lo, hi;
+  std::vector<CoefficientPoint> points;
 };
 struct CoefficientGroup {
   std::string title;  // "Gyro bias"
@@ -76,7 +94,9 @@ struct CoefficientGroup {
 };
 
 // Per window, signed per-axis errors (corrected - true) before and after correction, in deg/s and
-// mg, with the window mean's own noise (1-sigma from the samples' spread) for the band.
+// mg, with the window mean's own noise (1-sigma from the samples' spread) for the band. The accel
+// values of a window whose specific force is not known (a turn, a rate about a non-vertical axis)
+// are NaN: not drawn, not in the histogram.
 struct WindowResiduals {
   std::vector<double> time_s, temp_c;
   std::vector<int> segment;
@@ -89,11 +109,17 @@ struct WindowResiduals {
   double normalised_gyro_rms = 0.0, normalised_accel_rms = 0.0;  // ~1 when the model explains the run
 };
 
+// A plan with more segments than this prints only the segments with the largest errors after
+// correction (the certificate stays within its pages); the complete table is in the struct.
+inline constexpr int kMostResidualRowsPrinted = 20;
+
 struct ResidualRow {
-  int segment = -1;  // -1: all
-  std::string up;    // "[0, 0, 1]"
+  int segment = -1;    // -1: all
+  std::string up;      // "+z", or "[0.6, 0, 0.8]" when not along an axis
+  std::string motion;  // "static", "+100 deg/s" (about +x when not about up), "turn 360 deg about +x"
   double rate_dps = 0.0;
   int windows = 0;
+  int accel_windows = 0;  // with a known specific force: the accel figures are over these (0: none)
   double gyro_rms_before_dps = 0.0, gyro_rms_dps = 0.0, gyro_max_dps = 0.0;
   double accel_rms_before_mg = 0.0, accel_rms_mg = 0.0, accel_max_mg = 0.0;
 };
@@ -163,6 +189,7 @@ struct Certificate {
   double reference_temp_c = 25.0;
   std::vector<ReportInput> inputs;  // with their hashes
   std::vector<std::string> warnings;
+  std::optional<Station> station;  // none: the signers fill in where and by whom
   RunSummary run;
   FitSettings settings;
   std::optional<Verdict> verdict;
@@ -170,6 +197,11 @@ struct Certificate {
   std::vector<CoefficientGroup> curves;
   WindowResiduals residuals;
   std::vector<ResidualRow> residual_table;  // per segment, then all
+  // The rows printed: all of residual_table, or (more than kMostResidualRowsPrinted segments) the
+  // kMostResidualRowsPrinted - 1 segments whose larger of gyro and accel RMS after correction,
+  // each over the run's, is largest, in segment order, then all; residual_rows_omitted counts the others.
+  std::vector<ResidualRow> residual_table_printed;
+  int residual_rows_omitted = 0;
   NoiseSection noise;
   std::vector<ValidationRow> validation;  // empty: not run
 };
@@ -180,7 +212,8 @@ Certificate MakeCertificate(const CertificateSources& sources);
 // From a batch unit just fitted (its FitRunResult is in unit.fit).
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
                             const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const WindowOptions& windows = WindowOptions());
+                            const WindowOptions& windows = WindowOptions(),
+                            const std::optional<Station>& station = std::nullopt);
 
 // The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
 std::vector<Figure> MeasuredFigures(const Certificate& certificate);

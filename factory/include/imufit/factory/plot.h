@@ -75,6 +75,11 @@ struct Plot {
   bool log_x = false, log_y = false;
   bool y_tics = true;
   bool key = true;
+  bool key_above = false;  // the key in one row above the panel instead of at its right (narrow panels)
+  // At most this many tick labels on a linear axis (0 or 1: gnuplot's choice, which does not look at
+  // the panel's size): the step is 1, 2, 2.5 or 5 times a power of ten, the axis ends with the data.
+  int max_x_tics = 0, max_y_tics = 0;
+  bool y_from_zero = false;  // the y axis starts at 0 (counts)
   bool labels_at_bottom = false;
   std::optional<std::array<double, 2>> x_range, y_range;
   std::vector<PlotSeries> series;

@@ -29,12 +29,21 @@ struct WindowError {
   double temp_c = 0.0;
   Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+  // The truth the errors are taken against (a turn's: its mean rate over the whole occurrence).
+  Eigen::Vector3d omega_true_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d a_true_mps2 = Eigen::Vector3d::Zero();
+  // False where gravity turns in the body frame (a turn, a rate about a non-vertical axis): the
+  // specific force is then not constant, and accel_mps2 is against its value at the start.
+  bool specific_force_known = true;
 };
 
 // Errors aggregated over the windows of one segment (or of one held-out group).
+// The accelerometer's figures leave out windows whose specific force is not known (a turn or a rate
+// about a non-vertical axis: WindowError::specific_force_known).
 struct ErrorStats {
   int segment = -1;  // -1 for "all"
   int windows = 0;
+  int accel_windows = 0;  // of `windows`, those with a known specific force
   double gyro_rms_radps = 0.0;
   double gyro_max_radps = 0.0;
   double accel_rms_mps2 = 0.0;

@@ -39,6 +39,7 @@
 #ifndef IMUFIT_FIT_WINDOWS_H_
 #define IMUFIT_FIT_WINDOWS_H_
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,17 @@ struct Window {
   // The time the window stands for: its slots x the sample interval, s.
   double DurationS() const {
     return samples > 1 ? static_cast<double>(samples + lost_samples) * interval_s : 0.0;
+  }
+
+  // The noise of the window's mean per axis, in the samples' units: the per-sample spread over
+  // sqrt(samples). Where the truth is constant over the window, the sample standard deviation (it
+  // also holds the table's rate ripple and slow noise); in a turn's whole occurrence, whose rate
+  // varies, the second-difference figure, which sees the noise and not the rate profile. The fit
+  // weights its residuals by it; the certificate draws it as error bars.
+  Eigen::Vector3d NoiseOfMean(bool gyro) const {
+    const Eigen::Vector3d& spread =
+        whole_occurrence ? (gyro ? gyro_noise : accel_noise) : (gyro ? gyro_std : accel_std);
+    return spread / std::sqrt(static_cast<double>(samples > 0 ? samples : 1));
   }
 };
 

@@ -66,6 +66,26 @@ inline const char* EngineeringUnit(Sensor sensor, int coefficient) {
   return "deg/s/g";
 }
 
+// The factor f(T) that states coefficient `coefficient` (layout of sensor_model.h) of `sensor` at
+// `temp_c` in the unit of EngineeringUnit(): value = f(T) * C(T) (the table above). It depends on
+// the scale factors only, so it also states any other value of that coefficient at T (a window's
+// own estimate) and its 1-sigma.
+inline double EngineeringFactor(const SensorModel& model, Sensor sensor, int coefficient, double temp_c) {
+  const bool gyro = sensor == Sensor::kGyro;
+  const double* params = gyro ? model.gyro.data() : model.accel.data();
+  const double x = model.basis.Argument(temp_c);
+  const auto scale = [&](int axis) {
+    return EvaluateTemperaturePolynomial(params + (kScaleCoefficient + axis) * kPolynomialTerms, x);
+  };
+  if (coefficient < kScaleCoefficient) {  // bias over the same axis' scale
+    return gyro ? kRadToDeg / scale(coefficient) : 1e3 / (scale(coefficient) * kStandardGravityMps2);
+  }
+  if (coefficient < kMisalignmentCoefficient) return gyro ? kDegToRad : kStandardGravityMps2;
+  if (coefficient < kGSensitivityCoefficient) return 1e3;
+  return kRadToDeg * kStandardGravityMps2 /
+         scale((coefficient - kGSensitivityCoefficient) / 3);  // row i over S_g,i
+}
+
 // Coefficient `coefficient` (layout of sensor_model.h) of `sensor` at `temp_c`, in the unit of
 // EngineeringUnit(); `sigma` (same layout as `model`, its basis unused) may be null.
 inline EngineeringValue EngineeringCoefficient(const SensorModel& model, const SensorModel* sigma,
@@ -74,23 +94,9 @@ inline EngineeringValue EngineeringCoefficient(const SensorModel& model, const S
   const double* params = gyro ? model.gyro.data() : model.accel.data();
   const double* sigmas = sigma == nullptr ? nullptr : gyro ? sigma->gyro.data() : sigma->accel.data();
   const double x = model.basis.Argument(temp_c);
-  const auto at = [&](int index) {
-    return EvaluateTemperaturePolynomial(params + index * kPolynomialTerms, x);
-  };
-  double factor = 1.0;
-  if (coefficient < kScaleCoefficient) {  // bias over the same axis' scale
-    const double scale = at(kScaleCoefficient + coefficient);
-    factor = gyro ? kRadToDeg / scale : 1e3 / (scale * kStandardGravityMps2);
-  } else if (coefficient < kMisalignmentCoefficient) {
-    factor = gyro ? kDegToRad : kStandardGravityMps2;
-  } else if (coefficient < kGSensitivityCoefficient) {
-    factor = 1e3;
-  } else {  // row i of H over S_g,i
-    factor = kRadToDeg * kStandardGravityMps2 /
-             at(kScaleCoefficient + (coefficient - kGSensitivityCoefficient) / 3);
-  }
+  const double factor = EngineeringFactor(model, sensor, coefficient, temp_c);
   EngineeringValue result;
-  result.value = at(coefficient) * factor;
+  result.value = EvaluateTemperaturePolynomial(params + coefficient * kPolynomialTerms, x) * factor;
   if (sigmas != nullptr) {
     double variance = 0.0, power = 1.0;
     for (int k = 0; k < kPolynomialTerms; ++k, power *= x) {
@@ -100,6 +106,14 @@ inline EngineeringValue EngineeringCoefficient(const SensorModel& model, const S
     result.sigma = std::sqrt(variance) * std::abs(factor);
   }
   return result;
+}
+
+// ppm of ScaleChangePpm() per raw unit of scale factor: 1e6 / S(kFigureTempC). The change of any
+// value S of that scale factor is (S / S(kFigureTempC) - 1) * 1e6.
+inline double ScaleChangePpmPerRaw(const SensorModel& model, Sensor sensor, int axis) {
+  const double* params = (sensor == Sensor::kGyro ? model.gyro.data() : model.accel.data()) +
+                         (kScaleCoefficient + axis) * kPolynomialTerms;
+  return 1e6 / EvaluateTemperaturePolynomial(params, model.basis.Argument(kFigureTempC));
 }
 
 // The relative change of a scale factor from its kFigureTempC value, ppm, with the 1-sigma of the
@@ -113,16 +127,16 @@ inline EngineeringValue ScaleChangePpm(const SensorModel& model, const SensorMod
                                           : (gyro ? sigma->gyro.data() : sigma->accel.data()) +
                                                 (kScaleCoefficient + axis) * kPolynomialTerms;
   const double x = model.basis.Argument(temp_c), x0 = model.basis.Argument(kFigureTempC);
-  const double s0 = EvaluateTemperaturePolynomial(params, x0);
+  const double ppm_per_raw = ScaleChangePpmPerRaw(model, sensor, axis);
   EngineeringValue result;
-  result.value = (EvaluateTemperaturePolynomial(params, x) / s0 - 1.0) * 1e6;
+  result.value = EvaluateTemperaturePolynomial(params, x) * ppm_per_raw - 1e6;
   if (sigmas != nullptr) {
     double variance = 0.0, power = 1.0, power0 = 1.0;
     for (int k = 0; k < kPolynomialTerms; ++k, power *= x, power0 *= x0) {
       const double term = sigmas[k] * (power - power0);  // the change's sensitivity to term k
       variance += term * term;
     }
-    result.sigma = std::sqrt(variance) / std::abs(s0) * 1e6;
+    result.sigma = std::sqrt(variance) * std::abs(ppm_per_raw);
   }
   return result;
 }

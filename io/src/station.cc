@@ -1,0 +1,71 @@
+#include "imufit/io/station.h"
+
+#include "imufit/io/error.h"
+#include "yaml_util.h"
+
+namespace imufit {
+namespace {
+
+bool IsLeapYear(int year) { return (year % 4 == 0 && year % 100 != 0) || year % 400 == 0; }
+
+// A date written YYYY-MM-DD that exists in the Gregorian calendar.
+bool IsIsoDate(const std::string& text) {
+  if (text.size() != 10 || text[4] != '-' || text[7] != '-') return false;
+  for (size_t i : {0, 1, 2, 3, 5, 6, 8, 9}) {
+    if (text[i] < '0' || text[i] > '9') return false;
+  }
+  const int year = std::stoi(text.substr(0, 4)), month = std::stoi(text.substr(5, 2));
+  const int day = std::stoi(text.substr(8, 2));
+  constexpr int kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  if (month < 1 || month > 12 || day < 1) return false;
+  return day <= kDays[month - 1] + (month == 2 && IsLeapYear(year) ? 1 : 0);
+}
+
+// One line of text: not empty, no line break, at most kMaxStationTextBytes.
+std::string Line(const yaml::Located& value) {
+  const std::string text = value.String();
+  if (text.empty()) value.Fail("is empty (leave the key out instead)");
+  if (text.find_first_of("\r\n") != std::string::npos) value.Fail("must be one line of text");
+  if (text.size() > kMaxStationTextBytes) {
+    value.Fail("is " + std::to_string(text.size()) + " bytes long; at most " +
+               std::to_string(kMaxStationTextBytes) + " fit on a certificate");
+  }
+  return text;
+}
+
+StationEquipment Equipment(const yaml::Located& node) {
+  node.RejectUnknownKeys({"model", "serial"});
+  StationEquipment equipment;
+  if (node.Has("model")) equipment.model = Line(node["model"]);
+  if (node.Has("serial")) equipment.serial = Line(node["serial"]);
+  return equipment;
+}
+
+}  // namespace
+
+Station ReadStation(const std::string& path) {
+  const YAML::Node root_node = yaml::LoadFile(path);
+  const yaml::Located root{&path, root_node, ""};
+  root.RejectUnknownKeys({"format", "version", "station", "station_id", "location", "operator", "rate_table",
+                          "chamber", "reference_calibration_due", "notes"});
+  root.RequireFormat("imufit-station", kStationFormatVersion);
+  Station station;
+  station.path = path;
+  station.name = Line(root["station"]);
+  if (root.Has("station_id")) station.id = Line(root["station_id"]);
+  if (root.Has("location")) station.location = Line(root["location"]);
+  if (root.Has("operator")) station.operator_name = Line(root["operator"]);
+  if (root.Has("rate_table")) station.rate_table = Equipment(root["rate_table"]);
+  if (root.Has("chamber")) station.chamber = Equipment(root["chamber"]);
+  if (root.Has("reference_calibration_due")) {
+    const yaml::Located due = root["reference_calibration_due"];
+    station.reference_calibration_due = Line(due);
+    if (!IsIsoDate(station.reference_calibration_due)) {
+      due.Fail(QuoteForMessage(station.reference_calibration_due) + " is not a date written YYYY-MM-DD");
+    }
+  }
+  if (root.Has("notes")) station.notes = Line(root["notes"]);
+  return station;
+}
+
+}  // namespace imufit
