@@ -33,13 +33,14 @@ int RunApply(const ApplyArguments& args) {
 
 void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report) {
   if (report.outside_temp_range == 0) return;
-  std::fprintf(stderr,
-               "imufit: warning: %lld of %lld samples (%.1f %%) lie outside the calibration's fit "
-               "temperature range [%g, %g] degC (the run spans [%g, %g] degC): their correction is "
-               "an extrapolation\n",
-               report.outside_temp_range, report.samples, 100.0 * report.outside_temp_range / report.samples,
-               calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1], report.min_temp_c,
-               report.max_temp_c);
+  std::fprintf(
+      stderr,
+      "imufit: warning: %lld of %lld samples (%.1f %%) lie more than %g degC outside the calibration's "
+      "fit temperature range [%g, %g] degC (the run spans [%g, %g] degC): their correction is "
+      "an extrapolation\n",
+      report.outside_temp_range, report.samples, 100.0 * report.outside_temp_range / report.samples,
+      kFitRangeToleranceC, calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1],
+      report.min_temp_c, report.max_temp_c);
 }
 
 CommandRunner AddApplyCommand(CLI::App* root) {

@@ -235,7 +235,7 @@ int RunFit(FitArguments args) {
                  "shorter than %d samples dropped)\n",
                  stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used, stats.short_windows,
                  args.windows.min_samples);
-    if (const std::string note = TimeStampNote(stats, args.windows); !note.empty()) {
+    if (const std::string note = TimeStampNote(stats); !note.empty()) {
       std::fprintf(stderr, "  (time stamps: %s)\n", note.c_str());
     }
     return 1;
@@ -252,7 +252,7 @@ int RunFit(FitArguments args) {
   std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
               stats.trimmed_samples);
-  if (const std::string note = TimeStampNote(stats, args.windows); !note.empty()) {
+  if (const std::string note = TimeStampNote(stats); !note.empty()) {
     std::printf("  time stamps: %s\n", note.c_str());
   }
   std::printf("  residual RMS: gyro %.5f deg/s, accel %.4f mg (reduced chi-square %.3g / %.3g)\n",

@@ -288,7 +288,7 @@ TEST(Windows, ATurnWithBunchedStampsTakesOneIntervalASample) {
   EXPECT_EQ(windows[0].lost_samples, 0);
   EXPECT_NEAR(windows[0].DurationS(), 40.0, 1e-3);
   EXPECT_FALSE(builder.stats().StampsOnGrid());
-  const std::string note = TimeStampNote(builder.stats(), WindowOptions());
+  const std::string note = TimeStampNote(builder.stats());
   EXPECT_NE(
       note.find(
           "lost samples cannot be told from jitter, so in the turns each sample is taken as one interval"),
@@ -344,7 +344,7 @@ TEST(Windows, ATurnKeepsItsAngleWhenSamplesAreLost) {
     const double angle_rad = window.gyro_mean.x() * window.DurationS();
     EXPECT_NEAR(angle_rad, 2.0 * M_PI, 3e-5 + 2.0 * M_PI * 4e-6) << "jitter " << jitter_s << " s";
     EXPECT_NEAR(window.DurationS(), 4.01, 4.01 * 4e-6);
-    const std::string note = TimeStampNote(stats, WindowOptions());
+    const std::string note = TimeStampNote(stats);
     EXPECT_NE(note.find("6 samples lost in 4 gaps"), std::string::npos) << note;
   }
 }
@@ -358,7 +358,7 @@ TEST(Windows, ATurnWithALongGapIsDroppedAndSaysSo) {
   EXPECT_EQ(window.samples, 0);  // no window
   EXPECT_EQ(stats.turns_dropped_for_gaps, 1);
   EXPECT_NEAR(stats.longest_gap_s, 0.1, 1e-7);  // stamps near 1.7e9 s hold 2.4e-7 s
-  const std::string note = TimeStampNote(stats, options);
+  const std::string note = TimeStampNote(stats);
   EXPECT_NE(note.find("1 turn dropped for a gap longer than 0.05 s"), std::string::npos) << note;
   options.max_turn_gap_s = 0.2;
   const Window kept = TurnWindow(0.0, lost, options, &stats);

@@ -113,7 +113,7 @@ long long SampleClock::Place(double time_s) {
   return step;
 }
 
-std::string TimeStampNote(const WindowStats& stats, const WindowOptions& options) {
+std::string TimeStampNote(const WindowStats& stats) {
   std::string note;
   const auto add = [&note](const char* format, auto... values) {
     char line[320];
@@ -135,7 +135,7 @@ std::string TimeStampNote(const WindowStats& stats, const WindowOptions& options
   }
   if (stats.turns_dropped_for_gaps > 0) {
     add("%d turn%s dropped for a gap longer than %.3g s, which would bias the angle",
-        stats.turns_dropped_for_gaps, stats.turns_dropped_for_gaps == 1 ? "" : "s", options.max_turn_gap_s);
+        stats.turns_dropped_for_gaps, stats.turns_dropped_for_gaps == 1 ? "" : "s", stats.max_turn_gap_s);
   }
   if (stats.turns_off_grid > 0) {
     add("%d turn%s with a time stamp off the grid: each of its samples taken as one interval",
@@ -153,10 +153,13 @@ std::string WindowOptions::Validate() const {
   return "";
 }
 
-WindowBuilder::WindowBuilder(const WindowOptions& options) : options_(options) {}
+WindowBuilder::WindowBuilder(const WindowOptions& options) : options_(options) {
+  stats_.max_turn_gap_s = options.max_turn_gap_s;
+}
 
 WindowBuilder::WindowBuilder(const WindowOptions& options, const std::vector<TableSegment>& segments)
     : options_(options) {
+  stats_.max_turn_gap_s = options.max_turn_gap_s;
   for (const TableSegment& segment : segments) {
     if (segment.IsTurn()) turn_ids_.push_back(segment.id);
   }

@@ -27,7 +27,8 @@ CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* 
     if (report.samples == 0) report.min_temp_c = report.max_temp_c = raw.temp_c;
     report.min_temp_c = std::min(report.min_temp_c, raw.temp_c);
     report.max_temp_c = std::max(report.max_temp_c, raw.temp_c);
-    if (raw.temp_c < calibration.fit_temp_range_c[0] || raw.temp_c > calibration.fit_temp_range_c[1]) {
+    if (raw.temp_c < calibration.fit_temp_range_c[0] - kFitRangeToleranceC ||
+        raw.temp_c > calibration.fit_temp_range_c[1] + kFitRangeToleranceC) {
       ++report.outside_temp_range;
     }
     ++report.samples;

@@ -103,10 +103,14 @@ class FitResult:
     """termination, iterations, initial_cost, final_cost, windows_used, windows_downweighted,
     distinct_temps_c (degC), temp_range_c, gyro_residual_rms_radps, accel_residual_rms_mps2,
     gyro_reduced_chi2, accel_reduced_chi2, samples, transition_samples, trimmed_samples,
-    short_windows, brief_report, full_report, windows {segment, occurrence, samples, start_s,
+    short_windows, lost_samples, gaps, longest_gap_s (s), off_grid_samples, turns_dropped_for_gaps,
+    turns_off_grid, time_stamp_note (what the time stamps showed, as `imufit fit` prints it),
+    brief_report, full_report, windows {segment, occurrence, samples, start_s,
     end_s, temp_c, gyro_mean, accel_mean, gyro_std, accel_std}, residuals {window, gyro_radps,
     accel_mps2, gyro_sigma_radps, accel_sigma_mps2, downweighted}, folds {temp_c, fitted, why_not,
-    gyro_temp_order, accel_temp_order, order_lowered, errors}, check_errors."""
+    gyro_temp_order, accel_temp_order, order_lowered, errors {segment, windows, accel_windows (those
+    with a known specific force, over which the accel figures are), gyro_rms_radps, ...}},
+    check_errors."""
 
 def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Any) -> FitResult:
     """Fits the thermal model to a run, as `imufit fit` does. plan: plan YAML path; samples: a path

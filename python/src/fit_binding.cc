@@ -200,6 +200,7 @@ py::dict ErrorStatsDict(const ErrorStats& s) {
   py::dict d;
   d["segment"] = s.segment;
   d["windows"] = s.windows;
+  d["accel_windows"] = s.accel_windows;  // with a known specific force: the accel figures' windows
   d["gyro_rms_radps"] = s.gyro_rms_radps;
   d["gyro_max_radps"] = s.gyro_max_radps;
   d["accel_rms_mps2"] = s.accel_rms_mps2;
@@ -229,6 +230,13 @@ py::dict Diagnostics(const FitRunResult& result) {
   d["transition_samples"] = stats.transition_samples;
   d["trimmed_samples"] = stats.trimmed_samples;
   d["short_windows"] = stats.short_windows;
+  d["lost_samples"] = stats.lost_samples;
+  d["gaps"] = stats.gaps;
+  d["longest_gap_s"] = stats.longest_gap_s;
+  d["off_grid_samples"] = stats.off_grid_samples;
+  d["turns_dropped_for_gaps"] = stats.turns_dropped_for_gaps;
+  d["turns_off_grid"] = stats.turns_off_grid;
+  d["time_stamp_note"] = TimeStampNote(stats);
   d["brief_report"] = fit.BriefReport();
   d["full_report"] = fit.FullReport();
 

@@ -103,6 +103,12 @@ def test_simulate_with_lost_samples_matches_imufit_simulate(fixtures, tmp_path, 
         assert run[key].tobytes() == cli[key].tobytes(), key
     kept = np.isin(whole["time_s"], run["time_s"])
     assert np.array_equal(whole["gyro"][kept], run["gyro"])
+    # The fit finds the gaps on the run's time grid (those while the grid is acquired uncounted).
+    diagnostics = imufit.fit(plan, run).diagnostics
+    lost = len(whole["time_s"]) - len(run["time_s"])
+    assert 0.9 * lost <= diagnostics["lost_samples"] <= lost
+    assert diagnostics["off_grid_samples"] == 0
+    assert "samples lost in" in diagnostics["time_stamp_note"]
 
 
 def test_fit_of_a_simulated_run_recovers_the_truth(fixtures, tmp_path, run_imufit):

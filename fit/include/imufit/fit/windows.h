@@ -124,6 +124,7 @@ struct WindowStats {
   double longest_gap_s = 0.0;        // the longest, s
   long long off_grid_samples = 0;    // stamps more than SampleClock::kTolerance from their slot
   int turns_dropped_for_gaps = 0;    // turns with a gap longer than max_turn_gap_s
+  double max_turn_gap_s = 0.0;       // WindowOptions::max_turn_gap_s, the limit they were held to
   int turns_off_grid = 0;            // turns with a stamp off the grid: one slot a sample
 
   // Whether the time stamps lie on a uniform grid (at most one in a thousand off it), so that the
@@ -137,7 +138,7 @@ struct WindowStats {
 
 // What the time stamps showed, for a person: samples lost (and filled in within the turns),
 // turns dropped for a long gap, stamps off a uniform grid. Empty when there is nothing to say.
-std::string TimeStampNote(const WindowStats& stats, const WindowOptions& options);
+std::string TimeStampNote(const WindowStats& stats);
 
 // Places time stamps, in order, on a uniform grid t_k = a + b k (see above).
 //

@@ -19,9 +19,16 @@
 
 namespace imufit {
 
+// A temperature reading this close outside the calibration's fit_temp_range_c is no
+// extrapolation, degC: the range is the extremes of the fit's window readings, so the noise of the
+// thermometer alone puts a few samples of the same run just beyond it (a few hundredths of a
+// degree), where a cubic has not moved.
+inline constexpr double kFitRangeToleranceC = 0.5;
+
 struct CorrectFileReport {
   long long samples = 0;
-  // Samples whose temperature lies outside the calibration's fit_temp_range_c.
+  // Samples whose temperature lies more than kFitRangeToleranceC outside the calibration's
+  // fit_temp_range_c.
   long long outside_temp_range = 0;
   double min_temp_c = 0.0;
   double max_temp_c = 0.0;
