@@ -37,7 +37,7 @@ struct FitArguments {
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
   std::string report;  // certificate HTML to write
   std::string store;   // results store to record the fit in
-  std::string serial;   // the unit's serial; empty: the samples header's, else the plan's
+  std::string serial;  // the unit's serial; empty: the samples header's, else the plan's
   std::string station;  // station file shown on the certificate (with --report)
   double gyro_bias_stability_dph = 0.0;
   double accel_bias_stability_ug = 0.0;

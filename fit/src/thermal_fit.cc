@@ -464,7 +464,8 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     IMUFIT_CHECK(segment != segments.end(), "every window's segment must be in the plan");
     // A turn's truth is its whole occurrence's mean rate: the window must be that occurrence.
     // Windows built without the plan would bias the fit.
-    IMUFIT_CHECK(!segment->IsTurn() || w.whole_occurrence, "a window of a turn segment must be its whole occurrence");
+    IMUFIT_CHECK(!segment->IsTurn() || w.whole_occurrence,
+                 "a window of a turn segment must be its whole occurrence");
     const SegmentTruth truth =
         segment->IsTurn() ? TurnTruth(site, *segment, w.DurationS()) : TruthOf(site, *segment);
     fit_windows.push_back(FitWindow{&w, truth, basis.Argument(w.temp_c), segment->SpecificForceIsKnown()});

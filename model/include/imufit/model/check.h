@@ -23,8 +23,8 @@ namespace imufit::internal {
 
 }  // namespace imufit::internal
 
-#define IMUFIT_CHECK(condition, message)                                              \
-  do {                                                                                \
+#define IMUFIT_CHECK(condition, message)                                                        \
+  do {                                                                                          \
     if (!(condition)) ::imufit::internal::CheckFailed(__FILE__, __LINE__, #condition, message); \
   } while (false)
 
