@@ -238,6 +238,9 @@ int RunFit(FitArguments args) {
     if (const std::string note = TimeStampNote(stats); !note.empty()) {
       std::fprintf(stderr, "  (time stamps: %s)\n", note.c_str());
     }
+    if (const std::string note = SaturationNote(stats); !note.empty()) {
+      std::fprintf(stderr, "  (saturation: %s)\n", note.c_str());
+    }
     return 1;
   }
   if (!result.calibration) {
@@ -254,6 +257,9 @@ int RunFit(FitArguments args) {
               stats.trimmed_samples);
   if (const std::string note = TimeStampNote(stats); !note.empty()) {
     std::printf("  time stamps: %s\n", note.c_str());
+  }
+  if (const std::string note = SaturationNote(stats); !note.empty()) {
+    std::printf("  saturation: %s\n", note.c_str());
   }
   std::printf("  residual RMS: gyro %.5f deg/s, accel %.4f mg (reduced chi-square %.3g / %.3g)\n",
               DpsFromRadps(fit.gyro_rms_radps), MgFromMps2(fit.accel_rms_mps2), fit.gyro_reduced_chi2,
@@ -358,6 +364,16 @@ CommandRunner AddFitCommand(CLI::App* root) {
           "--max-turn-gap", w.max_turn_gap_s,
           "a turn whose time stamps have a longer gap (lost samples in a row), s, is dropped: integrating "
           "across it would bias the angle")
+      ->capture_default_str();
+  command
+      ->add_option(
+          "--gyro-full-scale", w.gyro_full_scale_raw,
+          "the gyro's full scale, raw units (e.g. 32767 counts): windows with a sample at or beyond it "
+          "are left out (0: found only where an output sits at the run's extreme)")
+      ->capture_default_str();
+  command
+      ->add_option("--accel-full-scale", w.accel_full_scale_raw,
+                   "the accelerometer's full scale, raw units, as --gyro-full-scale")
       ->capture_default_str();
   command->add_option("--max-iterations", f.max_iterations, "solver iterations at most, per pass")->capture_default_str();
   command->add_option("--threads", f.num_threads, "solver threads")->capture_default_str();

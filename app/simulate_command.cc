@@ -152,6 +152,15 @@ CommandRunner AddSimulateCommand(CLI::App* root) {
       ->capture_default_str();
   command->add_option("--drop-burst", o.drop_burst, "samples lost in a row at each loss")
       ->capture_default_str();
+  command
+      ->add_option(
+          "--gyro-full-scale", o.gyro_full_scale_raw,
+          "clip the raw gyro outputs to +- this, raw units, as a saturated converter does (0: no clip)")
+      ->capture_default_str();
+  command
+      ->add_option("--accel-full-scale", o.accel_full_scale_raw,
+                   "clip the raw accelerometer outputs to +- this, raw units (0: no clip)")
+      ->capture_default_str();
   command->add_option("--serial", args->serial,
                       "the unit's serial, written into the header of the samples (and --truth) as "
                       "'# serial: SERIAL', where fit, report and batch find it");

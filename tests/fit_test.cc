@@ -366,6 +366,78 @@ TEST(Windows, ATurnWithALongGapIsDroppedAndSaysSo) {
   EXPECT_EQ(stats.turns_dropped_for_gaps, 0);
 }
 
+// The 300 deg/s rates of SixPositionPlan reach about 5000 counts on a RandomMemsModel unit (16.5
+// counts per deg/s), the 100 deg/s ones about 1700: a full scale of 3000 pins the first.
+constexpr double kGyroFullScaleCounts = 3000.0;
+int FastRateWindows(const std::vector<Window>& windows, const std::vector<TableSegment>& plan) {
+  int fast = 0;
+  for (const Window& w : windows) fast += std::abs(plan[w.segment].rate_radps) > 200.0 * kDegToRad;
+  return fast;
+}
+
+TEST(Saturation, AnOutputPinnedAtTheRunsExtremeIsLeftOutAndTheFitKeepsTheRest) {
+  const SensorModel truth = testing::RandomMemsModel(2026);
+  const std::vector<TableSegment> plan = SixPositionPlan();
+  const std::vector<Window> all = Simulate(MemsNoise(17), plan, truth);
+  SimulationOptions clipped = MemsNoise(17);
+  clipped.gyro_full_scale_raw = kGyroFullScaleCounts;
+  WindowBuilder builder(WindowOptions(), plan);
+  SimulateRun(clipped, Site(), plan, truth,
+              [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
+  const std::vector<Window> windows = builder.Finish();
+  // Every 300 deg/s window has its rate axis pinned at +-3000: all of them are left out.
+  EXPECT_EQ(builder.stats().saturated_windows, FastRateWindows(all, plan));
+  EXPECT_EQ(windows.size() + builder.stats().saturated_windows, all.size());
+  EXPECT_EQ(FastRateWindows(windows, plan), 0);
+  const std::string note = SaturationNote(builder.stats());
+  EXPECT_NE(note.find("windows left out with an output at full scale"), std::string::npos) << note;
+  EXPECT_NE(note.find(" at 3000"), std::string::npos) << note;
+  // The 100 deg/s rates still determine the model: recovered within the sigmas.
+  const FitSummary fit = FitThermalModel(windows, Site(), plan, FitOptions());
+  ASSERT_TRUE(fit.IsSolutionUsable()) << fit.FullReport();
+  for (double z : ZScoresAt25(fit, truth)) EXPECT_LT(std::abs(z), kRecoverySigmas + 1.0);
+}
+
+TEST(Saturation, AGivenFullScaleLeavesOutPartlyClippedWindowsTooAndANoiseFreeRunIsNotJudged) {
+  const SensorModel truth = testing::RandomMemsModel(2026);
+  const std::vector<TableSegment> plan = SixPositionPlan();
+  const std::vector<Window> all = Simulate(MemsNoise(17), plan, truth);
+  // A full scale just above the fast rates' means: only their noise peaks clip, so no output is
+  // pinned and only the given full scale finds them (each clipped sample biases the mean).
+  double fast_mean = 0.0;
+  for (const Window& w : all) {
+    if (std::abs(plan[w.segment].rate_radps) > 200.0 * kDegToRad)
+      fast_mean = std::max(fast_mean, w.gyro_mean.cwiseAbs().maxCoeff());
+  }
+  SimulationOptions clipped = MemsNoise(17);
+  clipped.gyro_full_scale_raw = std::round(fast_mean + 1.0);
+  WindowBuilder blind(WindowOptions(), plan);
+  WindowOptions told;
+  told.gyro_full_scale_raw = clipped.gyro_full_scale_raw;
+  WindowBuilder builder(told, plan);
+  SimulateRun(clipped, Site(), plan, truth, [&](const Sample& raw, const SegmentTruth&) {
+    blind.Add(raw);
+    builder.Add(raw);
+  });
+  EXPECT_EQ(blind.Finish().size(), all.size());
+  EXPECT_EQ(blind.stats().saturated_windows, 0);
+  const std::vector<Window> windows = builder.Finish();
+  EXPECT_GT(builder.stats().saturated_windows, 0);
+  EXPECT_LE(builder.stats().saturated_windows, FastRateWindows(all, plan));
+  EXPECT_EQ(windows.size() + builder.stats().saturated_windows, all.size());
+
+  // Noise-free, every window's spread is zero: nothing is judged pinned (nothing could be told).
+  SimulationOptions noise_free = clipped;
+  noise_free.gyro_noise_density = noise_free.accel_noise_density = 0.0;
+  noise_free.quantize = false;
+  noise_free.gyro_full_scale_raw = kGyroFullScaleCounts;
+  WindowBuilder exact(WindowOptions(), plan);
+  SimulateRun(noise_free, Site(), plan, truth,
+              [&](const Sample& raw, const SegmentTruth&) { exact.Add(raw); });
+  EXPECT_EQ(exact.Finish().size(), all.size());
+  EXPECT_EQ(exact.stats().saturated_windows, 0);
+}
+
 TEST(Windows, DistinctTemperaturesCluster) {
   const std::vector<double> centres = DistinctTemperatures({25.2, -40.0, 24.8, 85.0, 85.4, -39.9}, 1.0);
   ASSERT_EQ(centres.size(), 3u);

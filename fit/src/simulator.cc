@@ -171,6 +171,8 @@ std::string SimulationOptions::Validate() const {
   }
   if (!(drop_probability >= 0.0 && drop_probability < 1.0)) return "the drop probability must lie in [0, 1)";
   if (drop_burst < 1) return "a loss takes at least one sample";
+  if (!(gyro_full_scale_raw >= 0.0) || !(accel_full_scale_raw >= 0.0))
+    return "a full scale cannot be negative";
   return "";
 }
 
@@ -261,6 +263,12 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
       if (options.quantize) {
         accel_m = accel_m.array().round();
         gyro_m = gyro_m.array().round();
+      }
+      if (options.gyro_full_scale_raw > 0.0) {
+        gyro_m = gyro_m.cwiseMax(-options.gyro_full_scale_raw).cwiseMin(options.gyro_full_scale_raw);
+      }
+      if (options.accel_full_scale_raw > 0.0) {
+        accel_m = accel_m.cwiseMax(-options.accel_full_scale_raw).cwiseMin(options.accel_full_scale_raw);
       }
       raw.gyro = gyro_m;
       raw.accel = accel_m;

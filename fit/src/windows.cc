@@ -150,6 +150,8 @@ std::string WindowOptions::Validate() const {
   if (!(max_duration_s >= 0.0)) return "the window duration cannot be negative";
   if (min_samples < 2) return "a window needs at least 2 samples";
   if (!(max_turn_gap_s >= 0.0)) return "the longest gap allowed in a turn cannot be negative";
+  if (!(gyro_full_scale_raw >= 0.0) || !(accel_full_scale_raw >= 0.0))
+    return "a full scale cannot be negative";
   return "";
 }
 
@@ -182,6 +184,11 @@ void WindowBuilder::Add(const Sample& sample) {
     ++stats_.gaps;
     stats_.longest_gap_s = std::max(stats_.longest_gap_s, gap_s);
   }
+  Eigen::Matrix<double, 6, 1> value;
+  value << sample.gyro, sample.accel;
+  if (stats_.samples == 0) stats_.raw_min = stats_.raw_max = value;
+  stats_.raw_min = stats_.raw_min.cwiseMin(value);
+  stats_.raw_max = stats_.raw_max.cwiseMax(value);
   ++stats_.samples;
   stats_.last_time_s = sample.time_s;
   stats_.min_temp_c = std::min(stats_.min_temp_c, sample.temp_c);
@@ -229,6 +236,7 @@ void WindowBuilder::Add(const Sample& sample) {
     lost_ = 0;
     longest_gap_s_ = 0.0;
     off_grid_ = false;
+    clipped_channel_ = -1;
     time_sum_ = 0.0;
     index_time_sum_ = 0.0;
     turn_slots_.clear();
@@ -246,8 +254,13 @@ void WindowBuilder::Add(const Sample& sample) {
   temp_mean_ += (sample.temp_c - temp_mean_) * inv_n;
   temp_min_ = std::min(temp_min_, sample.temp_c);
   temp_max_ = std::max(temp_max_, sample.temp_c);
-  Eigen::Matrix<double, 6, 1> value;
-  value << sample.gyro, sample.accel;
+  for (int c = 0; c < 6 && clipped_channel_ < 0; ++c) {
+    const double full_scale = c < 3 ? options_.gyro_full_scale_raw : options_.accel_full_scale_raw;
+    if (full_scale > 0.0 && std::abs(value(c)) >= full_scale) {
+      clipped_channel_ = c;
+      clipped_value_ = value(c);
+    }
+  }
   const Eigen::Matrix<double, 6, 1> delta = value - mean_;
   mean_ += delta * inv_n;
   m2_ += delta.cwiseProduct(value - mean_);
@@ -341,13 +354,65 @@ void WindowBuilder::Close() {
     window.accel_noise = noise.tail<3>();
   }
   window.whole_occurrence = whole_occurrence_;
+  if (clipped_channel_ >= 0) {
+    NoteSaturation(window, clipped_channel_, clipped_value_);
+    return;
+  }
   if (whole_occurrence_ && !CloseTurn(&window)) return;
   windows_.push_back(window);
 }
 
+void WindowBuilder::NoteSaturation(const Window& window, int channel, double value) {
+  constexpr int kSaturationExamples = 4;
+  ++stats_.saturated_windows;
+  if (static_cast<int>(stats_.saturation.size()) >= kSaturationExamples) return;
+  char line[160];
+  std::snprintf(line, sizeof line, "segment %d at t = %.1f s: %s %c at %.9g", window.segment, window.start_s,
+                channel < 3 ? "gyro" : "accel", "xyz"[channel % 3], value);
+  stats_.saturation.push_back(line);
+}
+
+void WindowBuilder::DropPinnedWindows() {
+  // A window whose output on a channel is one constant value (a zero spread), at the run's largest or
+  // smallest value of that channel, while the windows' median spread on it is not zero (the unit is
+  // not noise-free): the output was pinned at a rail.
+  std::vector<bool> pinned(windows_.size(), false);
+  for (int c = 0; c < 6; ++c) {
+    std::vector<double> spreads;
+    for (const Window& w : windows_) spreads.push_back(c < 3 ? w.gyro_std(c) : w.accel_std(c - 3));
+    if (spreads.empty()) continue;
+    std::nth_element(spreads.begin(), spreads.begin() + spreads.size() / 2, spreads.end());
+    if (!(spreads[spreads.size() / 2] > 0.0)) continue;
+    for (size_t i = 0; i < windows_.size(); ++i) {
+      const Window& w = windows_[i];
+      const double spread = c < 3 ? w.gyro_std(c) : w.accel_std(c - 3);
+      const double mean = c < 3 ? w.gyro_mean(c) : w.accel_mean(c - 3);
+      if (pinned[i] || spread != 0.0 || (mean != stats_.raw_max(c) && mean != stats_.raw_min(c))) continue;
+      pinned[i] = true;
+      NoteSaturation(w, c, mean);
+    }
+  }
+  std::vector<Window> kept;
+  for (size_t i = 0; i < windows_.size(); ++i) {
+    if (!pinned[i]) kept.push_back(windows_[i]);
+  }
+  windows_ = std::move(kept);
+}
+
 std::vector<Window> WindowBuilder::Finish() {
   Close();
+  DropPinnedWindows();
   return std::move(windows_);
+}
+
+std::string SaturationNote(const WindowStats& stats) {
+  if (stats.saturated_windows == 0) return "";
+  std::string note =
+      std::to_string(stats.saturated_windows) + " window" + (stats.saturated_windows == 1 ? "" : "s") +
+      " left out with an output at full scale (saturated: the plan's rate or the part's range?): ";
+  for (size_t i = 0; i < stats.saturation.size(); ++i) note += (i > 0 ? "; " : "") + stats.saturation[i];
+  if (stats.saturated_windows > static_cast<int>(stats.saturation.size())) note += "; ...";
+  return note;
 }
 
 }  // namespace imufit

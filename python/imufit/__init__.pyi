@@ -105,6 +105,7 @@ class FitResult:
     gyro_reduced_chi2, accel_reduced_chi2, samples, transition_samples, trimmed_samples,
     short_windows, lost_samples, gaps, longest_gap_s (s), off_grid_samples, turns_dropped_for_gaps,
     turns_off_grid, time_stamp_note (what the time stamps showed, as `imufit fit` prints it),
+    saturated_windows, saturation_note,
     brief_report, full_report, windows {segment, occurrence, samples, start_s,
     end_s, temp_c, gyro_mean, accel_mean, gyro_std, accel_std}, residuals {window, gyro_radps,
     accel_mps2, gyro_sigma_radps, accel_sigma_mps2, downweighted}, folds {temp_c, fitted, why_not,
@@ -119,7 +120,7 @@ def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: 
     "cauchy"), loss_scale, gyro_bias_stability_radps, accel_bias_stability_mps2,
     bias_correlation_s, max_iterations, closed_form_start, threads, distinct_temp_c,
     min_excitation_rate_radps, rank_tolerance, trim_s, window_temp_span_c, window_max_duration_s,
-    window_min_samples, max_turn_gap_s, temp_c (degC for a run without a temp_c column), segment_window_s,
+    window_min_samples, max_turn_gap_s, gyro_full_scale_raw, accel_full_scale_raw, temp_c (degC for a run without a temp_c column), segment_window_s,
     segment_noise_quantile, segment_threshold_factor, min_steady_s, direction_tolerance_deg,
     rate_tolerance (finding the segments of a run without a segment column), validate,
     check_samples, check_plan.
@@ -136,6 +137,7 @@ def simulate(plan: PathLike, truth: Calibration | PathLike, **options: Any) -> d
     gyro_random_walk (rad/s^2/sqrt(Hz)), accel_random_walk (m/s^3/sqrt(Hz)),
     gyro_bias_instability (rad/s), accel_bias_instability (m/s^2), bias_correlation_s,
     time_jitter_s, drop_probability and drop_burst (lost samples: the arrays are then shorter),
+    gyro_full_scale_raw, accel_full_scale_raw (outputs clipped),
     temp_noise_c, quantize, seed."""
 
 def simulate_options() -> dict[str, tuple[Any, str]]:

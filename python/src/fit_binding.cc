@@ -147,6 +147,11 @@ const OptionTable<FitRunOptions>& FitOptionTable() {
         .Field<double>("max_turn_gap_s",
                        "a turn with a longer gap in its time stamps (lost samples), s, is dropped",
                        [](O& o) -> double& { return o.windows.max_turn_gap_s; })
+        .Field<double>("gyro_full_scale_raw",
+                       "the gyro's full scale, raw (0: not given): clipped windows are left out",
+                       [](O& o) -> double& { return o.windows.gyro_full_scale_raw; })
+        .Field<double>("accel_full_scale_raw", "the accel's full scale, raw (0: not given)",
+                       [](O& o) -> double& { return o.windows.accel_full_scale_raw; })
         .Custom(
             "temp_c",
             "the temperature of every sample, degC, for samples without a temp_c column (None: read it)",
@@ -237,6 +242,8 @@ py::dict Diagnostics(const FitRunResult& result) {
   d["turns_dropped_for_gaps"] = stats.turns_dropped_for_gaps;
   d["turns_off_grid"] = stats.turns_off_grid;
   d["time_stamp_note"] = TimeStampNote(stats);
+  d["saturated_windows"] = stats.saturated_windows;
+  d["saturation_note"] = SaturationNote(stats);
   d["brief_report"] = fit.BriefReport();
   d["full_report"] = fit.FullReport();
 
@@ -414,6 +421,10 @@ const OptionTable<SimulationOptions>& SimulateOptionTable() {
                        [](O& o) -> double& { return o.drop_probability; })
         .Field<int>("drop_burst", "samples lost in a row at each loss",
                     [](O& o) -> int& { return o.drop_burst; })
+        .Field<double>("gyro_full_scale_raw", "clip the raw gyro outputs to +- this (0: no clip)",
+                       [](O& o) -> double& { return o.gyro_full_scale_raw; })
+        .Field<double>("accel_full_scale_raw", "clip the raw accel outputs to +- this (0: no clip)",
+                       [](O& o) -> double& { return o.accel_full_scale_raw; })
         .Field<double>("temp_noise_c", "white noise of the temperature reading, degC",
                        [](O& o) -> double& { return o.temp_noise_c; })
         .Field<bool>("quantize", "round raw outputs to integer counts",

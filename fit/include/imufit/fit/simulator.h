@@ -71,6 +71,10 @@ struct SimulationOptions {
   // sample nor its truth); the others keep their values and time stamps, from their own generator.
   double drop_probability = 0.0;
   int drop_burst = 1;
+  // The raw outputs' full scale, raw units (0: none): outputs are clipped to +-full scale, as a
+  // converter saturates.
+  double gyro_full_scale_raw = 0.0;
+  double accel_full_scale_raw = 0.0;
   std::uint64_t seed = 1;
 
   // An empty string when the options are usable, else what is wrong.

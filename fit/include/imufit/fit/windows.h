@@ -63,6 +63,12 @@ struct WindowOptions {
   // interpolation across the gap would bias its angle (see above; 0.05 s costs a 360 deg turn of
   // 4 s about 6 ppm of its angle).
   double max_turn_gap_s = 0.05;
+  // The raw outputs' full scale, raw units (0: not given): a window with a sample at or beyond
+  // +-full scale on an axis of that sensor is dropped, for a clipped sample biases its mean. Without
+  // it, a window whose output on an axis is one constant value at the run's extreme while the
+  // other windows show noise is taken for saturated and dropped (a partly clipped one is not seen).
+  double gyro_full_scale_raw = 0.0;
+  double accel_full_scale_raw = 0.0;
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
@@ -125,6 +131,13 @@ struct WindowStats {
   long long off_grid_samples = 0;    // stamps more than SampleClock::kTolerance from their slot
   int turns_dropped_for_gaps = 0;    // turns with a gap longer than max_turn_gap_s
   double max_turn_gap_s = 0.0;       // WindowOptions::max_turn_gap_s, the limit they were held to
+  // Windows dropped as saturated (see WindowOptions::gyro_full_scale_raw), and what was seen in the
+  // first few of them, e.g. "segment 7 at t = 36.5 s: gyro z at 32767".
+  int saturated_windows = 0;
+  std::vector<std::string> saturation;
+  // Each raw channel's extremes over the run (gyro x, y, z, accel x, y, z).
+  Eigen::Matrix<double, 6, 1> raw_min = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> raw_max = Eigen::Matrix<double, 6, 1>::Zero();
   int turns_off_grid = 0;            // turns with a stamp off the grid: one slot a sample
 
   // Whether the time stamps lie on a uniform grid (at most one in a thousand off it), so that the
@@ -135,6 +148,9 @@ struct WindowStats {
   double first_time_s = 0.0;
   double last_time_s = 0.0;
 };
+
+// What saturation was found, for a person; empty when none.
+std::string SaturationNote(const WindowStats& stats);
 
 // What the time stamps showed, for a person: samples lost (and filled in within the turns),
 // turns dropped for a long gap, stamps off a uniform grid. Empty when there is nothing to say.
@@ -201,6 +217,9 @@ class WindowBuilder {
   void Close();
   // Fills a turn's mean and noise from its kept samples; false when it is dropped for a gap.
   bool CloseTurn(Window* window);
+  // Drops the windows whose output is pinned at the run's extreme (Finish()).
+  void DropPinnedWindows();
+  void NoteSaturation(const Window& window, int channel, double value);
 
   WindowOptions options_;
   WindowStats stats_;
@@ -231,6 +250,8 @@ class WindowBuilder {
   long long lost_ = 0;           // empty slots in the open window
   double longest_gap_s_ = 0.0;
   bool off_grid_ = false;  // a stamp of the open window was off the grid
+  int clipped_channel_ = -1;  // a channel of the open window at or beyond its full scale
+  double clipped_value_ = 0.0;
   // Sums of (t - start_s) and of k (t - start_s) over the window's samples k = 0, 1, ...: the
   // interval of a window off the grid.
   double time_sum_ = 0.0;
