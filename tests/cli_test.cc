@@ -248,6 +248,24 @@ class CliTest : public ::testing::Test {
     return RunProgram(IMUFIT_EXE, args, (dir_ / "stdout.txt").string(), (dir_ / "stderr.txt").string());
   }
 
+  // The arguments of `imufit simulate` for a small noisy run of the 6-position plan (10 Hz, 3 s
+  // dwells, four soaks: enough for a fit, quick to make) into `out`; `extra` adds options.
+  static std::vector<std::string> SmallRunArgs(const std::string& out,
+                                               const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"simulate",
+                                     "--plan=" + Fixture("plan_6pos.yaml"),
+                                     "--calibration=" + Fixture("mems_truth.yaml"),
+                                     "--output=" + out,
+                                     "--rate=10",
+                                     "--dwell=3",
+                                     "--temps=-20,5,30,60",
+                                     "--gyro-noise-density=2e-4",
+                                     "--accel-noise-density=2e-3",
+                                     "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+
   // As Run, but the program cannot write a file larger than `max_file_bytes` (RLIMIT_FSIZE, with
   // SIGXFSZ ignored: a write past it fails with EFBIG, as on a disk that fills up).
   RunResult RunWithFileSizeLimit(const std::vector<std::string>& args, rlim_t max_file_bytes) const {
@@ -932,16 +950,7 @@ TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
 // A static-only run: refused as a whole (naming the gyro scale, suggesting --fit accel), fitted
 // with --fit accel: the accelerometer near the truth, the gyro held at scale 1 and 0 with sigma 0.
 TEST_F(CliTest, FitAccelAloneCalibratesAStaticOnlyRun) {
-  const std::string plan =
-      Write("static.yaml",
-            "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81274\nlatitude_deg: 52.27\n"
-            "segments:\n"
-            "  - {id: 1, up: [0, 0, 1], north: [1, 0, 0]}\n"
-            "  - {id: 2, up: [0, 0, -1], north: [1, 0, 0]}\n"
-            "  - {id: 3, up: [1, 0, 0], north: [0, 1, 0]}\n"
-            "  - {id: 4, up: [-1, 0, 0], north: [0, 1, 0]}\n"
-            "  - {id: 5, up: [0, 1, 0], north: [0, 0, 1]}\n"
-            "  - {id: 6, up: [0, -1, 0], north: [0, 0, 1]}\n");
+  const std::string plan = Fixture("plan_6faces_static.yaml");
   const std::string samples = SimulateNoiseless(plan, Fixture("mems_truth.yaml"), "static",
                                                 {"--temps=-20,5,30,55,80", "--dwell", "3"})
                                   .first;
@@ -1082,23 +1091,7 @@ TEST_F(CliTest, MultiOutputCommandsWriteAllOrNothing) {
 // that fills up; here a file size limit the samples fit under and the truth does not) leaves no
 // samples file, which would otherwise pass for a complete simulation.
 TEST_F(CliTest, SimulateWritesSamplesAndTruthTogetherOrNeither) {
-  const std::vector<std::string> args = {"simulate",
-                                         "-p",
-                                         Fixture("plan_6pos.yaml"),
-                                         "-c",
-                                         Fixture("mems_truth.yaml"),
-                                         "-o",
-                                         Path("samples.csv.gz"),
-                                         "--truth",
-                                         Path("truth.csv"),
-                                         "--rate",
-                                         "10",
-                                         "--dwell",
-                                         "3",
-                                         "--temps=-20,5,30,60",
-                                         "--gyro-noise-density",
-                                         "2e-4",
-                                         "-q"};
+  const std::vector<std::string> args = SmallRunArgs(Path("samples.csv.gz"), {"--truth", Path("truth.csv")});
   RunResult r = Run(args);
   ASSERT_EQ(r.status, 0) << r.err;
   const uintmax_t samples_bytes = fs::file_size(Path("samples.csv.gz"));
@@ -1118,7 +1111,7 @@ TEST_F(CliTest, SimulateWritesSamplesAndTruthTogetherOrNeither) {
 
   // Neither when the truth cannot even be started.
   std::vector<std::string> unwritable = args;
-  unwritable[std::find(args.begin(), args.end(), "--truth") - args.begin() + 1] = Path("missing/truth.csv");
+  unwritable.back() = Path("missing/truth.csv");  // the value of --truth
   r = Run(unwritable);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("missing/truth.csv: cannot create"), std::string::npos) << r.err;
@@ -1546,19 +1539,7 @@ std::string CertificateSerial(const std::string& html) {
 TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatch) {
   const std::string plan = Fixture("plan_6pos.yaml");  // no serial of its own
   const auto simulate = [&](const std::string& out, const std::vector<std::string>& extra) {
-    // A small run (10 Hz, 3 s dwells, four soaks): enough for a fit, quick to make.
-    std::vector<std::string> args = {"simulate",
-                                     "--plan=" + plan,
-                                     "--calibration=" + Fixture("mems_truth.yaml"),
-                                     "--output=" + out,
-                                     "--rate=10",
-                                     "--dwell=3",
-                                     "--temps=-20,5,30,60",
-                                     "--gyro-noise-density=2e-4",
-                                     "--accel-noise-density=2e-3",
-                                     "-q"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    const RunResult r = Run(args);
+    const RunResult r = Run(SmallRunArgs(out, extra));
     EXPECT_EQ(r.status, 0) << r.err;
   };
   fs::create_directories(work_ / "lot" / "u1");
@@ -1681,25 +1662,7 @@ TEST_F(CliTest, SerialsThatDisagreeAreWarnedAboutOrRefused) {
   const std::string named_plan = Write("named_plan.yaml", named_plan_text);
   fs::create_directories(work_ / "lot" / "u1");
   const auto simulate = [&](const std::string& out, const std::vector<std::string>& extra) {
-    std::vector<std::string> args = {"simulate",
-                                     "-p",
-                                     plan,
-                                     "-c",
-                                     Fixture("mems_truth.yaml"),
-                                     "-o",
-                                     out,
-                                     "--rate",
-                                     "10",
-                                     "--dwell",
-                                     "3",
-                                     "--temps=-20,5,30,60",
-                                     "--gyro-noise-density",
-                                     "2e-4",
-                                     "--accel-noise-density",
-                                     "2e-3",
-                                     "-q"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    const RunResult r = Run(args);
+    const RunResult r = Run(SmallRunArgs(out, extra));
     ASSERT_EQ(r.status, 0) << r.err;
   };
   const std::string named = Path("lot/u1/samples.csv");  // its header: "# serial: SN-77" on line 2

@@ -716,16 +716,7 @@ TEST_F(FactoryCliTest, StationFileIsShownHashedAndChecked) {
 // `imufit fit` and passes it to each unit, and the manifest records them, so a batch run again with
 // other options redoes the units (their results would change) while the same options skip them.
 TEST_F(FactoryCliTest, BatchFitsAStaticOnlyLotWithFitAccelAndRedoesUnitsWhenTheOptionsChange) {
-  const std::string plan =
-      Write("static.yaml",
-            "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81274\nlatitude_deg: 52.27\n"
-            "segments:\n"
-            "  - {id: 1, up: [0, 0, 1], north: [1, 0, 0]}\n"
-            "  - {id: 2, up: [0, 0, -1], north: [1, 0, 0]}\n"
-            "  - {id: 3, up: [1, 0, 0], north: [0, 1, 0]}\n"
-            "  - {id: 4, up: [-1, 0, 0], north: [0, 1, 0]}\n"
-            "  - {id: 5, up: [0, 1, 0], north: [0, 0, 1]}\n"
-            "  - {id: 6, up: [0, -1, 0], north: [0, 0, 1]}\n");
+  const std::string plan = kFixtures + "/plan_6faces_static.yaml";
   const std::string limits = Write("accel_limits.yaml",
                                    "format: imufit-limits\nversion: 1\n"
                                    "nominal: {accel_scale: 208.838}\n"
