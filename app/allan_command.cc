@@ -16,6 +16,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
 #include "imufit/io/series_reader.h"
+#include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 
 namespace imufit {
@@ -103,9 +104,15 @@ void PlausibilityWarnings(const AllanArguments& args, const UniformSeries& serie
   }
 }
 
+// What was analysed, for the summary and the plot's title: the samples, and the calibration they
+// were corrected through (the figures are the corrected unit's).
+std::string Analysed(const AllanArguments& args) {
+  return args.calibration.empty() ? args.samples : args.samples + " corrected by " + args.calibration;
+}
+
 void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64_t sample_count,
                   const std::vector<ColumnAnalysis>& results) {
-  std::printf("%s: %lld samples at %s s (%s s), %s, %zu taus, %.3g %% confidence\n", args.samples.c_str(),
+  std::printf("%s: %lld samples at %s s (%s s), %s, %zu taus, %.3g %% confidence\n", Analysed(args).c_str(),
               static_cast<long long>(sample_count), Number(series.sample_interval_s, 6).c_str(),
               Number(series.end_time_s - series.start_time_s - series.bridged_time_s, 6).c_str(),
               ToString(results.front().curve.estimator), results.front().curve.points.size(),
@@ -254,13 +261,21 @@ int RunAllan(const AllanArguments& args) {
 
   OutputTransaction written;  // the curves, the noise YAML and the plot together, or none
   WriteAllanCsv(args.output, results);
-  const NoiseRecord record{SoftwareVersion(), args.samples, series.sample_interval_s, n,
-                           series.end_time_s - series.start_time_s - series.bridged_time_s};
+  NoiseRecord record;
+  record.software = SoftwareVersion();
+  record.samples = args.samples;
+  if (!args.calibration.empty()) {
+    record.calibration = args.calibration;
+    record.calibration_sha256 = Sha256OfFile(args.calibration);
+  }
+  record.sample_interval_s = series.sample_interval_s;
+  record.sample_count = n;
+  record.duration_s = series.end_time_s - series.start_time_s - series.bridged_time_s;
   if (!args.noise_yaml.empty()) WriteNoiseYaml(args.noise_yaml, record, results);
   if (!args.plot.empty()) {
     char title[512];
     std::snprintf(title, sizeof title, "%s: %s, tau0 = %g s, %lld samples, %.3g %% confidence",
-                  args.samples.c_str(), ToString(results.front().curve.estimator), series.sample_interval_s,
+                  Analysed(args).c_str(), ToString(results.front().curve.estimator), series.sample_interval_s,
                   static_cast<long long>(n), 100.0 * args.confidence);
     DrawFile(AllanPlot(results, title, plot_units), args.plot);
   }

@@ -15,6 +15,9 @@ namespace {
 
 struct BatchArguments {
   BatchOptions batch;
+  FitRunArguments run;  // every unit is fitted with these, as imufit fit would fit it
+  bool validate = false;
+  bool allow_mismatch = false;
   bool no_report = false;
   bool quiet = false;
 };
@@ -41,12 +44,22 @@ void ShowProgress(const BatchProgress& p, bool terminal) {
 
 int RunBatchCommand(BatchArguments args) {
   BatchOptions& options = args.batch;
+  options.fit = args.run.Resolve();
+  options.fit.validate = args.validate;
+  options.fit.allow_serial_mismatch = args.allow_mismatch;
   options.fit.software = SoftwareVersion();
   options.fit.fit.num_threads = 1;  // parallel over units instead
   const bool terminal = isatty(STDERR_FILENO) != 0;
   if (!args.quiet) options.progress = [terminal](const BatchProgress& p) { ShowProgress(p, terminal); };
   options.write_reports = !args.no_report;
   const BatchResult result = RunBatch(options);
+  // Warnings even with --quiet, as imufit fit gives them (a unit skipped as unchanged gave its own
+  // when it was fitted; its certificate keeps them).
+  for (const UnitOutcome& u : result.units) {
+    for (const std::string& warning : u.warnings) {
+      std::fprintf(stderr, "imufit: warning: %s: %s\n", u.unit.c_str(), warning.c_str());
+    }
+  }
   if (!args.quiet) {
     std::printf(
         "imufit batch: %zu units: %d passed, %d failed limits, %d not fitted, %d errors; %d unchanged and "
@@ -78,7 +91,8 @@ CommandRunner AddBatchCommand(CLI::App* root) {
       "Fit every unit of a lot: each folder of UNITS_DIR is a unit (plan.yaml and samples.csv[.gz], or "
       "samples "
       "only with --plan). Writes OUT_DIR/<unit>/calibration.yaml, report.html and manifest.yaml, and "
-      "OUT_DIR/lot_summary.csv; a re-run skips units whose inputs and software are unchanged. Exit 0 every "
+      "OUT_DIR/lot_summary.csv; every unit is fitted with the fit options below, as imufit fit would fit it; "
+      "a re-run skips units whose inputs, fit options and software are unchanged. Exit 0 every "
       "unit "
       "passed, 3 some unit failed its limits or could not be fitted, 1 stopped early, 2 bad invocation.");
   command->add_option("units_dir", b.units_dir, "folder of unit folders")->required();
@@ -96,8 +110,12 @@ CommandRunner AddBatchCommand(CLI::App* root) {
                    "stop after fitting this many units (0: all); a later run resumes the lot")
       ->capture_default_str();
   command->add_flag("--no-report", args->no_report, "write no report.html per unit");
-  command->add_flag("--validate", b.fit.validate,
+  command->add_flag("--validate", args->validate,
                     "leave each interior temperature out in turn, refit, and put the errors in the reports");
+  command->add_flag("--allow-mismatch", args->allow_mismatch,
+                    "fit a unit even when its serial.txt names another unit than its samples header (a "
+                    "warning, also on the certificate); without it such a unit is an error");
+  AddFitRunOptions(command, &args->run);
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunBatchCommand(*args); };
 }

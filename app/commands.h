@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/segment_run.h"
 
 namespace imufit {
@@ -41,6 +42,38 @@ struct SamplesInputArguments {
 void AddTempOption(CLI::App* command, SamplesInputArguments* args);
 // --segment-window, --min-steady, --direction-tolerance, --rate-tolerance.
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
+
+// How a run is read into windows: what a certificate must read as the fit read it.
+struct RunReadingArguments {
+  WindowOptions windows;
+  SamplesInputArguments input;
+};
+// --trim, --window-temp-span, --window-max-duration, --window-min-samples, --max-turn-gap, --temp-c
+// and the segmentation options (fit, batch and report: run_options.cc).
+void AddRunReadingOptions(CLI::App* command, RunReadingArguments* args);
+
+// The options of a unit's fit, defined once for `imufit fit` and `imufit batch` so that the two
+// cannot drift apart (run_options.cc).
+struct FitRunArguments {
+  RunReadingArguments run;
+  FitOptions fit;  // the options CLI11 fills directly
+  std::string loss = "huber";
+  bool no_g_sensitivity = false;
+  std::string groups = "all";  // --fit
+  std::string prior;           // --prior: the held groups' values
+  double gyro_bias_stability_dph = 0.0;
+  double accel_bias_stability_ug = 0.0;
+  CLI::Option* gyro_order_option = nullptr;
+  CLI::Option* accel_order_option = nullptr;
+
+  // The FitRunOptions these options give (fit, windows, input): parses --loss and --fit, reads
+  // --prior, converts to SI, and with --temp-c makes the temperature orders 0. Throws InputError.
+  FitRunOptions Resolve() const;
+};
+// The fit options, and AddRunReadingOptions: --fit, --prior, --loss, --loss-scale,
+// --gyro-temp-order, --accel-temp-order, --no-g-sensitivity, the bias stabilities,
+// --bias-correlation, --max-iterations.
+void AddFitRunOptions(CLI::App* command, FitRunArguments* args);
 
 struct Calibration;
 struct CorrectFileReport;

@@ -28,10 +28,6 @@ struct FitArguments {
   std::string output;
   std::string check_plan;
   std::string check_samples;
-  std::string loss = "huber";
-  bool no_g_sensitivity = false;
-  std::string groups = "all";  // --fit
-  std::string prior;           // --prior: the held groups' values
   bool validate = false;
   bool quiet = false;
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
@@ -39,13 +35,8 @@ struct FitArguments {
   std::string store;   // results store to record the fit in
   std::string serial;  // the unit's serial; empty: the samples header's, else the plan's
   std::string station;  // station file shown on the certificate (with --report)
-  double gyro_bias_stability_dph = 0.0;
-  double accel_bias_stability_ug = 0.0;
-  FitOptions fit;
-  WindowOptions windows;
-  SamplesInputArguments input;
-  CLI::Option* gyro_order_option = nullptr;
-  CLI::Option* accel_order_option = nullptr;
+  bool allow_mismatch = false;  // --serial may contradict the samples header (a warning)
+  FitRunArguments run;          // the fit options, shared with imufit batch
 };
 
 // A value and its 1-sigma: the sigma goes through the same unit conversion as the value, whose
@@ -111,7 +102,7 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 
 // --limits, --report, --store: the factory additions, after the calibration is written.
 // Returns the exit status: 0, or kExitFailedLimits.
-int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
+int FinishFactory(const FitArguments& args, const FitRunOptions& options, const std::optional<Limits>& limits,
                   const std::optional<Station>& station, const FitRunResult& result,
                   OutputTransaction* outputs) {
   const Calibration& calibration = *result.calibration;
@@ -126,9 +117,10 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
     sources.calibration = calibration;
     sources.plan = result.plan;
     sources.run = result.run;
-    sources.windows = args.windows;
-    sources.samples_input = args.input.Get();
+    sources.windows = options.windows;
+    sources.samples_input = options.input;
     sources.folds = result.folds;
+    sources.warnings = result.serial_warnings;
     sources.limits = limits;  // judged with the noise the certificate measures
     // The calibration is not renamed into place yet (one transaction): hash the text it holds.
     sources.inputs = {{"calibration", args.output, Sha256Hex(CalibrationToYaml(calibration))},
@@ -170,8 +162,8 @@ int FinishFactory(const FitArguments& args, const std::optional<Limits>& limits,
 }
 
 int RunFit(FitArguments args) {
-  RefuseToOverwriteInputs(
-      args.output, {args.plan, args.samples, args.check_plan, args.check_samples, args.limits, args.prior});
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples,
+                                        args.limits, args.run.prior});
   if (!args.report.empty()) {
     RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples,
                                           args.limits, args.output, args.station});
@@ -184,42 +176,27 @@ int RunFit(FitArguments args) {
     if (args.report.empty()) throw InputError("--station", "is shown on the certificate: give --report too");
     station = ReadStation(args.station);
   }
-  std::string error;
-  if (!ParseRobustLoss(args.loss, &args.fit.loss, &error)) throw InputError("--loss", error);
-  args.fit.fit_g_sensitivity = !args.no_g_sensitivity;
-  if (!ParseFitGroups(args.groups, &args.fit, &error)) throw InputError("--fit", error);
-  if (!args.prior.empty()) args.fit.held = ReadCalibration(args.prior).model;
-  args.fit.gyro_bias_stability_radps = RadpsFromDph(args.gyro_bias_stability_dph);
-  args.fit.accel_bias_stability_mps2 = Mps2FromUg(args.accel_bias_stability_ug);
-  const bool fixed_temp = args.input.HasTemp();
-  if (fixed_temp) {
-    // One temperature determines no temperature dependence: order 0, unless the user asked otherwise.
-    const bool explicit_order = args.gyro_order_option->count() > 0 || args.accel_order_option->count() > 0;
-    if (explicit_order && (args.fit.gyro_temp_order != 0 || args.fit.accel_temp_order != 0)) {
-      throw InputError("--temp-c", "one temperature for the whole run determines only order-0 temperature "
-                                   "polynomials: use --gyro-temp-order 0 --accel-temp-order 0 (the default with --temp-c)");
-    }
-    args.fit.gyro_temp_order = 0;
-    args.fit.accel_temp_order = 0;
-  }
-  FitRunOptions options;
-  options.input = args.input.Get();
-  options.fit = args.fit;
-  options.windows = args.windows;
+  FitRunOptions options = args.run.Resolve();
   options.validate = args.validate;
   options.check_samples = args.check_samples;
   options.check_plan = args.check_plan;
   options.software = SoftwareVersion();
   options.serial = args.serial;
+  options.allow_serial_mismatch = args.allow_mismatch;
   if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
 
   const FitRunResult result = FitRun(args.plan, args.samples, options);
+  for (const std::string& warning : result.serial_warnings) {
+    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  }
+  const bool fixed_temp = options.input.temp_c.has_value();
   const FitSummary& fit = result.fit;
   const WindowStats& stats = result.run.stats;
   const std::vector<Window>& windows = result.run.windows;
   if (!args.quiet && fixed_temp) {
-    std::printf("imufit fit: note: no temp_c column, every sample at %g degC (--temp-c): temperature orders 0\n",
-                args.input.temp_c);
+    std::printf(
+        "imufit fit: note: no temp_c column, every sample at %g degC (--temp-c): temperature orders 0\n",
+        *options.input.temp_c);
   }
   if (!args.quiet && result.run.segmentation) {
     const Segmentation& segmentation = *result.run.segmentation;
@@ -231,10 +208,11 @@ int RunFit(FitArguments args) {
     std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n", args.samples.c_str());
     for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
     std::fprintf(stderr,
-                 "  (the run: %lld samples, %lld in transitions, %lld trimmed after moves, %d windows used, %lld windows "
+                 "  (the run: %lld samples, %lld in transitions, %lld trimmed after moves, %d windows used, "
+                 "%lld windows "
                  "shorter than %d samples dropped)\n",
-                 stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used, stats.short_windows,
-                 args.windows.min_samples);
+                 stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used,
+                 stats.short_windows, options.windows.min_samples);
     if (const std::string note = TimeStampNote(stats); !note.empty()) {
       std::fprintf(stderr, "  (time stamps: %s)\n", note.c_str());
     }
@@ -250,7 +228,7 @@ int RunFit(FitArguments args) {
   OutputTransaction outputs;
   WriteCalibration(args.output, *result.calibration);
 
-  if (args.quiet) return FinishFactory(args, limits, station, result, &outputs);
+  if (args.quiet) return FinishFactory(args, options, limits, station, result, &outputs);
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
   std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
               stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
@@ -265,7 +243,7 @@ int RunFit(FitArguments args) {
               DpsFromRadps(fit.gyro_rms_radps), MgFromMps2(fit.accel_rms_mps2), fit.gyro_reduced_chi2,
               fit.accel_reduced_chi2);
   if (fit.windows_downweighted > 0) {
-    std::printf("  down-weighted by the %s loss:", RobustLossName(args.fit.loss).c_str());
+    std::printf("  down-weighted by the %s loss:", RobustLossName(options.fit.loss).c_str());
     int shown = 0;
     for (const WindowResidual& r : fit.residuals) {
       if (!r.downweighted || shown++ >= 10) continue;
@@ -274,13 +252,14 @@ int RunFit(FitArguments args) {
     }
     std::printf("%s\n", fit.windows_downweighted > 10 ? " ..." : "");
   }
-  PrintCoefficients(fit, args.fit);
-  if (args.fit.gyro_bias_stability_radps == 0.0 || args.fit.accel_bias_stability_mps2 == 0.0) {
-    std::printf("  note: the sigmas reflect white noise only%s; give the unit's in-run bias stability\n"
-                "        (--gyro-bias-stability-dph, --accel-bias-stability-ug) if its bias wanders\n",
-                args.fit.gyro_bias_stability_radps == 0.0 && args.fit.accel_bias_stability_mps2 == 0.0
-                    ? ""
-                    : args.fit.gyro_bias_stability_radps == 0.0 ? " for the gyro" : " for the accelerometer");
+  PrintCoefficients(fit, options.fit);
+  if (options.fit.gyro_bias_stability_radps == 0.0 || options.fit.accel_bias_stability_mps2 == 0.0) {
+    std::printf(
+        "  note: the sigmas reflect white noise only%s; give the unit's in-run bias stability\n"
+        "        (--gyro-bias-stability-dph, --accel-bias-stability-ug) if its bias wanders\n",
+        options.fit.gyro_bias_stability_radps == 0.0 && options.fit.accel_bias_stability_mps2 == 0.0 ? ""
+        : options.fit.gyro_bias_stability_radps == 0.0 ? " for the gyro"
+                                                       : " for the accelerometer");
   }
   if (args.validate) {
     std::printf("  leave-one-temperature-out validation:\n");
@@ -302,15 +281,13 @@ int RunFit(FitArguments args) {
   if (!result.check_errors.empty()) {
     PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
   }
-  return FinishFactory(args, limits, station, result, &outputs);
+  return FinishFactory(args, options, limits, station, result, &outputs);
 }
 
 }  // namespace
 
 CommandRunner AddFitCommand(CLI::App* root) {
   auto args = std::make_shared<FitArguments>();
-  FitOptions& f = args->fit;
-  WindowOptions& w = args->windows;
   CLI::App* command = root->add_subcommand(
       "fit",
       "Fit biases, scale factors, misalignments, gyro g-sensitivity and their cubic temperature "
@@ -319,64 +296,8 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
   command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
-  args->gyro_order_option =
-      command->add_option("--gyro-temp-order", f.gyro_temp_order, "order of the gyro temperature polynomials, 0..3 (0 with --temp-c)")
-          ->capture_default_str()
-          ->check(CLI::Range(0, 3));
-  args->accel_order_option =
-      command->add_option("--accel-temp-order", f.accel_temp_order, "order of the accel temperature polynomials, 0..3 (0 with --temp-c)")
-          ->capture_default_str()
-          ->check(CLI::Range(0, 3));
-  AddTempOption(command, &args->input);
-  AddSegmentationOptions(command, &args->input);
-  command->add_flag("--no-g-sensitivity", args->no_g_sensitivity, "hold the gyro g-sensitivity at zero");
-  command
-      ->add_option("--fit", args->groups,
-                   "what to fit, comma-separated: all, gyro, gyro-bias, accel, accel-bias; the rest is held "
-                   "(--fit accel calibrates the accelerometer from a static-only run)")
-      ->capture_default_str();
-  command->add_option("--prior", args->prior,
-                      "calibration YAML whose values the held groups keep (default: scale 1, the rest 0)");
-  command->add_option("--loss", args->loss, "robust loss: none, huber, cauchy")->capture_default_str();
-  command->add_option("--loss-scale", f.loss_scale,
-                      "where the robust loss acts, in robust spreads of the windows' normalised residuals")
-      ->capture_default_str();
-  command->add_option("--gyro-bias-stability-dph", args->gyro_bias_stability_dph,
-                      "the unit's in-run gyro bias stability, deg/h 1-sigma (bias instability and random walk over "
-                      "--bias-correlation): added to the reported uncertainty")
-      ->capture_default_str();
-  command->add_option("--accel-bias-stability-ug", args->accel_bias_stability_ug,
-                      "the unit's in-run accel bias stability, micro-g 1-sigma: added to the reported uncertainty")
-      ->capture_default_str();
-  command->add_option("--bias-correlation", f.bias_correlation_s,
-                      "seconds over which the wandering bias is taken as constant")
-      ->capture_default_str();
-  command->add_option("--trim", w.trim_s, "seconds dropped at the start of each segment occurrence")->capture_default_str();
-  command->add_option("--window-temp-span", w.max_temp_span_c,
-                      "a window closes when its temperature has moved this far, degC")
-      ->capture_default_str();
-  command->add_option("--window-max-duration", w.max_duration_s, "a window closes after this many seconds (0: never)")
-      ->capture_default_str();
-  command->add_option("--window-min-samples", w.min_samples, "windows with fewer samples are dropped")
-      ->capture_default_str();
-  command
-      ->add_option(
-          "--max-turn-gap", w.max_turn_gap_s,
-          "a turn whose time stamps have a longer gap (lost samples in a row), s, is dropped: integrating "
-          "across it would bias the angle")
-      ->capture_default_str();
-  command
-      ->add_option(
-          "--gyro-full-scale", w.gyro_full_scale_raw,
-          "the gyro's full scale, raw units (e.g. 32767 counts): windows with a sample at or beyond it "
-          "are left out (0: found only where an output sits at the run's extreme)")
-      ->capture_default_str();
-  command
-      ->add_option("--accel-full-scale", w.accel_full_scale_raw,
-                   "the accelerometer's full scale, raw units, as --gyro-full-scale")
-      ->capture_default_str();
-  command->add_option("--max-iterations", f.max_iterations, "solver iterations at most, per pass")->capture_default_str();
-  command->add_option("--threads", f.num_threads, "solver threads")->capture_default_str();
+  AddFitRunOptions(command, &args->run);
+  command->add_option("--threads", args->run.fit.num_threads, "solver threads")->capture_default_str();
   command->add_flag("--validate", args->validate,
                     "leave each interior temperature out in turn, refit, and report the errors on it");
   command->add_option("--check-samples", args->check_samples, "a held-out run to report the calibration's errors on");
@@ -386,7 +307,11 @@ CommandRunner AddFitCommand(CLI::App* root) {
                       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
   command->add_option(
       "--serial", args->serial,
-      "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial)");
+      "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial); one "
+      "that contradicts the samples header is refused (exit 2) unless --allow-mismatch");
+  command->add_flag("--allow-mismatch", args->allow_mismatch,
+                    "fit even when --serial names another unit than the samples header (a warning, also on "
+                    "the certificate)");
   command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
   command->add_option(
       "--station", args->station,

@@ -11,6 +11,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/station.h"
+#include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
 namespace {
@@ -24,20 +25,36 @@ struct ReportArguments {
   std::string serial;
   std::string station;  // station file: where and by whom
   bool allow_mismatch = false;
-  WindowOptions windows;
-  SamplesInputArguments input;  // --temp-c and the segmentation options, as imufit fit has them
+  RunReadingArguments run;  // the run is read as imufit fit read it
 };
 
 int RunReport(const ReportArguments& args) {
   RefuseToOverwriteInputs(args.output,
                           {args.calibration, args.plan, args.samples, args.limits, args.station});
-  if (const std::string problem = args.windows.Validate(); !problem.empty())
-    throw InputError("imufit report", problem);
+  const WindowOptions& windows = args.run.windows;
+  const SamplesInput input = args.run.input.Get();
+  if (std::string problem = windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
+  if (std::string problem = input.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   CertificateSources sources;
   sources.calibration = ReadCalibration(args.calibration);
-  if (!args.serial.empty()) sources.calibration.serial = args.serial;
-  // A calibration fitted without a serial: the unit's own log may still name it.
-  if (sources.calibration.serial.empty()) sources.calibration.serial = ReadSamplesSerial(args.samples);
+  sources.plan = ReadPlan(args.plan);
+  // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
+  // the unit's own log's, then the plan's. Sources that disagree are warned about (unit_serial.h).
+  SerialSource stated, calibration, plan;
+  stated.kind = SerialSource::Kind::kStated;
+  stated.name = "--serial";
+  stated.serial = args.serial;
+  calibration.name = "the calibration " + args.calibration;
+  calibration.serial = sources.calibration.serial;
+  plan.name = "the plan " + args.plan;
+  plan.serial = sources.plan.serial;
+  UnitSerial serial =
+      ResolveSerial({stated, calibration, SamplesHeaderSerial(args.samples), plan}, args.allow_mismatch);
+  sources.calibration.serial = serial.serial;
+  for (const std::string& w : serial.warnings) {
+    sources.warnings.push_back(w);
+    std::fprintf(stderr, "imufit: warning: %s\n", w.c_str());
+  }
   if (!args.limits.empty()) sources.limits = ReadLimits(args.limits);
   if (!args.station.empty()) sources.station = ReadStation(args.station);
   // A certificate of a calibration for another run's data would certify nothing.
@@ -49,10 +66,9 @@ int RunReport(const ReportArguments& args) {
     sources.warnings.push_back(m + " (certified with --allow-mismatch)");
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
-  sources.plan = ReadPlan(args.plan);
-  sources.samples_input = args.input.Get();
-  sources.run = ReadRunWindows(sources.plan, args.samples, args.windows, sources.samples_input);
-  sources.windows = args.windows;
+  sources.samples_input = input;
+  sources.run = ReadRunWindows(sources.plan, args.samples, windows, sources.samples_input);
+  sources.windows = windows;
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
                     {"samples", args.samples, ""},
@@ -90,18 +106,16 @@ CommandRunner AddReportCommand(CLI::App* root) {
   command->add_option("--limits,-l", args->limits, "acceptance limits YAML");
   command->add_option("--output,-o", args->output, "HTML file to write")->required();
   command->add_option("--serial", args->serial,
-                      "the unit's serial (default: the calibration's, else the samples header's)");
+                      "the unit's serial (default: the calibration's, else the samples header's, else the "
+                      "plan's); one that contradicts the samples header is refused unless --allow-mismatch");
   command->add_option(
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
   command->add_flag("--allow-mismatch", args->allow_mismatch,
-                    "certify even when the calibration records other plan/samples hashes than these files' "
-                    "(the certificate says so)");
-  command->add_option("--trim", args->windows.trim_s, "as imufit fit --trim")->capture_default_str();
-  command->add_option("--max-turn-gap", args->windows.max_turn_gap_s, "as imufit fit --max-turn-gap")
-      ->capture_default_str();
-  AddTempOption(command, &args->input);
-  AddSegmentationOptions(command, &args->input);
+                    "certify even when the calibration records other plan/samples hashes than these files', "
+                    "or --serial names another unit than the samples header (the certificate says so)");
+  // The run must be cut into windows as the fit cut it: give the options the fit was given.
+  AddRunReadingOptions(command, &args->run);
   return [args] { return RunReport(*args); };
 }
 

@@ -59,6 +59,9 @@ int RunSimulate(SimulateArguments args) {
 
   // The serial as a unit's logger states it, so that fit, report and batch find it (samples.h).
   const std::string serial_line = args.serial.empty() ? "" : "\n" + SerialComment(args.serial, "--serial");
+  // The samples and the truth together, or neither: a samples file whose truth failed to write
+  // would pass for a complete simulation.
+  OutputTransaction outputs;
   std::ostringstream comment;
   comment << "simulated by " << SoftwareVersion() << " from plan " << args.plan << " and calibration "
           << args.calibration << ", seed " << options.seed << serial_line;
@@ -82,6 +85,7 @@ int RunSimulate(SimulateArguments args) {
   });
   samples.Commit();
   if (truth_samples) truth_samples->Commit();
+  outputs.Commit();
   if (!args.quiet) {
     std::printf("simulated %lld samples (%zu segments, %s) -> %s\n", count, plan.segments.size(),
                 options.ramp ? "temperature ramp" : "temperature soaks", args.output.c_str());

@@ -8,6 +8,9 @@
 // own output and truth, and on samples this file computes with its own forward model written
 // from docs/spec.md (it reads the calibration with yaml-cpp, not with imufit's reader), so that
 // neither the simulator nor imufit's reader and model are checked only against themselves.
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -27,6 +30,7 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Dense>
 
+#include "imufit/io/sha256.h"
 #include "imufit/model/sensor_model.h"
 #include "run_program.h"
 
@@ -242,6 +246,60 @@ class CliTest : public ::testing::Test {
   // Runs imufit with `args`, stdin from /dev/null, and captures its output.
   RunResult Run(const std::vector<std::string>& args) const {
     return RunProgram(IMUFIT_EXE, args, (dir_ / "stdout.txt").string(), (dir_ / "stderr.txt").string());
+  }
+
+  // The arguments of `imufit simulate` for a small noisy run of the 6-position plan (10 Hz, 3 s
+  // dwells, four soaks: enough for a fit, quick to make) into `out`; `extra` adds options.
+  static std::vector<std::string> SmallRunArgs(const std::string& out,
+                                               const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"simulate",
+                                     "--plan=" + Fixture("plan_6pos.yaml"),
+                                     "--calibration=" + Fixture("mems_truth.yaml"),
+                                     "--output=" + out,
+                                     "--rate=10",
+                                     "--dwell=3",
+                                     "--temps=-20,5,30,60",
+                                     "--gyro-noise-density=2e-4",
+                                     "--accel-noise-density=2e-3",
+                                     "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+
+  // As Run, but the program cannot write a file larger than `max_file_bytes` (RLIMIT_FSIZE, with
+  // SIGXFSZ ignored: a write past it fails with EFBIG, as on a disk that fills up).
+  RunResult RunWithFileSizeLimit(const std::vector<std::string>& args, rlim_t max_file_bytes) const {
+    const std::string out = (dir_ / "stdout.txt").string(), err = (dir_ / "stderr.txt").string();
+    std::vector<std::string> storage = {IMUFIT_EXE};
+    storage.insert(storage.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& arg : storage) argv.push_back(arg.data());
+    argv.push_back(nullptr);
+    const pid_t pid = ::fork();
+    if (pid == 0) {  // only async-signal-safe calls until exec
+      const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int null_fd = ::open("/dev/null", O_RDONLY);
+      if (out_fd < 0 || err_fd < 0 || null_fd < 0) ::_exit(126);
+      ::dup2(null_fd, 0);
+      ::dup2(out_fd, 1);
+      ::dup2(err_fd, 2);
+      const struct rlimit limit = {max_file_bytes, max_file_bytes};
+      ::setrlimit(RLIMIT_FSIZE, &limit);
+      ::signal(SIGXFSZ, SIG_IGN);
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+    RunResult result;
+    int status = 0;
+    if (pid < 0 || ::waitpid(pid, &status, 0) != pid) {
+      ADD_FAILURE() << "cannot run " << IMUFIT_EXE;
+      return result;
+    }
+    result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = ReadBytes(out);
+    result.err = ReadBytes(err);
+    return result;
   }
 
   // The names in the work folder.
@@ -897,16 +955,7 @@ TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
 // A static-only run: refused as a whole (naming the gyro scale, suggesting --fit accel), fitted
 // with --fit accel: the accelerometer near the truth, the gyro held at scale 1 and 0 with sigma 0.
 TEST_F(CliTest, FitAccelAloneCalibratesAStaticOnlyRun) {
-  const std::string plan =
-      Write("static.yaml",
-            "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81274\nlatitude_deg: 52.27\n"
-            "segments:\n"
-            "  - {id: 1, up: [0, 0, 1], north: [1, 0, 0]}\n"
-            "  - {id: 2, up: [0, 0, -1], north: [1, 0, 0]}\n"
-            "  - {id: 3, up: [1, 0, 0], north: [0, 1, 0]}\n"
-            "  - {id: 4, up: [-1, 0, 0], north: [0, 1, 0]}\n"
-            "  - {id: 5, up: [0, 1, 0], north: [0, 0, 1]}\n"
-            "  - {id: 6, up: [0, -1, 0], north: [0, 0, 1]}\n");
+  const std::string plan = Fixture("plan_6faces_static.yaml");
   const std::string samples = SimulateNoiseless(plan, Fixture("mems_truth.yaml"), "static",
                                                 {"--temps=-20,5,30,55,80", "--dwell", "3"})
                                   .first;
@@ -1041,6 +1090,37 @@ TEST_F(CliTest, MultiOutputCommandsWriteAllOrNothing) {
       Run({"allan", "-s", samples, "-o", Path("adev.csv"), "--noise-yaml", Path("missing/noise.yaml"), "-q"});
   EXPECT_EQ(allan.status, 2) << allan.err;
   EXPECT_EQ(Listing(), (std::set<std::string>{"calibration.yaml", "rates.csv"})) << "adev.csv written alone";
+}
+
+// simulate -o S --truth T writes both or neither: a truth file that fails at its very end (a disk
+// that fills up; here a file size limit the samples fit under and the truth does not) leaves no
+// samples file, which would otherwise pass for a complete simulation.
+TEST_F(CliTest, SimulateWritesSamplesAndTruthTogetherOrNeither) {
+  const std::vector<std::string> args = SmallRunArgs(Path("samples.csv.gz"), {"--truth", Path("truth.csv")});
+  RunResult r = Run(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const uintmax_t samples_bytes = fs::file_size(Path("samples.csv.gz"));
+  const uintmax_t truth_bytes = fs::file_size(Path("truth.csv"));
+  // The truth must fail when it is committed, after the samples are complete: it fits in the 1 MiB
+  // an output holds before its first write, and the samples fit under the limit.
+  constexpr uintmax_t kOutputBufferBytes = 1 << 20;
+  ASSERT_LT(truth_bytes, kOutputBufferBytes);
+  ASSERT_LT(samples_bytes, truth_bytes);
+  fs::remove(Path("samples.csv.gz"));
+  fs::remove(Path("truth.csv"));
+
+  r = RunWithFileSizeLimit(args, (samples_bytes + truth_bytes) / 2);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("truth.csv: write failed"), std::string::npos) << r.err;
+  EXPECT_EQ(Listing(), std::set<std::string>()) << "the samples were written without their truth";
+
+  // Neither when the truth cannot even be started.
+  std::vector<std::string> unwritable = args;
+  unwritable.back() = Path("missing/truth.csv");  // the value of --truth
+  r = Run(unwritable);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("missing/truth.csv: cannot create"), std::string::npos) << r.err;
+  EXPECT_EQ(Listing(), std::set<std::string>());
 }
 
 TEST_F(CliTest, OutputsNeverReplaceALinkOrSpecialFile) {
@@ -1464,19 +1544,7 @@ std::string CertificateSerial(const std::string& html) {
 TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatch) {
   const std::string plan = Fixture("plan_6pos.yaml");  // no serial of its own
   const auto simulate = [&](const std::string& out, const std::vector<std::string>& extra) {
-    // A small run (10 Hz, 3 s dwells, four soaks): enough for a fit, quick to make.
-    std::vector<std::string> args = {"simulate",
-                                     "--plan=" + plan,
-                                     "--calibration=" + Fixture("mems_truth.yaml"),
-                                     "--output=" + out,
-                                     "--rate=10",
-                                     "--dwell=3",
-                                     "--temps=-20,5,30,60",
-                                     "--gyro-noise-density=2e-4",
-                                     "--accel-noise-density=2e-3",
-                                     "-q"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    const RunResult r = Run(args);
+    const RunResult r = Run(SmallRunArgs(out, extra));
     EXPECT_EQ(r.status, 0) << r.err;
   };
   fs::create_directories(work_ / "lot" / "u1");
@@ -1492,7 +1560,8 @@ TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatc
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(YAML::LoadFile(Path("cal.yaml"))["serial"].as<std::string>(), "SN-77");
   EXPECT_EQ(CertificateSerial(ReadBytes(Path("cal.html"))), "SN-77");
-  r = Run({"fit", "-p", plan, "-s", named, "-o", Path("cal_override.yaml"), "--serial", "SN-OTHER", "-q"});
+  r = Run({"fit", "-p", plan, "-s", named, "-o", Path("cal_override.yaml"), "--serial", "SN-OTHER",
+           "--allow-mismatch", "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(YAML::LoadFile(Path("cal_override.yaml"))["serial"].as<std::string>(), "SN-OTHER");
 
@@ -1524,10 +1593,12 @@ TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatc
   EXPECT_EQ(CertificateSerial(html), "(no serial)");
   EXPECT_NE(html.find("data-warning=\"no serial"), std::string::npos);
 
-  // batch: u1 by its samples' header; u2's serial.txt wins over its header.
+  // batch: u1 by its samples' header; u2's serial.txt wins over its header (when allowed: a
+  // contradiction is refused otherwise, SerialsThatDisagreeAreWarnedAboutOrRefused).
   simulate(Path("lot/u2/samples.csv"), {"--serial", "SN-HEADER", "--seed", "3"});
   Write("lot/u2/serial.txt", "SN-FILE\n");
-  r = Run({"batch", Path("lot"), "--plan", plan, "-o", Path("out"), "--no-report", "--jobs", "1"});
+  r = Run({"batch", Path("lot"), "--plan", plan, "-o", Path("out"), "--no-report", "--jobs", "1",
+           "--allow-mismatch"});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const Table summary = ReadTable(Path("out/lot_summary.csv"));
   ASSERT_EQ(summary.rows.size(), 2u);
@@ -1557,6 +1628,147 @@ TEST_F(CliTest, SerialTravelsFromTheSamplesHeaderToCalibrationCertificateAndBatc
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(Path("bell_out.csv")));
+}
+
+// The warnings of a certificate (data-warning attributes), unescaped.
+std::vector<std::string> CertificateWarnings(const std::string& html) {
+  std::vector<std::string> warnings;
+  const std::string key = "data-warning=\"";
+  for (size_t at = html.find(key); at != std::string::npos; at = html.find(key, at + 1)) {
+    const size_t start = at + key.size();
+    std::string text = html.substr(start, html.find('"', start) - start);
+    for (const auto& [entity, character] :
+         {std::pair<std::string, std::string>{"&quot;", "\""}, {"&amp;", "&"}}) {
+      for (size_t e = text.find(entity); e != std::string::npos; e = text.find(entity, e + 1))
+        text.replace(e, entity.size(), character);
+    }
+    warnings.push_back(text);
+  }
+  return warnings;
+}
+
+// Whether one of `lines` holds every one of `parts`.
+bool AnyHoldsAll(const std::vector<std::string>& lines, const std::vector<std::string>& parts) {
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& line) {
+    return std::all_of(parts.begin(), parts.end(),
+                       [&](const std::string& part) { return line.find(part) != std::string::npos; });
+  });
+}
+
+// --serial (a batch unit's serial.txt), the samples header's serial and the plan's may name
+// different units. The first names the unit; each disagreement is a warning on stderr and on the
+// certificate naming both sources and serials; a stated serial that contradicts the samples' own
+// header (one unit's serial beside another unit's log) is refused at the header's line, exit 2,
+// unless --allow-mismatch.
+TEST_F(CliTest, SerialsThatDisagreeAreWarnedAboutOrRefused) {
+  const std::string plan = Fixture("plan_6pos.yaml");  // no serial of its own
+  std::string named_plan_text = ReadFile(plan);
+  named_plan_text.insert(named_plan_text.find("version:"), "serial: SN-PLAN\n");
+  const std::string named_plan = Write("named_plan.yaml", named_plan_text);
+  fs::create_directories(work_ / "lot" / "u1");
+  const auto simulate = [&](const std::string& out, const std::vector<std::string>& extra) {
+    const RunResult r = Run(SmallRunArgs(out, extra));
+    ASSERT_EQ(r.status, 0) << r.err;
+  };
+  const std::string named = Path("lot/u1/samples.csv");  // its header: "# serial: SN-77" on line 2
+  simulate(named, {"--serial", "SN-77", "--seed", "1"});
+  const std::string anonymous = Path("anonymous.csv");
+  simulate(anonymous, {"--seed", "2"});
+  const std::string header = "the samples header of " + named;
+
+  // The samples header and the plan: the header names the unit, a warning says what the plan said.
+  RunResult r =
+      Run({"fit", "-p", named_plan, "-s", named, "-o", Path("a.yaml"), "--report", Path("a.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string plan_vs_header = "the plan " + named_plan + " names the unit \"SN-PLAN\", " + header +
+                                     " names it \"SN-77\": \"SN-77\" is used";
+  EXPECT_NE(r.err.find("imufit: warning: " + plan_vs_header + "\n"), std::string::npos) << r.err;
+  EXPECT_EQ(YAML::LoadFile(Path("a.yaml"))["serial"].as<std::string>(), "SN-77");
+  EXPECT_TRUE(AnyHoldsAll(CertificateWarnings(ReadBytes(Path("a.html"))), {plan_vs_header}));
+
+  // --serial over the plan (the unit's log names none): a warning.
+  r = Run({"fit", "-p", named_plan, "-s", anonymous, "-o", Path("b.yaml"), "--serial", "SN-1", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("the plan " + named_plan +
+                       " names the unit \"SN-PLAN\", --serial names it \"SN-1\": "
+                       "\"SN-1\" is used"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(YAML::LoadFile(Path("b.yaml"))["serial"].as<std::string>(), "SN-1");
+
+  // --serial against the samples' own header: refused at the header's line, nothing written.
+  r = Run({"fit", "-p", plan, "-s", named, "-o", Path("c.yaml"), "--serial", "SN-OTHER", "--report",
+           Path("c.html")});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(
+      r.err.find(named + ":2:11: " + header +
+                 " names the unit \"SN-77\", --serial names it "
+                 "\"SN-OTHER\": are these that unit's samples? (--allow-mismatch uses \"SN-OTHER\" anyway)"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("c.yaml")));
+  EXPECT_FALSE(fs::exists(Path("c.html")));
+  // Allowed: --serial names the unit, with the warning on stderr and on the certificate.
+  r = Run({"fit", "-p", plan, "-s", named, "-o", Path("c.yaml"), "--serial", "SN-OTHER", "--report",
+           Path("c.html"), "--allow-mismatch", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string allowed = header +
+                              " names the unit \"SN-77\", --serial names it \"SN-OTHER\": \"SN-OTHER\" "
+                              "is used (allowed with --allow-mismatch)";
+  EXPECT_NE(r.err.find("imufit: warning: " + allowed + "\n"), std::string::npos) << r.err;
+  EXPECT_EQ(YAML::LoadFile(Path("c.yaml"))["serial"].as<std::string>(), "SN-OTHER");
+  std::string html = ReadBytes(Path("c.html"));
+  EXPECT_EQ(CertificateSerial(html), "SN-OTHER");
+  EXPECT_TRUE(AnyHoldsAll(CertificateWarnings(html), {allowed}));
+
+  // report: the calibration's serial against the header is a warning; --serial against the header
+  // is refused unless --allow-mismatch.
+  r = Run({"report", "-c", Path("c.yaml"), "-p", plan, "-s", named, "-o", Path("r.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string calibration_vs_header =
+      header + " names the unit \"SN-77\", the calibration " + Path("c.yaml") + " names it \"SN-OTHER\"";
+  EXPECT_NE(r.err.find(calibration_vs_header), std::string::npos) << r.err;
+  EXPECT_TRUE(AnyHoldsAll(CertificateWarnings(ReadBytes(Path("r.html"))), {calibration_vs_header}));
+  r = Run(
+      {"report", "-c", Path("c.yaml"), "-p", plan, "-s", named, "-o", Path("r2.html"), "--serial", "SN-3"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(named + ":2:11: " + header + " names the unit \"SN-77\", --serial names it \"SN-3\""),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("r2.html")));
+  r = Run({"report", "-c", Path("c.yaml"), "-p", plan, "-s", named, "-o", Path("r2.html"), "--serial", "SN-3",
+           "--allow-mismatch"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  html = ReadBytes(Path("r2.html"));
+  EXPECT_EQ(CertificateSerial(html), "SN-3");
+  EXPECT_TRUE(AnyHoldsAll(CertificateWarnings(html),
+                          {"--serial names it \"SN-3\"", "(allowed with --allow-mismatch)"}));
+
+  // batch: a unit whose serial.txt contradicts its samples header is an error (the lot exits 3);
+  // allowed, it is fitted under serial.txt's serial with the warning on stderr and its certificate.
+  Write("lot/u1/serial.txt", "SN-FILE\n");
+  r = Run({"batch", Path("lot"), "--plan", plan, "-o", Path("out"), "--jobs", "1", "-q"});
+  EXPECT_EQ(r.status, 3) << r.out << r.err;
+  Table summary = ReadTable(Path("out/lot_summary.csv"));
+  ASSERT_EQ(summary.rows.size(), 1u);
+  EXPECT_EQ(summary.rows[0][summary.Column("status")], "error");
+  const std::string serial_txt = Path("lot/u1/serial.txt");
+  EXPECT_NE(summary.rows[0][summary.Column("message")].find(named + ":2:11: " + header), std::string::npos);
+  EXPECT_NE(ReadFile(Path("out/lot_summary.csv")).find(serial_txt + " names it \"\"SN-FILE\"\""),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(Path("out/u1/calibration.yaml")));
+  r = Run({"batch", Path("lot"), "--plan", plan, "-o", Path("out"), "--jobs", "1", "-q", "--allow-mismatch"});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const std::string batch_allowed =
+      header + " names the unit \"SN-77\", " + serial_txt +
+      " names it \"SN-FILE\": \"SN-FILE\" is used (allowed with --allow-mismatch)";
+  EXPECT_NE(r.err.find("imufit: warning: u1: " + batch_allowed + "\n"), std::string::npos) << r.err;
+  summary = ReadTable(Path("out/lot_summary.csv"));
+  ASSERT_EQ(summary.rows.size(), 1u);
+  EXPECT_EQ(summary.rows[0][summary.Column("serial")], "SN-FILE");
+  html = ReadBytes(Path("out/u1/report.html"));
+  EXPECT_EQ(CertificateSerial(html), "SN-FILE");
+  EXPECT_TRUE(AnyHoldsAll(CertificateWarnings(html), {batch_allowed}));
 }
 
 // ------------------------------------------------------------------------------------------ allan
@@ -1624,6 +1836,18 @@ TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
   EXPECT_EQ(ReadBytes(Path("direct.csv")), ReadBytes(Path("applied.csv")));
   std::string direct_yaml = ReadBytes(Path("direct.yaml"));
   const std::string applied_yaml = ReadBytes(Path("applied.yaml"));
+  // The noise file names the calibration the figures were corrected through, with its SHA-256
+  // (only then); the summary names it too.
+  EXPECT_EQ(YAML::Load(direct_yaml)["noise"]["calibration"].as<std::string>(), truth);
+  EXPECT_EQ(YAML::Load(direct_yaml)["noise"]["calibration_sha256"].as<std::string>(), Sha256OfFile(truth));
+  EXPECT_FALSE(YAML::Load(applied_yaml)["noise"]["calibration"]);
+  EXPECT_FALSE(YAML::Load(applied_yaml)["noise"]["calibration_sha256"]);
+  EXPECT_EQ(direct_summary.find(Path("raw.csv.gz") + " corrected by " + truth + ": "), 0u) << direct_summary;
+  EXPECT_EQ(r.out.find(Path("corrected.csv") + ": "), 0u) << r.out;
+  const std::string recorded =
+      "  calibration: \"" + truth + "\"\n  calibration_sha256: \"" + Sha256OfFile(truth) + "\"\n";
+  ASSERT_NE(direct_yaml.find(recorded), std::string::npos) << direct_yaml;
+  direct_yaml.erase(direct_yaml.find(recorded), recorded.size());
   direct_yaml.replace(direct_yaml.find(Path("raw.csv.gz")), Path("raw.csv.gz").size(), Path("corrected.csv"));
   EXPECT_EQ(direct_yaml, applied_yaml);
   const auto summary_body = [](const std::string& summary) { return summary.substr(summary.find('\n')); };

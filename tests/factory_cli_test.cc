@@ -26,6 +26,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "imufit/io/sha256.h"
 #include "run_program.h"
@@ -709,6 +710,153 @@ TEST_F(FactoryCliTest, StationFileIsShownHashedAndChecked) {
   args.back() = Write("station2.yaml", std::string(kStation) + "# another bench\n");
   r = Run(args);
   EXPECT_NE(r.out.find("0 unchanged and skipped"), std::string::npos) << r.out;
+}
+
+// A static-only lot (six faces, no rotation) needs `--fit accel`: batch takes every fit option of
+// `imufit fit` and passes it to each unit, and the manifest records them, so a batch run again with
+// other options redoes the units (their results would change) while the same options skip them.
+TEST_F(FactoryCliTest, BatchFitsAStaticOnlyLotWithFitAccelAndRedoesUnitsWhenTheOptionsChange) {
+  const std::string plan = kFixtures + "/plan_6faces_static.yaml";
+  const std::string limits = Write("accel_limits.yaml",
+                                   "format: imufit-limits\nversion: 1\n"
+                                   "nominal: {accel_scale: 208.838}\n"
+                                   "criteria:\n"
+                                   "  - {quantity: accel_bias_mg, max_abs: 50}\n"
+                                   "  - {quantity: accel_scale_error_pct, max_abs: 2}\n"
+                                   "  - {quantity: fit_temp_range_c, covers: [-20, 60]}\n");
+  for (int unit = 1; unit <= 2; ++unit) {
+    const std::string folder = "static_lot/s" + std::to_string(unit);
+    fs::create_directories(dir_ / folder);
+    Simulate(plan, kFixtures + "/mems_truth.yaml", Path(folder + "/samples.csv"), 30 + unit);
+  }
+  const auto batch = [&](const std::string& out, const std::vector<std::string>& options) {
+    std::vector<std::string> args = {"batch", Path("static_lot"), "--plan", plan, "--limits", limits,
+                                     "-o",    Path(out),          "--jobs", "1"};
+    args.insert(args.end(), options.begin(), options.end());
+    return Run(args);
+  };
+  const auto manifest = [&](const std::string& out, const std::string& unit) {
+    return ReadBytes(dir_ / out / unit / "manifest.yaml");
+  };
+  const auto fit_block = [&](const std::string& out, const std::string& unit) {
+    return ReadBytes(dir_ / out / unit / "calibration.yaml");
+  };
+
+  // The whole model: the gyro scale is undetermined without rotation.
+  RunResult r = batch("out", {});
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.err;
+  EXPECT_EQ(Summary("out")["s1"]["status"], "not-fitted");
+  EXPECT_NE(Summary("out")["s1"]["message"].find("--fit accel"), std::string::npos);
+
+  // --fit accel: every unit fitted and passing, with the options in its calibration and manifest.
+  r = batch("out", {"--fit", "accel"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto summary = Summary("out");
+  for (const char* unit : {"s1", "s2"}) {
+    EXPECT_EQ(summary[unit]["status"], "fitted") << unit << ": " << summary[unit]["message"];
+    EXPECT_EQ(summary[unit]["verdict"], "PASS") << unit << ": " << summary[unit]["message"];
+    EXPECT_NE(fit_block("out", unit).find("fitted: [accel.bias, accel.scale, accel.misalignment]"),
+              std::string::npos);
+    EXPECT_NE(manifest("out", unit)
+                  .find("fit_options: \"fitted=accel.bias,accel.scale,accel.misalignment; "
+                        "held=nominal; "),
+              std::string::npos)
+        << manifest("out", unit);
+  }
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "s1" / "report.html"));
+  // The same options: nothing redone.
+  r = batch("out", {"--fit", "accel"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("2 unchanged and skipped"), std::string::npos) << r.out;
+
+  // Other options: every unit redone, with them.
+  r = batch("out", {"--fit", "accel", "--loss", "cauchy", "--window-temp-span", "0.25"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_NE(fit_block("out", "s1").find("loss: cauchy"), std::string::npos);
+  EXPECT_NE(manifest("out", "s2").find("; loss=cauchy; "), std::string::npos);
+  EXPECT_NE(manifest("out", "s2").find("; window_temp_span_c=0.25; "), std::string::npos);
+
+  // A prior names the held values: its numbers are part of the options, so editing the prior file
+  // redoes the units (and the held gyro scale follows it), a copy of it does not.
+  std::string prior_text = ReadBytes(kFixtures + "/mems_truth.yaml");
+  const std::string prior = Write("prior.yaml", prior_text);
+  const std::vector<std::string> with_prior = {"--fit", "gyro-bias,accel", "--prior", prior};
+  r = batch("out", with_prior);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const YAML::Node held = YAML::Load(fit_block("out", "s1"));
+  EXPECT_EQ(held["gyro"]["scale"]["x"][0].as<double>(),
+            YAML::Load(prior_text)["gyro"]["scale"]["x"][0].as<double>());
+  EXPECT_EQ(held["fit"]["held_values"].as<std::string>(), "prior");
+  EXPECT_NE(manifest("out", "s1").find("held=prior "), std::string::npos);
+  const std::string copy = Write("prior_copy.yaml", "# the same numbers elsewhere\n" + prior_text);
+  r = batch("out", {"--fit", "gyro-bias,accel", "--prior", copy});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("2 unchanged and skipped"), std::string::npos) << r.out;
+  const std::string scale_x = YAML::Load(prior_text)["gyro"]["scale"]["x"][0].as<std::string>();
+  prior_text.replace(prior_text.find(scale_x), scale_x.size(), "950.5");
+  Write("prior.yaml", prior_text);
+  r = batch("out", with_prior);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(YAML::Load(fit_block("out", "s1"))["gyro"]["scale"]["x"][0].as<double>(), 950.5);
+
+  // A manifest of an imufit that recorded no options: that unit is done again.
+  std::string old_manifest = manifest("out", "s2");
+  old_manifest.erase(old_manifest.find("fit_options:"));
+  Write("out/s2/manifest.yaml", old_manifest);
+  r = batch("out", with_prior);
+  EXPECT_NE(r.out.find("1 unchanged and skipped"), std::string::npos) << r.out;
+  // Units done without reports and run again with them: redone, so that every unit has its report.
+  r = batch("out_no_report", {"--fit", "accel", "--no-report"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out_no_report" / "s1" / "report.html"));
+  r = batch("out_no_report", {"--fit", "accel"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out_no_report" / "s1" / "report.html"));
+
+  // A lot logged without a thermometer or segment labels (one soak, 70 s on each face): --temp-c and
+  // the segmentation reach every unit and its certificate, which reads the samples again for the
+  // gyro noise of the longest static stretch.
+  fs::create_directories(dir_ / "bare_lot" / "b1");
+  r = Run({"simulate",
+           "--plan",
+           plan,
+           "--calibration",
+           kFixtures + "/mems_truth.yaml",
+           "-o",
+           Path("bare_lot/b1/samples.csv"),
+           "--rate",
+           "10",
+           "--dwell",
+           "70",
+           "--temps",
+           "25",
+           "--gyro-noise-density",
+           "2e-4",
+           "--accel-noise-density",
+           "2e-3",
+           "--no-temp-column",
+           "--no-segment-column",
+           "--seed",
+           "40",
+           "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Run({"batch", Path("bare_lot"), "--plan", plan, "-o", Path("bare_out"), "--jobs", "1", "-q", "--fit",
+           "accel", "--temp-c", "25"});
+  ASSERT_EQ(r.status, 0) << r.err << ReadBytes(dir_ / "bare_out" / "lot_summary.csv");
+  EXPECT_EQ(Summary("bare_out")["b1"]["status"], "fitted");
+  const std::string report = ReadBytes(dir_ / "bare_out" / "b1" / "report.html");
+  EXPECT_NE(report.find("data-figure=\"gyro_arw_deg_per_sqrt_hr.x\""), std::string::npos);
+  EXPECT_NE(manifest("bare_out", "b1").find("; temp_c=25; "), std::string::npos);
+  // --temp-c with a temperature order above 0 is refused before any unit, as by imufit fit.
+  r = Run({"batch", Path("bare_lot"), "--plan", plan, "-o", Path("bare_out2"), "--fit", "accel", "--temp-c",
+           "25", "--accel-temp-order", "2"});
+  EXPECT_EQ(r.status, kExitBadInput) << r.err;
+  EXPECT_NE(r.err.find("--temp-c: one temperature for the whole run determines only order-0"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "bare_out2"));
 }
 
 }  // namespace

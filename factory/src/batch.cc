@@ -53,6 +53,7 @@ struct Manifest {
   std::string serial, status, verdict, message;
   std::string calibration_sha256;  // of the calibration written (fitted units)
   std::string station_sha256;      // "" without a station file
+  std::string fit_options;         // FitRunOptions::Describe(): what the unit was fitted with
 };
 
 std::optional<Manifest> ReadManifest(const std::string& path) {
@@ -69,6 +70,9 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
     for (int i = 0; i < 8; ++i) *fields[i] = node[keys[i]].as<std::string>();
     if (node["calibration_sha256"]) m.calibration_sha256 = node["calibration_sha256"].as<std::string>();
     if (node["station_sha256"]) m.station_sha256 = node["station_sha256"].as<std::string>();
+    // Absent in a manifest of an imufit that did not record the options: they are unknown, so the
+    // unit is done again.
+    if (node["fit_options"]) m.fit_options = node["fit_options"].as<std::string>();
     return m;
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the unit is done again
@@ -88,7 +92,8 @@ void WriteManifest(const std::string& path, const Manifest& m) {
                                                                {"verdict", &m.verdict},
                                                                {"message", &m.message},
                                                                {"calibration_sha256", &m.calibration_sha256},
-                                                               {"station_sha256", &m.station_sha256}};
+                                                               {"station_sha256", &m.station_sha256},
+                                                               {"fit_options", &m.fit_options}};
   for (const auto& [key, value] : fields)
     out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
   out << YAML::EndMap;
@@ -140,6 +145,7 @@ struct Shared {
   std::string limits_sha256;
   std::optional<Station> station;
   std::string station_sha256;
+  std::string fit_options;  // options->fit.Describe()
   std::unique_ptr<ResultsStore> store;
   std::string lot;
   std::mutex store_mutex;
@@ -173,6 +179,7 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
   const fs::path out_dir = fs::path(options.output_dir) / outcome.unit;
   const std::string calibration_path = (out_dir / "calibration.yaml").string();
   const std::string manifest_path = (out_dir / "manifest.yaml").string();
+  const std::string report_path = (out_dir / "report.html").string();
   std::string calibration_yaml;
   Manifest manifest;
   try {
@@ -196,15 +203,19 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     manifest.samples_sha256 = outcome.samples_sha256;
     manifest.limits_sha256 = shared.limits_sha256;
     manifest.station_sha256 = shared.station_sha256;
+    manifest.fit_options = shared.fit_options;
 
-    // Unchanged since a finished run: take its outcome, redo nothing.
+    // Unchanged since a finished run (the same inputs, fit options and software, and its outputs
+    // still there): take its outcome, redo nothing.
     if (const std::optional<Manifest> previous = ReadManifest(manifest_path);
         previous && previous->software == manifest.software &&
         previous->plan_sha256 == manifest.plan_sha256 &&
         previous->samples_sha256 == manifest.samples_sha256 &&
         previous->limits_sha256 == manifest.limits_sha256 &&
         previous->station_sha256 == manifest.station_sha256 &&
-        (previous->status != "fitted" || fs::exists(calibration_path))) {
+        previous->fit_options == manifest.fit_options &&
+        (previous->status != "fitted" ||
+         (fs::exists(calibration_path) && (!options.write_reports || fs::exists(report_path))))) {
       outcome.skipped = true;
       outcome.serial = previous->serial;
       outcome.status = previous->status;
@@ -218,10 +229,12 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     RemoveLeftovers(out_dir);
     FitRunOptions fit_options = options.fit;
     fit_options.serial = serial_file;
+    fit_options.serial_source = (unit_dir / "serial.txt").string();
     fit_options.plan_sha256 = outcome.plan_sha256;
     fit_options.samples_sha256 = outcome.samples_sha256;
     FitRunResult result = FitRun(plan, samples, fit_options);
     if (!result.serial.empty()) outcome.serial = result.serial;  // serial.txt, the samples', the plan's
+    outcome.warnings = result.serial_warnings;
     if (result.fit.status == FitStatus::kUndetermined) {
       outcome.status = "not-fitted";
       outcome.message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");
@@ -240,14 +253,14 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     outcome.fit = std::move(result);
     if (outcome.status == "fitted" && options.write_reports) {
       const Certificate certificate = MakeCertificate(outcome, options.limits_path, shared.limits,
-                                                      calibration_path, options.fit.windows, shared.station);
+                                                      calibration_path, options.fit, shared.station);
       // The certificate judges with the noise it measured itself: its verdict is the unit's.
       if (certificate.verdict) {
         outcome.verdict_detail = *certificate.verdict;
         outcome.verdict = certificate.verdict->pass ? "PASS" : "FAIL";
         outcome.message = certificate.verdict->FailedSummary();
       }
-      WriteCertificate((out_dir / "report.html").string(), certificate);
+      WriteCertificate(report_path, certificate);
     }
   } catch (const InputError& e) {
     outcome.status = "error";
@@ -342,6 +355,7 @@ BatchResult RunBatch(const BatchOptions& options) {
   if (!fs::is_directory(options.units_dir)) throw InputError(options.units_dir, "not a folder");
   Shared shared;
   shared.options = &options;
+  shared.fit_options = options.fit.Describe();
   if (!options.limits_path.empty()) {
     shared.limits = ReadLimits(options.limits_path);
     shared.limits_sha256 = Sha256OfFile(options.limits_path);

@@ -643,7 +643,7 @@ std::vector<std::string> InputMismatches(const Calibration& calibration, const s
 
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
                             const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const WindowOptions& windows, const std::optional<Station>& station) {
+                            const FitRunOptions& options, const std::optional<Station>& station) {
   const FitRunResult& fit = *unit.fit;
   CertificateSources sources;
   sources.unit = unit.unit;
@@ -651,8 +651,10 @@ Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_p
   sources.calibration.serial = unit.serial;
   sources.plan = fit.plan;
   sources.run = fit.run;
-  sources.windows = windows;
+  sources.windows = options.windows;
+  sources.samples_input = options.input;
   sources.folds = fit.folds;
+  sources.warnings = unit.warnings;
   if (!unit.verdict.empty()) sources.verdict = unit.verdict_detail;
   sources.limits = limits;
   sources.inputs = {{"calibration", calibration_path, ""},

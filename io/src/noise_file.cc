@@ -105,8 +105,12 @@ std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysi
        << "  format: imufit-noise\n"
        << "  version: 1\n"
        << "  software: " << YamlString(record.software) << "\n"
-       << "  samples: " << YamlString(record.samples) << "\n"
-       << "  sample_interval_s: " << YamlNumber(record.sample_interval_s) << "\n"
+       << "  samples: " << YamlString(record.samples) << "\n";
+  if (!record.calibration.empty()) {
+    yaml << "  calibration: " << YamlString(record.calibration) << "\n"
+         << "  calibration_sha256: " << YamlString(record.calibration_sha256) << "\n";
+  }
+  yaml << "  sample_interval_s: " << YamlNumber(record.sample_interval_s) << "\n"
        << "  sample_count: " << record.sample_count << "\n"
        << "  duration_s: " << YamlNumber(record.duration_s) << "\n"
        << "  model: \"sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2\"\n"

@@ -20,26 +20,27 @@ bool HasControlCharacter(const std::string& text) {
                      [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
 }
 
-// The serial of ReadSamplesSerial, from a reader that has read the header.
-std::string SerialInHeader(const CsvReader& csv) {
+// The serial of LocateSamplesSerial, from a reader that has read the header.
+SamplesSerial SerialInHeader(const CsvReader& csv) {
   const std::string& path = csv.path();
-  std::string serial;
+  SamplesSerial serial;
   for (const CsvReader::Comment& comment : csv.header_comments()) {
     if (comment.text.compare(0, kSerialKey.size(), kSerialKey) != 0) continue;
     const size_t first = comment.text.find_first_not_of(" \t", kSerialKey.size());
     const long column = comment.column + static_cast<long>(std::min(first, comment.text.size()));
     if (first == std::string::npos) throw InputError(path, comment.line, column, "an empty serial");
     const std::string found = comment.text.substr(first);
-    if (!serial.empty() && found != serial) {
+    if (!serial.serial.empty() && found != serial.serial) {
       // Two units in one file, or a header pasted onto another unit's log: certify neither.
-      throw InputError(path, comment.line, column,
-                       "a second serial " + QuoteForMessage(found) + " after " + QuoteForMessage(serial));
+      throw InputError(
+          path, comment.line, column,
+          "a second serial " + QuoteForMessage(found) + " after " + QuoteForMessage(serial.serial));
     }
     if (HasControlCharacter(found)) {
       throw InputError(path, comment.line, column,
                        "the serial " + QuoteForMessage(found) + " holds a control character");
     }
-    serial = found;
+    if (serial.serial.empty()) serial = {found, comment.line, column};
   }
   return serial;
 }
@@ -47,7 +48,7 @@ std::string SerialInHeader(const CsvReader& csv) {
 }  // namespace
 
 SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c)
-    : csv_(std::move(path)), serial_(SerialInHeader(csv_)) {
+    : csv_(std::move(path)), serial_(SerialInHeader(csv_).serial) {
   time_column_ = csv_.RequireColumn("time_s");
   if (!temp_c) {
     try {
@@ -105,7 +106,9 @@ void SamplesReader::Fail(const std::string& column, const std::string& message) 
   csv_.Fail(*index, message);
 }
 
-std::string ReadSamplesSerial(const std::string& path) { return SerialInHeader(CsvReader(path)); }
+std::string ReadSamplesSerial(const std::string& path) { return LocateSamplesSerial(path).serial; }
+
+SamplesSerial LocateSamplesSerial(const std::string& path) { return SerialInHeader(CsvReader(path)); }
 
 std::string SerialComment(const std::string& serial, const std::string& source) {
   if (serial.empty()) return "";

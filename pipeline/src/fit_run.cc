@@ -1,9 +1,11 @@
 #include "imufit/pipeline/fit_run.h"
 
 #include <set>
+#include <sstream>
 
-#include "imufit/io/samples.h"
+#include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
 namespace {
@@ -70,14 +72,75 @@ std::string FitRunOptions::Validate() const {
   return "";
 }
 
+std::string FitRunOptions::Describe() const {
+  std::ostringstream text;
+  const auto add = [&text](const char* key, const std::string& value) {
+    text << (text.tellp() > 0 ? "; " : "") << key << "=" << value;
+  };
+  const auto number = [](double value) { return FormatDouble(value); };
+  std::string fitted;
+  for (const std::string& group : fit.Groups(true)) fitted += (fitted.empty() ? "" : ",") + group;
+  add("fitted", fitted);
+  if (!fit.Groups(false).empty()) {
+    std::string held = "nominal";
+    if (fit.held) {
+      std::string values = number(fit.held->basis.center_c) + " " + number(fit.held->basis.half_range_c);
+      for (double value : fit.held->gyro) values += " " + number(value);
+      for (double value : fit.held->accel) values += " " + number(value);
+      held = "prior " + Sha256Hex(values);
+    }
+    add("held", held);
+  }
+  add("gyro_temp_order", std::to_string(fit.gyro_temp_order));
+  add("accel_temp_order", std::to_string(fit.accel_temp_order));
+  add("loss", RobustLossName(fit.loss));
+  add("loss_scale", number(fit.loss_scale));
+  add("gyro_bias_stability_radps", number(fit.gyro_bias_stability_radps));
+  add("accel_bias_stability_mps2", number(fit.accel_bias_stability_mps2));
+  add("bias_correlation_s", number(fit.bias_correlation_s));
+  add("max_iterations", std::to_string(fit.max_iterations));
+  add("closed_form_start", fit.closed_form_start ? "true" : "false");
+  add("distinct_temp_c", number(fit.distinct_temp_c));
+  add("min_excitation_rate_radps", number(fit.min_excitation_rate_radps));
+  add("rank_tolerance", number(fit.rank_tolerance));
+  add("trim_s", number(windows.trim_s));
+  add("window_temp_span_c", number(windows.max_temp_span_c));
+  add("window_max_duration_s", number(windows.max_duration_s));
+  add("window_min_samples", std::to_string(windows.min_samples));
+  add("max_turn_gap_s", number(windows.max_turn_gap_s));
+  add("gyro_full_scale_raw", number(windows.gyro_full_scale_raw));
+  add("accel_full_scale_raw", number(windows.accel_full_scale_raw));
+  add("temp_c", input.temp_c ? number(*input.temp_c) : "column");
+  const SegmentationOptions& segmentation = input.segmentation;
+  add("segment_window_s", number(segmentation.window_s));
+  add("segment_noise_quantile", number(segmentation.noise_quantile));
+  add("segment_threshold_factor", number(segmentation.threshold_factor));
+  add("min_steady_s", number(segmentation.min_steady_s));
+  add("direction_tolerance_deg", number(segmentation.direction_tolerance_deg));
+  add("rate_tolerance", number(segmentation.rate_tolerance));
+  add("turn_margin_s", number(segmentation.turn_margin_s));
+  add("validate", validate ? "true" : "false");
+  if (!check_samples.empty()) add("check", check_samples + " " + check_plan);
+  add("allow_serial_mismatch", allow_serial_mismatch ? "true" : "false");
+  return text.str();
+}
+
 FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
                     const FitRunOptions& options) {
   FitRunResult result;
   result.plan = ReadPlan(plan_path);
   // The most specific source first: the caller's, the unit's own log, then the (possibly shared) plan.
-  result.serial = options.serial;
-  if (result.serial.empty()) result.serial = ReadSamplesSerial(samples_path);
-  if (result.serial.empty()) result.serial = result.plan.serial;
+  SerialSource stated;
+  stated.kind = SerialSource::Kind::kStated;
+  stated.name = options.serial_source;
+  stated.serial = options.serial;
+  SerialSource plan;
+  plan.name = "the plan " + plan_path;
+  plan.serial = result.plan.serial;
+  UnitSerial serial =
+      ResolveSerial({stated, SamplesHeaderSerial(samples_path), plan}, options.allow_serial_mismatch);
+  result.serial = std::move(serial.serial);
+  result.serial_warnings = std::move(serial.warnings);
   result.run = ReadRunWindows(result.plan, samples_path, options.windows, options.input);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   std::vector<Window> check_windows;

@@ -5,10 +5,11 @@
 // unit each, one solver thread per unit); a unit's failure never stops the others. For each unit
 // OUT_DIR/<unit>/ receives, each file atomically and in this order: calibration.yaml (when
 // fitted), report.html (with write_reports), then manifest.yaml last. The manifest
-// holds the SHA-256 of the unit's inputs (plan, samples, limits, station) and the software version;
-// a re-run skips a unit whose manifest matches, so a batch killed half way and run again redoes
-// only the units that had not finished. The lot summary OUT_DIR/lot_summary.csv is written at the
-// end from every unit's outcome (fitted now or before).
+// holds the SHA-256 of the unit's inputs (plan, samples, limits, station), the fit options
+// (FitRunOptions::Describe) and the software version; a re-run skips a unit whose manifest matches
+// (and whose outputs are there), so a batch killed half way and run again redoes only the units
+// that had not finished, and a batch run with other fit options redoes every unit. The lot summary
+// OUT_DIR/lot_summary.csv is written at the end from every unit's outcome (fitted now or before).
 #ifndef IMUFIT_FACTORY_BATCH_H_
 #define IMUFIT_FACTORY_BATCH_H_
 
@@ -27,6 +28,9 @@ namespace imufit {
 struct UnitOutcome {
   std::string unit;     // the folder name
   std::string serial;   // serial.txt's, the samples header's, the plan's, else the unit folder name
+  // Sources of the serial that disagree (unit_serial.h); shown on the certificate. Not kept for a
+  // skipped unit.
+  std::vector<std::string> warnings;
   std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
   std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
   std::string message;  // the failed criteria, or why it was not fitted
@@ -62,6 +66,7 @@ struct BatchOptions {
   int jobs = 0;
   // Stop after this many units have been fitted in this run (0: no limit) — for tests of resuming.
   int max_units = 0;
+  // Every unit's fit (its `serial` is the unit's serial.txt; serial_source is set per unit).
   FitRunOptions fit;
   // Write OUT_DIR/<unit>/report.html for each fitted unit and OUT_DIR/lot.html (report.h).
   bool write_reports = true;

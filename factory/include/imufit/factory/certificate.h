@@ -209,10 +209,11 @@ struct Certificate {
 // Computes the certificate; reads the samples input once more for the Allan section. Throws
 // InputError when an input file cannot be read.
 Certificate MakeCertificate(const CertificateSources& sources);
-// From a batch unit just fitted (its FitRunResult is in unit.fit).
+// From a batch unit just fitted (its FitRunResult is in unit.fit) with `options` (the windows and
+// the samples input the run was read with; the serial warnings come from unit.warnings).
 Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
                             const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const WindowOptions& windows = WindowOptions(),
+                            const FitRunOptions& options = FitRunOptions(),
                             const std::optional<Station>& station = std::nullopt);
 
 // The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).

@@ -3,8 +3,9 @@
 // by acceptance limits and certificates), with the engineer units of each IEEE 952 term.
 //
 //   allan.csv: column,estimator,tau_s,terms,dev,dev_lo,dev_hi — one row per column and tau.
-//   noise:     format imufit-noise, version 1; per column: kind, unit, fitted (or reason),
-//              points_used, reduced_chi_square, every term as [value, 1-sigma] in SI and in engineer
+//   noise:     format imufit-noise, version 1; the samples (and the calibration they were corrected
+//              through, with its SHA-256, when there was one: optional); per column: kind, unit, fitted (or
+//              reason), points_used, reduced_chi_square, every term as [value, 1-sigma] in SI and in engineer
 //              units, `<term>_resolved: false` for a term the fit did not resolve, the graphical
 //              read-outs; then Kalibr's continuous-time densities (the worst axis of each sensor).
 #ifndef IMUFIT_IO_NOISE_FILE_H_
@@ -39,6 +40,11 @@ void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& r
 struct NoiseRecord {
   std::string software;
   std::string samples;
+  // The calibration the raw samples were corrected through on the way in (`imufit allan
+  // --calibration`) and its SHA-256: the figures are the corrected unit's, so a reader must be able
+  // to tell which correction. Both "" (and not written) for samples analysed as they are.
+  std::string calibration;
+  std::string calibration_sha256;
   double sample_interval_s = 0.0;
   long long sample_count = 0;
   double duration_s = 0.0;

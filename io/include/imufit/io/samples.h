@@ -59,6 +59,16 @@ class SamplesReader {
 // header. Throws InputError for an unreadable file, an empty serial, or two different serials.
 std::string ReadSamplesSerial(const std::string& path);
 
+// The serial of a samples header and where it is stated (its first `# serial:` line, at the text
+// after "serial:"), so that a contradiction can be reported at its place (pipeline/unit_serial.h).
+struct SamplesSerial {
+  std::string serial;  // "" when no line states one (then line and column are 0)
+  long line = 0;
+  long column = 0;
+};
+// As ReadSamplesSerial, with the place.
+SamplesSerial LocateSamplesSerial(const std::string& path);
+
 // The comment text (without the '#') that states `serial` in a samples header, for SamplesWriter;
 // "" for an empty serial (no line). Throws InputError (naming `source`) when the serial holds a
 // control character. Commands that write samples from samples (apply, segment) carry it over.

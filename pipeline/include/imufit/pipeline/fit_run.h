@@ -35,8 +35,12 @@ struct FitRunOptions {
   // Written into the calibration's `software` key, e.g. "imufit 0.1.0".
   std::string software;
   // The unit's serial (--serial); empty: the samples header's `# serial:` line, else the plan's
-  // `serial`.
+  // `serial` (unit_serial.h: a disagreement is a warning, or an error).
   std::string serial;
+  // How messages name `serial`: "--serial", or a batch unit's serial.txt.
+  std::string serial_source = "--serial";
+  // Fit even when `serial` contradicts the samples header's serial (then a warning; --allow-mismatch).
+  bool allow_serial_mismatch = false;
   // SHA-256 of the plan and samples files, recorded in the calibration's `fit:` block so that a
   // certificate can tell that a calibration and a run belong together; computed when empty.
   std::string plan_sha256;
@@ -44,12 +48,20 @@ struct FitRunOptions {
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
+  // Every option above that can change what a fit of the same files gives (the calibration, its
+  // validation, an error), as one line of text; not the software, the serial or the hashes. The
+  // held values of a prior are named by a SHA-256 of their numbers, so that a prior file that is
+  // edited counts as changed and a copy elsewhere does not. The batch manifest compares it to decide
+  // whether a unit is unchanged.
+  std::string Describe() const;
 };
 
 struct FitRunResult {
   // The unit's serial as FitRunOptions::serial resolves it (also when the fit fails); empty when
   // nothing names the unit.
   std::string serial;
+  // Sources of the serial that disagree with it, one message each (unit_serial.h).
+  std::vector<std::string> serial_warnings;
   Plan plan;
   RunWindows run;
   FitSummary fit;
