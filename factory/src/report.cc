@@ -3,19 +3,46 @@
 #include "imufit/factory/report.h"
 
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
+#include "imufit/factory/allan_plot.h"
 #include "imufit/factory/html.h"
 #include "imufit/io/output_file.h"
 
 namespace imufit {
 namespace {
 
-std::string Fmt(const char* format, double value) {
-  char text[64];
+std::string Printf(const char* format, double value) {
+  char text[96];
   std::snprintf(text, sizeof text, format, value);
   return text;
 }
+
+}  // namespace
+
+std::string FormatNumber(const char* format, double value) {
+  const std::string text = Printf(format, value);
+  if (text != Printf(format, -0.0) && text != Printf(format, 0.0)) return text;
+  std::string unsigned_format = format;  // the '+' flag dropped from the conversion
+  for (size_t at = unsigned_format.find('%'); at != std::string::npos;
+       at = unsigned_format.find('%', at + 2)) {
+    if (unsigned_format[at + 1] == '%') continue;
+    size_t flag = at + 1;
+    while (flag < unsigned_format.size() && std::strchr("-+ #0", unsigned_format[flag]) != nullptr) {
+      if (unsigned_format[flag] == '+') {
+        unsigned_format.erase(flag, 1);
+      } else {
+        ++flag;
+      }
+    }
+  }
+  return Printf(unsigned_format.c_str(), 0.0);
+}
+
+namespace {
+
+std::string Fmt(const char* format, double value) { return FormatNumber(format, value); }
 
 std::string Count(long long value) { return std::to_string(value); }
 
@@ -205,36 +232,17 @@ PlotFigure ErrorFigure(const Certificate& c) {
   return figure;
 }
 
+// The gyro's Allan deviation as `imufit allan --plot --plot-units deg/h` draws it (allan_plot.h):
+// the curves with their confidence bars, the IEEE 952 fit and its terms, ARW and bias instability
+// marked where they are read; at the certificate's printed width.
 PlotFigure AllanFigure(const NoiseSection& noise) {
-  PlotFigure figure = Figure(1, 1, kFullWidthPx, 280);
-  Plot plot;
-  plot.title = "Gyro overlapping Allan deviation, segment " + Count(noise.segment) +
-               Fmt(", %.0f s", noise.duration_s) + Fmt(" at %.1f degC", noise.temp_c);
-  plot.x_label = "averaging time tau, s";
-  plot.y_label = "deg/h";
-  plot.log_x = plot.log_y = true;
-  plot.labels_at_bottom = true;
-  for (size_t i = 0; i < noise.axes.size(); ++i) {
-    const NoiseAxis& a = noise.axes[i];
-    PlotSeries points =
-        Series(PlotSeries::Style::kLinesPoints, a.axis, static_cast<int>(i), a.tau_s, a.dev_dph);
-    points.line_width = 1;
-    plot.series.push_back(points);
-    if (!a.model_tau_s.empty()) {
-      PlotSeries model =
-          Series(PlotSeries::Style::kLines, "", static_cast<int>(i), a.model_tau_s, a.model_dph);
-      model.dashed = true;
-      plot.series.push_back(model);
-    }
-    if (a.fitted) {
-      plot.labels.push_back(
-          {a.axis + ": ARW " +
-           (a.arw_resolved ? Fmt("%.3g deg/sqrt(h)", a.arw_deg_per_sqrt_hr) : "not resolved") +
-           ", bias instability " +
-           (a.bias_instability_resolved ? Fmt("%.3g deg/h", a.bias_instability_dph) : "not resolved")});
-    }
+  PlotFigure figure = AllanPlot(noise.columns, "", AllanPlotUnits::kDegPerHour);
+  figure.width_px = kFullWidthPx;
+  figure.height_px = 330;
+  for (Plot& panel : figure.panels) {
+    panel.title = "";        // the section's note says which stretch
+    panel.key_above = true;  // the panel keeps the page's width
   }
-  figure.panels.push_back(plot);
   return figure;
 }
 
@@ -335,15 +343,34 @@ void Identification(Html* h, const Certificate& c) {
 void RunAndSettings(Html* h, const Certificate& c) {
   h->Open("div", {{"class", "cols"}});
   h->Open("div").Element("h2", "Plan and run").Open("table");
-  std::string rates;
-  for (double r : c.run.rates_dps) rates += (rates.empty() ? "" : ", ") + Fmt("%g", r);
+  const auto list = [](const std::vector<double>& values) {
+    std::string text;
+    for (double v : values) text += (text.empty() ? "" : ", ") + Fmt("%g", v);
+    return text;
+  };
   h->Open("tr").Element("td", "plan").Element("td", c.run.plan_path, {{"class", "path"}}).Close("tr");
-  Row(h, {"segments", Count(c.run.segments) + " (" + Count(c.run.static_segments) + " static; rates " +
-                          (rates.empty() ? "none" : rates + " deg/s") + ")"});
+  std::string segments = Count(c.run.segments) + " (" + Count(c.run.static_segments) + " static";
+  if (!c.run.rates_dps.empty()) segments += "; rates " + list(c.run.rates_dps) + " deg/s";
+  if (c.run.turn_segments > 0) {
+    segments += "; " + Count(c.run.turn_segments) + (c.run.turn_segments == 1 ? " turn of " : " turns of ") +
+                list(c.run.turn_angles_deg) + " deg";
+  }
+  Row(h, {"segments", segments + ")"});
+
   Row(h, {"local gravity", Fmt("%.6g m/s\xc2\xb2", c.run.gravity_mps2)});
   Row(h, {"latitude", c.run.latitude_deg ? Fmt("%.4f deg", *c.run.latitude_deg) : "not given"});
   Row(h, {"samples read", Count(c.run.samples)});
-  Row(h, {"windows", Count(c.run.windows)});
+  // Whether every plan segment has a window: said either way (the warnings name the ones without).
+  const std::vector<int>& missing = c.run.segments_without_windows;
+  std::string ids;
+  for (int id : missing) ids += (ids.empty() ? "" : ", ") + Count(id);
+  h->Open("tr").Element("td", "windows").Open("td").Text(Count(c.run.windows));
+  h->Element("span",
+             missing.empty() ? ", in every plan segment"
+                             : (missing.size() == 1 ? "; none in segment " : "; none in segments ") + ids,
+             {{"data-key", "segments_without_windows"},
+              {"data-value", Count(static_cast<long long>(missing.size()))}});
+  h->Close("td").Close("tr");
   std::string temps;
   for (double t : c.run.temperatures_c) temps += (temps.empty() ? "" : ", ") + Fmt("%g", t);
   Row(h, {"temperatures (windows, nearest degC)", temps});
@@ -365,11 +392,12 @@ void RunAndSettings(Html* h, const Certificate& c) {
             Fmt("%.3g", s.gyro_reduced_chi2) + " / " + Fmt("%.3g", s.accel_reduced_chi2)});
     Row(h, {"temperature orders gyro / accel", Count(s.gyro_temp_order) + " / " + Count(s.accel_temp_order)});
     Row(h, {"g-sensitivity", s.g_sensitivity_fitted ? "fitted" : "held at zero"});
-    Row(h, {"solver", s.termination + ", " + Count(s.iterations) + " iterations"});
+    Row(h, {"solver",
+            s.termination + " " + Count(s.iterations) + (s.iterations == 1 ? " iteration" : " iterations")});
     Row(h, {"bias stability in the sigmas", s.gyro_bias_stability_dph > 0.0 || s.accel_bias_stability_ug > 0.0
                                                 ? Fmt("gyro %g deg/h", s.gyro_bias_stability_dph) +
                                                       Fmt(", accel %g micro-g", s.accel_bias_stability_ug)
-                                                : "no: the sigmas reflect white noise only"});
+                                                : "no (white noise only)"});
   }
   Row(h, {"trim after each move", Fmt("%g s", s.trim_s)});
   Row(h, {"window temperature span", Fmt("%g degC", s.window_temp_span_c)});
@@ -395,14 +423,16 @@ void Acceptance(Html* h, const Verdict& verdict) {
 
 void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
   // The sensor's prefix is the table's heading, so that two tables fit side by side on A4.
+  // Figures of neither sensor (coverage) are in the plan and run table.
   const std::string prefix = gyro ? "gyro_" : "accel_";
   h->Open("table").Open("thead");
   Row(h, {gyro ? "gyro" : "accelerometer", "value", "1-sigma", "U (k = 2)", "unit"}, "th");
   h->Close("thead").Open("tbody");
   for (const KeyFigureRow& f : figures) {
-    if ((f.name.rfind("gyro", 0) == 0) != gyro) continue;
-    h->Open("tr").Element("td", f.name.rfind(prefix, 0) == 0 ? f.name.substr(prefix.size()) : f.name);
-    Num(h, Fmt("%+.6g", f.value), {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
+    if (f.name.rfind(prefix, 0) != 0) continue;
+    h->Open("tr").Element("td", f.name.substr(prefix.size()));
+    Num(h, Fmt(f.is_coefficient ? "%+.6g" : "%.6g", f.value),
+        {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
     Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
     Num(h, f.expanded >= 0.0 ? Fmt("%.3g", f.expanded) : "\xe2\x80\x93");
     h->Element("td", f.unit).Close("tr");
@@ -468,7 +498,7 @@ void ResidualTable(Html* h, const Certificate& c) {
 
 void NoiseTable(Html* h, const NoiseSection& noise) {
   h->Open("table").Open("thead");
-  Row(h, {"axis", "ARW, deg/sqrt(h)", "bias instability, deg/h", "points"}, "th");
+  Row(h, {"axis", "ARW, deg/sqrt(h)", "bias instability, deg/h", "taus fitted"}, "th");
   h->Close("thead").Open("tbody");
   for (const NoiseAxis& a : noise.axes) {
     h->Open("tr").Element("td", "gyro_" + a.axis);
@@ -477,14 +507,14 @@ void NoiseTable(Html* h, const NoiseSection& noise) {
       continue;
     }
     if (a.arw_resolved) {
-      Num(h, Fmt("%.4g", a.arw_deg_per_sqrt_hr) + " \xc2\xb1 " + Fmt("%.2g", a.arw_sigma),
+      Num(h, Fmt("%.3g", a.arw_deg_per_sqrt_hr) + " \xc2\xb1 " + Fmt("%.2g", a.arw_sigma),
           {{"data-figure", "gyro_arw_deg_per_sqrt_hr." + a.axis},
            {"data-value", FormatDouble(a.arw_deg_per_sqrt_hr)}});
     } else {
       Num(h, "not resolved", {{"data-figure", "gyro_arw_deg_per_sqrt_hr." + a.axis}, {"data-value", "nan"}});
     }
     if (a.bias_instability_resolved) {
-      Num(h, Fmt("%.4g", a.bias_instability_dph) + " \xc2\xb1 " + Fmt("%.2g", a.bias_instability_sigma),
+      Num(h, Fmt("%.3g", a.bias_instability_dph) + " \xc2\xb1 " + Fmt("%.2g", a.bias_instability_sigma),
           {{"data-figure", "gyro_bias_instability_dph." + a.axis},
            {"data-value", FormatDouble(a.bias_instability_dph)}});
     } else {
@@ -524,12 +554,11 @@ void Validation(Html* h, const Certificate& c) {
   h->Close("tbody").Close("table");
   for (const ValidationRow& v : c.validation) {
     if (!v.fitted || !v.order_lowered) continue;
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "Without %.1f degC the fold is fitted at temperature order %d (gyro) / %d (accel): the "
-                  "other temperatures determine no more.",
-                  v.temp_c, v.gyro_temp_order, v.accel_temp_order);
-    h->Element("p", text, {{"class", "note"}});
+    h->Element("p",
+               "Without " + Fmt("%.1f", v.temp_c) + " degC the fold is fitted at temperature order " +
+                   Count(v.gyro_temp_order) + " (gyro) / " + Count(v.accel_temp_order) +
+                   " (accel): the other temperatures determine no more.",
+               {{"class", "note"}});
   }
   h->Close("div");
 }
@@ -614,6 +643,14 @@ std::string CertificateHtml(const Certificate& c) {
   if (!c.noise.computed) {
     h.Element("p", "Not drawn: " + c.noise.why_not + ".", {{"class", "note"}});
   } else {
+    h.Element(
+        "p",
+        "Segment " + Count(c.noise.segment) + ", " + Fmt("%.0f s", c.noise.duration_s) + " at " +
+            Fmt("%.1f degC", c.noise.temp_c) +
+            ": the raw outputs over the scale factor at that temperature. Bars: 68 % confidence; "
+            "lines: the IEEE 952 fit (solid) and its terms (dashed). ARW is read on the -1/2 line at "
+            "\xcf\x84 = 1 s (the large dot), bias instability B at the fit's floor 0.664 B (a diamond).",
+        {{"class", "note"}});
     Plots(&h, svgs, groups + 1, groups + 2, failure);
     NoiseTable(&h, c.noise);
   }
@@ -635,9 +672,13 @@ void WriteCertificate(const std::string& path, const Certificate& certificate) {
 
 namespace {
 
-constexpr int kMaxCategoryLabels = 40;      // unit or lot names under a plot; more are thinned out
-constexpr int kPlotWidthChars = 64;         // characters of tick labels side by side under a small plot
-constexpr int kSmallPlotWidthPx = 540;      // two to a row on the page: text stays legible when scaled
+// The lot page's plots are drawn at the size they print, as the certificate's (kHalfWidthPx two to
+// a row, kFullWidthPx across): drawn wider, the browser shrinks them, and their 10 pt labels print at
+// 6 pt. Names under a plot: at most this many (more are thinned out), upright when they would not
+// fit side by side in the characters of 10 pt text a panel has room for.
+constexpr int kMaxCategoryLabels = 24;
+constexpr int kHalfWidthChars = 40, kFullWidthChars = 80;
+constexpr int kStripHeightPx = 180, kStripUprightHeightPx = 215;  // upright names need more room
 constexpr size_t kMaxBarNotes = 24;         // yields printed on their bars up to this many lots
 constexpr double kNoteInsideBarPct = 15.0;  // a yield note goes inside its bar from this yield up
 const char* kHighlight = "#ff7f0e";         // this lot, an outlier's ring
@@ -680,15 +721,20 @@ void NiceY(const FigureView& view, Plot* plot) {
   plot->y_format = y.format;
 }
 
-void CategoryX(const std::vector<std::string>& labels, Plot* plot) {
-  const CategoryAxis axis = CategoryTics(labels, kMaxCategoryLabels, kPlotWidthChars);
+void CategoryX(const std::vector<std::string>& labels, int width_chars, Plot* plot) {
+  const CategoryAxis axis = CategoryTics(labels, kMaxCategoryLabels, width_chars);
   plot->x_tics = axis.tics;
   plot->x_tic_rotate_deg = axis.rotate_deg;
   plot->x_range = axis.range;
 }
 
-std::string Capabilities(const std::optional<double>& ppk, const std::optional<double>& cpk) {
-  return (ppk ? Fmt(", Ppk %.3g", *ppk) : "") + (cpk ? Fmt(", Cpk %.3g", *cpk) : "");
+// "gyro_bias_dps.x: Ppk 1.8, Cpk 2.1": the panel is half a page wide, the mean and sigma are in the
+// table above it.
+std::string StripTitle(const LotFigure& f) {
+  std::string title = f.name;
+  if (f.ppk) title += Fmt(": Ppk %.3g", *f.ppk);
+  if (f.cpk) title += Fmt(f.ppk ? ", Cpk %.3g" : ": Cpk %.3g", *f.cpk);
+  return title;
 }
 
 // A strip plot of one figure over the lot: a point per unit at its row, the limits, the mean and
@@ -697,11 +743,10 @@ std::string Capabilities(const std::optional<double>& ppk, const std::optional<d
 PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
   std::vector<std::string> labels;
   for (const LotUnitRow& r : lot.rows) labels.push_back(r.label);
-  Plot plot = Panel(f.name + ": mean " + Fmt("%.6g", f.mean) + ", \xcf\x83 " + Fmt("%.2g", f.stdev) +
-                        Capabilities(f.ppk, f.cpk),
-                    lot.unit_prefix.empty() ? "unit" : "unit (" + lot.unit_prefix + "\xe2\x80\xa6)", f.unit);
+  Plot plot =
+      Panel(StripTitle(f), lot.unit_prefix.empty() ? "unit" : lot.unit_prefix + "\xe2\x80\xa6", f.unit);
   plot.key = false;
-  CategoryX(labels, &plot);
+  CategoryX(labels, kHalfWidthChars, &plot);
   NiceY(f.view, &plot);
   PlotSeries normal = Series(PlotSeries::Style::kPoints, "", 0, {}, {});
   PlotSeries failed_elsewhere = normal, failed_here = normal, outlier = normal;
@@ -732,7 +777,7 @@ PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
     plot.markers.push_back({f.three_sigma[1], "+3\xcf\x83", kSigmaGrey, false, 3});
   }
   LimitLines(f.limits, f.view, &plot);
-  return OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230);
+  return OnePanel(plot, kHalfWidthPx, plot.x_tic_rotate_deg ? kStripUprightHeightPx : kStripHeightPx);
 }
 
 // The lots of a results store: their yields as a table and bars, then the key figures' lot means;
@@ -765,6 +810,11 @@ void AcrossLots(Html* h, const LotHistory& history, const std::vector<Svg>& svgs
   Plots(h, svgs, first, first + 1, failure);
   h->Close("div");
   h->Element("h3", "Key figures across lots");
+  if (history.lots.size() < 2) {
+    h->Element("p", "Only this lot is in the results store: there is no other lot to compare it with yet.",
+               {{"class", "note"}});
+    return;
+  }
   Plots(h, svgs, first + 1, svgs.size(), failure, "plots2");
 }
 
@@ -792,7 +842,7 @@ std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
   std::vector<PlotFigure> figures;
   Plot yield = Panel("Yield per lot (units that passed their limits)", "lot", "yield, %");
   yield.key = false;
-  CategoryX(names, &yield);
+  CategoryX(names, kFullWidthChars, &yield);
   yield.y_range = std::array<double, 2>{0.0, 100.0};
   yield.y_tic_step = 20.0;
   yield.y_format = "%.0f";
@@ -816,11 +866,12 @@ std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
     }
   }
   yield.series = {others, current};
-  figures.push_back(OnePanel(yield, 900, yield.x_tic_rotate_deg ? 300 : 240));
+  figures.push_back(OnePanel(yield, kFullWidthPx, yield.x_tic_rotate_deg ? 260 : 210));
+  if (history.lots.size() < 2) return figures;  // one lot: no trend to draw (AcrossLots says so)
   for (const LotTrend& t : history.trends) {
-    Plot plot = Panel(t.name + ": lot mean \xc2\xb1 1 \xcf\x83 of its units", "lot", t.unit);
+    Plot plot = Panel(t.name + ": lot mean \xc2\xb1 1\xcf\x83", "lot", t.unit);
     plot.key = false;
-    CategoryX(names, &plot);
+    CategoryX(names, kHalfWidthChars, &plot);
     NiceY(t.view, &plot);
     PlotSeries lots = Series(PlotSeries::Style::kErrorBars, "", 0, {}, {});
     lots.point_size = 0.8;
@@ -836,7 +887,8 @@ std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
     }
     plot.series = {lots, this_lot};
     LimitLines(t.limits, t.view, &plot);
-    figures.push_back(OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230));
+    figures.push_back(
+        OnePanel(plot, kHalfWidthPx, plot.x_tic_rotate_deg ? kStripUprightHeightPx : kStripHeightPx));
   }
   return figures;
 }
