@@ -64,6 +64,7 @@ thead { display: table-header-group; } td:first-child { white-space: nowrap; } t
 .keep { break-inside: avoid; page-break-inside: avoid; }
 .warn { background: #fff4d6; border: 1px solid #e0b000; padding: 4px 8px; margin: 6px 0; }
 .note { color: #555; font-size: 11px; }
+tr.failed td { background: #fde4e4; }
 .outlier { color: #b00; } .failed-unit { color: #b00; font-weight: bold; } tr.current td { background: #ffe9d6; font-weight: bold; }
 h2, h3 { break-after: avoid; page-break-after: avoid; }
 .sign { width: 100%; margin-top: 6px; } .sign td { height: 26px; } .sign td:first-child { width: 22%; }
@@ -183,9 +184,14 @@ PlotFigure CoefficientFigure(const CoefficientGroup& g) {
 
 // The errors of every window before and after correction, against temperature and time, with the
 // run's temperature and the histogram of the normalised errors: one 3 x 3 grid.
+// A run at one temperature (a hand session, a single soak): its coefficients are constants, so
+// there are no curves against temperature to draw, and its errors are drawn against time.
+bool OneTemperature(const Certificate& c) { return c.run.temperatures_c.size() < 2; }
+
 PlotFigure ErrorFigure(const Certificate& c) {
   const WindowResiduals& r = c.residuals;
-  PlotFigure figure = Figure(3, 3, kFullWidthPx, 480);
+  const bool one_temperature = OneTemperature(c);
+  PlotFigure figure = one_temperature ? Figure(2, 3, kFullWidthPx, 320) : Figure(3, 3, kFullWidthPx, 480);
   const char* axes[] = {"x", "y", "z"};  // keyed in the section's note, so the panels keep their width
   const auto panel = [&](const std::string& title, const std::vector<double>& x, const std::string& x_label,
                          const std::string& unit, const std::array<std::vector<double>, 3>& values,
@@ -204,8 +210,10 @@ PlotFigure ErrorFigure(const Certificate& c) {
     }
     figure.panels.push_back(plot);
   };
-  panel("Gyro error after correction", r.temp_c, "temperature, degC", "deg/s", r.gyro_dps, &r.gyro_noise_dps);
-  panel("Accel error after correction", r.temp_c, "temperature, degC", "mg", r.accel_mg, &r.accel_noise_mg);
+  const std::vector<double>& x = one_temperature ? r.time_s : r.temp_c;
+  const std::string x_label = one_temperature ? "time, s" : "temperature, degC";
+  panel("Gyro error after correction", x, x_label, "deg/s", r.gyro_dps, &r.gyro_noise_dps);
+  panel("Accel error after correction", x, x_label, "mg", r.accel_mg, &r.accel_noise_mg);
   Plot histogram = Panel("Normalised errors after", "error / window noise", "windows x axes");
   histogram.key = false;
   histogram.max_x_tics = 11;
@@ -217,6 +225,11 @@ PlotFigure ErrorFigure(const Certificate& c) {
   gyro.point_size = accel.point_size = 0.4;
   histogram.series = {gyro, accel};
   figure.panels.push_back(histogram);
+  if (one_temperature) {
+    panel("Gyro error before", x, x_label, "deg/s", r.gyro_before_dps, nullptr);
+    panel("Accel error before", x, x_label, "mg", r.accel_before_mg, nullptr);
+    return figure;
+  }
   panel("Gyro error after, against time", r.time_s, "time, s", "deg/s", r.gyro_dps, nullptr);
   panel("Accel error after, against time", r.time_s, "time, s", "mg", r.accel_mg, nullptr);
   Plot temp = Panel("Temperature (window means)", "time, s", "degC");
@@ -301,9 +314,16 @@ void Identification(Html* h, const Certificate& c) {
   if (c.verdict) {
     const char* v = c.verdict->pass ? "PASS" : "FAIL";
     h->Open("p").Element("span", v, {{"class", std::string("badge ") + v}, {"data-key", "verdict"}});
-    h->Text(" " + c.verdict->limits_name + " \xe2\x80\x94 " + Count(c.verdict->Failed()) + " of " +
-            Count(static_cast<long long>(c.verdict->criteria.size())) + " criteria failed");
+    const std::string criteria = Count(static_cast<long long>(c.verdict->criteria.size()));
+    h->Text(" " + c.verdict->limits_name + " \xe2\x80\x94 " +
+            (c.verdict->pass ? "all " + criteria + " criteria passed"
+                             : Count(c.verdict->Failed()) + " of " + criteria + " criteria failed"));
     h->Close("p");
+    // What failed, where the signer looks first (the table below has every criterion).
+    if (!c.verdict->pass) {
+      h->Element("p", "Failed: " + c.verdict->FailedSummary() + ".",
+                 {{"class", "FAIL"}, {"data-key", "failed_criteria"}});
+    }
   } else {
     h->Element("p",
                "No acceptance limits were given: this certificate states the calibration, not a verdict.",
@@ -412,10 +432,12 @@ void Acceptance(Html* h, const Verdict& verdict) {
   Row(h, {"criterion", "measured", "limit", "margin", "verdict"}, "th");
   h->Close("thead").Open("tbody");
   for (const CriterionResult& cr : verdict.criteria) {
-    h->Open("tr", {{"data-criterion", cr.name}, {"data-pass", cr.pass ? "1" : "0"}}).Element("td", cr.name);
+    HtmlAttributes row = {{"data-criterion", cr.name}, {"data-pass", cr.pass ? "1" : "0"}};
+    if (!cr.pass) row.push_back({"class", "failed"});
+    h->Open("tr", row).Element("td", cr.name);
     Num(h, cr.measured_text);
     Num(h, cr.limit_text);
-    Num(h, Fmt("%.4g", cr.margin) + " " + cr.unit);
+    Num(h, cr.margin_text);
     h->Element("td", cr.pass ? "PASS" : "FAIL", {{"class", cr.pass ? "PASS" : "FAIL"}}).Close("tr");
   }
   h->Close("tbody").Close("table");
@@ -567,7 +589,9 @@ void Validation(Html* h, const Certificate& c) {
 
 std::vector<PlotFigure> CertificatePlots(const Certificate& c) {
   std::vector<PlotFigure> figures;
-  for (const CoefficientGroup& g : c.curves) figures.push_back(CoefficientFigure(g));
+  if (!OneTemperature(c)) {
+    for (const CoefficientGroup& g : c.curves) figures.push_back(CoefficientFigure(g));
+  }
   figures.push_back(ErrorFigure(c));
   if (c.noise.computed) figures.push_back(AllanFigure(c.noise));
   return figures;
@@ -597,8 +621,9 @@ std::string CertificateHtml(const Certificate& c) {
   KeyFigures(&h, c);
 
   // Coefficients against temperature, two to a row (the heading stays with the first row), then
-  // the g-sensitivity grid. Figure i of CertificatePlots() is group i.
-  const size_t groups = c.curves.size();
+  // the g-sensitivity grid. Figure i of CertificatePlots() is group i; at one temperature there are
+  // none, and the errors are figure 0.
+  const size_t groups = OneTemperature(c) ? 0 : c.curves.size();
   std::vector<std::vector<size_t>> rows;
   size_t grid = groups;
   for (size_t g = 0; g < groups; ++g) {
@@ -615,11 +640,21 @@ std::string CertificateHtml(const Certificate& c) {
     h.Close("div");
   };
   h.Open("div", {{"class", "keep"}}).Element("h2", "Coefficients against temperature");
-  h.Element("p",
-            "Lines: the fitted polynomial; bands: its 1-sigma (each term's own, correlations not drawn); "
-            "circles: each window's own estimate (the coefficient that explains that window, all others as "
-            "fitted) with its noise as 1-sigma bars.",
-            {{"class", "note"}});
+  if (OneTemperature(c)) {
+    h.Element(
+        "p",
+        "The run was at one temperature" +
+            (c.run.temperatures_c.empty() ? std::string() : Fmt(" (%g degC)", c.run.temperatures_c[0])) +
+            ": every coefficient is a constant, stated under \"Coefficients at 25 degC\"; there is no "
+            "curve to draw.",
+        {{"class", "note"}});
+  } else {
+    h.Element("p",
+              "Lines: the fitted polynomial; bands: its 1-sigma (each term's own, correlations not drawn); "
+              "circles: each window's own estimate (the coefficient that explains that window, all others as "
+              "fitted) with its noise as 1-sigma bars.",
+              {{"class", "note"}});
+  }
   if (!failure.empty()) {
     Plots(&h, svgs, 0, 0, failure);
   } else if (!rows.empty()) {
@@ -657,8 +692,8 @@ std::string CertificateHtml(const Certificate& c) {
   h.Close("div");
   Validation(&h, c);
   h.Element("p",
-            "Units: deg/s and mg at 25 degC; 1 g = 9.80665 m/s\xc2\xb2. Coefficient model and file format: "
-            "docs/spec.md; conversions: docs/factory.md.",
+            "Units: angular rate in deg/s, specific force in mg (1 g = 9.80665 m/s\xc2\xb2); key figures at "
+            "25 degC. Coefficient model and file format: docs/spec.md; conversions: docs/factory.md.",
             {{"class", "note"}});
   h.Close("body").Close("html");
   return h.Finish();
@@ -710,8 +745,19 @@ void LimitLines(const std::optional<LimitInterval>& limits, const FigureView& vi
     plot->markers.push_back({*limits->lower, Fmt("%g", *limits->lower), kFailRed});
   if (limits->upper && view.upper_in_view)
     plot->markers.push_back({*limits->upper, Fmt("%g", *limits->upper), kFailRed});
-  if ((limits->lower && !view.lower_in_view) || (limits->upper && !view.upper_in_view))
+  // The sides off scale, in words: both ("limit |value| < 5 beyond this scale"), or the one that is
+  // not drawn (a symmetric limit with its other side drawn is not "beyond this scale").
+  const bool lower_drawn = limits->lower && view.lower_in_view,
+             upper_drawn = limits->upper && view.upper_in_view;
+  const bool lower_off = limits->lower && !lower_drawn, upper_off = limits->upper && !upper_drawn;
+  if (!lower_off && !upper_off) return;
+  if (!lower_drawn && !upper_drawn) {
     plot->x_label += "; limit " + LimitsText(limits) + " beyond this scale";
+  } else if (upper_off) {
+    plot->x_label += "; upper limit " + Fmt("%g", *limits->upper) + " above this scale";
+  } else {
+    plot->x_label += "; lower limit " + Fmt("%g", *limits->lower) + " below this scale";
+  }
 }
 
 void NiceY(const FigureView& view, Plot* plot) {
