@@ -451,7 +451,7 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
   if (section.duration_s < kMinAllanStretchS) {
     char text[160];
     std::snprintf(text, sizeof text,
-                  "the longest static stretch of the run is %.1f s, and the Allan deviation needs at least "
+                  "the longest static stretch is %.1f s, and the Allan deviation needs at least "
                   "%.0f s (imufit allan measures the noise on a long static log)",
                   section.duration_s, kMinAllanStretchS);
     section.why_not = text;
