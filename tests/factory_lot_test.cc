@@ -185,7 +185,16 @@ TEST_F(LotTest, LotSummaryMarksFailedAndOutlyingUnitsAndChoosesWhatAStripPlotSho
   EXPECT_EQ(strip.x_tics.size(), 5u);
   EXPECT_EQ(strip.x_tics[4].label, "05");
   EXPECT_EQ(plots[1].panels.at(0).markers.size(), 3u);  // mean and 3 sigma; the limits off scale
-  EXPECT_NE(plots[1].panels.at(0).x_label.find("beyond this scale"), std::string::npos);
+  EXPECT_NE(plots[1].panels.at(0).x_label.find("limit |value| < 1000 beyond this scale"), std::string::npos);
+  // One side drawn, the other off scale: the caption names the side it does not draw, not the limit.
+  LotSummary one_side = s;
+  one_side.figures[1].view.lower_in_view = true;
+  const std::vector<PlotFigure> one_side_plots = LotPlots(one_side);
+  const Plot& lower_drawn = one_side_plots[1].panels.at(0);
+  EXPECT_EQ(lower_drawn.markers.size(), 4u);
+  EXPECT_NE(lower_drawn.x_label.find("upper limit 1000 above this scale"), std::string::npos)
+      << lower_drawn.x_label;
+  EXPECT_EQ(lower_drawn.x_label.find("beyond"), std::string::npos) << lower_drawn.x_label;
 }
 
 // Records one unit's fit of `lot` with a gyro bias x of `bias_dps`.

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/allan_plot.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
@@ -336,6 +337,21 @@ TEST(RobustZScores, NoiseBetweenIdenticalUnitsIsNotAnOutlier) {
   EXPECT_TRUE(RobustZScores({0.8, 0.9, 1.0, 1.1, 6.0}, {0.1, 0.1, 0.1, 0.1, 0.1})[4].outlier);
 }
 
+// The renderer's number format: a value that prints as zero has no sign, whatever the format's
+// flags and the text around the number; any other value keeps its own.
+TEST(FormatNumber, NoFigurePrintsASignedZero) {
+  EXPECT_EQ(FormatNumber("%.1f", -0.02), "0.0");  // a held-out temperature just below 0 degC
+  EXPECT_EQ(FormatNumber("%.1f", -0.0), "0.0");
+  EXPECT_EQ(FormatNumber("%+.6g", 0.0), "0");  // a count of segments missing
+  EXPECT_EQ(FormatNumber("%+.6g", -0.0), "0");
+  EXPECT_EQ(FormatNumber("%+.1f", 0.04), "0.0");
+  EXPECT_EQ(FormatNumber("%.1f %%", -0.01), "0.0 %");
+  EXPECT_EQ(FormatNumber("gyro %+g deg/h", 0.0), "gyro 0 deg/h");
+  EXPECT_EQ(FormatNumber("%+.1f", 0.06), "+0.1");
+  EXPECT_EQ(FormatNumber("%+.6g", -1e-9), "-1e-09");  // small, not zero
+  EXPECT_EQ(FormatNumber("%.1f", -0.06), "-0.1");
+}
+
 // The certificate of the MEMS soak fixture: asserted on the struct, not on HTML.
 class CertificateTest : public FactoryTest {
  protected:
@@ -377,10 +393,21 @@ class CertificateTest : public FactoryTest {
 
 TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
   const Certificate c = Make(kFixtures + "/plan_6pos.yaml", std::nullopt);
-  // No serial anywhere: said, not hidden.
+  // No serial anywhere: said, not hidden, naming every place a serial can come from.
   EXPECT_TRUE(c.serial.empty());
   ASSERT_FALSE(c.warnings.empty());
   EXPECT_NE(c.warnings[0].find("no serial"), std::string::npos);
+  for (const char* source : {"--serial", "the calibration", "'# serial:' header line", "the plan"}) {
+    EXPECT_NE(c.warnings[0].find(source), std::string::npos) << source << ": " << c.warnings[0];
+  }
+  // The run: 6 static positions and two rates, every segment with windows.
+  EXPECT_EQ(c.run.static_segments, 6);
+  EXPECT_EQ(c.run.rates_dps, (std::vector<double>{100.0, 300.0}));
+  EXPECT_EQ(c.run.turn_segments, 0);
+  EXPECT_TRUE(c.run.segments_without_windows.empty());
+  // The solver's reason without the tolerances it quotes.
+  EXPECT_EQ(c.settings.termination.find("<="), std::string::npos) << c.settings.termination;
+  EXPECT_EQ(c.settings.termination.back(), '.') << c.settings.termination;
   ASSERT_EQ(c.inputs.size(), 2u);
   EXPECT_EQ(c.inputs[1].sha256, Sha256OfFile(kFixtures + "/mems_6pos_soak.csv.gz"));
   // Key figures: expanded uncertainty k = 2; the fit recovers the truth within its own uncertainty.
@@ -398,6 +425,11 @@ TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
     ADD_FAILURE() << name;
     return KeyFigureRow();
   };
+  // Coefficients are signed; the fit's diagnostics cannot be negative (printed without a sign).
+  EXPECT_TRUE(figure("gyro_bias_dps.x").is_coefficient);
+  EXPECT_TRUE(figure("accel_misalignment_mrad.xy").is_coefficient);
+  EXPECT_FALSE(figure("gyro_residual_rms_dps").is_coefficient);
+  EXPECT_FALSE(figure("coverage").is_coefficient);
   constexpr double kRecoverySigmas = 5.0;  // worst case, per figure
   for (const char* name : {"gyro_bias_dps.x", "gyro_g_sensitivity_dpsg.xx", "accel_bias_mg.z"}) {
     const KeyFigureRow f = figure(name);
@@ -539,11 +571,93 @@ TEST_F(CertificateTest, AHandSessionsTurnsAreJudgedAgainstTheirMeanRate) {
     EXPECT_EQ(row.accel_windows, segment->AxisIsVertical() ? 1 : 0) << row.motion;
   }
   EXPECT_EQ(turns, 3);
+  // The run summary counts turns as turns (not as rate segments of 0 deg/s).
+  EXPECT_EQ(c.run.static_segments, 6);
+  EXPECT_EQ(c.run.turn_segments, 3);
+  EXPECT_EQ(c.run.turn_angles_deg, (std::vector<double>{360.0}));
+  EXPECT_TRUE(c.run.rates_dps.empty());
+  // One temperature: no coefficient curves to draw (they are constants), the errors against time.
+  const std::vector<PlotFigure> plots = CertificatePlots(c);
+  ASSERT_EQ(plots.size(), 1u);
+  ASSERT_EQ(plots[0].panels.size(), 5u);
+  for (int p : {0, 1, 3, 4}) {
+    EXPECT_EQ(plots[0].panels[p].x_label, "time, s") << plots[0].panels[p].title;
+    EXPECT_EQ(plots[0].panels[p].series.at(0).x, c.residuals.time_s);
+  }
   // The normalised errors are noise: the turns' accelerometer means are not in them.
   constexpr double kMostNormalisedRms = 3.0;
   EXPECT_LT(c.residuals.normalised_gyro_rms, kMostNormalisedRms);
   EXPECT_LT(c.residuals.normalised_accel_rms, kMostNormalisedRms);
   EXPECT_LT(c.residual_table.back().accel_rms_mg, 1.0);
+}
+
+// A run with minute-long static dwells: the certificate's noise section is the analysis `imufit
+// allan` runs (ColumnAnalysis per gyro axis), drawn by the same plot module as `imufit allan --plot
+// --plot-units deg/h`: tau as the Greek letter, deg/h, the ARW where it is read, the table's figures
+// on the plot.
+TEST_F(CertificateTest, TheNoiseSectionIsDrawnByTheAllanPlotModule) {
+  const std::string plan_path = kFixtures + "/plan_6pos.yaml";
+  const Plan plan = ReadPlan(plan_path);
+  SimulationOptions options;
+  options.soak_temps_c = {25.0};
+  options.rate_hz = 20.0;
+  options.dwell_s = 70.0;  // above kMinAllanStretchS
+  options.transition_s = 1.0;
+  options.gyro_noise_density = 8.7e-5;  // 0.299 deg/sqrt(h)
+  options.accel_noise_density = 1.5e-3;
+  options.seed = 5;
+  const std::string samples = Simulate(plan, options, "static.csv");
+  FitRunOptions fit_options;
+  fit_options.fit.gyro_temp_order = fit_options.fit.accel_temp_order = 0;
+  const FitRunResult fit = FitRun(plan_path, samples, fit_options);
+  ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+  CertificateSources sources;
+  sources.calibration = *fit.calibration;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  sources.inputs = {{"samples", samples, ""}};
+  const Certificate c = MakeCertificate(sources);
+  ASSERT_TRUE(c.noise.computed) << c.noise.why_not;
+  ASSERT_EQ(c.noise.columns.size(), 3u);
+  ASSERT_EQ(c.noise.axes.size(), 3u);
+
+  const std::vector<PlotFigure> plots = CertificatePlots(c);
+  ASSERT_EQ(plots.size(), 2u);  // one temperature: the errors, then the Allan deviation
+  const PlotFigure& allan = plots[1];
+  const PlotFigure shared = AllanPlot(c.noise.columns, "", AllanPlotUnits::kDegPerHour);
+  ASSERT_EQ(allan.panels.size(), 1u);
+  ASSERT_EQ(shared.panels.size(), 1u);
+  const Plot& panel = allan.panels[0];
+  EXPECT_EQ(panel.x_label, "averaging time \xcf\x84 (s)");
+  EXPECT_EQ(panel.y_label, "overlapping Allan deviation (\xc2\xb0/h)");
+  ASSERT_EQ(panel.series.size(), shared.panels[0].series.size());
+  for (size_t i = 0; i < panel.series.size(); ++i) {
+    const std::vector<double>&ours = panel.series[i].y, &theirs = shared.panels[0].series[i].y;
+    ASSERT_EQ(ours.size(), theirs.size()) << i;
+    for (size_t k = 0; k < ours.size(); ++k) {
+      // NaN: where a term is not drawn (a gap), in both.
+      if (std::isnan(theirs[k])) {
+        EXPECT_TRUE(std::isnan(ours[k])) << i << " " << k;
+      } else {
+        EXPECT_EQ(ours[k], theirs[k]) << i << " " << k;
+      }
+    }
+  }
+  // The measured curve of gyro_x in deg/h.
+  ASSERT_FALSE(c.noise.columns[0].allan.points.empty());
+  EXPECT_NEAR(panel.series[0].y[0], DphFromRadps(c.noise.columns[0].allan.points[0].dev),
+              kConversionRelative * panel.series[0].y[0]);
+  // Every resolved ARW is marked on the plot with the figure the table prints.
+  constexpr double kArwRelative = 0.15;  // 70 s at 20 Hz fixes the white noise to a few percent
+  for (size_t a = 0; a < 3; ++a) {
+    const NoiseAxis& axis = c.noise.axes[a];
+    ASSERT_TRUE(axis.arw_resolved) << axis.axis;
+    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr, 0.299, kArwRelative * 0.299) << axis.axis;
+    const std::string words = "gyro_" + axis.axis + " ARW " + FormatNumber("%.3g", axis.arw_deg_per_sqrt_hr);
+    bool marked = false;
+    for (const PlotNote& n : panel.notes) marked = marked || n.text.rfind(words, 0) == 0;
+    EXPECT_TRUE(marked) << words;
+  }
 }
 
 // A plan of many segments (the 24-position tactical soak: 36 segments) prints the segments with

@@ -117,7 +117,7 @@ std::string Verdict::Table() const {
   text += line;
   for (const CriterionResult& c : criteria) {
     std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", c.name.c_str(),
-                  c.measured_text.c_str(), c.limit_text.c_str(), (Number(c.margin) + " " + c.unit).c_str(),
+                  c.measured_text.c_str(), c.limit_text.c_str(), c.margin_text.c_str(),
                   c.pass ? "PASS" : "FAIL");
     text += line;
   }
@@ -142,6 +142,7 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
       r.limit = 0.0;
       r.measured_text = Number(range[0]) + ".." + Number(range[1]) + " degC";
       r.limit_text = "covers " + Number(criterion.covers_c[0]) + ".." + Number(criterion.covers_c[1]);
+      r.margin_text = Number(r.margin) + " " + criterion.unit;
       r.pass = r.margin >= 0.0;
       verdict.criteria.push_back(r);
       continue;
@@ -175,12 +176,17 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
       if (!found) {
         r.measured_text = "not in calibration";
         r.margin = -r.limit;
+        r.margin_text = "none";
         r.pass = false;
       } else {
         // A max_abs criterion judges |value|: that is what it shows (a residual RMS is >= 0 anyway).
         r.measured = std::abs(r.measured);
         r.measured_text = Number(r.measured) + " " + criterion.unit;
         r.margin = r.limit - r.measured;
+        // Coverage counts segments missing; its margin is segments to spare, not missing ones.
+        r.margin_text = criterion.quantity == "coverage"
+                            ? Number(r.margin) + (r.margin == 1.0 ? " segment" : " segments")
+                            : Number(r.margin) + " " + criterion.unit;
         r.pass = r.margin > 0.0;
       }
       verdict.criteria.push_back(r);

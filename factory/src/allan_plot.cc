@@ -18,6 +18,10 @@ constexpr double kTermShownShare = 0.1;
 // The deviation axis reaches whole decades, at least this factor below the lowest point (room for
 // the bias-instability labels under the floor) and above the highest.
 constexpr double kRoomBelow = 4.0, kRoomAbove = 1.5;
+// The tau axis starts at the whole decade below the shortest tau and ends this factor beyond the
+// longest: room for its confidence bar, not a decade of nothing (gnuplot's own range reaches the
+// next decade, a third of the panel empty).
+constexpr double kRoomRight = 1.6;
 const char* kKeyGrey = "#555555";
 
 // A unit as a plot shows it: "deg/sqrt(h)" -> "°/√h", "micro-g" -> "µg", "m/s^2" -> "m/s²".
@@ -118,7 +122,7 @@ PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::stri
     const char* random_walk = kind == ColumnKind::kAccel ? "VRW" : "ARW";
     int in_panel = 0;
     for (const ColumnAnalysis& r : results) in_panel += r.kind == kind ? 1 : 0;
-    double lowest = INFINITY, highest = 0.0;
+    double lowest = INFINITY, highest = 0.0, shortest = INFINITY, longest = 0.0;
     int column = 0;                     // this column's place in the panel: its labels stack in that order
     std::vector<PlotNote> floor_words;  // the bias instabilities in words
     for (size_t c = 0; c < results.size(); ++c) {
@@ -138,6 +142,8 @@ PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::stri
         curve.hi.push_back((std::isfinite(p.dev_hi) ? p.dev_hi : p.dev) * scale);
         lowest = std::min(lowest, curve.lo.back());
         highest = std::max(highest, curve.hi.back());
+        shortest = std::min(shortest, p.tau_s);
+        longest = std::max(longest, p.tau_s);
       }
       plot.series.push_back(curve);
       if (!r.fit.fitted) {
@@ -250,6 +256,10 @@ PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::stri
     if (highest > 0.0 && std::isfinite(lowest) && lowest > 0.0) {
       plot.y_range = std::array<double, 2>{std::pow(10.0, std::floor(std::log10(lowest / kRoomBelow))),
                                            std::pow(10.0, std::ceil(std::log10(highest * kRoomAbove)))};
+    }
+    if (longest > 0.0 && std::isfinite(shortest)) {
+      plot.x_range =
+          std::array<double, 2>{std::pow(10.0, std::floor(std::log10(shortest))), longest * kRoomRight};
     }
     figure.panels.push_back(plot);
   }

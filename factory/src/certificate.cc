@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
 #include <set>
 #include <utility>
 
@@ -13,13 +12,11 @@
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
-#include "imufit/noise/column_analysis.h"
 
 namespace imufit {
 namespace {
 
 constexpr int kCurvePoints = 61;             // temperatures at which the coefficient curves are drawn
-constexpr int kModelCurvePoints = 80;        // taus at which the fitted Allan model is drawn
 constexpr double kHistogramHalfWidth = 5.0;  // normalised errors binned over [-5, 5]
 constexpr int kHistogramBins = 20;
 
@@ -86,6 +83,7 @@ FitSettings Settings(const Calibration& calibration, const WindowOptions& window
   s.g_sensitivity_fitted = FitText(calibration, "g_sensitivity_fitted") != "false";
   s.loss = FitText(calibration, "loss");
   s.termination = FitText(calibration, "termination");
+  if (const size_t end = s.termination.find(". "); end != std::string::npos) s.termination.resize(end + 1);
   return s;
 }
 
@@ -93,15 +91,24 @@ RunSummary SummariseRun(const Calibration& calibration, const Plan& plan, const 
   RunSummary r;
   r.plan_path = plan.path;
   r.segments = static_cast<int>(plan.segments.size());
-  std::set<double> rates;
+  std::set<double> rates, angles;
   for (const TableSegment& s : plan.segments) {
     if (s.IsStatic()) {
       ++r.static_segments;
+    } else if (s.IsTurn()) {
+      ++r.turn_segments;
+      angles.insert(std::abs(*s.angle_rad * kRadToDeg));
     } else {
       rates.insert(std::abs(DpsFromRadps(s.rate_radps)));
     }
   }
   r.rates_dps.assign(rates.begin(), rates.end());
+  r.turn_angles_deg.assign(angles.begin(), angles.end());
+  std::set<int> visited;
+  for (const Window& w : run.windows) visited.insert(w.segment);
+  for (const TableSegment& s : plan.segments) {
+    if (visited.count(s.id) == 0) r.segments_without_windows.push_back(s.id);
+  }
   r.gravity_mps2 = plan.site.gravity_mps2;
   if (plan.site.latitude_rad) r.latitude_deg = *plan.site.latitude_rad * kRadToDeg;
   r.samples = run.stats.samples;
@@ -444,8 +451,8 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
   if (section.duration_s < kMinAllanStretchS) {
     char text[160];
     std::snprintf(text, sizeof text,
-                  "the longest static stretch is %.1f s; at least %.0f s are needed (imufit allan on a long "
-                  "static log)",
+                  "the longest static stretch is %.1f s, and the Allan deviation needs at least "
+                  "%.0f s (imufit allan measures the noise on a long static log)",
                   section.duration_s, kMinAllanStretchS);
     section.why_not = text;
     return section;
@@ -468,14 +475,10 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
     std::vector<double> rates;
     rates.reserve(best.size());
     for (const Sample& s : best) rates.push_back(s.gyro(axis) / scale);
-    const ColumnAnalysis analysis = AnalyseColumn(std::string("gyro_") + axes[axis], ColumnKind::kGyro,
-                                                  std::move(rates), tau0_s, factors, options);
+    ColumnAnalysis analysis = AnalyseColumn(std::string("gyro_") + axes[axis], ColumnKind::kGyro,
+                                            std::move(rates), tau0_s, factors, options);
     NoiseAxis a;
     a.axis = axes[axis];
-    for (const AllanPoint& p : analysis.allan.points) {
-      a.tau_s.push_back(p.tau_s);
-      a.dev_dph.push_back(DphFromRadps(p.dev));
-    }
     const NoiseFitSummary& fit = analysis.fit;
     a.fitted = fit.fitted;
     a.why_not = fit.message;
@@ -487,31 +490,19 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
       a.bias_instability_dph = DphFromRadps(fit.value[kBiasInstability]);
       a.bias_instability_sigma = DphFromRadps(fit.sigma[kBiasInstability]);
       a.bias_instability_resolved = IsResolved(fit, kBiasInstability);
-      if (!a.tau_s.empty()) {
-        const double first = a.tau_s.front(), last = a.tau_s.back();
-        for (int i = 0; i <= kModelCurvePoints; ++i) {
-          const double tau = first * std::pow(last / first, static_cast<double>(i) / kModelCurvePoints);
-          a.model_tau_s.push_back(tau);
-          a.model_dph.push_back(DphFromRadps(fit.ModelDeviation(tau)));
-        }
-      }
     }
     section.axes.push_back(std::move(a));
+    section.columns.push_back(std::move(analysis));
   }
   return section;
 }
 
-// Warnings a signer must see: no serial, plan segments the run never visited.
-void CoverageWarnings(const Plan& plan, const RunWindows& run, std::vector<std::string>* warnings) {
-  std::map<int, int> windows_per_segment;
-  for (const Window& w : run.windows) ++windows_per_segment[w.segment];
-  for (const TableSegment& s : plan.segments) {
-    if (windows_per_segment.count(s.id) == 0) {
-      warnings->push_back(
-          "plan segment " + std::to_string(s.id) +
-          " has no usable window in the samples (never occurs, or every occurrence is shorter "
-          "than the trim and the minimum window)");
-    }
+// Plan segments the run never visited: a warning each.
+void CoverageWarnings(const RunSummary& run, std::vector<std::string>* warnings) {
+  for (int id : run.segments_without_windows) {
+    warnings->push_back("plan segment " + std::to_string(id) +
+                        " has no usable window in the samples (never occurs, or every occurrence is shorter "
+                        "than the trim and the minimum window)");
   }
 }
 
@@ -552,18 +543,23 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     c.inputs.push_back(input);
   }
   if (c.serial.empty()) {
-    c.warnings.push_back("no serial: neither the calibration, the plan nor --serial names the unit");
+    c.warnings.push_back(
+        "no serial: neither --serial, the calibration, the samples file's '# serial:' header line nor the "
+        "plan names the unit");
   }
   for (const std::string& w : sources.warnings) c.warnings.push_back(w);
   c.station = sources.station;
   if (c.station) StationWarnings(*c.station, c.calibrated_utc, c.written_utc, &c.warnings);
-  CoverageWarnings(sources.plan, sources.run, &c.warnings);
   c.run = SummariseRun(cal, sources.plan, sources.run);
+  CoverageWarnings(c.run, &c.warnings);
   c.settings = Settings(cal, sources.windows);
 
   for (const Figure& f : KeyFigures(cal)) {
-    c.figures.push_back(
-        {f.name, f.unit, f.value, f.sigma, f.sigma >= 0.0 ? kCoverageFactor * f.sigma : -1.0});
+    // Coefficients have a path in the model ("gyro.bias.x"); the others are the fit's diagnostics
+    // ("fit.gyro_residual_rms", "fit.missing_segments") and noise figures ("noise.gyro_x.arw...").
+    const bool is_coefficient = f.coefficient.rfind("gyro.", 0) == 0 || f.coefficient.rfind("accel.", 0) == 0;
+    c.figures.push_back({f.name, f.unit, is_coefficient, f.value, f.sigma,
+                         f.sigma >= 0.0 ? kCoverageFactor * f.sigma : -1.0});
   }
   const std::vector<WindowError> after =
       PredictWindows(cal.model, sources.run.windows, sources.plan.site, sources.plan.segments);

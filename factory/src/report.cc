@@ -3,19 +3,46 @@
 #include "imufit/factory/report.h"
 
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
+#include "imufit/factory/allan_plot.h"
 #include "imufit/factory/html.h"
 #include "imufit/io/output_file.h"
 
 namespace imufit {
 namespace {
 
-std::string Fmt(const char* format, double value) {
-  char text[64];
+std::string Printf(const char* format, double value) {
+  char text[96];
   std::snprintf(text, sizeof text, format, value);
   return text;
 }
+
+}  // namespace
+
+std::string FormatNumber(const char* format, double value) {
+  const std::string text = Printf(format, value);
+  if (text != Printf(format, -0.0) && text != Printf(format, 0.0)) return text;
+  std::string unsigned_format = format;  // the '+' flag dropped from the conversion
+  for (size_t at = unsigned_format.find('%'); at != std::string::npos;
+       at = unsigned_format.find('%', at + 2)) {
+    if (unsigned_format[at + 1] == '%') continue;
+    size_t flag = at + 1;
+    while (flag < unsigned_format.size() && std::strchr("-+ #0", unsigned_format[flag]) != nullptr) {
+      if (unsigned_format[flag] == '+') {
+        unsigned_format.erase(flag, 1);
+      } else {
+        ++flag;
+      }
+    }
+  }
+  return Printf(unsigned_format.c_str(), 0.0);
+}
+
+namespace {
+
+std::string Fmt(const char* format, double value) { return FormatNumber(format, value); }
 
 std::string Count(long long value) { return std::to_string(value); }
 
@@ -37,6 +64,7 @@ thead { display: table-header-group; } td:first-child { white-space: nowrap; } t
 .keep { break-inside: avoid; page-break-inside: avoid; }
 .warn { background: #fff4d6; border: 1px solid #e0b000; padding: 4px 8px; margin: 6px 0; }
 .note { color: #555; font-size: 11px; }
+tr.failed td { background: #fde4e4; }
 .outlier { color: #b00; } .failed-unit { color: #b00; font-weight: bold; } tr.current td { background: #ffe9d6; font-weight: bold; }
 h2, h3 { break-after: avoid; page-break-after: avoid; }
 .sign { width: 100%; margin-top: 6px; } .sign td { height: 26px; } .sign td:first-child { width: 22%; }
@@ -156,9 +184,14 @@ PlotFigure CoefficientFigure(const CoefficientGroup& g) {
 
 // The errors of every window before and after correction, against temperature and time, with the
 // run's temperature and the histogram of the normalised errors: one 3 x 3 grid.
+// A run at one temperature (a hand session, a single soak): its coefficients are constants, so
+// there are no curves against temperature to draw, and its errors are drawn against time.
+bool OneTemperature(const Certificate& c) { return c.run.temperatures_c.size() < 2; }
+
 PlotFigure ErrorFigure(const Certificate& c) {
   const WindowResiduals& r = c.residuals;
-  PlotFigure figure = Figure(3, 3, kFullWidthPx, 480);
+  const bool one_temperature = OneTemperature(c);
+  PlotFigure figure = one_temperature ? Figure(2, 3, kFullWidthPx, 320) : Figure(3, 3, kFullWidthPx, 480);
   const char* axes[] = {"x", "y", "z"};  // keyed in the section's note, so the panels keep their width
   const auto panel = [&](const std::string& title, const std::vector<double>& x, const std::string& x_label,
                          const std::string& unit, const std::array<std::vector<double>, 3>& values,
@@ -177,8 +210,10 @@ PlotFigure ErrorFigure(const Certificate& c) {
     }
     figure.panels.push_back(plot);
   };
-  panel("Gyro error after correction", r.temp_c, "temperature, degC", "deg/s", r.gyro_dps, &r.gyro_noise_dps);
-  panel("Accel error after correction", r.temp_c, "temperature, degC", "mg", r.accel_mg, &r.accel_noise_mg);
+  const std::vector<double>& x = one_temperature ? r.time_s : r.temp_c;
+  const std::string x_label = one_temperature ? "time, s" : "temperature, degC";
+  panel("Gyro error after correction", x, x_label, "deg/s", r.gyro_dps, &r.gyro_noise_dps);
+  panel("Accel error after correction", x, x_label, "mg", r.accel_mg, &r.accel_noise_mg);
   Plot histogram = Panel("Normalised errors after", "error / window noise", "windows x axes");
   histogram.key = false;
   histogram.max_x_tics = 11;
@@ -190,6 +225,11 @@ PlotFigure ErrorFigure(const Certificate& c) {
   gyro.point_size = accel.point_size = 0.4;
   histogram.series = {gyro, accel};
   figure.panels.push_back(histogram);
+  if (one_temperature) {
+    panel("Gyro error before", x, x_label, "deg/s", r.gyro_before_dps, nullptr);
+    panel("Accel error before", x, x_label, "mg", r.accel_before_mg, nullptr);
+    return figure;
+  }
   panel("Gyro error after, against time", r.time_s, "time, s", "deg/s", r.gyro_dps, nullptr);
   panel("Accel error after, against time", r.time_s, "time, s", "mg", r.accel_mg, nullptr);
   Plot temp = Panel("Temperature (window means)", "time, s", "degC");
@@ -205,36 +245,17 @@ PlotFigure ErrorFigure(const Certificate& c) {
   return figure;
 }
 
+// The gyro's Allan deviation as `imufit allan --plot --plot-units deg/h` draws it (allan_plot.h):
+// the curves with their confidence bars, the IEEE 952 fit and its terms, ARW and bias instability
+// marked where they are read; at the certificate's printed width.
 PlotFigure AllanFigure(const NoiseSection& noise) {
-  PlotFigure figure = Figure(1, 1, kFullWidthPx, 280);
-  Plot plot;
-  plot.title = "Gyro overlapping Allan deviation, segment " + Count(noise.segment) +
-               Fmt(", %.0f s", noise.duration_s) + Fmt(" at %.1f degC", noise.temp_c);
-  plot.x_label = "averaging time tau, s";
-  plot.y_label = "deg/h";
-  plot.log_x = plot.log_y = true;
-  plot.labels_at_bottom = true;
-  for (size_t i = 0; i < noise.axes.size(); ++i) {
-    const NoiseAxis& a = noise.axes[i];
-    PlotSeries points =
-        Series(PlotSeries::Style::kLinesPoints, a.axis, static_cast<int>(i), a.tau_s, a.dev_dph);
-    points.line_width = 1;
-    plot.series.push_back(points);
-    if (!a.model_tau_s.empty()) {
-      PlotSeries model =
-          Series(PlotSeries::Style::kLines, "", static_cast<int>(i), a.model_tau_s, a.model_dph);
-      model.dashed = true;
-      plot.series.push_back(model);
-    }
-    if (a.fitted) {
-      plot.labels.push_back(
-          {a.axis + ": ARW " +
-           (a.arw_resolved ? Fmt("%.3g deg/sqrt(h)", a.arw_deg_per_sqrt_hr) : "not resolved") +
-           ", bias instability " +
-           (a.bias_instability_resolved ? Fmt("%.3g deg/h", a.bias_instability_dph) : "not resolved")});
-    }
+  PlotFigure figure = AllanPlot(noise.columns, "", AllanPlotUnits::kDegPerHour);
+  figure.width_px = kFullWidthPx;
+  figure.height_px = 330;
+  for (Plot& panel : figure.panels) {
+    panel.title = "";        // the section's note says which stretch
+    panel.key_above = true;  // the panel keeps the page's width
   }
-  figure.panels.push_back(plot);
   return figure;
 }
 
@@ -293,9 +314,16 @@ void Identification(Html* h, const Certificate& c) {
   if (c.verdict) {
     const char* v = c.verdict->pass ? "PASS" : "FAIL";
     h->Open("p").Element("span", v, {{"class", std::string("badge ") + v}, {"data-key", "verdict"}});
-    h->Text(" " + c.verdict->limits_name + " \xe2\x80\x94 " + Count(c.verdict->Failed()) + " of " +
-            Count(static_cast<long long>(c.verdict->criteria.size())) + " criteria failed");
+    const std::string criteria = Count(static_cast<long long>(c.verdict->criteria.size()));
+    h->Text(" " + c.verdict->limits_name + " \xe2\x80\x94 " +
+            (c.verdict->pass ? "all " + criteria + " criteria passed"
+                             : Count(c.verdict->Failed()) + " of " + criteria + " criteria failed"));
     h->Close("p");
+    // What failed, where the signer looks first (the table below has every criterion).
+    if (!c.verdict->pass) {
+      h->Element("p", "Failed: " + c.verdict->FailedSummary() + ".",
+                 {{"class", "FAIL"}, {"data-key", "failed_criteria"}});
+    }
   } else {
     h->Element("p",
                "No acceptance limits were given: this certificate states the calibration, not a verdict.",
@@ -335,15 +363,34 @@ void Identification(Html* h, const Certificate& c) {
 void RunAndSettings(Html* h, const Certificate& c) {
   h->Open("div", {{"class", "cols"}});
   h->Open("div").Element("h2", "Plan and run").Open("table");
-  std::string rates;
-  for (double r : c.run.rates_dps) rates += (rates.empty() ? "" : ", ") + Fmt("%g", r);
+  const auto list = [](const std::vector<double>& values) {
+    std::string text;
+    for (double v : values) text += (text.empty() ? "" : ", ") + Fmt("%g", v);
+    return text;
+  };
   h->Open("tr").Element("td", "plan").Element("td", c.run.plan_path, {{"class", "path"}}).Close("tr");
-  Row(h, {"segments", Count(c.run.segments) + " (" + Count(c.run.static_segments) + " static; rates " +
-                          (rates.empty() ? "none" : rates + " deg/s") + ")"});
+  std::string segments = Count(c.run.segments) + " (" + Count(c.run.static_segments) + " static";
+  if (!c.run.rates_dps.empty()) segments += "; rates " + list(c.run.rates_dps) + " deg/s";
+  if (c.run.turn_segments > 0) {
+    segments += "; " + Count(c.run.turn_segments) + (c.run.turn_segments == 1 ? " turn of " : " turns of ") +
+                list(c.run.turn_angles_deg) + " deg";
+  }
+  Row(h, {"segments", segments + ")"});
+
   Row(h, {"local gravity", Fmt("%.6g m/s\xc2\xb2", c.run.gravity_mps2)});
   Row(h, {"latitude", c.run.latitude_deg ? Fmt("%.4f deg", *c.run.latitude_deg) : "not given"});
   Row(h, {"samples read", Count(c.run.samples)});
-  Row(h, {"windows", Count(c.run.windows)});
+  // Whether every plan segment has a window: said either way (the warnings name the ones without).
+  const std::vector<int>& missing = c.run.segments_without_windows;
+  std::string ids;
+  for (int id : missing) ids += (ids.empty() ? "" : ", ") + Count(id);
+  h->Open("tr").Element("td", "windows").Open("td").Text(Count(c.run.windows));
+  h->Element("span",
+             missing.empty() ? ", in every plan segment"
+                             : (missing.size() == 1 ? "; none in segment " : "; none in segments ") + ids,
+             {{"data-key", "segments_without_windows"},
+              {"data-value", Count(static_cast<long long>(missing.size()))}});
+  h->Close("td").Close("tr");
   std::string temps;
   for (double t : c.run.temperatures_c) temps += (temps.empty() ? "" : ", ") + Fmt("%g", t);
   Row(h, {"temperatures (windows, nearest degC)", temps});
@@ -365,11 +412,12 @@ void RunAndSettings(Html* h, const Certificate& c) {
             Fmt("%.3g", s.gyro_reduced_chi2) + " / " + Fmt("%.3g", s.accel_reduced_chi2)});
     Row(h, {"temperature orders gyro / accel", Count(s.gyro_temp_order) + " / " + Count(s.accel_temp_order)});
     Row(h, {"g-sensitivity", s.g_sensitivity_fitted ? "fitted" : "held at zero"});
-    Row(h, {"solver", s.termination + ", " + Count(s.iterations) + " iterations"});
+    Row(h, {"solver",
+            s.termination + " " + Count(s.iterations) + (s.iterations == 1 ? " iteration" : " iterations")});
     Row(h, {"bias stability in the sigmas", s.gyro_bias_stability_dph > 0.0 || s.accel_bias_stability_ug > 0.0
                                                 ? Fmt("gyro %g deg/h", s.gyro_bias_stability_dph) +
                                                       Fmt(", accel %g micro-g", s.accel_bias_stability_ug)
-                                                : "no: the sigmas reflect white noise only"});
+                                                : "no (white noise only)"});
   }
   Row(h, {"trim after each move", Fmt("%g s", s.trim_s)});
   Row(h, {"window temperature span", Fmt("%g degC", s.window_temp_span_c)});
@@ -384,10 +432,12 @@ void Acceptance(Html* h, const Verdict& verdict) {
   Row(h, {"criterion", "measured", "limit", "margin", "verdict"}, "th");
   h->Close("thead").Open("tbody");
   for (const CriterionResult& cr : verdict.criteria) {
-    h->Open("tr", {{"data-criterion", cr.name}, {"data-pass", cr.pass ? "1" : "0"}}).Element("td", cr.name);
+    HtmlAttributes row = {{"data-criterion", cr.name}, {"data-pass", cr.pass ? "1" : "0"}};
+    if (!cr.pass) row.push_back({"class", "failed"});
+    h->Open("tr", row).Element("td", cr.name);
     Num(h, cr.measured_text);
     Num(h, cr.limit_text);
-    Num(h, Fmt("%.4g", cr.margin) + " " + cr.unit);
+    Num(h, cr.margin_text);
     h->Element("td", cr.pass ? "PASS" : "FAIL", {{"class", cr.pass ? "PASS" : "FAIL"}}).Close("tr");
   }
   h->Close("tbody").Close("table");
@@ -395,14 +445,16 @@ void Acceptance(Html* h, const Verdict& verdict) {
 
 void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
   // The sensor's prefix is the table's heading, so that two tables fit side by side on A4.
+  // Figures of neither sensor (coverage) are in the plan and run table.
   const std::string prefix = gyro ? "gyro_" : "accel_";
   h->Open("table").Open("thead");
   Row(h, {gyro ? "gyro" : "accelerometer", "value", "1-sigma", "U (k = 2)", "unit"}, "th");
   h->Close("thead").Open("tbody");
   for (const KeyFigureRow& f : figures) {
-    if ((f.name.rfind("gyro", 0) == 0) != gyro) continue;
-    h->Open("tr").Element("td", f.name.rfind(prefix, 0) == 0 ? f.name.substr(prefix.size()) : f.name);
-    Num(h, Fmt("%+.6g", f.value), {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
+    if (f.name.rfind(prefix, 0) != 0) continue;
+    h->Open("tr").Element("td", f.name.substr(prefix.size()));
+    Num(h, Fmt(f.is_coefficient ? "%+.6g" : "%.6g", f.value),
+        {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
     Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
     Num(h, f.expanded >= 0.0 ? Fmt("%.3g", f.expanded) : "\xe2\x80\x93");
     h->Element("td", f.unit).Close("tr");
@@ -468,7 +520,7 @@ void ResidualTable(Html* h, const Certificate& c) {
 
 void NoiseTable(Html* h, const NoiseSection& noise) {
   h->Open("table").Open("thead");
-  Row(h, {"axis", "ARW, deg/sqrt(h)", "bias instability, deg/h", "points"}, "th");
+  Row(h, {"axis", "ARW, deg/sqrt(h)", "bias instability, deg/h", "taus fitted"}, "th");
   h->Close("thead").Open("tbody");
   for (const NoiseAxis& a : noise.axes) {
     h->Open("tr").Element("td", "gyro_" + a.axis);
@@ -477,14 +529,14 @@ void NoiseTable(Html* h, const NoiseSection& noise) {
       continue;
     }
     if (a.arw_resolved) {
-      Num(h, Fmt("%.4g", a.arw_deg_per_sqrt_hr) + " \xc2\xb1 " + Fmt("%.2g", a.arw_sigma),
+      Num(h, Fmt("%.3g", a.arw_deg_per_sqrt_hr) + " \xc2\xb1 " + Fmt("%.2g", a.arw_sigma),
           {{"data-figure", "gyro_arw_deg_per_sqrt_hr." + a.axis},
            {"data-value", FormatDouble(a.arw_deg_per_sqrt_hr)}});
     } else {
       Num(h, "not resolved", {{"data-figure", "gyro_arw_deg_per_sqrt_hr." + a.axis}, {"data-value", "nan"}});
     }
     if (a.bias_instability_resolved) {
-      Num(h, Fmt("%.4g", a.bias_instability_dph) + " \xc2\xb1 " + Fmt("%.2g", a.bias_instability_sigma),
+      Num(h, Fmt("%.3g", a.bias_instability_dph) + " \xc2\xb1 " + Fmt("%.2g", a.bias_instability_sigma),
           {{"data-figure", "gyro_bias_instability_dph." + a.axis},
            {"data-value", FormatDouble(a.bias_instability_dph)}});
     } else {
@@ -524,12 +576,11 @@ void Validation(Html* h, const Certificate& c) {
   h->Close("tbody").Close("table");
   for (const ValidationRow& v : c.validation) {
     if (!v.fitted || !v.order_lowered) continue;
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "Without %.1f degC the fold is fitted at temperature order %d (gyro) / %d (accel): the "
-                  "other temperatures determine no more.",
-                  v.temp_c, v.gyro_temp_order, v.accel_temp_order);
-    h->Element("p", text, {{"class", "note"}});
+    h->Element("p",
+               "Without " + Fmt("%.1f", v.temp_c) + " degC the fold is fitted at temperature order " +
+                   Count(v.gyro_temp_order) + " (gyro) / " + Count(v.accel_temp_order) +
+                   " (accel): the other temperatures determine no more.",
+               {{"class", "note"}});
   }
   h->Close("div");
 }
@@ -538,7 +589,9 @@ void Validation(Html* h, const Certificate& c) {
 
 std::vector<PlotFigure> CertificatePlots(const Certificate& c) {
   std::vector<PlotFigure> figures;
-  for (const CoefficientGroup& g : c.curves) figures.push_back(CoefficientFigure(g));
+  if (!OneTemperature(c)) {
+    for (const CoefficientGroup& g : c.curves) figures.push_back(CoefficientFigure(g));
+  }
   figures.push_back(ErrorFigure(c));
   if (c.noise.computed) figures.push_back(AllanFigure(c.noise));
   return figures;
@@ -568,8 +621,9 @@ std::string CertificateHtml(const Certificate& c) {
   KeyFigures(&h, c);
 
   // Coefficients against temperature, two to a row (the heading stays with the first row), then
-  // the g-sensitivity grid. Figure i of CertificatePlots() is group i.
-  const size_t groups = c.curves.size();
+  // the g-sensitivity grid. Figure i of CertificatePlots() is group i; at one temperature there are
+  // none, and the errors are figure 0.
+  const size_t groups = OneTemperature(c) ? 0 : c.curves.size();
   std::vector<std::vector<size_t>> rows;
   size_t grid = groups;
   for (size_t g = 0; g < groups; ++g) {
@@ -586,11 +640,21 @@ std::string CertificateHtml(const Certificate& c) {
     h.Close("div");
   };
   h.Open("div", {{"class", "keep"}}).Element("h2", "Coefficients against temperature");
-  h.Element("p",
-            "Lines: the fitted polynomial; bands: its 1-sigma (each term's own, correlations not drawn); "
-            "circles: each window's own estimate (the coefficient that explains that window, all others as "
-            "fitted) with its noise as 1-sigma bars.",
-            {{"class", "note"}});
+  if (OneTemperature(c)) {
+    h.Element(
+        "p",
+        "The run was at one temperature" +
+            (c.run.temperatures_c.empty() ? std::string() : Fmt(" (%g degC)", c.run.temperatures_c[0])) +
+            ": every coefficient is a constant, stated under \"Coefficients at 25 degC\"; there is no "
+            "curve to draw.",
+        {{"class", "note"}});
+  } else {
+    h.Element("p",
+              "Lines: the fitted polynomial; bands: its 1-sigma (each term's own, correlations not drawn); "
+              "circles: each window's own estimate (the coefficient that explains that window, all others as "
+              "fitted) with its noise as 1-sigma bars.",
+              {{"class", "note"}});
+  }
   if (!failure.empty()) {
     Plots(&h, svgs, 0, 0, failure);
   } else if (!rows.empty()) {
@@ -614,14 +678,22 @@ std::string CertificateHtml(const Certificate& c) {
   if (!c.noise.computed) {
     h.Element("p", "Not drawn: " + c.noise.why_not + ".", {{"class", "note"}});
   } else {
+    h.Element(
+        "p",
+        "Segment " + Count(c.noise.segment) + ", " + Fmt("%.0f s", c.noise.duration_s) + " at " +
+            Fmt("%.1f degC", c.noise.temp_c) +
+            ": the raw outputs over the scale factor at that temperature. Bars: 68 % confidence; "
+            "lines: the IEEE 952 fit (solid) and its terms (dashed). ARW is read on the -1/2 line at "
+            "\xcf\x84 = 1 s (the large dot), bias instability B at the fit's floor 0.664 B (a diamond).",
+        {{"class", "note"}});
     Plots(&h, svgs, groups + 1, groups + 2, failure);
     NoiseTable(&h, c.noise);
   }
   h.Close("div");
   Validation(&h, c);
   h.Element("p",
-            "Units: deg/s and mg at 25 degC; 1 g = 9.80665 m/s\xc2\xb2. Coefficient model and file format: "
-            "docs/spec.md; conversions: docs/factory.md.",
+            "Units: angular rate in deg/s, specific force in mg (1 g = 9.80665 m/s\xc2\xb2); key figures at "
+            "25 degC. Coefficient model and file format: docs/spec.md; conversions: docs/factory.md.",
             {{"class", "note"}});
   h.Close("body").Close("html");
   return h.Finish();
@@ -635,9 +707,13 @@ void WriteCertificate(const std::string& path, const Certificate& certificate) {
 
 namespace {
 
-constexpr int kMaxCategoryLabels = 40;      // unit or lot names under a plot; more are thinned out
-constexpr int kPlotWidthChars = 64;         // characters of tick labels side by side under a small plot
-constexpr int kSmallPlotWidthPx = 540;      // two to a row on the page: text stays legible when scaled
+// The lot page's plots are drawn at the size they print, as the certificate's (kHalfWidthPx two to
+// a row, kFullWidthPx across): drawn wider, the browser shrinks them, and their 10 pt labels print at
+// 6 pt. Names under a plot: at most this many (more are thinned out), upright when they would not
+// fit side by side in the characters of 10 pt text a panel has room for.
+constexpr int kMaxCategoryLabels = 24;
+constexpr int kHalfWidthChars = 40, kFullWidthChars = 80;
+constexpr int kStripHeightPx = 180, kStripUprightHeightPx = 215;  // upright names need more room
 constexpr size_t kMaxBarNotes = 24;         // yields printed on their bars up to this many lots
 constexpr double kNoteInsideBarPct = 15.0;  // a yield note goes inside its bar from this yield up
 const char* kHighlight = "#ff7f0e";         // this lot, an outlier's ring
@@ -669,8 +745,19 @@ void LimitLines(const std::optional<LimitInterval>& limits, const FigureView& vi
     plot->markers.push_back({*limits->lower, Fmt("%g", *limits->lower), kFailRed});
   if (limits->upper && view.upper_in_view)
     plot->markers.push_back({*limits->upper, Fmt("%g", *limits->upper), kFailRed});
-  if ((limits->lower && !view.lower_in_view) || (limits->upper && !view.upper_in_view))
+  // The sides off scale, in words: both ("limit |value| < 5 beyond this scale"), or the one that is
+  // not drawn (a symmetric limit with its other side drawn is not "beyond this scale").
+  const bool lower_drawn = limits->lower && view.lower_in_view,
+             upper_drawn = limits->upper && view.upper_in_view;
+  const bool lower_off = limits->lower && !lower_drawn, upper_off = limits->upper && !upper_drawn;
+  if (!lower_off && !upper_off) return;
+  if (!lower_drawn && !upper_drawn) {
     plot->x_label += "; limit " + LimitsText(limits) + " beyond this scale";
+  } else if (upper_off) {
+    plot->x_label += "; upper limit " + Fmt("%g", *limits->upper) + " above this scale";
+  } else {
+    plot->x_label += "; lower limit " + Fmt("%g", *limits->lower) + " below this scale";
+  }
 }
 
 void NiceY(const FigureView& view, Plot* plot) {
@@ -680,15 +767,20 @@ void NiceY(const FigureView& view, Plot* plot) {
   plot->y_format = y.format;
 }
 
-void CategoryX(const std::vector<std::string>& labels, Plot* plot) {
-  const CategoryAxis axis = CategoryTics(labels, kMaxCategoryLabels, kPlotWidthChars);
+void CategoryX(const std::vector<std::string>& labels, int width_chars, Plot* plot) {
+  const CategoryAxis axis = CategoryTics(labels, kMaxCategoryLabels, width_chars);
   plot->x_tics = axis.tics;
   plot->x_tic_rotate_deg = axis.rotate_deg;
   plot->x_range = axis.range;
 }
 
-std::string Capabilities(const std::optional<double>& ppk, const std::optional<double>& cpk) {
-  return (ppk ? Fmt(", Ppk %.3g", *ppk) : "") + (cpk ? Fmt(", Cpk %.3g", *cpk) : "");
+// "gyro_bias_dps.x: Ppk 1.8, Cpk 2.1": the panel is half a page wide, the mean and sigma are in the
+// table above it.
+std::string StripTitle(const LotFigure& f) {
+  std::string title = f.name;
+  if (f.ppk) title += Fmt(": Ppk %.3g", *f.ppk);
+  if (f.cpk) title += Fmt(f.ppk ? ", Cpk %.3g" : ": Cpk %.3g", *f.cpk);
+  return title;
 }
 
 // A strip plot of one figure over the lot: a point per unit at its row, the limits, the mean and
@@ -697,11 +789,10 @@ std::string Capabilities(const std::optional<double>& ppk, const std::optional<d
 PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
   std::vector<std::string> labels;
   for (const LotUnitRow& r : lot.rows) labels.push_back(r.label);
-  Plot plot = Panel(f.name + ": mean " + Fmt("%.6g", f.mean) + ", \xcf\x83 " + Fmt("%.2g", f.stdev) +
-                        Capabilities(f.ppk, f.cpk),
-                    lot.unit_prefix.empty() ? "unit" : "unit (" + lot.unit_prefix + "\xe2\x80\xa6)", f.unit);
+  Plot plot =
+      Panel(StripTitle(f), lot.unit_prefix.empty() ? "unit" : lot.unit_prefix + "\xe2\x80\xa6", f.unit);
   plot.key = false;
-  CategoryX(labels, &plot);
+  CategoryX(labels, kHalfWidthChars, &plot);
   NiceY(f.view, &plot);
   PlotSeries normal = Series(PlotSeries::Style::kPoints, "", 0, {}, {});
   PlotSeries failed_elsewhere = normal, failed_here = normal, outlier = normal;
@@ -732,7 +823,7 @@ PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
     plot.markers.push_back({f.three_sigma[1], "+3\xcf\x83", kSigmaGrey, false, 3});
   }
   LimitLines(f.limits, f.view, &plot);
-  return OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230);
+  return OnePanel(plot, kHalfWidthPx, plot.x_tic_rotate_deg ? kStripUprightHeightPx : kStripHeightPx);
 }
 
 // The lots of a results store: their yields as a table and bars, then the key figures' lot means;
@@ -765,6 +856,11 @@ void AcrossLots(Html* h, const LotHistory& history, const std::vector<Svg>& svgs
   Plots(h, svgs, first, first + 1, failure);
   h->Close("div");
   h->Element("h3", "Key figures across lots");
+  if (history.lots.size() < 2) {
+    h->Element("p", "Only this lot is in the results store: there is no other lot to compare it with yet.",
+               {{"class", "note"}});
+    return;
+  }
   Plots(h, svgs, first + 1, svgs.size(), failure, "plots2");
 }
 
@@ -792,7 +888,7 @@ std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
   std::vector<PlotFigure> figures;
   Plot yield = Panel("Yield per lot (units that passed their limits)", "lot", "yield, %");
   yield.key = false;
-  CategoryX(names, &yield);
+  CategoryX(names, kFullWidthChars, &yield);
   yield.y_range = std::array<double, 2>{0.0, 100.0};
   yield.y_tic_step = 20.0;
   yield.y_format = "%.0f";
@@ -816,11 +912,12 @@ std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
     }
   }
   yield.series = {others, current};
-  figures.push_back(OnePanel(yield, 900, yield.x_tic_rotate_deg ? 300 : 240));
+  figures.push_back(OnePanel(yield, kFullWidthPx, yield.x_tic_rotate_deg ? 260 : 210));
+  if (history.lots.size() < 2) return figures;  // one lot: no trend to draw (AcrossLots says so)
   for (const LotTrend& t : history.trends) {
-    Plot plot = Panel(t.name + ": lot mean \xc2\xb1 1 \xcf\x83 of its units", "lot", t.unit);
+    Plot plot = Panel(t.name + ": lot mean \xc2\xb1 1\xcf\x83", "lot", t.unit);
     plot.key = false;
-    CategoryX(names, &plot);
+    CategoryX(names, kHalfWidthChars, &plot);
     NiceY(t.view, &plot);
     PlotSeries lots = Series(PlotSeries::Style::kErrorBars, "", 0, {}, {});
     lots.point_size = 0.8;
@@ -836,7 +933,8 @@ std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history) {
     }
     plot.series = {lots, this_lot};
     LimitLines(t.limits, t.view, &plot);
-    figures.push_back(OnePanel(plot, kSmallPlotWidthPx, plot.x_tic_rotate_deg ? 290 : 230));
+    figures.push_back(
+        OnePanel(plot, kHalfWidthPx, plot.x_tic_rotate_deg ? kStripUprightHeightPx : kStripHeightPx));
   }
   return figures;
 }

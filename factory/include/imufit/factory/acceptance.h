@@ -38,6 +38,9 @@ struct CriterionResult {
   double margin = 0.0;  // limit - |measured| (coverage: degC to spare at the tighter end); >= 0 passes
   std::string measured_text;
   std::string limit_text;
+  // The margin with its unit ("0.0207 deg/s/g", "20 degC"; coverage: "1 segment", segments to spare);
+  // "none" when the value is not in the calibration (there is nothing to measure a margin from).
+  std::string margin_text;
   bool pass = false;
 };
 

@@ -25,6 +25,7 @@
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/station.h"
+#include "imufit/noise/column_analysis.h"
 #include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
@@ -62,6 +63,9 @@ struct CertificateSources {
 struct KeyFigureRow {
   std::string name;  // e.g. "gyro_bias_dps.x"
   std::string unit;
+  // A coefficient of the model (signed: printed with its sign); else a quantity that cannot be
+  // negative (a residual RMS, a noise figure, segments missing).
+  bool is_coefficient = false;
   double value = 0.0;
   double sigma = -1.0;     // 1-sigma; < 0: none
   double expanded = -1.0;  // k = 2; < 0: none
@@ -133,8 +137,6 @@ struct NoiseAxis {
   double bias_instability_dph = 0.0, bias_instability_sigma = 0.0;
   bool bias_instability_resolved = false;
   int points = 0;
-  std::vector<double> tau_s, dev_dph;          // the measured overlapping Allan deviation, deg/h
-  std::vector<double> model_tau_s, model_dph;  // the fitted IEEE 952 model
 };
 struct NoiseSection {
   bool computed = false;
@@ -143,6 +145,9 @@ struct NoiseSection {
   double duration_s = 0.0;
   double temp_c = 0.0;
   std::vector<NoiseAxis> axes;
+  // Per gyro axis ("gyro_x", ...), in rad/s: the overlapping Allan deviation and its IEEE 952 fit
+  // as `imufit allan` computes them, drawn by the same plot (allan_plot.h) in deg/h.
+  std::vector<ColumnAnalysis> columns;
 };
 
 struct ValidationRow {
@@ -159,7 +164,10 @@ struct ValidationRow {
 // The fit's settings and diagnostics, from the calibration's `fit:` block (known = false without).
 struct FitSettings {
   bool known = false;
-  std::string loss, termination;
+  std::string loss;
+  // Why the solver stopped: the first sentence of Ceres's message ("Function tolerance reached.");
+  // the tolerances it quotes after it are in the calibration's `fit:` block.
+  std::string termination;
   int iterations = 0, windows_used = 0, windows_downweighted = 0;
   int gyro_temp_order = 3, accel_temp_order = 3;
   bool g_sensitivity_fitted = true;
@@ -170,8 +178,11 @@ struct FitSettings {
 
 struct RunSummary {
   std::string plan_path;
-  int segments = 0, static_segments = 0;
-  std::vector<double> rates_dps;  // distinct |rate| of the rate segments
+  int segments = 0, static_segments = 0, turn_segments = 0;
+  std::vector<double> rates_dps;        // distinct |rate| of the rate segments
+  std::vector<double> turn_angles_deg;  // distinct |angle| of the turns
+  // Plan segments with no usable window in the run (never visited, or every visit too short).
+  std::vector<int> segments_without_windows;
   double gravity_mps2 = 0.0;
   std::optional<double> latitude_deg;
   long long samples = 0;

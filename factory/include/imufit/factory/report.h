@@ -17,6 +17,11 @@
 
 namespace imufit {
 
+// `value` through a printf format of one number (text around the conversion allowed). A value that
+// prints as zero prints without a sign: a held-out temperature of -0.02 degC through "%.1f" is
+// "0.0", not "-0.0", and 0 through "%+g" is "0", not "+0" (zero is on neither side).
+std::string FormatNumber(const char* format, double value);
+
 // The plots of a certificate, in page order (coefficients against temperature, residuals,
 // temperature against time, histogram, Allan deviation).
 std::vector<PlotFigure> CertificatePlots(const Certificate& certificate);
@@ -26,8 +31,8 @@ void WriteCertificate(const std::string& path, const Certificate& certificate);
 
 // The lot page's strip plots, one per key figure: a point per unit, the limits, mean and 3 sigma.
 std::vector<PlotFigure> LotPlots(const LotSummary& lot);
-// Across lots: the yield per lot (bars, this lot highlighted), then per trend figure the lots'
-// means with their sigma.
+// Across lots: the yield per lot (bars, this lot highlighted), then, from two lots on, per trend
+// figure the lots' means with their sigma.
 std::vector<PlotFigure> LotHistoryPlots(const LotHistory& history);
 std::string LotPageHtml(const LotSummary& lot);
 // The lots of a results store on a page of their own (`imufit history DB --lot --html`).
