@@ -27,6 +27,8 @@ double Resultant(const std::vector<double>& time_s, double interval_s, double* p
 
 }  // namespace
 
+void SampleClock::ResetLine() { weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0; }
+
 void SampleClock::Update(double slot, double time_s) {
   // Exponentially weighted Welford update: W = l W + 1, mean += d / W, C = l C + d_k (t - mean_t).
   constexpr double kDecay = 1.0 - 1.0 / kMemory;
@@ -68,7 +70,7 @@ void SampleClock::Acquire() {
     // Slots from the grid, then the line through them; the first stamp's slot is 0.
     const double start_s = t.front() + best_s * phase / (2.0 * M_PI);
     const double first = std::round((t.front() - start_s) / best_s);
-    weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0;
+    ResetLine();
     double previous = -1.0;
     locked_ = true;
     for (double time_s : t) {
@@ -79,7 +81,7 @@ void SampleClock::Acquire() {
     }
   }
   if (!locked_) {  // one slot a stamp, as placed provisionally
-    weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0;
+    ResetLine();
     for (size_t i = 0; i < t.size(); ++i) Update(static_cast<double>(i), t[i]);
   }
   acquiring_.clear();
@@ -89,7 +91,7 @@ void SampleClock::Acquire() {
 long long SampleClock::Place(double time_s) {
   if (!acquired_) {
     // Provisionally one slot after the last; the line through them for interval_s() meanwhile.
-    if (acquiring_.empty()) weight_ = mean_slot_ = mean_time_s_ = slot_variance_ = covariance_ = 0.0;
+    if (acquiring_.empty()) ResetLine();
     acquiring_.push_back(time_s);
     Update(static_cast<double>(acquiring_.size() - 1), time_s);
     on_grid_ = true;
@@ -172,12 +174,12 @@ void WindowBuilder::Add(const Sample& sample) {
     stats_.min_temp_c = stats_.max_temp_c = sample.temp_c;
     stats_.first_time_s = sample.time_s;
   }
-  // The sample's slot on the run's time grid; empty slots before it are lost samples.
-  slot_ += clock_.Place(sample.time_s);
-  const long long lost = stats_.samples == 0 ? 0 : slot_ - previous_slot_ - 1;
-  const long long slot = slot_;
+  // The sample's slot on the run's time grid; the empty slots it skips are lost samples (the first
+  // stamp's step is 1).
+  const long long step = clock_.Place(sample.time_s);
+  slot_ += step;
+  const long long lost = step - 1;
   const double gap_s = static_cast<double>(lost) * clock_.interval_s();
-  previous_slot_ = slot;
   if (!clock_.on_grid()) ++stats_.off_grid_samples;
   if (lost > 0) {
     stats_.lost_samples += lost;
@@ -268,7 +270,7 @@ void WindowBuilder::Add(const Sample& sample) {
   previous_[0] = previous_[1];
   previous_[1] = value;
   if (whole_occurrence_) {
-    turn_slots_.push_back(slot);
+    turn_slots_.push_back(slot_);
     turn_values_.push_back(value);
   }
 }

@@ -190,6 +190,7 @@ class SampleClock {
  private:
   void Acquire();
   void Update(double slot, double time_s);
+  void ResetLine();
 
   std::vector<double> acquiring_;  // stamps since the last (re)acquisition began
   bool acquired_ = false;
@@ -245,8 +246,7 @@ class WindowBuilder {
   Eigen::Matrix<double, 6, 1> previous_[2];
   Eigen::Matrix<double, 6, 1> second_difference_sum_ = Eigen::Matrix<double, 6, 1>::Zero();
   SampleClock clock_;
-  long long slot_ = -1;          // the run's sample's slot: its clock's steps summed
-  long long previous_slot_ = 0;  // of the run's sample before
+  long long slot_ = -1;  // the last sample's slot: its clock's steps summed
   long long lost_ = 0;           // empty slots in the open window
   double longest_gap_s_ = 0.0;
   bool off_grid_ = false;  // a stamp of the open window was off the grid
