@@ -8,7 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
-#include "imufit/fit/segmentation.h"
+#include "imufit/run/segmentation.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 

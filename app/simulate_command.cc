@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "commands.h"
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "imufit/fit/simulator.h"
-#include "imufit/fit/windows.h"
+#include "imufit/sim/simulator.h"
+#include "imufit/run/windows.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"

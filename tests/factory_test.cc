@@ -21,7 +21,7 @@
 #include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"

@@ -7,11 +7,11 @@
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/fit/validation.h"
 #include "imufit/fit/window_cost.h"
-#include "imufit/fit/windows.h"
+#include "imufit/run/windows.h"
 #include "test_models.h"
 
 namespace imufit {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"

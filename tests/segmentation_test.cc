@@ -14,8 +14,8 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
-#include "imufit/fit/segmentation.h"
-#include "imufit/fit/simulator.h"
+#include "imufit/run/segmentation.h"
+#include "imufit/sim/simulator.h"
 #include "test_models.h"
 
 namespace imufit {

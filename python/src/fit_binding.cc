@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "binding.h"
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/io/plan.h"
 #include "imufit/pipeline/fit_run.h"
 

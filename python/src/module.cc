@@ -2,7 +2,7 @@
 #include <exception>
 
 #include "binding.h"
-#include "imufit/fit/segmentation.h"
+#include "imufit/run/segmentation.h"
 #include "imufit/io/error.h"
 #include "imufit/model/sensor_model.h"
 

@@ -38,7 +38,7 @@
 #include <string>
 #include <vector>
 
-#include "imufit/fit/windows.h"
+#include "imufit/run/windows.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "imufit/fit/thermal_fit.h"
-#include "imufit/fit/windows.h"
+#include "imufit/run/windows.h"
 
 namespace imufit {
 

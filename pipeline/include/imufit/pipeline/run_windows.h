@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "imufit/fit/segmentation.h"
-#include "imufit/fit/windows.h"
+#include "imufit/run/segmentation.h"
+#include "imufit/run/windows.h"
 #include "imufit/io/plan.h"
 #include "imufit/pipeline/segment_run.h"
 

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "imufit/fit/segmentation.h"
+#include "imufit/run/segmentation.h"
 #include "imufit/io/plan.h"
 
 namespace imufit {

@@ -1,4 +1,4 @@
-#include "imufit/fit/windows.h"
+#include "imufit/run/windows.h"
 
 #include <algorithm>
 #include <cmath>

@@ -43,8 +43,8 @@
 // Gyro rest is told from a rate by the gyro offset from the nearest rest before, against half the
 // smallest plan rate in raw units (the raw scale estimated from the largest offset of the run and
 // the largest plan rate); in a plan without rate segments every steady piece is a rest.
-#ifndef IMUFIT_FIT_SEGMENTATION_H_
-#define IMUFIT_FIT_SEGMENTATION_H_
+#ifndef IMUFIT_RUN_SEGMENTATION_H_
+#define IMUFIT_RUN_SEGMENTATION_H_
 
 #include <stdexcept>
 #include <string>
@@ -195,4 +195,4 @@ std::string SegmentationReport(const Segmentation& segmentation);
 
 }  // namespace imufit
 
-#endif  // IMUFIT_FIT_SEGMENTATION_H_
+#endif  // IMUFIT_RUN_SEGMENTATION_H_

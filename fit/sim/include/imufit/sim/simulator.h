@@ -23,8 +23,8 @@
 // vertical spins at its rate from the start of the dwell. In both, world-fixed directions turn in
 // the body frame exactly (up_b(t) = R(n, -angle(t)) up): gravity, the vertical Earth rate and
 // the g-sensitivity term follow the orientation sample by sample.
-#ifndef IMUFIT_FIT_SIMULATOR_H_
-#define IMUFIT_FIT_SIMULATOR_H_
+#ifndef IMUFIT_SIM_SIMULATOR_H_
+#define IMUFIT_SIM_SIMULATOR_H_
 
 #include <cstdint>
 #include <functional>
@@ -93,4 +93,4 @@ void SimulateRun(const SimulationOptions& options, const TableSite& site,
 
 }  // namespace imufit
 
-#endif  // IMUFIT_FIT_SIMULATOR_H_
+#endif  // IMUFIT_SIM_SIMULATOR_H_

@@ -36,8 +36,8 @@
 // derivative times dt^2.
 //
 // Units: whatever the samples carry (raw for a fit, SI for a check of a corrected run).
-#ifndef IMUFIT_FIT_WINDOWS_H_
-#define IMUFIT_FIT_WINDOWS_H_
+#ifndef IMUFIT_RUN_WINDOWS_H_
+#define IMUFIT_RUN_WINDOWS_H_
 
 #include <cmath>
 #include <string>
@@ -263,4 +263,4 @@ class WindowBuilder {
 
 }  // namespace imufit
 
-#endif  // IMUFIT_FIT_WINDOWS_H_
+#endif  // IMUFIT_RUN_WINDOWS_H_

@@ -1,4 +1,4 @@
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 
 #include <algorithm>
 #include <cmath>

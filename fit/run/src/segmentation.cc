@@ -1,4 +1,4 @@
-#include "imufit/fit/segmentation.h"
+#include "imufit/run/segmentation.h"
 
 #include <algorithm>
 #include <cmath>
