@@ -551,16 +551,10 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     sensor->loss = new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP);
     for (size_t w = 0; w < sensor->windows.size(); ++w) {
       const FitWindow& fw = sensor->windows[w];
-      ceres::CostFunction* cost = nullptr;
-      if (sensor == &gyro) {
-        cost = new ceres::AutoDiffCostFunction<WindowCost<kGyroParameters>, 3, kGyroParameters>(
-            new WindowCost<kGyroParameters>(RawFor(fw, true), TruthFor(fw, true), fw.truth.a_mps2, fw.x,
-                                            sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
-      } else {
-        cost = new ceres::AutoDiffCostFunction<WindowCost<kAccelParameters>, 3, kAccelParameters>(
-            new WindowCost<kAccelParameters>(RawFor(fw, false), TruthFor(fw, false), fw.truth.a_mps2, fw.x,
-                                             sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
-      }
+      const bool is_gyro = sensor == &gyro;
+      const auto create = is_gyro ? &WindowCost<kGyroParameters>::Create : &WindowCost<kAccelParameters>::Create;
+      ceres::CostFunction* cost = create(RawFor(fw, is_gyro), TruthFor(fw, is_gyro), fw.truth.a_mps2, fw.x,
+                                         sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data());
       sensor->blocks.push_back(problem.AddResidualBlock(cost, sensor->loss, sensor->q.data()));
     }
     if (static_cast<int>(sensor->held.size()) == sensor->parameters) {
