@@ -232,13 +232,14 @@ void SetSteps(SensorProblem* sensor) {
   }
 }
 
-// Window noise: the noise of the raw mean (the weights, fixed: they do not move with the
-// parameters), floored, and the same in SI at the start's scale factor (for reports and the
-// bias-stability covariance).
-void SetSigmas(bool gyro, SensorProblem* sensor) {
+// The first of the two noise figures of each window, set before the start: the weights. The noise
+// of the window's raw mean (windows.h), per axis, floored at kSigmaFloorFraction of the sensor's
+// median window noise. They are in raw units, so they do not move with the parameters: the
+// closed-form start weighs its least squares with them and the cost (window_cost.h) divides by
+// them.
+void SetWeightsForStart(bool gyro, SensorProblem* sensor) {
   const size_t count = sensor->windows.size();
   sensor->sigma_raw.assign(count, Eigen::Vector3d::Ones());
-  sensor->sigma.assign(count, Eigen::Vector3d::Ones());
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<double> values;
     for (size_t w = 0; w < count; ++w) {
@@ -246,12 +247,24 @@ void SetSigmas(bool gyro, SensorProblem* sensor) {
       values.push_back(sensor->sigma_raw[w](axis));
     }
     const double floor = kSigmaFloorFraction * Median(values);
-    const double scale =
-        std::abs(sensor->p0.empty() ? 1.0 : sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
     for (size_t w = 0; w < count; ++w) {
       double& s = sensor->sigma_raw[w](axis);
       s = floor > 0.0 ? std::max(s, floor) : 1.0;
-      sensor->sigma[w](axis) = s / (scale > 0.0 ? scale : 1.0);
+    }
+  }
+}
+
+// The second, set from the start once it is final: the weights in SI, sigma = sigma_raw / |S0|
+// with S0 the start's constant scale factor of the axis (the SI noise to first order). The
+// residuals are reported with them and the bias-stability covariance converts SI offsets to
+// normalised residuals with them; they stay fixed while the solver moves the scale.
+void SetSiSigmasFromStart(SensorProblem* sensor) {
+  const size_t count = sensor->windows.size();
+  sensor->sigma.assign(count, Eigen::Vector3d::Ones());
+  for (int axis = 0; axis < 3; ++axis) {
+    const double scale = std::abs(sensor->p0[(kScaleCoefficient + axis) * kPolynomialTerms]);
+    for (size_t w = 0; w < count; ++w) {
+      sensor->sigma[w](axis) = sensor->sigma_raw[w](axis) / (scale > 0.0 ? scale : 1.0);
     }
   }
 }
@@ -512,14 +525,13 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
         gyro.window_index.push_back(static_cast<int>(w));
       }
     }
-    SetSigmas(is_gyro, sensor);
+    SetWeightsForStart(is_gyro, sensor);
     const SensorFit mode = is_gyro ? options.gyro_fit : options.accel_fit;
     const std::vector<double> held = HeldParameters(options, is_gyro, basis);
     if (mode == SensorFit::kAll) {
       LinearStart(sensor->windows, is_gyro, sensor);
     } else {
       sensor->p0 = held;
-      SetSigmas(is_gyro, sensor);  // the weights at the held scale
       if (mode == SensorFit::kBias) BiasStart(sensor->windows, is_gyro, sensor);
     }
     if (!options.closed_form_start) {
@@ -534,7 +546,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     for (int i = 0; i < sensor->parameters; ++i) {
       if (!options.Fits(is_gyro, i / kPolynomialTerms)) sensor->p0[i] = held[i];
     }
-    SetSigmas(is_gyro, sensor);  // the SI figures at the start's scale
+    SetSiSigmasFromStart(sensor);
     SetSteps(sensor);
     sensor->q.assign(sensor->parameters, 0.0);
     for (int c = 0; c < sensor->coefficients; ++c) {
@@ -551,16 +563,11 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
     sensor->loss = new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP);
     for (size_t w = 0; w < sensor->windows.size(); ++w) {
       const FitWindow& fw = sensor->windows[w];
-      ceres::CostFunction* cost = nullptr;
-      if (sensor == &gyro) {
-        cost = new ceres::AutoDiffCostFunction<WindowCost<kGyroParameters>, 3, kGyroParameters>(
-            new WindowCost<kGyroParameters>(RawFor(fw, true), TruthFor(fw, true), fw.truth.a_mps2, fw.x,
-                                            sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
-      } else {
-        cost = new ceres::AutoDiffCostFunction<WindowCost<kAccelParameters>, 3, kAccelParameters>(
-            new WindowCost<kAccelParameters>(RawFor(fw, false), TruthFor(fw, false), fw.truth.a_mps2, fw.x,
-                                             sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data()));
-      }
+      const bool is_gyro = sensor == &gyro;
+      const auto create =
+          is_gyro ? &WindowCost<kGyroParameters>::Create : &WindowCost<kAccelParameters>::Create;
+      ceres::CostFunction* cost = create(RawFor(fw, is_gyro), TruthFor(fw, is_gyro), fw.truth.a_mps2, fw.x,
+                                         sensor->sigma_raw[w], sensor->p0.data(), sensor->step.data());
       sensor->blocks.push_back(problem.AddResidualBlock(cost, sensor->loss, sensor->q.data()));
     }
     if (static_cast<int>(sensor->held.size()) == sensor->parameters) {

@@ -17,12 +17,15 @@
 //
 // with p the model's parameters in the fit's temperature basis (layout of sensor_model.h), p0
 // the closed-form start and `step` a per-parameter magnitude, so every q is O(1).
-// Header-only so that tests can instantiate it with ceres::Jet and with double.
+// Header-only so that tests can instantiate it with ceres::Jet and with double; Create() gives
+// the fit its autodiff cost, the way Ceres's examples build theirs.
 #ifndef IMUFIT_FIT_WINDOW_COST_H_
 #define IMUFIT_FIT_WINDOW_COST_H_
 
+#include <algorithm>
 #include <array>
 
+#include <ceres/autodiff_cost_function.h>
 #include <Eigen/Core>
 
 #include "imufit/model/sensor_model.h"
@@ -43,6 +46,15 @@ class WindowCost {
       : raw_mean_(raw_mean), truth_(truth), a_true_(a_true), x_(x), inverse_sigma_(sigma_raw.cwiseInverse()) {
     std::copy(p0, p0 + kParameters, p0_.begin());
     std::copy(step, step + kParameters, step_.begin());
+  }
+
+  // The window's cost for the solver: 3 residuals over one parameter block, q (kParameters). The
+  // arguments are the constructor's; the caller (the ceres::Problem) owns the result.
+  static ceres::CostFunction* Create(const Eigen::Vector3d& raw_mean, const Eigen::Vector3d& truth,
+                                     const Eigen::Vector3d& a_true, double x,
+                                     const Eigen::Vector3d& sigma_raw, const double* p0, const double* step) {
+    return new ceres::AutoDiffCostFunction<WindowCost, 3, kParameters>(
+        new WindowCost(raw_mean, truth, a_true, x, sigma_raw, p0, step));
   }
 
   template <typename T>
