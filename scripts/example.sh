@@ -24,22 +24,9 @@ imufit_say "simulating a soak at -35, -10, 25, 55, 80 degC (fixtures/plan_6pos.y
   --gyro-noise-density 8.7e-5 --gyro-bias-instability 2.4e-5 --accel-noise-density 1.5e-3 \
   --accel-bias-instability 6e-4 --temp-noise 0.05 --quantize --seed 1
 
-# Is there a `fit` subcommand? (Ask the list: `imufit fit --help` exits 0 even without one, as
-# CLI11 answers --help before it complains about an unknown word.)
-has_command() { "$imufit" --help | awk -v name="$1" '/^Subcommands:/ { list = 1; next }
-                                                      list && $1 == name { found = 1 }
-                                                      END { exit !found }'; }
-if has_command fit && "$imufit" fit --help >/dev/null 2>&1; then
-  imufit_say "fitting the calibration (imufit fit)"
-  "$imufit" fit --plan "$fixtures/plan_6pos.yaml" --samples "$out/raw.csv" -o "$out/calibration.yaml"
-  calibration=$out/calibration.yaml
-  source_note="the fitted calibration"
-else
-  imufit_say "this imufit has no 'fit' command yet (it is being written): applying the truth calibration"
-  imufit_say "instead, so the summary shows the noise floor that a perfect fit would reach"
-  calibration=$fixtures/mems_truth.yaml
-  source_note="the truth calibration (no fit yet)"
-fi
+imufit_say "fitting the calibration (imufit fit)"
+calibration=$out/calibration.yaml
+"$imufit" fit --plan "$fixtures/plan_6pos.yaml" --samples "$out/raw.csv" -o "$calibration"
 
 imufit_say "correcting the run (imufit apply)"
 "$imufit" apply --calibration "$calibration" --samples "$out/raw.csv" -o "$out/corrected.csv"
@@ -48,7 +35,7 @@ imufit_say "correcting the run (imufit apply)"
 # steadily) show calibration errors; the per-sample RMS also holds the sensor noise. "Nominal
 # scale only" is the raw output divided by the data-sheet sensitivity (16.4 LSB per deg/s,
 # 2048 LSB per g): what one gets without a calibration.
-imufit_say "summary: corrected with $source_note, compared with the truth (transitions left out)"
+imufit_say "summary: corrected with the fitted calibration, compared with the truth (transitions left out)"
 strip() { grep -v '^#' "$1"; }
 paste -d, <(strip "$out/corrected.csv") <(strip "$out/truth.csv") <(strip "$out/raw.csv") | awk -F, '
   function abs(x) { return x < 0 ? -x : x }

@@ -9,7 +9,8 @@ IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
                      libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
                      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
-                     python3-matplotlib python3-setuptools python3-wheel python3-pip clang libfuzzer-14-dev chromium poppler-utils ccache)
+                     python3-matplotlib python3-setuptools python3-wheel python3-pip clang clang-format
+                     libfuzzer-14-dev chromium poppler-utils ccache)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {

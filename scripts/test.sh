@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite, from a fresh Debian machine: installs what is missing, then builds and runs
+# The whole test suite, from a fresh Debian machine: installs what is missing, checks that the C++
+# is formatted as .clang-format says (a few seconds, before any build), then builds and runs
 # every test with ctest twice: in a Release build (build-release/) and in a build with
 # AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/, -DIMUFIT_SANITIZE=ON); after the
 # Release tests, the Python module's tests with pytest (python/tests); at the end, when clang with
@@ -20,7 +21,27 @@ run_suite() {  # run_suite NAME DIR
   (cd "$2" && ctest --output-on-failure --timeout 900 -j "$jobs")
 }
 
+# Every tracked C/C++ file as clang-format formats it (.clang-format: Google style, 110 columns);
+# the files that are not are listed with the command that fixes them.
+check_format() {
+  if ! git -C "$IMUFIT_ROOT" rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+    imufit_say "not a git checkout: the format check is skipped"
+    return 0
+  fi
+  local files=() unformatted=()
+  mapfile -t files < <(git -C "$IMUFIT_ROOT" ls-files -- '*.cc' '*.h' '*.cpp' '*.hpp')
+  imufit_say "format: clang-format --dry-run --Werror on ${#files[@]} tracked C/C++ files ($(clang-format --version))"
+  mapfile -t unformatted < <(cd "$IMUFIT_ROOT" && clang-format --dry-run --Werror "${files[@]}" 2>&1 |
+                               sed -n 's/^\([^:]*\):[0-9]*:[0-9]*: error: .*/\1/p' | sort -u)
+  if [[ ${#unformatted[@]} -gt 0 ]]; then
+    printf '  %s\n' "${unformatted[@]}" >&2
+    imufit_die "${#unformatted[@]} of ${#files[@]} C/C++ files are not formatted as .clang-format says;" \
+      "fix them with: clang-format -i FILE... (from the top of the clone)"
+  fi
+}
+
 imufit_install_deps
+check_format
 
 imufit_say "Release build (build-release/)"
 started=$SECONDS
