@@ -11,7 +11,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
-#include "imufit/io/units.h"
+#include "imufit/factory/engineering_units.h"
 
 namespace imufit {
 namespace {
