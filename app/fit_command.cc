@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "imufit/factory/acceptance.h"
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/engineering_units.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/fit/thermal_fit.h"
@@ -47,7 +48,8 @@ std::string Format(const char* format, double value, double sigma) {
   return text;
 }
 
-// The 25 degC values a test engineer reads first, in familiar units (io/units.h), with 1-sigma.
+// The 25 degC values a test engineer reads first, in familiar units (engineering_units.h), with
+// 1-sigma.
 // Held groups (--fit) show their value and "held" instead of a sigma.
 void PrintCoefficients(const FitSummary& fit, const FitOptions& options) {
   struct Figure {

@@ -18,6 +18,7 @@
 #include "imufit/factory/acceptance.h"
 #include "imufit/factory/allan_plot.h"
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/engineering_units.h"
 #include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"

@@ -4,9 +4,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -142,8 +144,7 @@ Calibration ExampleCalibration() {
   calibration.model = testing::RandomMemsModel(42);
   SensorModel sigma = testing::RandomMemsModel(43);
   calibration.sigma = sigma;
-  calibration.extra = YAML::Node(YAML::NodeType::Map);
-  calibration.extra["fit"]["iterations"] = 7;
+  calibration.fit.emplace().iterations = 7;
   return calibration;
 }
 
@@ -162,7 +163,8 @@ TEST_F(IoTest, CalibrationRoundTripsBitExactly) {
   ASSERT_TRUE(read.sigma.has_value());
   EXPECT_EQ(read.sigma->gyro, written.sigma->gyro);
   EXPECT_EQ(read.sigma->accel, written.sigma->accel);
-  EXPECT_EQ(read.extra["fit"]["iterations"].as<int>(), 7);
+  ASSERT_TRUE(read.fit.has_value());
+  EXPECT_EQ(read.fit->iterations, 7);
   // Writing what was read gives the same text again.
   EXPECT_EQ(CalibrationToYaml(read), CalibrationToYaml(written));
 }
@@ -237,6 +239,82 @@ TEST_F(IoTest, CalibrationReaderIgnoresUnknownKeysAndHonoursReferenceTemperature
   const Calibration read = ReadCalibration(Write("cal.yaml", text));
   EXPECT_EQ(read.model.basis.center_c, 20.0);
   EXPECT_EQ(read.extra["noise"]["gyro_arw_deg_per_sqrt_hr"].as<double>(), 0.3);
+}
+
+// The fit's record: every key of the `fit:` and `check:` blocks round-trips through its typed
+// member, lists of temperatures one per line and lists of names and ids on one line, keys the
+// reader does not know kept after the others, and a value of the wrong type located at its key.
+TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
+  Calibration calibration = ExampleCalibration();
+  FitRecord& fit = *calibration.fit;
+  fit.plan = "plan.yaml";
+  fit.samples = "runs/unit 1.csv.gz";
+  fit.plan_sha256 = std::string(64, 'a');
+  fit.samples_sha256 = std::string(64, 'b');
+  fit.samples_read = 26950;
+  fit.segments_found_in_data = 8;
+  fit.plan_passes_found = 1;
+  fit.windows_used = 90;
+  fit.windows_downweighted = 2;
+  fit.distinct_temperatures_c = std::vector<double>{-40.000955338170442, 24.99948422253722};
+  fit.termination = "Function tolerance reached. |cost_change|/cost: 6.794760e-12 <= 1.000000e-10";
+  fit.gyro_residual_rms_radps = 4.0316131030556947e-05;
+  fit.accel_residual_rms_mps2 = 0.00071912390028319533;
+  fit.gyro_reduced_chi2 = std::numeric_limits<double>::quiet_NaN();
+  fit.accel_reduced_chi2 = 1.2273404099354459;
+  fit.gyro_temp_order = 3;
+  fit.accel_temp_order = 2;
+  fit.g_sensitivity_fitted = false;
+  fit.fitted = std::vector<std::string>{"gyro.bias", "accel.bias"};
+  fit.held = std::vector<std::string>{};
+  fit.held_values = "prior";
+  fit.loss = "huber";
+  fit.gyro_bias_stability_radps = 0.0;
+  fit.accel_bias_stability_mps2 = 0.00071588544999999992;
+  fit.bias_correlation_s = 100.0;
+  fit.segments_without_windows = std::vector<int>{3, 7};
+  fit.missing_segments = 2;
+  calibration.check.emplace().samples = "check.csv";
+  calibration.check->gyro_error_rms_radps = 1e-3;
+  calibration.extra = YAML::Node(YAML::NodeType::Map);
+  calibration.extra["noise"]["format"] = "imufit-noise";
+  const std::string text = CalibrationToYaml(calibration);
+  for (const char* line :
+       {"\nfit:\n  plan: plan.yaml\n  samples: runs/unit 1.csv.gz\n", "\n  distinct_temperatures_c:\n    - -40.000955338170442\n",
+        "\n  fitted: [gyro.bias, accel.bias]\n  held: []\n  held_values: prior\n", "\n  gyro_reduced_chi2: .nan\n",
+        "\n  g_sensitivity_fitted: false\n", "\n  segments_without_windows: [3, 7]\n  missing_segments: 2\ncheck:\n",
+        "\ncheck:\n  samples: check.csv\n  gyro_error_rms_radps: 0.001\nnoise:\n"}) {
+    EXPECT_NE(text.find(line), std::string::npos) << line << "\nin:\n" << text;
+  }
+  const Calibration read = ReadCalibration(Write("cal.yaml", text));
+  ASSERT_TRUE(read.fit.has_value());
+  EXPECT_EQ(read.fit->samples, fit.samples);
+  EXPECT_EQ(read.fit->samples_read, 26950);
+  EXPECT_EQ(read.fit->distinct_temperatures_c, fit.distinct_temperatures_c);
+  EXPECT_TRUE(std::isnan(*read.fit->gyro_reduced_chi2));
+  EXPECT_EQ(read.fit->accel_reduced_chi2, fit.accel_reduced_chi2);  // ==, bit for bit
+  EXPECT_EQ(read.fit->g_sensitivity_fitted, false);
+  EXPECT_EQ(read.fit->held, std::vector<std::string>{});
+  EXPECT_EQ(read.fit->segments_without_windows, (std::vector<int>{3, 7}));
+  EXPECT_FALSE(read.fit->extra.IsMap());
+  ASSERT_TRUE(read.check.has_value());
+  EXPECT_EQ(read.check->gyro_error_rms_radps, 1e-3);
+  EXPECT_FALSE(read.check->accel_error_rms_mps2.has_value());  // not written: not set
+  EXPECT_EQ(read.extra.size(), 1u);  // noise
+  EXPECT_EQ(CalibrationToYaml(read), text);
+
+  // A key of the block this reader does not know is kept, after the others.
+  std::string unknown = text;
+  unknown.insert(unknown.find("  plan: plan.yaml"), "  leave_one_out: [1, 2]\n");
+  const Calibration kept = ReadCalibration(Write("unknown.yaml", unknown));
+  ASSERT_TRUE(kept.fit->extra.IsMap());
+  EXPECT_EQ(kept.fit->extra["leave_one_out"].size(), 2u);
+  EXPECT_NE(CalibrationToYaml(kept).find("missing_segments: 2\n  leave_one_out: [1, 2]\ncheck:"), std::string::npos);
+
+  std::string wrong = text;
+  wrong.replace(wrong.find("iterations: 7"), 13, "iterations: seven");
+  const InputError e = Catch([&] { ReadCalibration(Write("wrong.yaml", wrong)); });
+  EXPECT_NE(e.message().find("fit.iterations: \"seven\" is not an integer"), std::string::npos) << e.what();
 }
 
 // ---------------------------------------------------------------- plan
@@ -677,7 +755,7 @@ TEST_F(IoTest, ManyUnknownCalibrationKeysAreKeptInLinearTime) {
   std::string text = CalibrationToYaml(ExampleCalibration());
   for (int i = 0; i < 30000; ++i) text += "k" + std::to_string(i) + ": " + std::to_string(i) + "\n";
   const Calibration read = ReadCalibration(Write("many.yaml", text));
-  EXPECT_EQ(read.extra.size(), 30001u);  // with `fit`
+  EXPECT_EQ(read.extra.size(), 30000u);  // `fit` is read into Calibration::fit
   EXPECT_EQ(read.extra["k29999"].as<int>(), 29999);
 }
 

@@ -16,18 +16,13 @@ std::string Number(double value) {
   return text;
 }
 
-double FitNumber(const Calibration& calibration, const char* key, bool* found) {
-  *found = false;
-  if (!calibration.extra || !calibration.extra.IsMap() || !calibration.extra["fit"]) return 0.0;
-  const YAML::Node node = calibration.extra["fit"][key];
-  if (!node || !node.IsScalar()) return 0.0;
-  try {
-    const double value = node.as<double>();
-    *found = value >= 0.0;
-    return value;
-  } catch (const YAML::Exception&) {
-    return 0.0;
-  }
+// A figure of the fit's record, when the calibration has one and it says (>= 0: "not run" values
+// are negative).
+std::optional<double> FitFigure(const Calibration& calibration, std::optional<double> FitRecord::*member) {
+  if (!calibration.fit) return std::nullopt;
+  const std::optional<double>& value = (*calibration.fit).*member;
+  if (!value || !(*value >= 0.0)) return std::nullopt;
+  return value;
 }
 
 }  // namespace
@@ -69,16 +64,15 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
       }
     }
   }
-  bool found = false;
-  const double gyro_rms = FitNumber(calibration, "gyro_residual_rms_radps", &found);
-  if (found)
-    figures.push_back(
-        {"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(gyro_rms), -1.0});
-  const double missing = FitNumber(calibration, "missing_segments", &found);
-  if (found) figures.push_back({"coverage", "fit.missing_segments", "segments missing", missing, -1.0});
-  const double accel_rms = FitNumber(calibration, "accel_residual_rms_mps2", &found);
-  if (found) {
-    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(accel_rms), -1.0});
+  if (const std::optional<double> rms = FitFigure(calibration, &FitRecord::gyro_residual_rms_radps)) {
+    figures.push_back({"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(*rms), -1.0});
+  }
+  if (calibration.fit && calibration.fit->missing_segments && *calibration.fit->missing_segments >= 0) {
+    figures.push_back({"coverage", "fit.missing_segments", "segments missing",
+                       static_cast<double>(*calibration.fit->missing_segments), -1.0});
+  }
+  if (const std::optional<double> rms = FitFigure(calibration, &FitRecord::accel_residual_rms_mps2)) {
+    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(*rms), -1.0});
   }
   return figures;
 }

@@ -11,7 +11,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
-#include "imufit/io/units.h"
+#include "imufit/factory/engineering_units.h"
 
 namespace imufit {
 namespace {
@@ -45,44 +45,25 @@ std::string MotionText(const TableSegment& segment) {
   return segment.axis && !segment.AxisIsVertical() ? text + (" about " + DirectionText(*segment.axis)) : text;
 }
 
-// A number from the calibration's `fit:` block, when there.
-bool FitValue(const Calibration& calibration, const char* key, double* value) {
-  if (!calibration.extra || !calibration.extra.IsMap() || !calibration.extra["fit"]) return false;
-  const YAML::Node node = calibration.extra["fit"][key];
-  if (!node || !node.IsScalar()) return false;
-  try {
-    *value = node.as<double>();
-    return true;
-  } catch (const YAML::Exception&) {
-    return false;
-  }
-}
-
-std::string FitText(const Calibration& calibration, const char* key) {
-  if (!calibration.extra || !calibration.extra.IsMap() || !calibration.extra["fit"]) return "";
-  const YAML::Node node = calibration.extra["fit"][key];
-  return node && node.IsScalar() ? node.Scalar() : "";
-}
-
 FitSettings Settings(const Calibration& calibration, const WindowOptions& windows) {
   FitSettings s;
   s.trim_s = windows.trim_s;
   s.window_temp_span_c = windows.max_temp_span_c;
-  double v = 0.0;
-  if (!FitValue(calibration, "windows_used", &v)) return s;
+  if (!calibration.fit || !calibration.fit->windows_used) return s;
+  const FitRecord& fit = *calibration.fit;
   s.known = true;
-  s.windows_used = static_cast<int>(v);
-  if (FitValue(calibration, "windows_downweighted", &v)) s.windows_downweighted = static_cast<int>(v);
-  if (FitValue(calibration, "iterations", &v)) s.iterations = static_cast<int>(v);
-  if (FitValue(calibration, "gyro_temp_order", &v)) s.gyro_temp_order = static_cast<int>(v);
-  if (FitValue(calibration, "accel_temp_order", &v)) s.accel_temp_order = static_cast<int>(v);
-  if (FitValue(calibration, "gyro_reduced_chi2", &v)) s.gyro_reduced_chi2 = v;
-  if (FitValue(calibration, "accel_reduced_chi2", &v)) s.accel_reduced_chi2 = v;
-  if (FitValue(calibration, "gyro_bias_stability_radps", &v)) s.gyro_bias_stability_dph = DphFromRadps(v);
-  if (FitValue(calibration, "accel_bias_stability_mps2", &v)) s.accel_bias_stability_ug = UgFromMps2(v);
-  s.g_sensitivity_fitted = FitText(calibration, "g_sensitivity_fitted") != "false";
-  s.loss = FitText(calibration, "loss");
-  s.termination = FitText(calibration, "termination");
+  s.windows_used = *fit.windows_used;
+  s.windows_downweighted = fit.windows_downweighted.value_or(s.windows_downweighted);
+  s.iterations = fit.iterations.value_or(s.iterations);
+  s.gyro_temp_order = fit.gyro_temp_order.value_or(s.gyro_temp_order);
+  s.accel_temp_order = fit.accel_temp_order.value_or(s.accel_temp_order);
+  s.gyro_reduced_chi2 = fit.gyro_reduced_chi2.value_or(s.gyro_reduced_chi2);
+  s.accel_reduced_chi2 = fit.accel_reduced_chi2.value_or(s.accel_reduced_chi2);
+  if (fit.gyro_bias_stability_radps) s.gyro_bias_stability_dph = DphFromRadps(*fit.gyro_bias_stability_radps);
+  if (fit.accel_bias_stability_mps2) s.accel_bias_stability_ug = UgFromMps2(*fit.accel_bias_stability_mps2);
+  s.g_sensitivity_fitted = fit.g_sensitivity_fitted.value_or(true);
+  s.loss = fit.loss.value_or("");
+  s.termination = fit.termination.value_or("");
   if (const size_t end = s.termination.find(". "); end != std::string::npos) s.termination.resize(end + 1);
   return s;
 }
@@ -622,18 +603,18 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
 std::vector<std::string> InputMismatches(const Calibration& calibration, const std::string& plan_path,
                                          const std::string& samples_path) {
   std::vector<std::string> mismatches;
-  const auto check = [&](const char* key, const char* role, const std::string& path) {
-    const std::string recorded = FitText(calibration, key);
-    if (recorded.empty() || path.empty()) return;
+  const auto check = [&](const std::optional<std::string>& recorded, const char* role, const std::string& path) {
+    if (!recorded || recorded->empty() || path.empty()) return;
     const std::string actual = Sha256OfFile(path);
-    if (actual != recorded) {
+    if (actual != *recorded) {
       mismatches.push_back(std::string("the calibration was fitted to a ") + role + " with SHA-256 " +
-                           recorded.substr(0, 16) + "..., not " + path + " (" + actual.substr(0, 16) +
+                           recorded->substr(0, 16) + "..., not " + path + " (" + actual.substr(0, 16) +
                            "...)");
     }
   };
-  check("plan_sha256", "plan", plan_path);
-  check("samples_sha256", "samples file", samples_path);
+  if (!calibration.fit) return mismatches;
+  check(calibration.fit->plan_sha256, "plan", plan_path);
+  check(calibration.fit->samples_sha256, "samples file", samples_path);
   return mismatches;
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "fit_record_yaml.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/model/check.h"
@@ -17,8 +18,8 @@ namespace imufit {
 namespace {
 
 constexpr const char* kKnownKeys[] = {
-    "format",           "version",          "serial", "created_utc", "software",
-    "reference_temp_c", "fit_temp_range_c", "gyro",   "accel",       "sigma"};
+    "format",           "version", "serial", "created_utc", "software", "reference_temp_c",
+    "fit_temp_range_c", "gyro",    "accel",  "sigma",       "fit",      "check"};
 
 std::string Quoted(const std::string& text) {
   YAML::Emitter emitter;
@@ -72,20 +73,23 @@ void CheckInvertible(const yaml::Located& sensor, const double* params, int coef
         !std::isfinite(largest)) {
       char text[480];
       if (sign_change) {
-        std::snprintf(text, sizeof text,
-                      "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
-                      "%.4g at %.4g degC); the correction divides by it; %s",
-                      range[0], range[1], e.min_value, e.min_at_c, e.max_value, e.max_at_c,
-                      ScaleSignAdvice(gyro, axis).c_str());
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor changes sign within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC, "
+            "%.4g at %.4g degC); the correction divides by it; %s",
+            range[0], range[1], e.min_value, e.min_at_c, e.max_value, e.max_at_c,
+            ScaleSignAdvice(gyro, axis).c_str());
       } else if (negative) {
-        std::snprintf(text, sizeof text,
-                      "the scale factor is negative within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC); %s",
-                      range[0], range[1], e.max_value, e.max_at_c, ScaleSignAdvice(gyro, axis).c_str());
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor is negative within fit_temp_range_c [%g, %g] degC (%.4g at %.4g degC); %s",
+            range[0], range[1], e.max_value, e.max_at_c, ScaleSignAdvice(gyro, axis).c_str());
       } else {
-        std::snprintf(text, sizeof text,
-                      "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
-                      "at most %.3g elsewhere); the correction divides by it",
-                      range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
+        std::snprintf(
+            text, sizeof text,
+            "the scale factor comes near zero within fit_temp_range_c [%g, %g] degC (%.3g at %.4g degC, "
+            "at most %.3g elsewhere); the correction divides by it",
+            range[0], range[1], EvaluateTemperaturePolynomial(c, at_c - center_c), at_c, largest);
       }
       sensor["scale"][kCoefficientNames[kScaleCoefficient + axis].axis].Fail(text);
     }
@@ -159,6 +163,8 @@ Calibration ReadCalibration(const std::string& path) {
     ReadSensor(sigma["accel"], sigmas.accel.data(), kAccelCoefficients);
     calibration.sigma = sigmas;
   }
+  if (root.Has("fit")) calibration.fit = ReadFitRecord(root["fit"]);
+  if (root.Has("check")) calibration.check = ReadCheckRecord(root["check"]);
   calibration.extra = YAML::Node(YAML::NodeType::Map);
   for (const auto& entry : root_node) {
     const std::string& key = entry.first.Scalar();
@@ -192,10 +198,21 @@ std::string CalibrationToYaml(const Calibration& calibration) {
     out += "  accel:\n";
     AppendSensor(calibration.sigma->accel.data(), kAccelCoefficients, "    ", &out);
   }
-  if (calibration.extra.IsMap() && calibration.extra.size() > 0) {
+  // The fit's record, then the further keys, in one YAML map.
+  YAML::Node tail(YAML::NodeType::Map);
+  if (calibration.fit) tail.force_insert("fit", FitRecordNode(*calibration.fit));
+  if (calibration.check) tail.force_insert("check", CheckRecordNode(*calibration.check));
+  if (calibration.extra.IsMap()) {
+    for (const auto& entry : calibration.extra) {
+      const std::string& key = entry.first.Scalar();
+      IMUFIT_CHECK(key != "fit" && key != "check", "the fit's record is written from its typed members");
+      tail.force_insert(entry.first, entry.second);
+    }
+  }
+  if (tail.size() > 0) {
     YAML::Emitter emitter;
     emitter.SetDoublePrecision(17);
-    emitter << calibration.extra;
+    emitter << tail;
     out += emitter.c_str();
     out += "\n";
   }

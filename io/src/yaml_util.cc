@@ -191,6 +191,15 @@ long Located::Integer() const {
   return value;
 }
 
+bool Located::Bool() const {
+  if (!node.IsScalar()) Fail("expected true or false");
+  RefuseText("true or false");
+  bool value = false;
+  if (!YAML::convert<bool>::decode(node, value))
+    Fail(QuoteForMessage(node.Scalar()) + " is not true or false");
+  return value;
+}
+
 std::string Located::String() const {
   if (!node.IsScalar()) Fail("expected a text value");
   return node.Scalar();

@@ -35,6 +35,7 @@ struct Located {
   void RejectUnknownKeys(std::initializer_list<const char*> allowed) const;
   double Double() const;
   long Integer() const;
+  bool Bool() const;  // true or false (YAML's other spellings of them too)
   std::string String() const;
   std::vector<double> Doubles(size_t count) const;  // a sequence of exactly `count` numbers
   // Checks the `format` and `version` keys of a versioned imufit file; returns the version.

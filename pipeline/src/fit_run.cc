@@ -10,56 +10,48 @@
 namespace imufit {
 namespace {
 
-YAML::Node Diagnostics(const FitRunResult& result, const std::string& plan_path,
-                       const std::string& samples_path, const std::string& plan_sha256,
-                       const std::string& samples_sha256, const FitOptions& options) {
+// The calibration's `fit:` block (io/fit_record.h), without the files' hashes.
+FitRecord RecordOf(const FitRunResult& result, const std::string& plan_path, const std::string& samples_path,
+                   const FitOptions& options) {
   const FitSummary& fit = result.fit;
-  YAML::Node node;
-  node["plan"] = plan_path;
-  node["samples"] = samples_path;
-  node["plan_sha256"] = plan_sha256;
-  node["samples_sha256"] = samples_sha256;
-  node["samples_read"] = result.run.stats.samples;
+  FitRecord record;
+  record.plan = plan_path;
+  record.samples = samples_path;
+  record.samples_read = result.run.stats.samples;
   if (result.run.segmentation) {
-    node["segments_found_in_data"] = static_cast<int>(result.run.segmentation->matches.size());
-    node["plan_passes_found"] = result.run.segmentation->passes;
+    record.segments_found_in_data = static_cast<int>(result.run.segmentation->matches.size());
+    record.plan_passes_found = result.run.segmentation->passes;
   }
-  node["windows_used"] = fit.windows_used;
-  node["windows_downweighted"] = fit.windows_downweighted;
-  node["distinct_temperatures_c"] = fit.distinct_temps_c;
-  node["iterations"] = fit.iterations;
-  node["termination"] = fit.termination;
-  node["gyro_residual_rms_radps"] = fit.gyro_rms_radps;
-  node["accel_residual_rms_mps2"] = fit.accel_rms_mps2;
-  node["gyro_reduced_chi2"] = fit.gyro_reduced_chi2;
-  node["accel_reduced_chi2"] = fit.accel_reduced_chi2;
-  node["gyro_temp_order"] = options.gyro_temp_order;
-  node["accel_temp_order"] = options.accel_temp_order;
-  node["g_sensitivity_fitted"] = options.Fits(true, kGSensitivityCoefficient);
+  record.windows_used = fit.windows_used;
+  record.windows_downweighted = fit.windows_downweighted;
+  record.distinct_temperatures_c = fit.distinct_temps_c;
+  record.iterations = fit.iterations;
+  record.termination = fit.termination;
+  record.gyro_residual_rms_radps = fit.gyro_rms_radps;
+  record.accel_residual_rms_mps2 = fit.accel_rms_mps2;
+  record.gyro_reduced_chi2 = fit.gyro_reduced_chi2;
+  record.accel_reduced_chi2 = fit.accel_reduced_chi2;
+  record.gyro_temp_order = options.gyro_temp_order;
+  record.accel_temp_order = options.accel_temp_order;
+  record.g_sensitivity_fitted = options.Fits(true, kGSensitivityCoefficient);
   // What the fit estimated; the held groups keep their stated values (a prior calibration's, or
   // scale 1 and 0 otherwise) and a sigma of 0.
-  for (const bool fitted : {true, false}) {
-    const char* key = fitted ? "fitted" : "held";
-    node[key] = YAML::Node(YAML::NodeType::Sequence);
-    for (const std::string& group : options.Groups(fitted)) node[key].push_back(group);
-    node[key].SetStyle(YAML::EmitterStyle::Flow);
-  }
-  if (!options.Groups(false).empty()) node["held_values"] = options.held ? "prior" : "scale 1, others 0";
-  node["loss"] = RobustLossName(options.loss);
-  node["gyro_bias_stability_radps"] = options.gyro_bias_stability_radps;
-  node["accel_bias_stability_mps2"] = options.accel_bias_stability_mps2;
-  node["bias_correlation_s"] = options.bias_correlation_s;
+  record.fitted = options.Groups(true);
+  record.held = options.Groups(false);
+  if (!record.held->empty()) record.held_values = options.held ? "prior" : "scale 1, others 0";
+  record.loss = RobustLossName(options.loss);
+  record.gyro_bias_stability_radps = options.gyro_bias_stability_radps;
+  record.accel_bias_stability_mps2 = options.accel_bias_stability_mps2;
+  record.bias_correlation_s = options.bias_correlation_s;
   // Plan segments without a single usable window (never visited, or every visit too short).
   std::set<int> visited;
   for (const Window& w : result.run.windows) visited.insert(w.segment);
-  YAML::Node missing(YAML::NodeType::Sequence);
+  record.segments_without_windows.emplace();
   for (const TableSegment& segment : result.plan.segments) {
-    if (visited.count(segment.id) == 0) missing.push_back(segment.id);
+    if (visited.count(segment.id) == 0) record.segments_without_windows->push_back(segment.id);
   }
-  node["segments_without_windows"] = missing;
-  node["segments_without_windows"].SetStyle(YAML::EmitterStyle::Flow);
-  node["missing_segments"] = static_cast<int>(missing.size());
-  return node;
+  record.missing_segments = static_cast<int>(record.segments_without_windows->size());
+  return record;
 }
 
 }  // namespace
@@ -151,7 +143,11 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   }
 
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
+  result.record = RecordOf(result, plan_path, samples_path, options.fit);
   if (!result.fit.IsSolutionUsable()) return result;
+  result.record.plan_sha256 = options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256;
+  result.record.samples_sha256 =
+      options.samples_sha256.empty() ? Sha256OfFile(samples_path) : options.samples_sha256;
 
   Calibration calibration;
   calibration.serial = result.serial;
@@ -160,11 +156,7 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   calibration.fit_temp_range_c = result.fit.temp_range_c;
   calibration.model = result.fit.model;
   calibration.sigma = result.fit.sigma;
-  calibration.extra = YAML::Node(YAML::NodeType::Map);
-  calibration.extra["fit"] = Diagnostics(
-      result, plan_path, samples_path,
-      options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256,
-      options.samples_sha256.empty() ? Sha256OfFile(samples_path) : options.samples_sha256, options.fit);
+  calibration.fit = result.record;
 
   if (options.validate) {
     result.folds =
@@ -175,9 +167,11 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
         PredictWindows(result.fit.model, check_windows, check_plan.site, check_plan.segments);
     result.check_errors = ErrorsBySegment(errors);
     result.check_errors.push_back(SummariseErrors(errors));
-    calibration.extra["check"]["samples"] = options.check_samples;
-    calibration.extra["check"]["gyro_error_rms_radps"] = result.check_errors.back().gyro_rms_radps;
-    calibration.extra["check"]["accel_error_rms_mps2"] = result.check_errors.back().accel_rms_mps2;
+    CheckRecord check;
+    check.samples = options.check_samples;
+    check.gyro_error_rms_radps = result.check_errors.back().gyro_rms_radps;
+    check.accel_error_rms_mps2 = result.check_errors.back().accel_rms_mps2;
+    calibration.check = check;
   }
   result.calibration = std::move(calibration);
   return result;

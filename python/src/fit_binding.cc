@@ -217,21 +217,22 @@ py::dict ErrorStatsDict(const ErrorStats& s) {
 // objects (arrays for per-window values).
 py::dict Diagnostics(const FitRunResult& result) {
   const FitSummary& fit = result.fit;
+  const FitRecord& record = result.record;  // what the calibration's fit: block says
   const WindowStats& stats = result.run.stats;
   py::dict d;
-  d["termination"] = fit.termination;
-  d["iterations"] = fit.iterations;
+  d["termination"] = *record.termination;
+  d["iterations"] = *record.iterations;
   d["initial_cost"] = fit.initial_cost;
   d["final_cost"] = fit.final_cost;
-  d["windows_used"] = fit.windows_used;
-  d["windows_downweighted"] = fit.windows_downweighted;
-  d["distinct_temps_c"] = ToArray(fit.distinct_temps_c);
+  d["windows_used"] = *record.windows_used;
+  d["windows_downweighted"] = *record.windows_downweighted;
+  d["distinct_temps_c"] = ToArray(*record.distinct_temperatures_c);
   d["temp_range_c"] = py::make_tuple(fit.temp_range_c[0], fit.temp_range_c[1]);
-  d["gyro_residual_rms_radps"] = fit.gyro_rms_radps;
-  d["accel_residual_rms_mps2"] = fit.accel_rms_mps2;
-  d["gyro_reduced_chi2"] = fit.gyro_reduced_chi2;
-  d["accel_reduced_chi2"] = fit.accel_reduced_chi2;
-  d["samples"] = stats.samples;
+  d["gyro_residual_rms_radps"] = *record.gyro_residual_rms_radps;
+  d["accel_residual_rms_mps2"] = *record.accel_residual_rms_mps2;
+  d["gyro_reduced_chi2"] = *record.gyro_reduced_chi2;
+  d["accel_reduced_chi2"] = *record.accel_reduced_chi2;
+  d["samples"] = *record.samples_read;
   d["transition_samples"] = stats.transition_samples;
   d["trimmed_samples"] = stats.trimmed_samples;
   d["short_windows"] = stats.short_windows;

@@ -2,7 +2,7 @@
 //
 // Key figures are the calibration's coefficients at 25 degC, evaluated through the model's
 // polynomial (whatever the calibration's reference_temp_c), in the units a test engineer reads
-// (io/units.h: deg/s, mg, raw/(deg/s), raw/g, mrad, deg/s/g), each with its 1-sigma from the
+// (engineering_units.h: deg/s, mg, raw/(deg/s), raw/g, mrad, deg/s/g), each with its 1-sigma from the
 // `sigma` tree; plus the fit's residual RMS (deg/s, mg) from the calibration's `fit:` block and
 // the gyro noise figures of a `noise:` block (io/noise_file.h).
 #ifndef IMUFIT_FACTORY_ACCEPTANCE_H_
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "imufit/factory/engineering_units.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
-#include "imufit/io/units.h"
 
 namespace imufit {
 

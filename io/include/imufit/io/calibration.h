@@ -2,9 +2,10 @@
 //
 // Coefficients are written as lists c0..c3 of powers of dT = T - 25 degC, each number in its
 // shortest round-trip form, so write -> read gives back the same doubles (==). An optional
-// `sigma` tree mirrors the coefficients with their 1-sigma uncertainties. Keys the reader does
-// not know are kept in `extra` (and written back); a `format` other than imufit-calibration or
-// a version above kCalibrationFormatVersion is refused.
+// `sigma` tree mirrors the coefficients with their 1-sigma uncertainties; the optional `fit:` and
+// `check:` blocks are the fit's typed record (fit_record.h). Keys the reader does not know are
+// kept in `extra` (and written back); a `format` other than imufit-calibration or a version above
+// kCalibrationFormatVersion is refused.
 #ifndef IMUFIT_IO_CALIBRATION_H_
 #define IMUFIT_IO_CALIBRATION_H_
 
@@ -14,6 +15,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/io/fit_record.h"
 #include "imufit/model/sensor_model.h"
 
 namespace imufit {
@@ -30,8 +32,11 @@ struct Calibration {
   SensorModel model;
   // 1-sigma of every parameter, same layout as `model` (its basis is not used).
   std::optional<SensorModel> sigma;
-  // Further top-level keys (fit diagnostics, noise figures): a YAML map, written after the
-  // coefficients; on reading, every key this reader does not know.
+  // What the fit did and on which files (`fit:`), and its errors on a held-out run (`check:`).
+  std::optional<FitRecord> fit;
+  std::optional<CheckRecord> check;
+  // Further top-level keys (noise figures, ...): a YAML map, written after the fit's record; on
+  // reading, every key this reader does not know. Holds no `fit` or `check` key.
   YAML::Node extra;
 };
 

@@ -2,9 +2,9 @@
 // that batch tooling fits units through the same code path instead of shelling out.
 //
 // FitRun() reads the plan and the samples (and a held-out run, if given), fits, validates when
-// asked, and builds the calibration to write (with its `sigma` tree and a `fit:` diagnostics
-// block). It writes nothing. Bad input throws InputError; a run that does not determine the
-// model, or a fit that does not converge, is reported through `fit.status` (then `calibration`
+// asked, and builds the calibration to write (with its `sigma` tree and the fit's record, the
+// `fit:` block of io/fit_record.h). It writes nothing. Bad input throws InputError; a run that does not
+// determine the model, or a fit that does not converge, is reported through `fit.status` (then `calibration`
 // is not set). A samples file without a segment column is labelled from the plan first
 // (segment_run.h); when it does not match the plan, PlanMismatchError is thrown.
 #ifndef IMUFIT_PIPELINE_FIT_RUN_H_
@@ -65,12 +65,15 @@ struct FitRunResult {
   Plan plan;
   RunWindows run;
   FitSummary fit;
+  // The calibration's `fit:` block, also when the fit is not usable (then without the hashes).
+  FitRecord record;
   std::vector<HeldOutGroup> folds;         // with options.validate
   std::vector<ErrorStats> check_errors;    // per segment, then all ("segment" -1); with check_samples
   std::optional<Calibration> calibration;  // when fit.IsSolutionUsable()
 };
 
-FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path, const FitRunOptions& options);
+FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
+                    const FitRunOptions& options);
 
 }  // namespace imufit
 
