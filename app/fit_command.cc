@@ -137,7 +137,7 @@ int FinishFactory(const FitArguments& args, const FitRunOptions& options, const 
     verdict = certificate ? *certificate->verdict : EvaluateLimits(*limits, calibration);
     if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
   }
-  if (certificate) WriteCertificate(args.report, *certificate);
+  if (certificate) WriteCertificate(args.report, *certificate, outputs);
   outputs->Commit();  // the calibration and the report together, or neither
   if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
   if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
@@ -226,7 +226,7 @@ int RunFit(FitArguments args) {
     return 1;
   }
   OutputTransaction outputs;
-  WriteCalibration(args.output, *result.calibration);
+  WriteCalibration(args.output, *result.calibration, &outputs);
 
   if (args.quiet) return FinishFactory(args, options, limits, station, result, &outputs);
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());

@@ -770,26 +770,42 @@ TEST_F(IoTest, AnOutputTransactionWritesAllOrNothing) {
   const std::string second = (dir_ / "second.html").string();
   {
     OutputTransaction outputs;
-    WriteFileAtomically(first, "new first\n");
+    WriteFileAtomically(first, "new first\n", &outputs);
     EXPECT_EQ(Read(first), "old first\n") << "renamed before the transaction commits";
     // The second output fails (its folder does not exist): the first must not change.
-    EXPECT_THROW(WriteFileAtomically((dir_ / "missing" / "x.html").string(), "y"), InputError);
+    EXPECT_THROW(WriteFileAtomically((dir_ / "missing" / "x.html").string(), "y", &outputs), InputError);
   }
   EXPECT_EQ(Read(first), "old first\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1)
       << "temporary left behind";
   {
     OutputTransaction outputs;
-    WriteFileAtomically(first, "new first\n");
-    WriteFileAtomically(second, "new second\n");
+    WriteFileAtomically(first, "new first\n", &outputs);
+    WriteFileAtomically(second, "new second\n", &outputs);
     EXPECT_FALSE(fs::exists(second));
     outputs.Commit();
   }
   EXPECT_EQ(Read(first), "new first\n");
   EXPECT_EQ(Read(second), "new second\n");
-  // Outside a transaction, Commit() renames at once again.
+  // Without a transaction, Commit() renames at once.
   WriteFileAtomically(second, "third\n");
   EXPECT_EQ(Read(second), "third\n");
+}
+
+// A transaction changes only the outputs it is given: one written without it while it is open is
+// renamed at once, and is not taken back when the transaction is dropped.
+TEST_F(IoTest, AnOutputTransactionHoldsOnlyTheOutputsItIsGiven) {
+  const std::string held = (dir_ / "held.yaml").string();
+  const std::string apart = (dir_ / "apart.yaml").string();
+  {
+    OutputTransaction outputs;
+    WriteFileAtomically(held, "held\n", &outputs);
+    WriteFileAtomically(apart, "apart\n");
+    EXPECT_EQ(Read(apart), "apart\n") << "an output not given the transaction was held by it";
+    EXPECT_FALSE(fs::exists(held));
+  }
+  EXPECT_FALSE(fs::exists(held));
+  EXPECT_EQ(Read(apart), "apart\n");
 }
 
 TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
@@ -802,7 +818,7 @@ TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
       OutputFile file(path);
       file.Write(std::string(3 << 20, 'x'));  // past the first flush
       OutputTransaction outputs;
-      WriteFileAtomically(path + ".other", "pending in a transaction\n");
+      WriteFileAtomically(path + ".other", "pending in a transaction\n", &outputs);
       ::raise(signal_number);
       ::_exit(0);  // not reached
     }

@@ -118,8 +118,9 @@ std::string SerialComment(const std::string& serial, const std::string& source) 
   return std::string(kSerialKey) + " " + serial;
 }
 
-SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment)
-    : file_(std::move(path)), columns_(columns) {
+SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment,
+                             OutputTransaction* transaction)
+    : file_(std::move(path), transaction), columns_(columns) {
   if (!comment.empty()) {
     std::istringstream lines(comment);
     std::string line;

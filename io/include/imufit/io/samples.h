@@ -82,11 +82,13 @@ struct SampleColumns {
 
 class SamplesWriter {
  public:
-  // Starts `path` (atomically: nothing appears until Commit()). `with_segment` adds the
-  // segment column. `comment`, if not empty, is written first as '#' lines.
+  // Starts `path` (atomically: nothing appears until Commit(), or until the commit of
+  // `transaction` when not null). `with_segment` adds the segment column. `comment`, if not
+  // empty, is written first as '#' lines.
   SamplesWriter(std::string path, bool with_segment, const std::string& comment = "")
       : SamplesWriter(std::move(path), SampleColumns{with_segment, true}, comment) {}
-  SamplesWriter(std::string path, SampleColumns columns, const std::string& comment = "");
+  SamplesWriter(std::string path, SampleColumns columns, const std::string& comment = "",
+                OutputTransaction* transaction = nullptr);
 
   void Write(const Sample& sample);
   void Commit() { file_.Commit(); }
