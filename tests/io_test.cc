@@ -14,10 +14,12 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
+#include "imufit/io/file_reads.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
 #include "test_models.h"
 
@@ -806,6 +808,35 @@ TEST_F(IoTest, AnOutputTransactionHoldsOnlyTheOutputsItIsGiven) {
   }
   EXPECT_FALSE(fs::exists(held));
   EXPECT_EQ(Read(apart), "apart\n");
+}
+
+// A CSV reader hashes the file's bytes as they are on disk (compressed, for .gz) while it streams
+// them, and counts as one opening of the file.
+TEST_F(IoTest, ACsvReaderHashesTheFileAsItReadsIt) {
+  for (const std::string name : {"hashed.csv", "hashed.csv.gz"}) {
+    const std::string path = (dir_ / name).string();
+    {
+      SamplesWriter writer(path, true);
+      for (int i = 0; i < 200000; ++i) {  // several read blocks, plain and compressed
+        Sample sample;
+        sample.time_s = i * 0.01;
+        sample.gyro = Eigen::Vector3d(i % 7, i % 11, i % 13);
+        writer.Write(sample);
+      }
+      writer.Commit();
+    }
+    const long long opened = TimesOpenedForReading(path);
+    Sha256 digest;
+    SamplesReader reader(path, true, std::nullopt, &digest);
+    Sample sample;
+    long long samples = 0;
+    while (reader.Next(&sample)) ++samples;
+    EXPECT_EQ(samples, 200000);
+    EXPECT_EQ(TimesOpenedForReading(path), opened + 1) << name;
+    EXPECT_EQ(digest.HexDigest(), Sha256OfFile(path)) << name;
+    EXPECT_EQ(TimesOpenedForReading(path), opened + 2) << name << ": Sha256OfFile opens it too";
+  }
+  EXPECT_EQ(TimesOpenedForReading((dir_ / "missing.csv").string()), 0);
 }
 
 TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {

@@ -47,8 +47,9 @@ SamplesSerial SerialInHeader(const CsvReader& csv) {
 
 }  // namespace
 
-SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c)
-    : csv_(std::move(path)), serial_(SerialInHeader(csv_).serial) {
+SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c,
+                             Sha256* raw_digest)
+    : csv_(std::move(path), raw_digest), serial_(SerialInHeader(csv_)) {
   time_column_ = csv_.RequireColumn("time_s");
   if (!temp_c) {
     try {
