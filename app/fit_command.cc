@@ -183,6 +183,7 @@ int RunFit(FitArguments args) {
   options.software = SoftwareVersion();
   options.serial = args.serial;
   options.allow_serial_mismatch = args.allow_mismatch;
+  options.keep_static_stretch = !args.report.empty();  // the certificate's noise section
   if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
 
   const FitRunResult result = FitRun(args.plan, args.samples, options);

@@ -11,6 +11,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/station.h"
+#include "imufit/pipeline/run_windows.h"
 #include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
@@ -67,11 +68,12 @@ int RunReport(const ReportArguments& args) {
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
   sources.samples_input = input;
-  sources.run = ReadRunWindows(sources.plan, args.samples, windows, sources.samples_input);
+  // Read once for the windows, the hash and the noise section's static stretch.
+  sources.run = RunReader(sources.plan, args.samples, input).Read(windows, /*keep_static_stretch=*/true);
   sources.windows = windows;
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
-                    {"samples", args.samples, ""},
+                    {"samples", args.samples, sources.run.samples_sha256},
                     {"limits", args.limits, ""},
                     {"station", args.station, ""}};
   const Certificate certificate = MakeCertificate(sources);
