@@ -37,6 +37,7 @@ int RunReport(const ReportArguments& args) {
   if (std::string problem = windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   if (std::string problem = input.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   CertificateSources sources;
+  sources.software = SoftwareVersion();
   sources.calibration = ReadCalibration(args.calibration);
   sources.plan = ReadPlan(args.plan);
   // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
@@ -77,7 +78,7 @@ int RunReport(const ReportArguments& args) {
                     {"limits", args.limits, ""},
                     {"station", args.station, ""}};
   const Certificate certificate = MakeCertificate(sources);
-  WarnIfNoSerial(certificate, args.calibration);
+  WarnIfNoSerial(certificate.serial, args.calibration);
   WriteCertificate(args.output, certificate);
   const std::optional<Verdict>& verdict = certificate.verdict;
   std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
@@ -87,8 +88,8 @@ int RunReport(const ReportArguments& args) {
 
 }  // namespace
 
-void WarnIfNoSerial(const Certificate& certificate, const std::string& file) {
-  if (!certificate.serial.empty()) return;
+void WarnIfNoSerial(const std::string& serial, const std::string& file) {
+  if (!serial.empty()) return;
   std::fprintf(stderr,
                "imufit: warning: %s: no serial (give --serial, or a '# serial:' line in the samples header): "
                "the certificate says \"(no serial)\"\n",

@@ -505,7 +505,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   c.calibrated_utc = cal.created_utc;
   c.written_utc = UtcNow();
   c.calibration_software = cal.software;
-  c.report_software = cal.software;
+  c.report_software = sources.software;
   c.git_revision = IMUFIT_GIT_REVISION;
   c.reference_temp_c = cal.model.basis.center_c;
   std::vector<ReportInput> inputs = sources.inputs;
@@ -615,30 +615,6 @@ std::vector<std::string> InputMismatches(const Calibration& calibration, const s
   check("plan_sha256", "plan", plan_path);
   check("samples_sha256", "samples file", samples_path);
   return mismatches;
-}
-
-Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
-                            const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const FitRunOptions& options, const std::optional<Station>& station) {
-  const FitRunResult& fit = *unit.fit;
-  CertificateSources sources;
-  sources.unit = unit.unit;
-  sources.calibration = *fit.calibration;
-  sources.calibration.serial = unit.serial;
-  sources.plan = fit.plan;
-  sources.run = fit.run;
-  sources.windows = options.windows;
-  sources.samples_input = options.input;
-  sources.folds = fit.folds;
-  sources.warnings = unit.warnings;
-  if (!unit.verdict.empty()) sources.verdict = unit.verdict_detail;
-  sources.limits = limits;
-  sources.inputs = {{"calibration", calibration_path, ""},
-                    {"plan", unit.plan_path, unit.plan_sha256},
-                    {"samples", unit.samples_path, unit.samples_sha256},
-                    {"limits", limits_path, ""}};
-  sources.station = station;
-  return MakeCertificate(sources);
 }
 
 // ---------------------------------------------------------------- the lot page

@@ -43,6 +43,9 @@ struct ReportInput {
 // Everything a certificate is computed from.
 struct CertificateSources {
   std::string unit;  // the batch unit folder, or empty
+  // The program that writes the certificate, e.g. "imufit 0.1.0" (the calibration names the one
+  // that made it).
+  std::string software;
   Calibration calibration;
   Plan plan;
   // run.segmentation: the labels of a file without a segment column; run.static_stretch: the noise
@@ -222,12 +225,6 @@ struct Certificate {
 // Computes the certificate; reads the samples input once more for the Allan section unless
 // sources.run kept the static stretch. Throws InputError when an input file cannot be read.
 Certificate MakeCertificate(const CertificateSources& sources);
-// From a batch unit just fitted (its FitRunResult is in unit.fit) with `options` (the windows and
-// the samples input the run was read with; the serial warnings come from unit.warnings).
-Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
-                            const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const FitRunOptions& options = FitRunOptions(),
-                            const std::optional<Station>& station = std::nullopt);
 
 // The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
 std::vector<Figure> MeasuredFigures(const Certificate& certificate);
