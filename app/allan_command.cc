@@ -260,7 +260,7 @@ int RunAllan(const AllanArguments& args) {
   PlausibilityWarnings(args, series, results);
 
   OutputTransaction written;  // the curves, the noise YAML and the plot together, or none
-  WriteAllanCsv(args.output, results);
+  WriteAllanCsv(args.output, results, &written);
   NoiseRecord record;
   record.software = SoftwareVersion();
   record.samples = args.samples;
@@ -271,13 +271,13 @@ int RunAllan(const AllanArguments& args) {
   record.sample_interval_s = series.sample_interval_s;
   record.sample_count = n;
   record.duration_s = series.end_time_s - series.start_time_s - series.bridged_time_s;
-  if (!args.noise_yaml.empty()) WriteNoiseYaml(args.noise_yaml, record, results);
+  if (!args.noise_yaml.empty()) WriteNoiseYaml(args.noise_yaml, record, results, &written);
   if (!args.plot.empty()) {
     char title[512];
     std::snprintf(title, sizeof title, "%s: %s, tau0 = %g s, %lld samples, %.3g %% confidence",
                   Analysed(args).c_str(), ToString(results.front().curve.estimator), series.sample_interval_s,
                   static_cast<long long>(n), 100.0 * args.confidence);
-    DrawFile(AllanPlot(results, title, plot_units), args.plot);
+    DrawFile(AllanPlot(results, title, plot_units), args.plot, &written);
   }
   written.Commit();
   if (!args.quiet) PrintSummary(args, series, n, results);

@@ -81,10 +81,10 @@ struct CorrectFileReport;
 // range (an extrapolation): apply_command.cc; apply and allan --calibration share it.
 void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report);
 
-struct Certificate;
-// A certificate that names no unit says "(no serial)" (under a warning on the page); this says so
-// on stderr too, naming `file` (report_command.cc; fit --report and report share it).
-void WarnIfNoSerial(const Certificate& certificate, const std::string& file);
+// A certificate that names no unit (its `serial` empty) says "(no serial)" (under a warning on the
+// page); this says so on stderr too, naming `file` (report_command.cc; fit --report and report
+// share it).
+void WarnIfNoSerial(const std::string& serial, const std::string& file);
 
 // Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).

@@ -5,18 +5,11 @@
 #include <optional>
 
 #include "commands.h"
-#include "imufit/factory/acceptance.h"
-#include "imufit/factory/certificate.h"
+#include "imufit/factory/certify.h"
 #include "imufit/factory/engineering_units.h"
-#include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/fit/thermal_fit.h"
-#include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
-#include "imufit/io/limits.h"
-#include "imufit/io/output_file.h"
-#include "imufit/io/sha256.h"
-#include "imufit/io/station.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
 
@@ -31,11 +24,11 @@ struct FitArguments {
   std::string check_samples;
   bool validate = false;
   bool quiet = false;
-  std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
-  std::string report;  // certificate HTML to write
-  std::string store;   // results store to record the fit in
-  std::string serial;  // the unit's serial; empty: the samples header's, else the plan's
-  std::string station;  // station file shown on the certificate (with --report)
+  std::string limits;           // acceptance limits: verdict table, exit 3 when they fail
+  std::string report;           // certificate HTML to write
+  std::string store;            // results store to record the fit in
+  std::string serial;           // the unit's serial; empty: the samples header's, else the plan's
+  std::string station;          // station file shown on the certificate (with --report)
   bool allow_mismatch = false;  // --serial may contradict the samples header (a warning)
   FitRunArguments run;          // the fit options, shared with imufit batch
 };
@@ -87,8 +80,8 @@ void PrintCoefficients(const FitSummary& fit, const FitOptions& options) {
   std::printf("    gyro g-sensitivity, deg/s/g:\n");
   for (int h = 0; h < 9; ++h) {
     const int c = kGSensitivityCoefficient + h;
-    std::printf("      %-2s  %s%s", kCoefficientNames[c].axis, text("%+.5f +- %.5f", at25(Sensor::kGyro, c)).c_str(),
-                h % 3 == 2 ? "\n" : "   ");
+    std::printf("      %-2s  %s%s", kCoefficientNames[c].axis,
+                text("%+.5f +- %.5f", at25(Sensor::kGyro, c)).c_str(), h % 3 == 2 ? "\n" : "   ");
   }
 }
 
@@ -96,88 +89,14 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
   std::printf("  %s\n    segment  windows   gyro RMS / max, deg/s      accel RMS / max, mg\n", title);
   for (const ErrorStats& s : stats) {
     std::printf("    %7s  %7d   %10.5f / %-10.5f   %8.4f / %-8.4f\n",
-                s.segment < 0 ? "all" : std::to_string(s.segment).c_str(), s.windows, DpsFromRadps(s.gyro_rms_radps),
-                DpsFromRadps(s.gyro_max_radps), MgFromMps2(s.accel_rms_mps2),
+                s.segment < 0 ? "all" : std::to_string(s.segment).c_str(), s.windows,
+                DpsFromRadps(s.gyro_rms_radps), DpsFromRadps(s.gyro_max_radps), MgFromMps2(s.accel_rms_mps2),
                 MgFromMps2(s.accel_max_mps2));
   }
 }
 
-// --limits, --report, --store: the factory additions, after the calibration is written.
-// Returns the exit status: 0, or kExitFailedLimits.
-int FinishFactory(const FitArguments& args, const FitRunOptions& options, const std::optional<Limits>& limits,
-                  const std::optional<Station>& station, const FitRunResult& result,
-                  OutputTransaction* outputs) {
-  const Calibration& calibration = *result.calibration;
-  std::string plan_sha256, samples_sha256;
-  if (!args.report.empty() || !args.store.empty()) {
-    plan_sha256 = Sha256OfFile(args.plan);
-    samples_sha256 = Sha256OfFile(args.samples);
-  }
-  std::optional<Certificate> certificate;
-  if (!args.report.empty()) {
-    CertificateSources sources;
-    sources.calibration = calibration;
-    sources.plan = result.plan;
-    sources.run = result.run;
-    sources.windows = options.windows;
-    sources.samples_input = options.input;
-    sources.folds = result.folds;
-    sources.warnings = result.serial_warnings;
-    sources.limits = limits;  // judged with the noise the certificate measures
-    // The calibration is not renamed into place yet (one transaction): hash the text it holds.
-    sources.inputs = {{"calibration", args.output, Sha256Hex(CalibrationToYaml(calibration))},
-                      {"plan", args.plan, plan_sha256},
-                      {"samples", args.samples, samples_sha256},
-                      {"limits", args.limits, ""},
-                      {"station", args.station, ""}};
-    sources.station = station;
-    certificate = MakeCertificate(sources);
-    WarnIfNoSerial(*certificate, args.samples);
-  }
-  std::optional<Verdict> verdict;
-  if (limits) {
-    verdict = certificate ? *certificate->verdict : EvaluateLimits(*limits, calibration);
-    if (!args.quiet || !verdict->pass) std::printf("%s", verdict->Table().c_str());
-  }
-  if (certificate) WriteCertificate(args.report, *certificate);
-  outputs->Commit();  // the calibration and the report together, or neither
-  if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
-  if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
-  if (!args.store.empty()) {
-    StoredFit row;
-    row.serial = calibration.serial.empty() ? args.samples : calibration.serial;
-    row.unit = args.samples;
-    row.time_utc = calibration.created_utc;
-    row.software = calibration.software;
-    row.plan_sha256 = plan_sha256;
-    row.samples_sha256 = samples_sha256;
-    row.limits_sha256 = args.limits.empty() ? "" : Sha256OfFile(args.limits);
-    row.status = "fitted";
-    row.verdict = verdict ? (verdict->pass ? "PASS" : "FAIL") : "";
-    row.message = verdict ? verdict->FailedSummary() : "";
-    row.calibration_yaml = CalibrationToYaml(calibration);
-    row.figures = KeyFigures(calibration);
-    ResultsStore(args.store).Record(row);
-    if (!args.quiet) std::printf("  recorded in %s\n", args.store.c_str());
-  }
-  return verdict && !verdict->pass ? kExitFailedLimits : 0;
-}
-
-int RunFit(FitArguments args) {
-  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples,
-                                        args.limits, args.run.prior});
-  if (!args.report.empty()) {
-    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples,
-                                          args.limits, args.output, args.station});
-  }
-  // A bad limits or station file is reported before any work.
-  std::optional<Limits> limits;
-  if (!args.limits.empty()) limits = ReadLimits(args.limits);
-  std::optional<Station> station;
-  if (!args.station.empty()) {
-    if (args.report.empty()) throw InputError("--station", "is shown on the certificate: give --report too");
-    station = ReadStation(args.station);
-  }
+// The fit's options from the command line.
+FitRunOptions ResolveOptions(const FitArguments& args) {
   FitRunOptions options = args.run.Resolve();
   options.validate = args.validate;
   options.check_samples = args.check_samples;
@@ -185,56 +104,74 @@ int RunFit(FitArguments args) {
   options.software = SoftwareVersion();
   options.serial = args.serial;
   options.allow_serial_mismatch = args.allow_mismatch;
-  if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
+  options.keep_static_stretch = !args.report.empty();  // the certificate's noise section
+  if (const std::string problem = options.Validate(); !problem.empty())
+    throw InputError("imufit fit", problem);
+  return options;
+}
 
-  const FitRunResult result = FitRun(args.plan, args.samples, options);
-  for (const std::string& warning : result.serial_warnings) {
-    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+// What the unit is certified with: the fit's reading of the run, the program, --limits and
+// --station (read: a bad file is reported before any work) and --store (opened into `store`).
+CertifySettings ReadFactoryInputs(const FitArguments& args, const FitRunOptions& options,
+                                  std::unique_ptr<ResultsStore>* store) {
+  CertifySettings settings;
+  settings.software = options.software;
+  settings.windows = options.windows;
+  settings.samples_input = options.input;
+  ReadLimitsAndStation(args.limits, args.station, &settings);
+  if (!args.store.empty()) {
+    *store = std::make_unique<ResultsStore>(args.store);
+    settings.store = store->get();
   }
-  const bool fixed_temp = options.input.temp_c.has_value();
-  const FitSummary& fit = result.fit;
-  const WindowStats& stats = result.run.stats;
-  const std::vector<Window>& windows = result.run.windows;
-  if (!args.quiet && fixed_temp) {
+  return settings;
+}
+
+// What is said before the fit's outcome: a run at one temperature, the segments found in the data.
+void PrintRunNotes(const FitRunOptions& options, const FitRunResult& result) {
+  if (options.input.temp_c) {
     std::printf(
         "imufit fit: note: no temp_c column, every sample at %g degC (--temp-c): temperature orders 0\n",
         *options.input.temp_c);
   }
-  if (!args.quiet && result.run.segmentation) {
+  if (result.run.segmentation) {
     const Segmentation& segmentation = *result.run.segmentation;
     std::printf("imufit fit: no segment column: %zu segments found in %d pass%s through the plan:\n%s",
                 segmentation.matches.size(), segmentation.passes, segmentation.passes == 1 ? "" : "es",
                 SegmentationReport(segmentation).c_str());
   }
-  if (fit.status == FitStatus::kUndetermined) {
-    std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n", args.samples.c_str());
-    for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
-    std::fprintf(stderr,
-                 "  (the run: %lld samples, %lld in transitions, %lld trimmed after moves, %d windows used, "
-                 "%lld windows "
-                 "shorter than %d samples dropped)\n",
-                 stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used,
-                 stats.short_windows, options.windows.min_samples);
-    if (const std::string note = TimeStampNote(stats); !note.empty()) {
-      std::fprintf(stderr, "  (time stamps: %s)\n", note.c_str());
-    }
-    if (const std::string note = SaturationNote(stats); !note.empty()) {
-      std::fprintf(stderr, "  (saturation: %s)\n", note.c_str());
-    }
-    return 1;
-  }
-  if (!result.calibration) {
-    std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(), fit.BriefReport().c_str());
-    return 1;
-  }
-  OutputTransaction outputs;
-  WriteCalibration(args.output, *result.calibration);
+}
 
-  if (args.quiet) return FinishFactory(args, options, limits, station, result, &outputs);
+// A run that does not determine the model: what is missing, and what the run held. Returns 1.
+int ReportUndetermined(const FitArguments& args, const FitRunOptions& options, const FitRunResult& result) {
+  const FitSummary& fit = result.fit;
+  const WindowStats& stats = result.run.stats;
+  std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n",
+               args.samples.c_str());
+  for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
+  std::fprintf(stderr,
+               "  (the run: %lld samples, %lld in transitions, %lld trimmed after moves, %d windows used, "
+               "%lld windows "
+               "shorter than %d samples dropped)\n",
+               stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used,
+               stats.short_windows, options.windows.min_samples);
+  if (const std::string note = TimeStampNote(stats); !note.empty()) {
+    std::fprintf(stderr, "  (time stamps: %s)\n", note.c_str());
+  }
+  if (const std::string note = SaturationNote(stats); !note.empty()) {
+    std::fprintf(stderr, "  (saturation: %s)\n", note.c_str());
+  }
+  return 1;
+}
+
+// The fit: the run, the residuals, the windows the robust loss down-weighted, the coefficients.
+void PrintFit(const FitRunOptions& options, const FitRunResult& result) {
+  const FitSummary& fit = result.fit;
+  const WindowStats& stats = result.run.stats;
   std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
-  std::printf("  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
-              stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
-              stats.trimmed_samples);
+  std::printf(
+      "  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
+      stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
+      stats.trimmed_samples);
   if (const std::string note = TimeStampNote(stats); !note.empty()) {
     std::printf("  time stamps: %s\n", note.c_str());
   }
@@ -249,7 +186,7 @@ int RunFit(FitArguments args) {
     int shown = 0;
     for (const WindowResidual& r : fit.residuals) {
       if (!r.downweighted || shown++ >= 10) continue;
-      const Window& w = windows[r.window];
+      const Window& w = result.run.windows[r.window];
       std::printf(" [segment %d, %.1f degC, t=%.1f s]", w.segment, w.temp_c, w.start_s);
     }
     std::printf("%s\n", fit.windows_downweighted > 10 ? " ..." : "");
@@ -263,27 +200,91 @@ int RunFit(FitArguments args) {
         : options.fit.gyro_bias_stability_radps == 0.0 ? " for the gyro"
                                                        : " for the accelerometer");
   }
-  if (args.validate) {
-    std::printf("  leave-one-temperature-out validation:\n");
-    if (result.folds.empty()) std::printf("    not enough temperatures (needs at least 3 groups)\n");
-    for (const HeldOutGroup& g : result.folds) {
-      if (!g.fitted) {
-        std::printf("    without %.1f degC: not fitted (%s)\n", g.temp_c, g.why_not.c_str());
-        continue;
-      }
-      std::printf("    without %6.1f degC: %3d held-out windows, gyro RMS %.5f deg/s (max %.5f), accel RMS %.4f mg (max %.4f)\n",
-                  g.temp_c, g.errors.windows, DpsFromRadps(g.errors.gyro_rms_radps), DpsFromRadps(g.errors.gyro_max_radps),
-                  MgFromMps2(g.errors.accel_rms_mps2), MgFromMps2(g.errors.accel_max_mps2));
-      if (g.order_lowered) {
-        std::printf("      (held out at temperature order %d gyro / %d accel: the other temperatures determine no more)\n",
-                    g.gyro_temp_order, g.accel_temp_order);
-      }
+}
+
+// --validate: the errors on each temperature left out in turn.
+void PrintValidation(const std::vector<HeldOutGroup>& folds) {
+  std::printf("  leave-one-temperature-out validation:\n");
+  if (folds.empty()) std::printf("    not enough temperatures (needs at least 3 groups)\n");
+  for (const HeldOutGroup& g : folds) {
+    if (!g.fitted) {
+      std::printf("    without %.1f degC: not fitted (%s)\n", g.temp_c, g.why_not.c_str());
+      continue;
+    }
+    std::printf(
+        "    without %6.1f degC: %3d held-out windows, gyro RMS %.5f deg/s (max %.5f), accel RMS %.4f mg "
+        "(max %.4f)\n",
+        g.temp_c, g.errors.windows, DpsFromRadps(g.errors.gyro_rms_radps),
+        DpsFromRadps(g.errors.gyro_max_radps), MgFromMps2(g.errors.accel_rms_mps2),
+        MgFromMps2(g.errors.accel_max_mps2));
+    if (g.order_lowered) {
+      std::printf(
+          "      (held out at temperature order %d gyro / %d accel: the other temperatures determine no "
+          "more)\n",
+          g.gyro_temp_order, g.accel_temp_order);
     }
   }
-  if (!result.check_errors.empty()) {
-    PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
+}
+
+// After CertifyUnit: the verdict, the files written, the store. Returns the exit status: 0,
+// kExitFailedLimits, or 2 when the store refused the fit.
+int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool recorded) {
+  if (!args.report.empty()) WarnIfNoSerial(unit.fit->calibration->serial, args.samples);
+  const bool judged = !unit.verdict.empty();
+  if (judged && (!args.quiet || !unit.verdict_detail.pass))
+    std::printf("%s", unit.verdict_detail.Table().c_str());
+  if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
+  if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
+  if (!recorded) {
+    std::fprintf(stderr, "imufit: %s\n", unit.message.c_str());
+    return 2;
   }
-  return FinishFactory(args, options, limits, station, result, &outputs);
+  if (!args.store.empty() && !args.quiet) std::printf("  recorded in %s\n", args.store.c_str());
+  return judged && !unit.verdict_detail.pass ? kExitFailedLimits : 0;
+}
+
+int RunFit(const FitArguments& args) {
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples,
+                                        args.limits, args.run.prior});
+  if (!args.report.empty()) {
+    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples,
+                                          args.limits, args.output, args.station});
+  }
+  if (!args.station.empty() && args.report.empty()) {
+    throw InputError("--station", "is shown on the certificate: give --report too");
+  }
+  const FitRunOptions options = ResolveOptions(args);
+  std::unique_ptr<ResultsStore> store;
+  const CertifySettings settings = ReadFactoryInputs(args, options, &store);
+
+  UnitOutcome unit;
+  unit.plan_path = args.plan;
+  unit.samples_path = args.samples;
+  unit.fit = FitRun(args.plan, args.samples, options);
+  const FitRunResult& result = *unit.fit;
+  for (const std::string& warning : result.serial_warnings) {
+    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  }
+  if (!args.quiet) PrintRunNotes(options, result);
+  if (result.fit.status == FitStatus::kUndetermined) return ReportUndetermined(args, options, result);
+  if (!result.calibration) {
+    std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(),
+                 result.fit.BriefReport().c_str());
+    return 1;
+  }
+  if (!args.quiet) {
+    PrintFit(options, result);
+    if (args.validate) PrintValidation(result.folds);
+    if (!result.check_errors.empty()) {
+      PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
+    }
+  }
+  unit.serial = result.serial;
+  unit.warnings = result.serial_warnings;
+  unit.plan_sha256 = result.plan_sha256;
+  unit.samples_sha256 = result.run.samples_sha256;
+  const bool recorded = CertifyUnit(settings, {args.output, args.report}, &unit);
+  return ReportCertified(args, unit, recorded);
 }
 
 }  // namespace
@@ -294,7 +295,8 @@ CommandRunner AddFitCommand(CLI::App* root) {
       "fit",
       "Fit biases, scale factors, misalignments, gyro g-sensitivity and their cubic temperature "
       "dependence to a rate-table run; write the calibration YAML with 1-sigma uncertainties. Exit 1 when "
-      "the run does not determine the model (the message says what is missing) or the fit does not converge.");
+      "the run does not determine the model (the message says what is missing) or the fit does not "
+      "converge.");
   command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
   command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
@@ -302,11 +304,13 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--threads", args->run.fit.num_threads, "solver threads")->capture_default_str();
   command->add_flag("--validate", args->validate,
                     "leave each interior temperature out in turn, refit, and report the errors on it");
-  command->add_option("--check-samples", args->check_samples, "a held-out run to report the calibration's errors on");
+  command->add_option("--check-samples", args->check_samples,
+                      "a held-out run to report the calibration's errors on");
   command->add_option("--check-plan", args->check_plan, "the plan of --check-samples (default: --plan)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
-  command->add_option("--limits,-l", args->limits,
-                      "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
+  command->add_option(
+      "--limits,-l", args->limits,
+      "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
   command->add_option(
       "--serial", args->serial,
       "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial); one "
@@ -314,11 +318,13 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_flag("--allow-mismatch", args->allow_mismatch,
                     "fit even when --serial names another unit than the samples header (a warning, also on "
                     "the certificate)");
-  command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
+  command->add_option("--report", args->report,
+                      "write the unit's calibration certificate (self-contained HTML)");
   command->add_option(
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
-  command->add_option("--store", args->store, "record the fit in this results store (SQLite; created when missing)");
+  command->add_option("--store", args->store,
+                      "record the fit in this results store (SQLite; created when missing)");
   return [args] { return RunFit(*args); };
 }
 

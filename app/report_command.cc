@@ -11,6 +11,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/station.h"
+#include "imufit/pipeline/run_windows.h"
 #include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
@@ -36,6 +37,7 @@ int RunReport(const ReportArguments& args) {
   if (std::string problem = windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   if (std::string problem = input.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   CertificateSources sources;
+  sources.software = SoftwareVersion();
   sources.calibration = ReadCalibration(args.calibration);
   sources.plan = ReadPlan(args.plan);
   // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
@@ -67,15 +69,16 @@ int RunReport(const ReportArguments& args) {
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
   sources.samples_input = input;
-  sources.run = ReadRunWindows(sources.plan, args.samples, windows, sources.samples_input);
+  // Read once for the windows, the hash and the noise section's static stretch.
+  sources.run = RunReader(sources.plan, args.samples, input).Read(windows, /*keep_static_stretch=*/true);
   sources.windows = windows;
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
-                    {"samples", args.samples, ""},
+                    {"samples", args.samples, sources.run.samples_sha256},
                     {"limits", args.limits, ""},
                     {"station", args.station, ""}};
   const Certificate certificate = MakeCertificate(sources);
-  WarnIfNoSerial(certificate, args.calibration);
+  WarnIfNoSerial(certificate.serial, args.calibration);
   WriteCertificate(args.output, certificate);
   const std::optional<Verdict>& verdict = certificate.verdict;
   std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
@@ -85,8 +88,8 @@ int RunReport(const ReportArguments& args) {
 
 }  // namespace
 
-void WarnIfNoSerial(const Certificate& certificate, const std::string& file) {
-  if (!certificate.serial.empty()) return;
+void WarnIfNoSerial(const std::string& serial, const std::string& file) {
+  if (!serial.empty()) return;
   std::fprintf(stderr,
                "imufit: warning: %s: no serial (give --serial, or a '# serial:' line in the samples header): "
                "the certificate says \"(no serial)\"\n",

@@ -65,12 +65,13 @@ int RunSimulate(SimulateArguments args) {
   std::ostringstream comment;
   comment << "simulated by " << SoftwareVersion() << " from plan " << args.plan << " and calibration "
           << args.calibration << ", seed " << options.seed << serial_line;
-  SamplesWriter samples(args.output, SampleColumns{!args.no_segment_column, !args.no_temp_column}, comment.str());
+  SamplesWriter samples(args.output, SampleColumns{!args.no_segment_column, !args.no_temp_column},
+                        comment.str(), &outputs);
   std::optional<SamplesWriter> truth_samples;
   if (!args.truth_output.empty()) {
     truth_samples.emplace(
-        args.truth_output, true,
-        "true angular rate (rad/s) and specific force (m/s^2) of " + args.output + serial_line);
+        args.truth_output, SampleColumns{true, true},
+        "true angular rate (rad/s) and specific force (m/s^2) of " + args.output + serial_line, &outputs);
   }
   long long count = 0;
   SimulateRun(options, plan.site, plan.segments, truth.model, [&](const Sample& raw, const SegmentTruth& truth_of) {

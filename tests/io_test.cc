@@ -16,10 +16,12 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
+#include "imufit/io/file_reads.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
 #include "test_models.h"
 
@@ -848,26 +850,71 @@ TEST_F(IoTest, AnOutputTransactionWritesAllOrNothing) {
   const std::string second = (dir_ / "second.html").string();
   {
     OutputTransaction outputs;
-    WriteFileAtomically(first, "new first\n");
+    WriteFileAtomically(first, "new first\n", &outputs);
     EXPECT_EQ(Read(first), "old first\n") << "renamed before the transaction commits";
     // The second output fails (its folder does not exist): the first must not change.
-    EXPECT_THROW(WriteFileAtomically((dir_ / "missing" / "x.html").string(), "y"), InputError);
+    EXPECT_THROW(WriteFileAtomically((dir_ / "missing" / "x.html").string(), "y", &outputs), InputError);
   }
   EXPECT_EQ(Read(first), "old first\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1)
       << "temporary left behind";
   {
     OutputTransaction outputs;
-    WriteFileAtomically(first, "new first\n");
-    WriteFileAtomically(second, "new second\n");
+    WriteFileAtomically(first, "new first\n", &outputs);
+    WriteFileAtomically(second, "new second\n", &outputs);
     EXPECT_FALSE(fs::exists(second));
     outputs.Commit();
   }
   EXPECT_EQ(Read(first), "new first\n");
   EXPECT_EQ(Read(second), "new second\n");
-  // Outside a transaction, Commit() renames at once again.
+  // Without a transaction, Commit() renames at once.
   WriteFileAtomically(second, "third\n");
   EXPECT_EQ(Read(second), "third\n");
+}
+
+// A transaction changes only the outputs it is given: one written without it while it is open is
+// renamed at once, and is not taken back when the transaction is dropped.
+TEST_F(IoTest, AnOutputTransactionHoldsOnlyTheOutputsItIsGiven) {
+  const std::string held = (dir_ / "held.yaml").string();
+  const std::string apart = (dir_ / "apart.yaml").string();
+  {
+    OutputTransaction outputs;
+    WriteFileAtomically(held, "held\n", &outputs);
+    WriteFileAtomically(apart, "apart\n");
+    EXPECT_EQ(Read(apart), "apart\n") << "an output not given the transaction was held by it";
+    EXPECT_FALSE(fs::exists(held));
+  }
+  EXPECT_FALSE(fs::exists(held));
+  EXPECT_EQ(Read(apart), "apart\n");
+}
+
+// A CSV reader hashes the file's bytes as they are on disk (compressed, for .gz) while it streams
+// them, and counts as one opening of the file.
+TEST_F(IoTest, ACsvReaderHashesTheFileAsItReadsIt) {
+  for (const std::string name : {"hashed.csv", "hashed.csv.gz"}) {
+    const std::string path = (dir_ / name).string();
+    {
+      SamplesWriter writer(path, true);
+      for (int i = 0; i < 200000; ++i) {  // several read blocks, plain and compressed
+        Sample sample;
+        sample.time_s = i * 0.01;
+        sample.gyro = Eigen::Vector3d(i % 7, i % 11, i % 13);
+        writer.Write(sample);
+      }
+      writer.Commit();
+    }
+    const long long opened = TimesOpenedForReading(path);
+    Sha256 digest;
+    SamplesReader reader(path, true, std::nullopt, &digest);
+    Sample sample;
+    long long samples = 0;
+    while (reader.Next(&sample)) ++samples;
+    EXPECT_EQ(samples, 200000);
+    EXPECT_EQ(TimesOpenedForReading(path), opened + 1) << name;
+    EXPECT_EQ(digest.HexDigest(), Sha256OfFile(path)) << name;
+    EXPECT_EQ(TimesOpenedForReading(path), opened + 2) << name << ": Sha256OfFile opens it too";
+  }
+  EXPECT_EQ(TimesOpenedForReading((dir_ / "missing.csv").string()), 0);
 }
 
 TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
@@ -880,7 +927,7 @@ TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
       OutputFile file(path);
       file.Write(std::string(3 << 20, 'x'));  // past the first flush
       OutputTransaction outputs;
-      WriteFileAtomically(path + ".other", "pending in a transaction\n");
+      WriteFileAtomically(path + ".other", "pending in a transaction\n", &outputs);
       ::raise(signal_number);
       ::_exit(0);  // not reached
     }

@@ -140,27 +140,29 @@ std::string Join(const std::vector<std::string>& parts, const char* separator) {
 
 // Everything a worker needs that is shared by all units.
 struct Shared {
-  const BatchOptions* options;
-  std::optional<Limits> limits;
-  std::string limits_sha256;
-  std::optional<Station> station;
-  std::string station_sha256;
+  const BatchOptions* options = nullptr;
+  CertifySettings certify;  // the software, limits, station, store and lot
   std::string fit_options;  // options->fit.Describe()
   std::unique_ptr<ResultsStore> store;
-  std::string lot;
-  std::mutex store_mutex;
 };
 
-void Judge(const Shared& shared, const Calibration& calibration, UnitOutcome* outcome) {
-  outcome->figures = KeyFigures(calibration);
-  if (!shared.limits) return;
-  outcome->verdict_detail = EvaluateLimits(*shared.limits, calibration);
-  outcome->verdict = outcome->verdict_detail.pass ? "PASS" : "FAIL";
-  outcome->message = outcome->verdict_detail.FailedSummary();
+// Where a unit's outputs go: OUT_DIR/<unit>/.
+struct UnitPaths {
+  fs::path folder;
+  std::string calibration, report, manifest;
+};
+
+UnitPaths PathsOf(const BatchOptions& options, const std::string& unit) {
+  UnitPaths paths;
+  paths.folder = fs::path(options.output_dir) / unit;
+  paths.calibration = (paths.folder / "calibration.yaml").string();
+  paths.report = (paths.folder / "report.html").string();
+  paths.manifest = (paths.folder / "manifest.yaml").string();
+  return paths;
 }
 
 // The serial in UNIT/serial.txt (its first line, trimmed), or "" without that file.
-std::string UnitSerial(const fs::path& unit_dir) {
+std::string SerialFile(const fs::path& unit_dir) {
   std::ifstream stream(unit_dir / "serial.txt");
   std::string line;
   if (!stream || !std::getline(stream, line)) return "";
@@ -169,150 +171,137 @@ std::string UnitSerial(const fs::path& unit_dir) {
   return first == std::string::npos ? "" : line.substr(first, last - first + 1);
 }
 
-UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
-  const BatchOptions& options = *shared.options;
-  const auto start = std::chrono::steady_clock::now();
-  UnitOutcome outcome;
-  outcome.unit = unit_dir.filename().string();
-  outcome.serial = outcome.unit;
-  outcome.status = "error";
-  const fs::path out_dir = fs::path(options.output_dir) / outcome.unit;
-  const std::string calibration_path = (out_dir / "calibration.yaml").string();
-  const std::string manifest_path = (out_dir / "manifest.yaml").string();
-  const std::string report_path = (out_dir / "report.html").string();
-  std::string calibration_yaml;
+// The unit's plan (its plan.yaml, else the shared plan) and samples (samples.csv.gz, else
+// samples.csv), and their hashes.
+void FindInputs(const BatchOptions& options, const fs::path& unit_dir, UnitOutcome* unit) {
+  std::string samples = (unit_dir / "samples.csv.gz").string();
+  if (!fs::exists(samples)) samples = (unit_dir / "samples.csv").string();
+  if (!fs::exists(samples)) throw InputError(unit_dir.string(), "no samples.csv or samples.csv.gz");
+  std::string plan = (unit_dir / "plan.yaml").string();
+  if (!fs::exists(plan)) {
+    if (options.shared_plan.empty()) throw InputError(unit_dir.string(), "no plan.yaml and no shared --plan");
+    plan = options.shared_plan;
+  }
+  unit->plan_path = plan;
+  unit->samples_path = samples;
+  unit->plan_sha256 = Sha256OfFile(plan);
+  unit->samples_sha256 = Sha256OfFile(samples);
+}
+
+// What the unit's manifest says of its inputs (the outcome is added when the unit is done).
+Manifest InputsManifest(const Shared& shared, const UnitOutcome& unit) {
   Manifest manifest;
+  manifest.software = shared.options->fit.software;
+  manifest.plan_sha256 = unit.plan_sha256;
+  manifest.samples_sha256 = unit.samples_sha256;
+  manifest.limits_sha256 = shared.certify.limits_sha256;
+  manifest.station_sha256 = shared.certify.station_sha256;
+  manifest.fit_options = shared.fit_options;
+  return manifest;
+}
+
+// Takes a finished run's outcome when the unit is unchanged since (the same inputs, fit options
+// and software, and its outputs still there): then nothing is redone.
+bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPaths& paths,
+                   UnitOutcome* unit) {
+  const std::optional<Manifest> previous = ReadManifest(paths.manifest);
+  if (!previous || previous->software != manifest.software || previous->plan_sha256 != manifest.plan_sha256 ||
+      previous->samples_sha256 != manifest.samples_sha256 ||
+      previous->limits_sha256 != manifest.limits_sha256 ||
+      previous->station_sha256 != manifest.station_sha256 || previous->fit_options != manifest.fit_options) {
+    return false;
+  }
+  if (previous->status == "fitted" &&
+      !(fs::exists(paths.calibration) && (!shared.options->write_reports || fs::exists(paths.report)))) {
+    return false;
+  }
+  unit->skipped = true;
+  unit->serial = previous->serial;
+  unit->status = previous->status;
+  unit->verdict = previous->verdict;
+  unit->message = previous->message;
+  if (unit->status == "fitted")
+    JudgeUnit(shared.certify, ReadCalibration(paths.calibration), std::nullopt, unit);
+  return true;
+}
+
+// Fits the unit, whose serial.txt states its serial. A unit not fitted says why; a fitted one's
+// calibration carries the unit's serial (the folder name when nothing else names the unit).
+void FitUnit(const Shared& shared, const fs::path& unit_dir, const UnitPaths& paths, UnitOutcome* unit) {
+  fs::create_directories(paths.folder);
+  RemoveLeftovers(paths.folder);
+  FitRunOptions options = shared.options->fit;
+  options.serial = SerialFile(unit_dir);
+  options.serial_source = (unit_dir / "serial.txt").string();
+  options.plan_sha256 = unit->plan_sha256;
+  options.keep_static_stretch = shared.options->write_reports;  // the certificate's noise section
+  unit->fit = FitRun(unit->plan_path, unit->samples_path, options);
+  FitRunResult& result = *unit->fit;
+  if (!result.serial.empty()) unit->serial = result.serial;  // serial.txt, the samples', the plan's
+  unit->warnings = result.serial_warnings;
+  if (result.fit.status == FitStatus::kUndetermined) {
+    unit->status = "not-fitted";
+    unit->message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");
+  } else if (!result.calibration) {
+    unit->status = "not-fitted";
+    unit->message = result.fit.BriefReport();
+  } else if (result.calibration->serial.empty()) {
+    result.calibration->serial = unit->serial;
+  }
+}
+
+// Marks the unit done: its manifest, written last.
+void WriteUnitManifest(const UnitPaths& paths, const UnitOutcome& unit, Manifest manifest) {
+  manifest.serial = unit.serial;
+  manifest.status = unit.status;
+  manifest.verdict = unit.verdict;
+  manifest.message = unit.message;
+  if (!unit.calibration_yaml.empty()) manifest.calibration_sha256 = Sha256Hex(unit.calibration_yaml);
+  fs::create_directories(paths.folder);
+  WriteManifest(paths.manifest, manifest);
+}
+
+UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
+  const auto start = std::chrono::steady_clock::now();
+  UnitOutcome unit;
+  unit.unit = unit_dir.filename().string();
+  unit.serial = unit.unit;
+  unit.status = "error";
+  const UnitPaths paths = PathsOf(*shared.options, unit.unit);
+  Manifest manifest;
+  bool offered = false;  // to the store: CertifyUnit records a fitted unit
+  bool recorded = false;
   try {
-    std::string samples = (unit_dir / "samples.csv.gz").string();
-    if (!fs::exists(samples)) samples = (unit_dir / "samples.csv").string();
-    if (!fs::exists(samples)) throw InputError(unit_dir.string(), "no samples.csv or samples.csv.gz");
-    std::string plan = (unit_dir / "plan.yaml").string();
-    if (!fs::exists(plan)) {
-      if (options.shared_plan.empty())
-        throw InputError(unit_dir.string(), "no plan.yaml and no shared --plan");
-      plan = options.shared_plan;
-    }
-    outcome.plan_path = plan;
-    outcome.samples_path = samples;
-    const std::string serial_file = UnitSerial(unit_dir);
-    outcome.plan_sha256 = Sha256OfFile(plan);
-    outcome.samples_sha256 = Sha256OfFile(samples);
-    manifest = Manifest{};
-    manifest.software = options.fit.software;
-    manifest.plan_sha256 = outcome.plan_sha256;
-    manifest.samples_sha256 = outcome.samples_sha256;
-    manifest.limits_sha256 = shared.limits_sha256;
-    manifest.station_sha256 = shared.station_sha256;
-    manifest.fit_options = shared.fit_options;
-
-    // Unchanged since a finished run (the same inputs, fit options and software, and its outputs
-    // still there): take its outcome, redo nothing.
-    if (const std::optional<Manifest> previous = ReadManifest(manifest_path);
-        previous && previous->software == manifest.software &&
-        previous->plan_sha256 == manifest.plan_sha256 &&
-        previous->samples_sha256 == manifest.samples_sha256 &&
-        previous->limits_sha256 == manifest.limits_sha256 &&
-        previous->station_sha256 == manifest.station_sha256 &&
-        previous->fit_options == manifest.fit_options &&
-        (previous->status != "fitted" ||
-         (fs::exists(calibration_path) && (!options.write_reports || fs::exists(report_path))))) {
-      outcome.skipped = true;
-      outcome.serial = previous->serial;
-      outcome.status = previous->status;
-      outcome.verdict = previous->verdict;
-      outcome.message = previous->message;
-      if (outcome.status == "fitted") Judge(shared, ReadCalibration(calibration_path), &outcome);
-      return outcome;
-    }
-
-    fs::create_directories(out_dir);
-    RemoveLeftovers(out_dir);
-    FitRunOptions fit_options = options.fit;
-    fit_options.serial = serial_file;
-    fit_options.serial_source = (unit_dir / "serial.txt").string();
-    fit_options.plan_sha256 = outcome.plan_sha256;
-    fit_options.samples_sha256 = outcome.samples_sha256;
-    FitRunResult result = FitRun(plan, samples, fit_options);
-    if (!result.serial.empty()) outcome.serial = result.serial;  // serial.txt, the samples', the plan's
-    outcome.warnings = result.serial_warnings;
-    if (result.fit.status == FitStatus::kUndetermined) {
-      outcome.status = "not-fitted";
-      outcome.message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");
-    } else if (!result.calibration) {
-      outcome.status = "not-fitted";
-      outcome.message = result.fit.BriefReport();
-    } else {
-      outcome.status = "fitted";
-      Calibration& calibration = *result.calibration;
-      if (calibration.serial.empty()) calibration.serial = outcome.serial;
-      calibration_yaml = CalibrationToYaml(calibration);
-      WriteFileAtomically(calibration_path, calibration_yaml);
-      manifest.calibration_sha256 = Sha256Hex(calibration_yaml);
-      Judge(shared, calibration, &outcome);
-    }
-    outcome.fit = std::move(result);
-    if (outcome.status == "fitted" && options.write_reports) {
-      const Certificate certificate = MakeCertificate(outcome, options.limits_path, shared.limits,
-                                                      calibration_path, options.fit, shared.station);
-      // The certificate judges with the noise it measured itself: its verdict is the unit's.
-      if (certificate.verdict) {
-        outcome.verdict_detail = *certificate.verdict;
-        outcome.verdict = certificate.verdict->pass ? "PASS" : "FAIL";
-        outcome.message = certificate.verdict->FailedSummary();
-      }
-      WriteCertificate(report_path, certificate);
+    FindInputs(*shared.options, unit_dir, &unit);
+    manifest = InputsManifest(shared, unit);
+    if (TakeUnchanged(shared, manifest, paths, &unit)) return unit;
+    FitUnit(shared, unit_dir, paths, &unit);
+    if (unit.fit->calibration) {
+      const UnitFiles files{paths.calibration, shared.options->write_reports ? paths.report : ""};
+      recorded = CertifyUnit(shared.certify, files, &unit);
+      offered = true;
+      unit.fit->run.static_stretch.reset();  // measured: not kept for the rest of the lot
     }
   } catch (const InputError& e) {
-    outcome.status = "error";
-    outcome.message = e.what();
+    unit.status = "error";
+    unit.message = e.what();
   } catch (const std::exception& e) {
-    outcome.status = "error";
-    outcome.message = std::string("error: ") + e.what();
+    unit.status = "error";
+    unit.message = std::string("error: ") + e.what();
   }
-  outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  // Record, then mark done: a crash between the two redoes the unit (a second row in the store),
-  // never loses it.
-  if (shared.store && !outcome.plan_sha256.empty()) {
-    StoredFit row;
-    row.serial = outcome.serial;
-    row.unit = outcome.unit;
-    row.lot = shared.lot;
-    row.time_utc = UtcNow();
-    row.software = options.fit.software;
-    row.plan_sha256 = outcome.plan_sha256;
-    row.samples_sha256 = outcome.samples_sha256;
-    row.limits_sha256 = shared.limits_sha256;
-    row.status = outcome.status;
-    row.verdict = outcome.verdict;
-    row.message = outcome.message;
-    row.calibration_yaml = calibration_yaml;
-    row.figures = outcome.figures;
-    std::lock_guard<std::mutex> lock(shared.store_mutex);
-    try {
-      shared.store->Record(row);
-    } catch (const std::exception& e) {
-      // Not recorded: no manifest either, so that the next run does the unit again.
-      outcome.status = "error";
-      outcome.verdict.clear();
-      outcome.message = std::string("not recorded in the results store: ") + e.what();
-      return outcome;
-    }
+  unit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (unit.plan_sha256.empty()) return unit;  // no inputs: nothing to record or to mark done
+  // Recorded, then marked done: a crash between the two redoes the unit (a second row in the
+  // store), never loses it. A unit the store refused gets no manifest: the next run redoes it.
+  if (!offered) recorded = RecordUnit(shared.certify, &unit);
+  if (!recorded) return unit;
+  try {
+    WriteUnitManifest(paths, unit, manifest);
+  } catch (const std::exception& e) {
+    unit.status = "error";
+    unit.message = std::string("cannot write the manifest: ") + e.what();
   }
-  if (!outcome.plan_sha256.empty()) {
-    manifest.serial = outcome.serial;
-    manifest.status = outcome.status;
-    manifest.verdict = outcome.verdict;
-    manifest.message = outcome.message;
-    try {
-      fs::create_directories(out_dir);
-      WriteManifest(manifest_path, manifest);
-    } catch (const std::exception& e) {
-      outcome.status = "error";
-      outcome.message = std::string("cannot write the manifest: ") + e.what();
-    }
-  }
-  return outcome;
+  return unit;
 }
 
 std::string SummaryCell(const std::string& text) {
@@ -339,54 +328,48 @@ void WriteLotSummary(const std::string& path, const BatchResult& result) {
   out.Commit();
 }
 
-}  // namespace
-
-std::string BatchOptions::Validate() const {
-  if (units_dir.empty()) return "no units folder";
-  if (output_dir.empty()) return "no output folder";
-  if (jobs < 0) return "jobs must be >= 0";
-  if (max_units < 0) return "max_units must be >= 0";
-  return fit.Validate();
+// The lot's name in the store: --lot, else the units folder's name.
+std::string LotName(const BatchOptions& options) {
+  if (!options.lot.empty()) return options.lot;
+  const fs::path units = fs::path(options.units_dir).lexically_normal();
+  const std::string name = units.filename().string();
+  return name.empty() ? units.parent_path().filename().string() : name;  // "units/" ends in ""
 }
 
-BatchResult RunBatch(const BatchOptions& options) {
+// The unit folders, in name order (not .git and the like).
+std::vector<fs::path> ListUnits(const std::string& units_dir) {
+  std::vector<fs::path> units;
+  for (const fs::directory_entry& entry : fs::directory_iterator(units_dir)) {
+    if (entry.is_directory() && entry.path().filename().string()[0] != '.') units.push_back(entry.path());
+  }
+  std::sort(units.begin(), units.end());
+  return units;
+}
+
+// Everything shared by the units, each input checked: a bad one is the lot's error, before any unit.
+void Prepare(const BatchOptions& options, Shared* shared) {
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit batch", problem);
   if (!fs::is_directory(options.units_dir)) throw InputError(options.units_dir, "not a folder");
-  Shared shared;
-  shared.options = &options;
-  shared.fit_options = options.fit.Describe();
-  if (!options.limits_path.empty()) {
-    shared.limits = ReadLimits(options.limits_path);
-    shared.limits_sha256 = Sha256OfFile(options.limits_path);
-  }
-  if (!options.station_path.empty()) {
-    shared.station = ReadStation(options.station_path);
-    shared.station_sha256 = Sha256OfFile(options.station_path);
-  }
-  if (!options.shared_plan.empty()) ReadPlan(options.shared_plan);  // a bad shared plan is the lot's error
+  shared->options = &options;
+  shared->fit_options = options.fit.Describe();
+  shared->certify.software = options.fit.software;
+  shared->certify.windows = options.fit.windows;
+  shared->certify.samples_input = options.fit.input;
+  ReadLimitsAndStation(options.limits_path, options.station_path, &shared->certify);
+  if (!options.shared_plan.empty()) ReadPlan(options.shared_plan);
   std::error_code error;
   fs::create_directories(options.output_dir, error);
-  if (!fs::is_directory(options.output_dir)) {
+  if (!fs::is_directory(options.output_dir))
     throw InputError(options.output_dir, "cannot create the output folder");
-  }
-  const FolderLock lock(options.output_dir);
-  shared.lot =
-      options.lot.empty() ? fs::path(options.units_dir).lexically_normal().filename().string() : options.lot;
-  if (shared.lot.empty())
-    shared.lot = fs::path(options.units_dir).lexically_normal().parent_path().filename().string();
-  if (!options.store_path.empty()) shared.store = std::make_unique<ResultsStore>(options.store_path);
+}
 
-  std::vector<fs::path> units;
-  for (const fs::directory_entry& entry : fs::directory_iterator(options.units_dir)) {
-    if (entry.is_directory() && entry.path().filename().string()[0] != '.')
-      units.push_back(entry.path());  // not .git and the like
-  }
-  std::sort(units.begin(), units.end());
-
-  BatchResult result;
-  result.units.resize(units.size());
-  std::vector<bool> finished(units.size(), false);
+// The units processed by a pool of threads; a unit is nullopt when max_units stopped the batch
+// before it.
+std::vector<std::optional<UnitOutcome>> ProcessUnits(const Shared& shared,
+                                                     const std::vector<fs::path>& units) {
+  const BatchOptions& options = *shared.options;
+  std::vector<std::optional<UnitOutcome>> outcomes(units.size());
   std::atomic<size_t> next{0};
   std::atomic<int> fitted{0};
   std::mutex progress_mutex;
@@ -401,12 +384,11 @@ BatchResult RunBatch(const BatchOptions& options) {
       UnitOutcome outcome = ProcessUnit(shared, units[i]);
       if (!outcome.skipped) ++fitted;
       std::lock_guard<std::mutex> lock(progress_mutex);
-      result.units[i] = std::move(outcome);
-      finished[i] = true;
+      outcomes[i] = std::move(outcome);
       ++progress.done;
-      progress.skipped += result.units[i].skipped ? 1 : 0;
+      progress.skipped += outcomes[i]->skipped ? 1 : 0;
       progress.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      progress.last = &result.units[i];
+      progress.last = &*outcomes[i];
       if (options.progress) options.progress(progress);
     }
   };
@@ -416,34 +398,63 @@ BatchResult RunBatch(const BatchOptions& options) {
   std::vector<std::thread> threads;
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
+  return outcomes;
+}
 
-  std::vector<UnitOutcome> done;
-  for (size_t i = 0; i < units.size(); ++i) {
-    if (!finished[i]) {
+// The finished units and their counts.
+BatchResult Tally(std::vector<std::optional<UnitOutcome>> outcomes) {
+  BatchResult result;
+  for (std::optional<UnitOutcome>& outcome : outcomes) {
+    if (!outcome) {
       result.complete = false;
       continue;
     }
-    UnitOutcome& u = result.units[i];
+    const UnitOutcome& u = *outcome;
     result.skipped += u.skipped ? 1 : 0;
     if (u.status == "error") ++result.errors;
     if (u.status == "not-fitted") ++result.not_fitted;
     if (u.verdict == "PASS") ++result.passed;
     if (u.verdict == "FAIL") ++result.failed;
-    done.push_back(std::move(u));
+    result.units.push_back(std::move(*outcome));
   }
-  result.units = std::move(done);
-  if (result.complete) {
-    WriteLotSummary((fs::path(options.output_dir) / "lot_summary.csv").string(), result);
-    if (options.write_reports) {
-      std::optional<Limits> limits;
-      if (!options.limits_path.empty()) limits = ReadLimits(options.limits_path);
-      LotSummary summary = MakeLotSummary(shared.lot, result, options.fit.software, limits);
-      // With a results store, the page compares this lot with every lot recorded there.
-      if (shared.store)
-        summary.history = MakeLotHistory(shared.store.get(), shared.lot, limits ? &*limits : nullptr);
-      WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), LotPageHtml(summary));
-    }
+  return result;
+}
+
+// OUT_DIR/lot_summary.csv, and with reports OUT_DIR/lot.html (with a results store, the page
+// compares this lot with every lot recorded there).
+void WriteLotOutputs(const Shared& shared, const BatchResult& result) {
+  const BatchOptions& options = *shared.options;
+  WriteLotSummary((fs::path(options.output_dir) / "lot_summary.csv").string(), result);
+  if (!options.write_reports) return;
+  const std::optional<Limits>& limits = shared.certify.limits;
+  LotSummary summary = MakeLotSummary(shared.certify.lot, result, options.fit.software, limits);
+  if (shared.store) {
+    summary.history = MakeLotHistory(shared.store.get(), shared.certify.lot, limits ? &*limits : nullptr);
   }
+  WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), LotPageHtml(summary));
+}
+
+}  // namespace
+
+std::string BatchOptions::Validate() const {
+  if (units_dir.empty()) return "no units folder";
+  if (output_dir.empty()) return "no output folder";
+  if (jobs < 0) return "jobs must be >= 0";
+  if (max_units < 0) return "max_units must be >= 0";
+  return fit.Validate();
+}
+
+BatchResult RunBatch(const BatchOptions& options) {
+  Shared shared;
+  Prepare(options, &shared);
+  const FolderLock lock(options.output_dir);
+  shared.certify.lot = LotName(options);
+  if (!options.store_path.empty()) {
+    shared.store = std::make_unique<ResultsStore>(options.store_path);
+    shared.certify.store = shared.store.get();
+  }
+  BatchResult result = Tally(ProcessUnits(shared, ListUnits(options.units_dir)));
+  if (result.complete) WriteLotOutputs(shared, result);
   return result;
 }
 

@@ -404,31 +404,9 @@ std::vector<ResidualRow> PrintedResidualRows(const std::vector<ResidualRow>& tab
 // The Allan deviation of the gyro over the longest static stretch of the run (raw outputs over the
 // scale factor at the stretch's temperature: rad/s), with the IEEE 952 fit's ARW and bias
 // instability.
-NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::string& samples_path,
-                       const SamplesInput& input, const std::optional<Segmentation>& segmentation) {
+NoiseSection GyroNoise(const Calibration& cal, const StaticStretch& stretch) {
   NoiseSection section;
-  // The samples are read as the fit read them: without a segment column, labelled from the plan
-  // (the fit's own segmentation when it has one, else found again).
-  SamplesReader reader(samples_path, /*require_segment=*/false, input.temp_c);
-  std::optional<Labeller> labeller;
-  if (!reader.has_segment()) {
-    labeller.emplace(segmentation ? *segmentation : SegmentSamplesFile(plan, samples_path, input));
-  }
-  std::vector<Sample> best, current;
-  Sample sample;
-  const auto close_stretch = [&] {
-    if (current.size() > best.size()) best.swap(current);
-    current.clear();
-  };
-  while (reader.Next(&sample)) {
-    if (labeller) sample.segment = labeller->Label(sample.time_s);
-    const TableSegment* segment = plan.Find(sample.segment);
-    const bool is_static = segment != nullptr && segment->IsStatic();
-    if (!is_static || (!current.empty() && current.back().segment != sample.segment)) close_stretch();
-    if (is_static) current.push_back(sample);
-  }
-  close_stretch();
-  section.duration_s = best.size() > 1 ? best.back().time_s - best.front().time_s : 0.0;
+  section.duration_s = stretch.duration_s();
   if (section.duration_s < kMinAllanStretchS) {
     char text[160];
     std::snprintf(text, sizeof text,
@@ -439,13 +417,11 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
     return section;
   }
   section.computed = true;
-  section.segment = best.front().segment;
-  double temp_sum = 0.0;
-  for (const Sample& s : best) temp_sum += s.temp_c;
-  section.temp_c = temp_sum / best.size();
-  const double tau0_s = section.duration_s / (best.size() - 1);
+  section.segment = stretch.segment;
+  section.temp_c = stretch.mean_temp_c();
+  const double tau0_s = section.duration_s / (stretch.size() - 1);
   std::vector<int64_t> factors;
-  AveragingFactors(TauSpec(), AllanEstimator::kOadev, static_cast<int64_t>(best.size()), tau0_s, &factors);
+  AveragingFactors(TauSpec(), AllanEstimator::kOadev, static_cast<int64_t>(stretch.size()), tau0_s, &factors);
   AllanOptions options;
   options.threads = 1;
   const double x = cal.model.basis.Argument(section.temp_c);
@@ -454,8 +430,8 @@ NoiseSection GyroNoise(const Calibration& cal, const Plan& plan, const std::stri
     const double scale = EvaluateTemperaturePolynomial(
         cal.model.gyro.data() + (kScaleCoefficient + axis) * kPolynomialTerms, x);
     std::vector<double> rates;
-    rates.reserve(best.size());
-    for (const Sample& s : best) rates.push_back(s.gyro(axis) / scale);
+    rates.reserve(stretch.gyro[axis].size());
+    for (double raw : stretch.gyro[axis]) rates.push_back(raw / scale);
     ColumnAnalysis analysis = AnalyseColumn(std::string("gyro_") + axes[axis], ColumnKind::kGyro,
                                             std::move(rates), tau0_s, factors, options);
     NoiseAxis a;
@@ -510,7 +486,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   c.calibrated_utc = cal.created_utc;
   c.written_utc = UtcNow();
   c.calibration_software = cal.software;
-  c.report_software = cal.software;
+  c.report_software = sources.software;
   c.git_revision = IMUFIT_GIT_REVISION;
   c.reference_temp_c = cal.model.basis.center_c;
   std::vector<ReportInput> inputs = sources.inputs;
@@ -557,7 +533,11 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   for (const ReportInput& in : c.inputs) {
     if (in.role != "samples") continue;
     try {
-      c.noise = GyroNoise(cal, sources.plan, in.path, sources.samples_input, sources.run.segmentation);
+      // The stretch the run's reading kept, else read from the file now.
+      c.noise = GyroNoise(cal, sources.run.static_stretch
+                                   ? *sources.run.static_stretch
+                                   : ReadStaticStretch(sources.plan, in.path, sources.samples_input,
+                                                       sources.run.segmentation));
     } catch (const std::exception& e) {
       c.noise = NoiseSection();
       c.noise.why_not = e.what();
@@ -616,30 +596,6 @@ std::vector<std::string> InputMismatches(const Calibration& calibration, const s
   check(calibration.fit->plan_sha256, "plan", plan_path);
   check(calibration.fit->samples_sha256, "samples file", samples_path);
   return mismatches;
-}
-
-Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
-                            const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const FitRunOptions& options, const std::optional<Station>& station) {
-  const FitRunResult& fit = *unit.fit;
-  CertificateSources sources;
-  sources.unit = unit.unit;
-  sources.calibration = *fit.calibration;
-  sources.calibration.serial = unit.serial;
-  sources.plan = fit.plan;
-  sources.run = fit.run;
-  sources.windows = options.windows;
-  sources.samples_input = options.input;
-  sources.folds = fit.folds;
-  sources.warnings = unit.warnings;
-  if (!unit.verdict.empty()) sources.verdict = unit.verdict_detail;
-  sources.limits = limits;
-  sources.inputs = {{"calibration", calibration_path, ""},
-                    {"plan", unit.plan_path, unit.plan_sha256},
-                    {"samples", unit.samples_path, unit.samples_sha256},
-                    {"limits", limits_path, ""}};
-  sources.station = station;
-  return MakeCertificate(sources);
 }
 
 // ---------------------------------------------------------------- the lot page

@@ -699,8 +699,9 @@ std::string CertificateHtml(const Certificate& c) {
   return h.Finish();
 }
 
-void WriteCertificate(const std::string& path, const Certificate& certificate) {
-  WriteFileAtomically(path, CertificateHtml(certificate));
+void WriteCertificate(const std::string& path, const Certificate& certificate,
+                      OutputTransaction* transaction) {
+  WriteFileAtomically(path, CertificateHtml(certificate), transaction);
 }
 
 // ---------------------------------------------------------------- the lot page

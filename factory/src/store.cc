@@ -120,6 +120,7 @@ void ResultsStore::Execute(const std::string& sql) {
 }
 
 int64_t ResultsStore::Record(const StoredFit& fit) {
+  const std::lock_guard<std::mutex> lock(record_mutex_);
   Execute("BEGIN IMMEDIATE");
   int64_t id = 0;
   {

@@ -219,8 +219,9 @@ std::string CalibrationToYaml(const Calibration& calibration) {
   return out;
 }
 
-void WriteCalibration(const std::string& path, const Calibration& calibration) {
-  WriteFileAtomically(path, CalibrationToYaml(calibration));
+void WriteCalibration(const std::string& path, const Calibration& calibration,
+                      OutputTransaction* transaction) {
+  WriteFileAtomically(path, CalibrationToYaml(calibration), transaction);
 }
 
 std::string UtcNow() {

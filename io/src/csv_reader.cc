@@ -12,7 +12,9 @@
 #include <unordered_set>
 
 #include "imufit/io/error.h"
+#include "imufit/io/file_reads.h"
 #include "imufit/io/path.h"
+#include "imufit/io/sha256.h"
 
 namespace imufit {
 namespace {
@@ -54,12 +56,14 @@ bool ParseSmallInteger(std::string_view text, double* value) {
 // Reads bytes from a plain file (read(2)) or a gzip stream (zlib's inflate over read(2)). The gzip
 // stream is checked to its end: a stream cut short, one whose CRC-32 or length trailer does not
 // match, bytes after the last member, or a file named .gz that is not gzip are InputErrors.
-// Concatenated members (`cat a.gz b.gz`) are one stream, as gzip(1) reads them.
+// Concatenated members (`cat a.gz b.gz`) are one stream, as gzip(1) reads them. Every byte read
+// from the file goes through ReadRaw(), and so through the digest when there is one.
 class CsvReader::Source {
  public:
-  explicit Source(const std::string& path) : path_(path) {
+  Source(const std::string& path, Sha256* digest) : path_(path), digest_(digest) {
     fd_ = ::open(path.c_str(), O_RDONLY);
     if (fd_ < 0) throw InputError(path_, std::string("cannot open: ") + std::strerror(errno));
+    CountOpenedForReading(path_);
     if (IsGzipPath(path)) {
       gzip_ = true;
       raw_.resize(kRawBytes);
@@ -113,7 +117,10 @@ class CsvReader::Source {
   size_t ReadRaw(char* data, size_t size) {
     for (;;) {
       const ssize_t n = ::read(fd_, data, size);
-      if (n >= 0) return static_cast<size_t>(n);
+      if (n >= 0) {
+        if (digest_ != nullptr) digest_->Update(std::string_view(data, static_cast<size_t>(n)));
+        return static_cast<size_t>(n);
+      }
       if (errno != EINTR) throw InputError(path_, std::string("cannot read: ") + std::strerror(errno));
     }
   }
@@ -147,6 +154,7 @@ class CsvReader::Source {
   }
 
   std::string path_;
+  Sha256* digest_;
   int fd_ = -1;
   bool gzip_ = false;
   bool inflating_ = false;
@@ -158,9 +166,9 @@ class CsvReader::Source {
   long long compressed_bytes_ = 0;
 };
 
-CsvReader::CsvReader(std::string path) : path_(std::move(path)) {
+CsvReader::CsvReader(std::string path, Sha256* raw_digest) : path_(std::move(path)) {
   errno = 0;
-  source_ = std::make_unique<Source>(path_);
+  source_ = std::make_unique<Source>(path_, raw_digest);
   buffer_.resize(kBlockBytes);
   std::string_view line;
   while (NextLine(&line)) {

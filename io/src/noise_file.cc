@@ -77,8 +77,9 @@ const NoiseTermUnits& UnitsOf(ColumnKind kind, int term) {
   return kOther[term];
 }
 
-void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results) {
-  OutputFile file(path);
+void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results,
+                   OutputTransaction* transaction) {
+  OutputFile file(path, transaction);
   file.Write("column,estimator,tau_s,terms,dev,dev_lo,dev_hi\n");
   for (const ColumnAnalysis& result : results) {
     for (const AllanPoint& point : result.curve.points) {
@@ -179,8 +180,8 @@ std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysi
 }
 
 void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
-                    const std::vector<ColumnAnalysis>& results) {
-  WriteFileAtomically(path, NoiseYaml(record, results));
+                    const std::vector<ColumnAnalysis>& results, OutputTransaction* transaction) {
+  WriteFileAtomically(path, NoiseYaml(record, results), transaction);
 }
 
 std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& extra, const std::string& column,

@@ -89,8 +89,6 @@ void CheckDestination(const std::string& path) {
   }
 }
 
-thread_local OutputTransaction* g_transaction = nullptr;
-
 }  // namespace
 
 void InstallOutputCleanupOnSignals() {
@@ -106,10 +104,7 @@ void InstallOutputCleanupOnSignals() {
   }
 }
 
-OutputTransaction::OutputTransaction() : previous_(g_transaction) { g_transaction = this; }
-
 OutputTransaction::~OutputTransaction() {
-  g_transaction = previous_;
   for (const Pending& pending : pending_) {
     ::unlink(pending.temp_path.c_str());
     UnregisterTempFile(pending.slot);
@@ -121,7 +116,6 @@ void OutputTransaction::Add(std::string temp_path, std::string path, int slot) {
 }
 
 void OutputTransaction::Commit() {
-  if (g_transaction == this) g_transaction = previous_;
   // Every output is complete and synced on disk; only the renames are left, in one folder each,
   // so the last thing that can fail has been done for all of them before any is renamed.
   for (const Pending& pending : pending_) CheckDestination(pending.path);
@@ -135,7 +129,8 @@ void OutputTransaction::Commit() {
   }
 }
 
-OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
+OutputFile::OutputFile(std::string path, OutputTransaction* transaction)
+    : path_(std::move(path)), transaction_(transaction) {
   namespace fs = std::filesystem;
   const fs::path destination(path_);
   if (!destination.has_filename()) throw InputError(path_, "not a file name");
@@ -236,8 +231,8 @@ void OutputFile::Commit() {
     ::close(fd_);
     fd_ = -1;
   }
-  if (g_transaction != nullptr) {
-    g_transaction->Add(temp_path_, path_, temp_slot_);  // renamed with the others, or removed
+  if (transaction_ != nullptr) {
+    transaction_->Add(temp_path_, path_, temp_slot_);  // renamed with the others, or removed
     committed_ = true;
     return;
   }
@@ -249,8 +244,8 @@ void OutputFile::Commit() {
   committed_ = true;
 }
 
-void WriteFileAtomically(const std::string& path, std::string_view text) {
-  OutputFile file(path);
+void WriteFileAtomically(const std::string& path, std::string_view text, OutputTransaction* transaction) {
+  OutputFile file(path, transaction);
   file.Write(text);
   file.Commit();
 }

@@ -47,8 +47,9 @@ SamplesSerial SerialInHeader(const CsvReader& csv) {
 
 }  // namespace
 
-SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c)
-    : csv_(std::move(path)), serial_(SerialInHeader(csv_).serial) {
+SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c,
+                             Sha256* raw_digest)
+    : csv_(std::move(path), raw_digest), serial_(SerialInHeader(csv_)) {
   time_column_ = csv_.RequireColumn("time_s");
   if (!temp_c) {
     try {
@@ -118,8 +119,9 @@ std::string SerialComment(const std::string& serial, const std::string& source) 
   return std::string(kSerialKey) + " " + serial;
 }
 
-SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment)
-    : file_(std::move(path)), columns_(columns) {
+SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std::string& comment,
+                             OutputTransaction* transaction)
+    : file_(std::move(path), transaction), columns_(columns) {
   if (!comment.empty()) {
     std::istringstream lines(comment);
     std::string line;

@@ -1,11 +1,14 @@
 #include "imufit/io/sha256.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 
 #include "imufit/io/error.h"
+#include "imufit/io/file_reads.h"
 
 namespace imufit {
 namespace {
@@ -26,11 +29,19 @@ inline uint32_t Rotr(uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
 
 }  // namespace
 
-Sha256::Sha256()
-    : state_{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19} {
-}
+// FIPS 180-4 section 6.2 over 64-byte blocks; `buffer` holds the bytes of an unfinished block.
+struct Sha256::State {
+  std::array<uint32_t, 8> hash{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                               0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+  std::array<unsigned char, 64> buffer{};
+  size_t buffered = 0;
+  uint64_t length_bytes = 0;
 
-void Sha256::Block(const unsigned char* block) {
+  void Block(const unsigned char* block);
+  void Update(std::string_view data);
+};
+
+void Sha256::State::Block(const unsigned char* block) {
   uint32_t w[64];
   for (int t = 0; t < 16; ++t) {
     w[t] = uint32_t(block[4 * t]) << 24 | uint32_t(block[4 * t + 1]) << 16 | uint32_t(block[4 * t + 2]) << 8 |
@@ -41,8 +52,8 @@ void Sha256::Block(const unsigned char* block) {
     const uint32_t s1 = Rotr(w[t - 2], 17) ^ Rotr(w[t - 2], 19) ^ (w[t - 2] >> 10);
     w[t] = w[t - 16] + s0 + w[t - 7] + s1;
   }
-  uint32_t a = state_[0], b = state_[1], c = state_[2], d = state_[3];
-  uint32_t e = state_[4], f = state_[5], g = state_[6], h = state_[7];
+  uint32_t a = hash[0], b = hash[1], c = hash[2], d = hash[3];
+  uint32_t e = hash[4], f = hash[5], g = hash[6], h = hash[7];
   for (int t = 0; t < 64; ++t) {
     const uint32_t t1 =
         h + (Rotr(e, 6) ^ Rotr(e, 11) ^ Rotr(e, 25)) + ((e & f) ^ (~e & g)) + kRound[t] + w[t];
@@ -56,45 +67,51 @@ void Sha256::Block(const unsigned char* block) {
     b = a;
     a = t1 + t2;
   }
-  state_[0] += a;
-  state_[1] += b;
-  state_[2] += c;
-  state_[3] += d;
-  state_[4] += e;
-  state_[5] += f;
-  state_[6] += g;
-  state_[7] += h;
+  hash[0] += a;
+  hash[1] += b;
+  hash[2] += c;
+  hash[3] += d;
+  hash[4] += e;
+  hash[5] += f;
+  hash[6] += g;
+  hash[7] += h;
 }
 
-void Sha256::Update(std::string_view data) {
-  length_bytes_ += data.size();
+void Sha256::State::Update(std::string_view data) {
+  length_bytes += data.size();
   const auto* p = reinterpret_cast<const unsigned char*>(data.data());
   size_t n = data.size();
-  if (buffered_ > 0) {
-    const size_t take = std::min(n, buffer_.size() - buffered_);
-    std::memcpy(buffer_.data() + buffered_, p, take);
-    buffered_ += take;
+  if (buffered > 0) {
+    const size_t take = std::min(n, buffer.size() - buffered);
+    std::memcpy(buffer.data() + buffered, p, take);
+    buffered += take;
     p += take;
     n -= take;
-    if (buffered_ < buffer_.size()) return;
-    Block(buffer_.data());
-    buffered_ = 0;
+    if (buffered < buffer.size()) return;
+    Block(buffer.data());
+    buffered = 0;
   }
   for (; n >= 64; p += 64, n -= 64) Block(p);
-  std::memcpy(buffer_.data(), p, n);
-  buffered_ = n;
+  std::memcpy(buffer.data(), p, n);
+  buffered = n;
 }
+
+Sha256::Sha256() : state_(std::make_unique<State>()) {}
+
+Sha256::~Sha256() = default;
+
+void Sha256::Update(std::string_view data) { state_->Update(data); }
 
 std::string Sha256::HexDigest() {
   // Padding: 0x80, zeros to 56 mod 64, then the message length in bits, big-endian.
-  const uint64_t length_bits = length_bytes_ * 8;
+  const uint64_t length_bits = state_->length_bytes * 8;
   unsigned char pad[72] = {0x80};
-  const size_t zeros = (buffered_ < 56 ? 56 - buffered_ : 120 - buffered_);
+  const size_t zeros = (state_->buffered < 56 ? 56 - state_->buffered : 120 - state_->buffered);
   for (int i = 0; i < 8; ++i) pad[zeros + i] = static_cast<unsigned char>(length_bits >> (56 - 8 * i));
-  Update(std::string_view(reinterpret_cast<const char*>(pad), zeros + 8));
+  state_->Update(std::string_view(reinterpret_cast<const char*>(pad), zeros + 8));
   static const char* kHex = "0123456789abcdef";
   std::string hex;
-  for (uint32_t word : state_) {
+  for (uint32_t word : state_->hash) {
     for (int shift = 28; shift >= 0; shift -= 4) hex += kHex[(word >> shift) & 0xf];
   }
   return hex;
@@ -109,6 +126,7 @@ std::string Sha256Hex(std::string_view data) {
 std::string Sha256OfFile(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  CountOpenedForReading(path);
   Sha256 hash;
   char block[1 << 16];
   while (stream.read(block, sizeof block) || stream.gcount() > 0)

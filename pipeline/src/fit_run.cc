@@ -54,6 +54,33 @@ FitRecord RecordOf(const FitRunResult& result, const std::string& plan_path, con
   return record;
 }
 
+// The unit's serial: the most specific source first (the caller's, the unit's own log, then the
+// possibly shared plan).
+UnitSerial ResolveUnitSerial(const FitRunOptions& options, const std::string& plan_path, const Plan& plan,
+                             const SamplesReader& samples) {
+  SerialSource stated;
+  stated.kind = SerialSource::Kind::kStated;
+  stated.name = options.serial_source;
+  stated.serial = options.serial;
+  SerialSource planned;
+  planned.name = "the plan " + plan_path;
+  planned.serial = plan.serial;
+  return ResolveSerial({stated, SamplesHeaderSerial(samples), planned}, options.allow_serial_mismatch);
+}
+
+// The calibration of a usable fit, with its `fit:` record.
+Calibration MakeCalibration(const FitRunResult& result, const FitRunOptions& options) {
+  Calibration calibration;
+  calibration.serial = result.serial;
+  calibration.created_utc = UtcNow();
+  calibration.software = options.software;
+  calibration.fit_temp_range_c = result.fit.temp_range_c;
+  calibration.model = result.fit.model;
+  calibration.sigma = result.fit.sigma;
+  calibration.fit = result.record;
+  return calibration;
+}
+
 }  // namespace
 
 std::string FitRunOptions::Validate() const {
@@ -121,22 +148,15 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
                     const FitRunOptions& options) {
   FitRunResult result;
   result.plan = ReadPlan(plan_path);
-  // The most specific source first: the caller's, the unit's own log, then the (possibly shared) plan.
-  SerialSource stated;
-  stated.kind = SerialSource::Kind::kStated;
-  stated.name = options.serial_source;
-  stated.serial = options.serial;
-  SerialSource plan;
-  plan.name = "the plan " + plan_path;
-  plan.serial = result.plan.serial;
-  UnitSerial serial =
-      ResolveSerial({stated, SamplesHeaderSerial(samples_path), plan}, options.allow_serial_mismatch);
+  result.plan_sha256 = options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256;
+  RunReader samples(result.plan, samples_path, options.input);
+  UnitSerial serial = ResolveUnitSerial(options, plan_path, result.plan, samples.header());
   result.serial = std::move(serial.serial);
   result.serial_warnings = std::move(serial.warnings);
-  result.run = ReadRunWindows(result.plan, samples_path, options.windows, options.input);
+  result.run = samples.Read(options.windows, options.keep_static_stretch);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
-  std::vector<Window> check_windows;
   Plan check_plan;
+  std::vector<Window> check_windows;
   if (!options.check_samples.empty()) {
     check_plan = ReadPlan(options.check_plan.empty() ? plan_path : options.check_plan);
     check_windows = ReadRunWindows(check_plan, options.check_samples, options.windows, options.input).windows;
@@ -145,19 +165,9 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
   if (!result.fit.IsSolutionUsable()) return result;
-  result.record.plan_sha256 = options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256;
-  result.record.samples_sha256 =
-      options.samples_sha256.empty() ? Sha256OfFile(samples_path) : options.samples_sha256;
-
-  Calibration calibration;
-  calibration.serial = result.serial;
-  calibration.created_utc = UtcNow();
-  calibration.software = options.software;
-  calibration.fit_temp_range_c = result.fit.temp_range_c;
-  calibration.model = result.fit.model;
-  calibration.sigma = result.fit.sigma;
-  calibration.fit = result.record;
-
+  result.record.plan_sha256 = result.plan_sha256;
+  result.record.samples_sha256 = result.run.samples_sha256;
+  Calibration calibration = MakeCalibration(result, options);
   if (options.validate) {
     result.folds =
         LeaveOneTemperatureOut(result.run.windows, result.plan.site, result.plan.segments, options.fit);

@@ -1,38 +1,69 @@
 #include "imufit/pipeline/run_windows.h"
 
 #include <set>
+#include <utility>
 
-#include "imufit/io/samples.h"
+#include "imufit/model/check.h"
 
 namespace imufit {
+namespace {
 
-RunWindows ReadRunWindows(const Plan& plan, const std::string& samples_path, const WindowOptions& options,
-                          const SamplesInput& input) {
+// The samples of `reader`, labelled by `labeller` when not null, into windows, each checked
+// against the plan, and into the static stretch when not null.
+void ReadSamples(const Plan& plan, SamplesReader* reader, Labeller* labeller, WindowBuilder* builder,
+                 LongestStaticStretch* stretch) {
   std::set<int> ids;
   for (const TableSegment& segment : plan.segments) ids.insert(segment.id);
-  RunWindows run;
-  SamplesReader reader(samples_path, /*require_segment=*/false, input.temp_c);
-  std::optional<Labeller> labeller;
-  if (!reader.has_segment()) {
-    run.segmentation = SegmentSamplesFile(plan, samples_path, input);
-    labeller.emplace(*run.segmentation);
-  }
-  WindowBuilder builder(options, plan.segments);
   Sample sample;
   int last_checked = kTransitionSegment;
-  while (reader.Next(&sample)) {
-    if (labeller) sample.segment = labeller->Label(sample.time_s);
+  while (reader->Next(&sample)) {
+    if (labeller != nullptr) sample.segment = labeller->Label(sample.time_s);
     if (sample.segment != kTransitionSegment && sample.segment != last_checked) {
       if (ids.count(sample.segment) == 0) {
-        reader.Fail("segment", "segment " + std::to_string(sample.segment) + " is not in the plan " + plan.path);
+        reader->Fail("segment",
+                     "segment " + std::to_string(sample.segment) + " is not in the plan " + plan.path);
       }
       last_checked = sample.segment;
     }
-    builder.Add(sample);
+    builder->Add(sample);
+    if (stretch != nullptr) stretch->Add(sample);
   }
+}
+
+}  // namespace
+
+RunReader::RunReader(const Plan& plan, std::string samples_path, const SamplesInput& input)
+    : plan_(plan),
+      input_(input),
+      first_pass_(std::move(samples_path), /*require_segment=*/false, input.temp_c, &digest_) {}
+
+RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretch) {
+  IMUFIT_CHECK(!read_, "RunReader::Read() reads the file once");
+  read_ = true;
+  RunWindows run;
+  // Without a segment column the first pass finds the segments and the second labels the samples.
+  std::optional<SamplesReader> second_pass;
+  std::optional<Labeller> labeller;
+  if (!first_pass_.has_segment()) {
+    run.segmentation = SegmentSamples(plan_, &first_pass_, input_);
+    labeller.emplace(*run.segmentation);
+    second_pass.emplace(first_pass_.path(), /*require_segment=*/false, input_.temp_c);
+  }
+  WindowBuilder builder(options, plan_.segments);
+  std::optional<LongestStaticStretch> stretch;
+  if (keep_static_stretch) stretch.emplace(plan_);
+  ReadSamples(plan_, second_pass ? &*second_pass : &first_pass_, labeller ? &*labeller : nullptr, &builder,
+              stretch ? &*stretch : nullptr);
   run.windows = builder.Finish();
   run.stats = builder.stats();
+  run.samples_sha256 = digest_.HexDigest();  // the first pass has read the whole file
+  if (stretch) run.static_stretch = stretch->Finish();
   return run;
+}
+
+RunWindows ReadRunWindows(const Plan& plan, const std::string& samples_path, const WindowOptions& options,
+                          const SamplesInput& input) {
+  return RunReader(plan, samples_path, input).Read(options);
 }
 
 }  // namespace imufit

@@ -21,13 +21,17 @@ std::optional<double> TempToRead(const std::string& samples_path, const SamplesI
 Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path,
                                 const SamplesInput& input) {
   SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
+  return SegmentSamples(plan, &reader, input);
+}
+
+Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const SamplesInput& input) {
   MotionDetector detector(input.segmentation);
   Sample sample;
-  while (reader.Next(&sample)) detector.Add(sample);
+  while (reader->Next(&sample)) detector.Add(sample);
   try {
     return MatchPlan(detector.Finish(), plan.segments, input.segmentation);
   } catch (const PlanMismatchError& e) {
-    throw PlanMismatchError(samples_path + ": the log does not match the plan " + plan.path + ": " +
+    throw PlanMismatchError(reader->path() + ": the log does not match the plan " + plan.path + ": " +
                             e.what());
   }
 }

@@ -5,8 +5,9 @@
 
 namespace imufit {
 
-SerialSource SamplesHeaderSerial(const std::string& samples_path) {
-  const SamplesSerial found = LocateSamplesSerial(samples_path);
+namespace {
+
+SerialSource HeaderSource(const std::string& samples_path, const SamplesSerial& found) {
   SerialSource source;
   source.kind = SerialSource::Kind::kHeader;
   source.name = "the samples header of " + samples_path;
@@ -15,6 +16,16 @@ SerialSource SamplesHeaderSerial(const std::string& samples_path) {
   source.line = found.line;
   source.column = found.column;
   return source;
+}
+
+}  // namespace
+
+SerialSource SamplesHeaderSerial(const std::string& samples_path) {
+  return HeaderSource(samples_path, LocateSamplesSerial(samples_path));
+}
+
+SerialSource SamplesHeaderSerial(const SamplesReader& reader) {
+  return HeaderSource(reader.path(), reader.located_serial());
 }
 
 UnitSerial ResolveSerial(const std::vector<SerialSource>& sources, bool allow_mismatch) {

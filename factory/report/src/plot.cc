@@ -381,7 +381,7 @@ std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
   return svgs;
 }
 
-void DrawFile(const PlotFigure& figure, const std::string& path) {
+void DrawFile(const PlotFigure& figure, const std::string& path, OutputTransaction* transaction) {
   const bool png = HasSuffix(path, ".png");
   TempFolder folder;
   const std::string image = folder.path + (png ? "/figure.png" : "/figure.svg");
@@ -391,7 +391,7 @@ void DrawFile(const PlotFigure& figure, const std::string& path) {
   }
   const std::string bytes = ReadBytes(image);
   if (bytes.empty()) throw std::runtime_error("gnuplot could not draw " + path);
-  WriteFileAtomically(path, bytes);
+  WriteFileAtomically(path, bytes, transaction);
 }
 
 bool GnuplotAvailable() {

@@ -2,9 +2,10 @@
 //
 // UNITS_DIR holds one folder per unit: plan.yaml + samples.csv (or samples.csv.gz), or samples
 // only when a shared plan is given. Units are fitted in parallel (a pool of `jobs` threads, one
-// unit each, one solver thread per unit); a unit's failure never stops the others. For each unit
-// OUT_DIR/<unit>/ receives, each file atomically and in this order: calibration.yaml (when
-// fitted), report.html (with write_reports), then manifest.yaml last. The manifest
+// unit each, one solver thread per unit); a unit's failure never stops the others. Each fitted
+// unit is certified as `imufit fit` certifies one (certify.h). For each unit OUT_DIR/<unit>/
+// receives calibration.yaml (when fitted) and report.html (with write_reports) together, then
+// manifest.yaml last, after the unit is recorded in the store. The manifest
 // holds the SHA-256 of the unit's inputs (plan, samples, limits, station), the fit options
 // (FitRunOptions::Describe) and the software version; a re-run skips a unit whose manifest matches
 // (and whose outputs are there), so a batch killed half way and run again redoes only the units
@@ -18,33 +19,10 @@
 #include <string>
 #include <vector>
 
-#include "imufit/factory/acceptance.h"
-#include "imufit/io/limits.h"
+#include "imufit/factory/certify.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
-
-// One unit's outcome.
-struct UnitOutcome {
-  std::string unit;     // the folder name
-  std::string serial;   // serial.txt's, the samples header's, the plan's, else the unit folder name
-  // Sources of the serial that disagree (unit_serial.h); shown on the certificate. Not kept for a
-  // skipped unit.
-  std::vector<std::string> warnings;
-  std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
-  std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
-  std::string message;  // the failed criteria, or why it was not fitted
-  std::vector<Figure> figures;
-  std::string plan_path;
-  std::string samples_path;
-  std::string plan_sha256;
-  std::string samples_sha256;
-  bool skipped = false;  // unchanged since a previous run: nothing redone
-  double seconds = 0.0;
-  // The fit's result and the calibration (not filled for skipped units).
-  std::optional<FitRunResult> fit;
-  Verdict verdict_detail;
-};
 
 struct BatchProgress {
   int done = 0;  // units finished (skipped ones included)

@@ -43,9 +43,14 @@ struct ReportInput {
 // Everything a certificate is computed from.
 struct CertificateSources {
   std::string unit;  // the batch unit folder, or empty
+  // The program that writes the certificate, e.g. "imufit 0.1.0" (the calibration names the one
+  // that made it).
+  std::string software;
   Calibration calibration;
   Plan plan;
-  RunWindows run;                   // run.segmentation: the labels of a file without a segment column
+  // run.segmentation: the labels of a file without a segment column; run.static_stretch: the noise
+  // section's samples (else read from the samples input).
+  RunWindows run;
   WindowOptions windows;            // how the run was cut into windows (trim, ...)
   SamplesInput samples_input;       // how the samples file is read (--temp-c for a file without temp_c)
   std::vector<HeldOutGroup> folds;  // empty when validation was not run
@@ -217,15 +222,9 @@ struct Certificate {
   std::vector<ValidationRow> validation;  // empty: not run
 };
 
-// Computes the certificate; reads the samples input once more for the Allan section. Throws
-// InputError when an input file cannot be read.
+// Computes the certificate; reads the samples input once more for the Allan section unless
+// sources.run kept the static stretch. Throws InputError when an input file cannot be read.
 Certificate MakeCertificate(const CertificateSources& sources);
-// From a batch unit just fitted (its FitRunResult is in unit.fit) with `options` (the windows and
-// the samples input the run was read with; the serial warnings come from unit.warnings).
-Certificate MakeCertificate(const UnitOutcome& unit, const std::string& limits_path,
-                            const std::optional<Limits>& limits, const std::string& calibration_path,
-                            const FitRunOptions& options = FitRunOptions(),
-                            const std::optional<Station>& station = std::nullopt);
 
 // The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
 std::vector<Figure> MeasuredFigures(const Certificate& certificate);

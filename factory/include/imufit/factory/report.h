@@ -14,6 +14,7 @@
 
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/plot.h"
+#include "imufit/io/output_file.h"
 
 namespace imufit {
 
@@ -26,8 +27,9 @@ std::string FormatNumber(const char* format, double value);
 // temperature against time, histogram, Allan deviation).
 std::vector<PlotFigure> CertificatePlots(const Certificate& certificate);
 std::string CertificateHtml(const Certificate& certificate);
-// Writes it atomically.
-void WriteCertificate(const std::string& path, const Certificate& certificate);
+// Writes it atomically, in `transaction` when not null.
+void WriteCertificate(const std::string& path, const Certificate& certificate,
+                      OutputTransaction* transaction = nullptr);
 
 // The lot page's strip plots, one per key figure: a point per unit, the limits, mean and 3 sigma.
 std::vector<PlotFigure> LotPlots(const LotSummary& lot);

@@ -12,6 +12,7 @@
 #define IMUFIT_FACTORY_STORE_H_
 
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -76,7 +77,8 @@ class ResultsStore {
 
   const std::string& path() const { return path_; }
 
-  // Records one fit in one transaction; returns its id.
+  // Records one fit in one transaction; returns its id. Safe from several threads at once (the
+  // units of a batch).
   int64_t Record(const StoredFit& fit);
 
   // Every fit of a serial, oldest first, with figures.
@@ -97,6 +99,7 @@ class ResultsStore {
 
   std::string path_;
   sqlite3* db_ = nullptr;
+  std::mutex record_mutex_;  // one Record() at a time
 };
 
 }  // namespace imufit

@@ -16,6 +16,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/io/fit_record.h"
+#include "imufit/io/output_file.h"
 #include "imufit/model/sensor_model.h"
 
 namespace imufit {
@@ -43,8 +44,9 @@ struct Calibration {
 Calibration ReadCalibration(const std::string& path);
 // The file's text; `calibration.model.basis.half_range_c` must be 1.
 std::string CalibrationToYaml(const Calibration& calibration);
-// Writes atomically (OutputFile).
-void WriteCalibration(const std::string& path, const Calibration& calibration);
+// Writes atomically (OutputFile), in `transaction` when not null.
+void WriteCalibration(const std::string& path, const Calibration& calibration,
+                      OutputTransaction* transaction = nullptr);
 
 // The current UTC time as "YYYY-MM-DDTHH:MM:SSZ".
 std::string UtcNow();

@@ -6,6 +6,9 @@
 // "" for a quote) but may not span lines; a row may not have more fields than the header. A
 // UTF-8 byte-order mark before the header is skipped. Numbers are parsed with std::from_chars.
 //
+// The reader can hash the file as it streams it (the SHA-256 of its bytes as they are on disk), so
+// that a file whose hash is recorded need not be read again for it.
+//
 // Errors are InputErrors located at file:line:field, e.g.
 //   samples.csv:412:5: gyro_y: "1.2.3" is not a number
 #ifndef IMUFIT_IO_CSV_READER_H_
@@ -20,6 +23,8 @@
 
 namespace imufit {
 
+class Sha256;
+
 class CsvReader {
  public:
   // Input limits (docs/conventions.md): a longer line or more fields is an InputError, so a
@@ -31,8 +36,11 @@ class CsvReader {
   static constexpr size_t kMaxHeaderComments = 256;
   static constexpr size_t kMaxHeaderCommentBytes = 1024;
 
-  // Opens `path` (gzip when it ends in ".gz") and reads its header. Throws InputError.
-  explicit CsvReader(std::string path);
+  // Opens `path` (gzip when it ends in ".gz") and reads its header. Throws InputError. When
+  // `raw_digest` is not null, every byte of the file as it is on disk (compressed, for .gz) is fed
+  // to it as it is read: once NextRow() has returned false, it has seen the whole file. It must
+  // outlive the reader.
+  explicit CsvReader(std::string path, Sha256* raw_digest = nullptr);
   ~CsvReader();
   CsvReader(const CsvReader&) = delete;
   CsvReader& operator=(const CsvReader&) = delete;

@@ -18,6 +18,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/io/output_file.h"
 #include "imufit/noise/column_analysis.h"
 
 namespace imufit {
@@ -33,8 +34,9 @@ struct NoiseTermUnits {
 };
 const NoiseTermUnits& UnitsOf(ColumnKind kind, int term);
 
-// Writes the Allan deviation CSV (each column's `curve`) atomically.
-void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results);
+// Writes the Allan deviation CSV (each column's `curve`) atomically, in `transaction` when not null.
+void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results,
+                   OutputTransaction* transaction = nullptr);
 
 // What the noise block says about the record the columns came from.
 struct NoiseRecord {
@@ -51,9 +53,9 @@ struct NoiseRecord {
 };
 // The text of the noise block (top-level key `noise:`).
 std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysis>& results);
-// Writes it atomically.
+// Writes it atomically, in `transaction` when not null.
 void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
-                    const std::vector<ColumnAnalysis>& results);
+                    const std::vector<ColumnAnalysis>& results, OutputTransaction* transaction = nullptr);
 
 // [value, 1-sigma] of noise.columns.<column>.<key> in a calibration's further keys (Calibration::
 // extra), when there and a pair of numbers.

@@ -8,6 +8,9 @@
 //
 // An existing destination must be a regular file that may be written: a symbolic link, FIFO,
 // device node, directory or read-only file is refused (InputError) rather than replaced.
+//
+// Several outputs that belong together (a calibration and its certificate) are written in one
+// OutputTransaction, given explicitly to each writer: all of them appear, or none.
 #ifndef IMUFIT_IO_OUTPUT_FILE_H_
 #define IMUFIT_IO_OUTPUT_FILE_H_
 
@@ -17,10 +20,13 @@
 
 namespace imufit {
 
+class OutputTransaction;
+
 class OutputFile {
  public:
   // Creates the temporary file; throws InputError naming `path` when its folder is not writable.
-  explicit OutputFile(std::string path);
+  // With a `transaction` (may be null), Commit() leaves the finished file to the transaction.
+  explicit OutputFile(std::string path, OutputTransaction* transaction = nullptr);
   ~OutputFile();
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
@@ -28,7 +34,8 @@ class OutputFile {
   void Write(std::string_view text);
   // Appends the shortest decimal text that reads back as exactly `value`.
   void WriteNumber(double value);
-  // Flushes, syncs and renames the temporary file over the destination. Throws InputError.
+  // Flushes, syncs and renames the temporary file over the destination; in a transaction, the
+  // rename is the transaction's (with the other outputs). Throws InputError.
   void Commit();
 
   const std::string& path() const { return path_; }
@@ -40,6 +47,7 @@ class OutputFile {
   void Flush();
 
   std::string path_;
+  OutputTransaction* transaction_;
   std::string temp_path_;
   std::string buffer_;
   int fd_ = -1;
@@ -48,30 +56,31 @@ class OutputFile {
   int temp_slot_ = -1;  // in the table of temporaries removed on a signal
 };
 
-// Several outputs written all or nothing (`fit -o .. --report ..`). While a transaction is open
-// on this thread, OutputFile::Commit() completes its temporary file (flushed, synced, closed)
-// but leaves it in place; the transaction's Commit() renames them all over their destinations.
-// A transaction destroyed without Commit() (an error in any output) removes every temporary,
-// so no destination changes. The renames themselves are the only step after which a failure
-// (of the file system) can leave some outputs replaced and others not.
+// Several outputs written all or nothing (`fit -o .. --report ..`). An OutputFile made with a
+// transaction completes its temporary file in Commit() (flushed, synced, closed) but leaves it in
+// place; the transaction's Commit() renames them all over their destinations. A transaction
+// destroyed without Commit() (an error in any output) removes every temporary, so no destination
+// changes. The renames themselves are the only step after which a failure (of the file system)
+// can leave some outputs replaced and others not.
 class OutputTransaction {
  public:
-  OutputTransaction();
+  OutputTransaction() = default;
   ~OutputTransaction();
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
 
   void Commit();
-  // Called by OutputFile::Commit().
-  void Add(std::string temp_path, std::string path, int slot);
 
  private:
+  friend class OutputFile;
+  // A finished temporary file (OutputFile::Commit()), renamed over `path` by Commit().
+  void Add(std::string temp_path, std::string path, int slot);
+
   struct Pending {
     std::string temp_path, path;
     int slot;
   };
   std::vector<Pending> pending_;
-  OutputTransaction* previous_;
 };
 
 // Removes the temporary files of uncommitted outputs when the program is stopped by SIGINT,
@@ -79,8 +88,9 @@ class OutputTransaction {
 // (nohup) stay ignored. Called once by main().
 void InstallOutputCleanupOnSignals();
 
-// Writes `text` to `path` atomically (OutputFile in one call).
-void WriteFileAtomically(const std::string& path, std::string_view text);
+// Writes `text` to `path` atomically (OutputFile in one call), in `transaction` when not null.
+void WriteFileAtomically(const std::string& path, std::string_view text,
+                         OutputTransaction* transaction = nullptr);
 
 // Throws InputError when `output` names the same file as one of `inputs`: imufit never replaces
 // a file it is reading.

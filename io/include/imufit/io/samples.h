@@ -18,13 +18,23 @@
 
 namespace imufit {
 
+// The serial of a samples header and where it is stated (its first `# serial:` line, at the text
+// after "serial:"), so that a contradiction can be reported at its place (pipeline/unit_serial.h).
+struct SamplesSerial {
+  std::string serial;  // "" when no line states one (then line and column are 0)
+  long line = 0;
+  long column = 0;
+};
+
 class SamplesReader {
  public:
   // Opens a samples file; `require_segment` makes the segment column mandatory (imufit fit).
   // `temp_c`, when given, is the temperature of every sample of a file without a temp_c column
   // (a run without a thermometer); a file that has the column is then refused, so that no reading
-  // is silently replaced. Throws InputError naming the missing column.
-  SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c = std::nullopt);
+  // is silently replaced. Throws InputError naming the missing column. `raw_digest`, when not
+  // null, hashes the file as it is read (CsvReader).
+  SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c = std::nullopt,
+                Sha256* raw_digest = nullptr);
 
   // Reads the next sample; false at the end. Throws InputError on a bad value, a time that does
   // not increase, or a segment id below -1.
@@ -32,7 +42,9 @@ class SamplesReader {
 
   bool has_segment() const { return segment_column_ >= 0; }
   // The unit's serial from the header's `# serial:` line (ReadSamplesSerial), or "".
-  const std::string& serial() const { return serial_; }
+  const std::string& serial() const { return serial_.serial; }
+  // The same with its place in the header (LocateSamplesSerial).
+  const SamplesSerial& located_serial() const { return serial_; }
   bool has_temp() const { return temp_column_ >= 0; }
   // Throws an InputError located at the current row and the column called `column`.
   [[noreturn]] void Fail(const std::string& column, const std::string& message) const;
@@ -46,7 +58,7 @@ class SamplesReader {
   int temp_column_ = -1;
   double fixed_temp_c_ = 0.0;  // without a temp_c column
   int segment_column_ = -1;
-  std::string serial_;
+  SamplesSerial serial_;
   int gyro_columns_[3];
   int accel_columns_[3];
   bool first_ = true;
@@ -59,13 +71,6 @@ class SamplesReader {
 // header. Throws InputError for an unreadable file, an empty serial, or two different serials.
 std::string ReadSamplesSerial(const std::string& path);
 
-// The serial of a samples header and where it is stated (its first `# serial:` line, at the text
-// after "serial:"), so that a contradiction can be reported at its place (pipeline/unit_serial.h).
-struct SamplesSerial {
-  std::string serial;  // "" when no line states one (then line and column are 0)
-  long line = 0;
-  long column = 0;
-};
 // As ReadSamplesSerial, with the place.
 SamplesSerial LocateSamplesSerial(const std::string& path);
 
@@ -82,11 +87,13 @@ struct SampleColumns {
 
 class SamplesWriter {
  public:
-  // Starts `path` (atomically: nothing appears until Commit()). `with_segment` adds the
-  // segment column. `comment`, if not empty, is written first as '#' lines.
+  // Starts `path` (atomically: nothing appears until Commit(), or until the commit of
+  // `transaction` when not null). `with_segment` adds the segment column. `comment`, if not
+  // empty, is written first as '#' lines.
   SamplesWriter(std::string path, bool with_segment, const std::string& comment = "")
       : SamplesWriter(std::move(path), SampleColumns{with_segment, true}, comment) {}
-  SamplesWriter(std::string path, SampleColumns columns, const std::string& comment = "");
+  SamplesWriter(std::string path, SampleColumns columns, const std::string& comment = "",
+                OutputTransaction* transaction = nullptr);
 
   void Write(const Sample& sample);
   void Commit() { file_.Commit(); }

@@ -4,28 +4,29 @@
 #ifndef IMUFIT_IO_SHA256_H_
 #define IMUFIT_IO_SHA256_H_
 
-#include <array>
-#include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
 namespace imufit {
 
-// Incremental SHA-256: Update() any number of times, then HexDigest() once.
+// Incremental SHA-256: Update() any number of times, then HexDigest() once. The state is kept
+// out of this header, so that the implementation (this file's own, or a crypto library's) can
+// change without its users noticing. Readers hash a file while they stream it (csv_reader.h).
 class Sha256 {
  public:
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
+
   void Update(std::string_view data);
   // The digest as 64 lowercase hex digits. Finishes the hash: call once.
   std::string HexDigest();
 
  private:
-  void Block(const unsigned char* block);
-
-  std::array<uint32_t, 8> state_;
-  std::array<unsigned char, 64> buffer_{};
-  size_t buffered_ = 0;
-  uint64_t length_bytes_ = 0;
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 std::string Sha256Hex(std::string_view data);

@@ -3,10 +3,13 @@
 //
 // FitRun() reads the plan and the samples (and a held-out run, if given), fits, validates when
 // asked, and builds the calibration to write (with its `sigma` tree and the fit's record, the
-// `fit:` block of io/fit_record.h). It writes nothing. Bad input throws InputError; a run that does not
-// determine the model, or a fit that does not converge, is reported through `fit.status` (then `calibration`
-// is not set). A samples file without a segment column is labelled from the plan first
-// (segment_run.h); when it does not match the plan, PlanMismatchError is thrown.
+// `fit:` block of io/fit_record.h). It writes nothing. The samples file is read once (twice without
+// a segment column, run_windows.h); what a certificate needs of it (the hash, the segmentation, the
+// longest static stretch) comes with the result, so that nobody reads it again. Bad input throws
+// InputError; a run that does not determine the model, or a fit that does not converge, is reported
+// through `fit.status` (then `calibration` is not set). A samples file without a segment column is
+// labelled from the plan first (segment_run.h); when it does not match the plan, PlanMismatchError
+// is thrown.
 #ifndef IMUFIT_PIPELINE_FIT_RUN_H_
 #define IMUFIT_PIPELINE_FIT_RUN_H_
 
@@ -41,10 +44,13 @@ struct FitRunOptions {
   std::string serial_source = "--serial";
   // Fit even when `serial` contradicts the samples header's serial (then a warning; --allow-mismatch).
   bool allow_serial_mismatch = false;
-  // SHA-256 of the plan and samples files, recorded in the calibration's `fit:` block so that a
-  // certificate can tell that a calibration and a run belong together; computed when empty.
+  // SHA-256 of the plan file, recorded in the calibration's `fit:` block (with the samples', which
+  // is computed while they are read) so that a certificate can tell that a calibration and a run
+  // belong together; computed when empty.
   std::string plan_sha256;
-  std::string samples_sha256;
+  // Keep the run's longest static stretch (result.run.static_stretch) for a certificate's noise
+  // section; changes nothing else.
+  bool keep_static_stretch = false;
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
@@ -63,6 +69,7 @@ struct FitRunResult {
   // Sources of the serial that disagree with it, one message each (unit_serial.h).
   std::vector<std::string> serial_warnings;
   Plan plan;
+  std::string plan_sha256;  // the samples' is run.samples_sha256
   RunWindows run;
   FitSummary fit;
   // The calibration's `fit:` block, also when the fit is not usable (then without the hashes).

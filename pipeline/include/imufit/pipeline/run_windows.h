@@ -2,6 +2,11 @@
 //
 // imufit::pipeline links io (files) and fit (windows, the fit); the command, the benchmarks and
 // any batch tooling build on it instead of re-writing the read loop.
+//
+// A run is read as few times as the work needs: once for a file with a segment column, twice for
+// one without (the first pass finds the segments, segment_run.h). On the way the reader hashes the
+// file (its SHA-256, for the calibration and the certificate) and, when asked, keeps the longest
+// static stretch (static_stretch.h, the certificate's noise), so that nobody reads it again.
 #ifndef IMUFIT_PIPELINE_RUN_WINDOWS_H_
 #define IMUFIT_PIPELINE_RUN_WINDOWS_H_
 
@@ -12,7 +17,10 @@
 #include "imufit/run/segmentation.h"
 #include "imufit/run/windows.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/samples.h"
+#include "imufit/io/sha256.h"
 #include "imufit/pipeline/segment_run.h"
+#include "imufit/pipeline/static_stretch.h"
 
 namespace imufit {
 
@@ -21,12 +29,40 @@ struct RunWindows {
   WindowStats stats;
   // Set when the file had no segment column and the segments were found in the data.
   std::optional<Segmentation> segmentation;
+  // SHA-256 of the samples file's bytes as they are on disk, computed as they were read.
+  std::string samples_sha256;
+  // The longest static stretch of the run, when the reading was asked to keep it.
+  std::optional<StaticStretch> static_stretch;
 };
 
-// Streams `samples_path` (CSV or .csv.gz) through a WindowBuilder. Throws InputError for bad
-// input, including a sample whose segment id the plan does not have (located at its line). A file
-// without a segment column is labelled first (segment_run.h: one more pass over the file); then
-// PlanMismatchError says where the log and the plan disagree.
+// A run's samples file, opened: its header is read (the serial in it can be checked before any
+// work is done), then Read() reads the samples.
+class RunReader {
+ public:
+  // Opens `samples_path` (CSV or .csv.gz) for a run of `plan` (which must outlive the reader), read
+  // as `input` says. Throws InputError for a bad file or header.
+  RunReader(const Plan& plan, std::string samples_path, const SamplesInput& input);
+  RunReader(const RunReader&) = delete;
+  RunReader& operator=(const RunReader&) = delete;
+
+  // The samples file's header, read.
+  const SamplesReader& header() const { return first_pass_; }
+
+  // Streams the samples through a WindowBuilder (once only). Throws InputError for bad input,
+  // including a sample whose segment id the plan does not have (located at its line). A file
+  // without a segment column is labelled first (one more pass over the file); then
+  // PlanMismatchError says where the log and the plan disagree.
+  RunWindows Read(const WindowOptions& options, bool keep_static_stretch = false);
+
+ private:
+  const Plan& plan_;
+  SamplesInput input_;
+  Sha256 digest_;
+  SamplesReader first_pass_;  // hashes into digest_
+  bool read_ = false;
+};
+
+// RunReader(plan, samples_path, input).Read(options).
 RunWindows ReadRunWindows(const Plan& plan, const std::string& samples_path, const WindowOptions& options,
                           const SamplesInput& input = SamplesInput());
 

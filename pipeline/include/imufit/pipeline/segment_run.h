@@ -9,6 +9,7 @@
 
 #include "imufit/run/segmentation.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/samples.h"
 
 namespace imufit {
 
@@ -27,6 +28,8 @@ struct SamplesInput {
 // Pass 1 over `samples_path` and the match with `plan` (its segment column, if any, is ignored).
 // Throws InputError for bad input and PlanMismatchError when the log and the plan disagree.
 Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path, const SamplesInput& input);
+// The same over a reader that has read nothing but the header yet; reads it to its end.
+Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const SamplesInput& input);
 
 struct LabelledFileReport {
   long long samples = 0;

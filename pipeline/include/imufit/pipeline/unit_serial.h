@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "imufit/io/samples.h"
+
 namespace imufit {
 
 struct SerialSource {
@@ -37,6 +39,8 @@ struct SerialSource {
 // The samples header's serial as a source (reads the file up to its header; throws InputError for a
 // bad header, as ReadSamplesSerial does).
 SerialSource SamplesHeaderSerial(const std::string& samples_path);
+// The same from a reader of the file, which has read the header already.
+SerialSource SamplesHeaderSerial(const SamplesReader& reader);
 
 struct UnitSerial {
   std::string serial;  // "" when no source names one

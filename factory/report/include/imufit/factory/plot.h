@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "imufit/io/output_file.h"
+
 namespace imufit {
 
 // A qualitative palette (Tableau 10), readable in print and for most colour-blind readers.
@@ -130,8 +132,8 @@ struct Svg {
 std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal, const std::string& output);
 // Draws every figure in one gnuplot run.
 std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures);
-// Draws one figure into `path` (ending in .svg or .png), atomically.
-void DrawFile(const PlotFigure& figure, const std::string& path);
+// Draws one figure into `path` (ending in .svg or .png), atomically, in `transaction` when not null.
+void DrawFile(const PlotFigure& figure, const std::string& path, OutputTransaction* transaction = nullptr);
 // Whether gnuplot is on PATH.
 bool GnuplotAvailable();
 

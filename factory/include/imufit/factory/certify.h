@@ -1,0 +1,102 @@
+// imufit — one unit judged, certified, committed and recorded: what `imufit fit --limits --report
+// --store` does after its fit, and what `imufit batch` does for every unit it fits, in one place.
+//
+// CertifyUnit() takes a unit FitRun() has fitted and, in this order,
+//   certifies it: its certificate (certificate.h) when a report is asked for, the noise section
+//     from the static stretch the run's reading kept (FitRunOptions::keep_static_stretch), so
+//     that the samples file is not read again;
+//   judges it: its key figures, and its verdict against the acceptance limits with the noise
+//     figures the certificate measured (acceptance.h);
+//   commits it: the calibration and the certificate written in one OutputTransaction, both or
+//     neither;
+//   records it: one row in the results store (store.h), when there is one (RecordUnit()).
+// The certificate names the software that made the calibration (the calibration's `software`)
+// and the software that certifies it (CertifySettings::software: the program's version, which
+// the program passes in).
+#ifndef IMUFIT_FACTORY_CERTIFY_H_
+#define IMUFIT_FACTORY_CERTIFY_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imufit/factory/acceptance.h"
+#include "imufit/factory/store.h"
+#include "imufit/io/limits.h"
+#include "imufit/io/station.h"
+#include "imufit/pipeline/fit_run.h"
+
+namespace imufit {
+
+// One unit: its inputs, its fit and what became of it.
+struct UnitOutcome {
+  std::string unit;    // the batch unit folder; "" for `imufit fit`
+  std::string serial;  // serial.txt's, the samples header's, the plan's, else the unit folder name
+  // Sources of the serial that disagree (unit_serial.h); shown on the certificate. Not kept for a
+  // skipped unit.
+  std::vector<std::string> warnings;
+  std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
+  std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
+  std::string message;  // the failed criteria, or why it was not fitted
+  std::vector<Figure> figures;
+  std::string plan_path;
+  std::string samples_path;
+  std::string plan_sha256;
+  std::string samples_sha256;
+  bool skipped = false;  // unchanged since a previous run: nothing redone
+  double seconds = 0.0;
+  // The fit's result and the calibration (not filled for skipped units).
+  std::optional<FitRunResult> fit;
+  std::string calibration_yaml;  // the calibration file's text (fitted units)
+  Verdict verdict_detail;
+};
+
+// What every unit is certified with: the one unit of `imufit fit`, or each unit of a batch.
+struct CertifySettings {
+  // The program that certifies and records, e.g. "imufit 0.1.0".
+  std::string software;
+  // How the runs were read into windows (the certificate shows it).
+  WindowOptions windows;
+  SamplesInput samples_input;
+  // Acceptance limits (none: no verdict) and the SHA-256 of their file.
+  std::optional<Limits> limits;
+  std::string limits_sha256;
+  // Where and by whom (none: the signers fill it in) and the SHA-256 of the station file.
+  std::optional<Station> station;
+  std::string station_sha256;
+  // The results store units are recorded in (none: not recorded; not owned), and their lot
+  // ("" for a single fit).
+  ResultsStore* store = nullptr;
+  std::string lot;
+};
+
+// Reads the limits and the station file into `settings` (either path may be empty), with their
+// hashes: a bad file is reported (InputError) before any unit is fitted.
+void ReadLimitsAndStation(const std::string& limits_path, const std::string& station_path,
+                          CertifySettings* settings);
+
+// Where a unit's outputs go.
+struct UnitFiles {
+  std::string calibration;
+  std::string report;  // the certificate; "" for none
+};
+
+// Certifies, judges, commits and records `unit`: unit->fit holds FitRun's result with a calibration
+// (the serial it is to carry set), and unit->plan_path, samples_path and their hashes are filled.
+// Sets the unit's status ("fitted"), figures, verdict and calibration text. Throws InputError when
+// an output cannot be written (then none is). Returns RecordUnit()'s answer.
+bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit);
+
+// The unit's key figures, and its verdict against settings.limits: `certified` (a certificate's,
+// judged with the noise it measured) when given, else the calibration's alone.
+void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
+               const std::optional<Verdict>& certified, UnitOutcome* unit);
+
+// Records `unit`, whatever its status, in settings.store when there is one (safe from several
+// threads at once). Returns false when the store refuses it: then the unit is an "error" whose
+// message says why.
+bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FACTORY_CERTIFY_H_

@@ -1,0 +1,111 @@
+#include "imufit/factory/certify.h"
+
+#include <utility>
+
+#include "imufit/factory/certificate.h"
+#include "imufit/factory/report.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/output_file.h"
+#include "imufit/io/sha256.h"
+#include "imufit/model/check.h"
+
+namespace imufit {
+namespace {
+
+// The unit's certificate, from its fit and the settings; every input hashed already.
+Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles& files,
+                                const UnitOutcome& unit) {
+  const FitRunResult& fit = *unit.fit;
+  CertificateSources sources;
+  sources.unit = unit.unit;
+  sources.software = settings.software;
+  sources.calibration = *fit.calibration;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  sources.windows = settings.windows;
+  sources.samples_input = settings.samples_input;
+  sources.folds = fit.folds;
+  sources.warnings = unit.warnings;
+  sources.limits = settings.limits;  // judged with the noise the certificate measures
+  // The calibration is not in place yet (it is committed with the certificate): hash its text.
+  sources.inputs = {{"calibration", files.calibration, Sha256Hex(unit.calibration_yaml)},
+                    {"plan", unit.plan_path, unit.plan_sha256},
+                    {"samples", unit.samples_path, unit.samples_sha256},
+                    {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
+                    {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
+  sources.station = settings.station;
+  return MakeCertificate(sources);
+}
+
+// The calibration and the certificate, both or neither.
+void Commit(const UnitFiles& files, const UnitOutcome& unit, const std::optional<Certificate>& certificate) {
+  OutputTransaction outputs;
+  WriteFileAtomically(files.calibration, unit.calibration_yaml, &outputs);
+  if (certificate) WriteCertificate(files.report, *certificate, &outputs);
+  outputs.Commit();
+}
+
+}  // namespace
+
+void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
+               const std::optional<Verdict>& certified, UnitOutcome* unit) {
+  unit->figures = KeyFigures(calibration);
+  if (!settings.limits) return;
+  unit->verdict_detail = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
+  unit->verdict = unit->verdict_detail.pass ? "PASS" : "FAIL";
+  unit->message = unit->verdict_detail.FailedSummary();
+}
+
+void ReadLimitsAndStation(const std::string& limits_path, const std::string& station_path,
+                          CertifySettings* settings) {
+  if (!limits_path.empty()) {
+    settings->limits = ReadLimits(limits_path);
+    settings->limits_sha256 = Sha256OfFile(limits_path);
+  }
+  if (!station_path.empty()) {
+    settings->station = ReadStation(station_path);
+    settings->station_sha256 = Sha256OfFile(station_path);
+  }
+}
+
+bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit) {
+  IMUFIT_CHECK(unit->fit && unit->fit->calibration, "CertifyUnit() certifies a fitted unit");
+  const Calibration& calibration = *unit->fit->calibration;
+  unit->status = "fitted";
+  unit->calibration_yaml = CalibrationToYaml(calibration);
+  std::optional<Certificate> certificate;
+  if (!files.report.empty()) certificate = MakeUnitCertificate(settings, files, *unit);
+  JudgeUnit(settings, calibration, certificate ? certificate->verdict : std::nullopt, unit);
+  Commit(files, *unit, certificate);
+  return RecordUnit(settings, unit);
+}
+
+bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit) {
+  if (settings.store == nullptr) return true;
+  StoredFit row;
+  row.unit = unit->unit.empty() ? unit->samples_path : unit->unit;
+  row.serial = unit->serial.empty() ? row.unit : unit->serial;
+  row.lot = settings.lot;
+  const bool fitted = unit->fit && unit->fit->calibration && unit->status == "fitted";
+  row.time_utc = fitted ? unit->fit->calibration->created_utc : UtcNow();
+  row.software = settings.software;
+  row.plan_sha256 = unit->plan_sha256;
+  row.samples_sha256 = unit->samples_sha256;
+  row.limits_sha256 = settings.limits_sha256;
+  row.status = unit->status;
+  row.verdict = unit->verdict;
+  row.message = unit->message;
+  row.calibration_yaml = unit->calibration_yaml;
+  row.figures = unit->figures;
+  try {
+    settings.store->Record(row);
+  } catch (const std::exception& e) {
+    unit->status = "error";
+    unit->verdict.clear();
+    unit->message = std::string("not recorded in the results store: ") + e.what();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace imufit
