@@ -38,7 +38,7 @@ namespace fs = std::filesystem;
 using testing::RunResult;
 
 const std::string kFixtures = IMUFIT_FIXTURES_DIR;
-// The exit statuses of docs/spec.md section 4 and the factory addition (docs/factory.md).
+// The exit statuses of docs/spec.md section 4.
 constexpr int kExitBadInput = 2;
 constexpr int kExitNotDone = 1;
 constexpr int kExitFailedLimits = 3;
