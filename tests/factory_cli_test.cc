@@ -29,7 +29,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/io/sha256.h"
-#include "run_program.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {
@@ -38,12 +38,12 @@ namespace fs = std::filesystem;
 using testing::RunResult;
 
 const std::string kFixtures = IMUFIT_FIXTURES_DIR;
-// The exit statuses of docs/spec.md section 4 and the factory addition (docs/factory.md).
+// The exit statuses of docs/spec.md section 4.
 constexpr int kExitBadInput = 2;
 constexpr int kExitNotDone = 1;
 constexpr int kExitFailedLimits = 3;
 constexpr int kUnits = 5;
-// Issue 10: a passing unit's certificate prints on at most about 4 pages.
+// A passing unit's certificate prints on at most about 4 pages.
 constexpr int kMostPagesOfAPassingCertificate = 4;
 
 constexpr const char* kLimits = R"(format: imufit-limits
@@ -116,31 +116,16 @@ std::string ReportFigure(const std::string& html, const std::string& name) {
   return std::regex_search(html, match, pattern) ? match[1].str() : "<none>";
 }
 
-class FactoryCliTest : public ::testing::Test {
+class FactoryCliTest : public testing::TempDirTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("imufit_factory_cli_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
+    TempDirTest::SetUp();
     fs::create_directories(dir_ / "units");
     Write("limits.yaml", kLimits);
     MakeLot();
   }
-  void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
-  }
-
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string Write(const std::string& name, const std::string& text) const {
-    std::ofstream(Path(name), std::ios::binary) << text;
-    return Path(name);
-  }
 
   RunResult Run(const std::vector<std::string>& args) const { return RunProgram(IMUFIT_EXE, args); }
-
-  RunResult RunProgram(const std::string& program, const std::vector<std::string>& args) const {
-    return testing::RunProgram(program, args, Path("stdout.txt"), Path("stderr.txt"));
-  }
 
   // Simulates a unit's run with a fixed seed and a little white noise.
   void Simulate(const std::string& plan, const std::string& truth, const std::string& samples, int seed) {
@@ -271,8 +256,6 @@ class FactoryCliTest : public ::testing::Test {
     for (const auto& row : ReadCsv(ReadBytes(dir_ / out / "lot_summary.csv"))) by_unit[row.at("unit")] = row;
     return by_unit;
   }
-
-  fs::path dir_;
 };
 
 TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {

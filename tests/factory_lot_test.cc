@@ -19,6 +19,7 @@
 #include "imufit/factory/store.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/units.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {
@@ -28,23 +29,11 @@ namespace fs = std::filesystem;
 // Absolute tolerance of sums and ratios of a few numbers of order 1 recomputed by hand.
 constexpr double kArithmeticAbsolute = 1e-12;
 
-class LotTest : public ::testing::Test {
+class LotTest : public testing::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("imufit_factory_lot_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
-  }
   Limits WriteLimits(const std::string& text) const {
-    const std::string path = (dir_ / "limits.yaml").string();
-    std::ofstream(path) << "format: imufit-limits\nversion: 1\n" << text;
-    return ReadLimits(path);
+    return ReadLimits(Write("limits.yaml", "format: imufit-limits\nversion: 1\n" + text));
   }
-  fs::path dir_;
 };
 
 Figure MakeFigure(const std::string& name, const std::string& unit, double value, double sigma) {

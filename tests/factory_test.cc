@@ -31,6 +31,7 @@
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {
@@ -42,24 +43,7 @@ constexpr double kConversionRelative = 1e-12;
 
 const std::string kFixtures = IMUFIT_FIXTURES_DIR;
 
-class FactoryTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("imufit_factory_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
-  }
-  std::string Write(const std::string& name, const std::string& text) const {
-    const std::string path = (dir_ / name).string();
-    std::ofstream(path, std::ios::binary) << text;
-    return path;
-  }
-  fs::path dir_;
-};
+using FactoryTest = testing::TempDirTest;
 
 TEST(Sha256, FipsVectors) {
   // FIPS 180-2 appendix B.1, B.2, B.3, and the empty message.
@@ -272,8 +256,8 @@ TEST_F(FactoryTest, StoreRefusesANewerSchemaAndForeignFiles) {
       InputError);
 }
 
-// Issue 10 item 4: a calibration whose coefficients are written about another reference
-// temperature (40 degC) states the same unit: every figure is the same, to rounding.
+// A calibration whose coefficients are written about another reference temperature (40 degC)
+// states the same unit: every figure is the same, to rounding.
 TEST_F(FactoryTest, FiguresDoNotDependOnTheReferenceTemperature) {
   const Calibration at25 = ReadCalibration(kFixtures + "/mems_truth.yaml");
   Calibration at40 = at25;

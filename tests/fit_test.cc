@@ -236,20 +236,46 @@ TEST(SampleClock, AcquiresTheGridThroughLostSamplesAndRelocksAfterAJump) {
   for (int k = 0; k < 600; k += 10) lost.push_back(k + 1);
   std::vector<long long> slots;
   std::vector<double> time_s = Stamps(3000, 0.004, lost, &slots, 9);
-  // Then the host's clock jumps by 0.37 s and the log goes on.
-  for (int k = 0; k < 3000; ++k)
-    time_s.push_back(time_s.back() + 0.37 + 0.01 * k), slots.push_back(slots.back() + 37 + k);
+  const size_t jump = time_s.size();
+  // Then the host's clock jumps forward by 37.5 intervals, half an interval off the grid, with no
+  // sample lost at the jump, and the log goes on with less jitter than that half interval (a jump
+  // smaller than the jitter is jitter). After the relock one sample in fifty is lost.
+  constexpr double kJumpS = 0.375;
+  constexpr int kRelockedBy = SampleClock::kRelock + SampleClock::kAcquire;  // stamps after the jump
+  std::mt19937_64 engine(10);
+  std::uniform_real_distribution<double> small_jitter(-0.0001, 0.0001);
+  long long next_slot = slots.back() + 1;
+  long long lost_after_relock = 0;
+  for (int k = 1; k <= 3000; ++k, ++next_slot) {
+    if (k > kRelockedBy + 100 && k % 50 == 25) {
+      ++lost_after_relock;
+      continue;
+    }
+    time_s.push_back(1.7e9 + 0.01 * static_cast<double>(next_slot) + kJumpS + small_jitter(engine));
+    slots.push_back(next_slot);
+  }
   SampleClock clock;
   long long slot = slots[SampleClock::kAcquire - 1];
-  long long misplaced = 0;
+  long long misplaced = 0, misplaced_after_relock = 0, off_grid_after_jump = 0, found_after_relock = 0;
   for (size_t i = 0; i < time_s.size(); ++i) {
     const long long step = clock.Place(time_s[i]);
+    if (i >= jump) off_grid_after_jump += !clock.on_grid();
     if (i < SampleClock::kAcquire) continue;
     slot += step;
-    // After the jump the clock relocks within kRelock + kAcquire stamps and is off by the jump.
-    if (i < 3000 - lost.size()) misplaced += slot != slots[i];
+    if (i < jump) misplaced += slot != slots[i];
+    // The slots after the relock are counted from the new grid: each step as the truth's.
+    if (i >= jump + kRelockedBy) {
+      misplaced_after_relock += step != slots[i] - slots[i - 1];
+      found_after_relock += step - 1;
+    }
   }
   EXPECT_EQ(misplaced, 0);
+  // The jump moves every stamp off the old grid until kRelock in a row start a new acquisition; on
+  // the new grid none is off it, and every lost sample is found.
+  EXPECT_EQ(off_grid_after_jump, SampleClock::kRelock);
+  EXPECT_EQ(misplaced_after_relock, 0);
+  EXPECT_EQ(found_after_relock, lost_after_relock);
+  EXPECT_GT(lost_after_relock, 40);
   EXPECT_NEAR(clock.interval_s(), 0.01, 1e-7);
 }
 
@@ -765,7 +791,7 @@ std::vector<TableSegment> FacesAndTiltedRates() {
 }
 
 // A run at one temperature (order 0), 10 s dwells, no latitude: the Earth rate across a turn's
-// axis turns with the unit and is not part of a turn's truth (docs/conventions.md).
+// axis turns with the unit and is not part of a turn's truth (docs/spec.md section 2).
 TableSite NoLatitude() {
   TableSite site = Site();
   site.latitude_rad.reset();

@@ -23,6 +23,7 @@
 #include "imufit/noise/allan.h"
 #include "imufit/noise/noise_model.h"
 #include "imufit/noise/statistics.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {
@@ -493,18 +494,8 @@ TEST(NoiseFitTest, TooFewPointsIsReportedNotFitted) {
 
 namespace fs = std::filesystem;
 
-class AllanCliTest : public ::testing::Test {
+class AllanCliTest : public testing::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("imufit_allan_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-
   // Writes a samples file: time_s at `interval`, temp_c, gyro_x (white, sigma 0.01 rad/s) and
   // accel_y (white, 0.02 m/s^2 around 9.8), `rows` rows; `time_of` may bend the time column.
   std::string WriteSamples(const std::string& name, int rows, double interval = 0.01,
@@ -541,14 +532,8 @@ class AllanCliTest : public ::testing::Test {
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   }
 
-  static std::string Read(const std::string& path) {
-    std::ifstream stream(path, std::ios::binary);
-    std::stringstream text;
-    text << stream.rdbuf();
-    return text.str();
-  }
+  static std::string Read(const std::string& path) { return testing::ReadBytes(path); }
 
-  fs::path dir_;
   std::string error_;
   std::string output_;
 };

@@ -14,6 +14,7 @@
 #include "imufit/io/samples.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/run_windows.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {
@@ -118,15 +119,14 @@ TEST(ReadRunWindows, RefusesASegmentThePlanDoesNotHave) {
   }
 }
 
-// Unlabelled logs (issue 9): a run simulated from the fixture truth, written with and without its
-// segment (and temp_c) column, with jittered time stamps, and fitted through FitRun as `imufit fit`
-// does.
-class UnlabelledRun : public ::testing::Test {
+// Unlabelled logs: a run simulated from the fixture truth, written with and without its segment
+// (and temp_c) column, with jittered time stamps, and fitted through FitRun as `imufit fit` does.
+class UnlabelledRun : public testing::TempDirTest {
  protected:
-  // Simulates the 6-position plan and writes it to `name` (in the test's temporary folder) with the
-  // given columns; returns the path.
+  // Simulates the 6-position plan and writes it to `name` (in the test's folder) with the given
+  // columns; returns the path.
   std::string Write(const std::string& name, const SimulationOptions& options, SampleColumns columns) {
-    const std::string path = ::testing::TempDir() + "/imufit_unlabelled_" + name;
+    const std::string path = Path(name);
     SamplesWriter writer(path, columns);
     SimulateRun(options, plan_.site, plan_.segments, truth_.model,
                 [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
