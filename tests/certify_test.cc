@@ -98,7 +98,7 @@ class CertifyTest : public ::testing::TestWithParam<bool> {
 TEST_P(CertifyTest, FitReportAndStoreReadTheSamplesAtMostTwice) {
   const std::string limits_path = Path("limits.yaml");
   std::ofstream(limits_path) << kLimits;
-  const long long reads_before = TimesOpenedForReading(samples_);
+  const FileReadCounter reads(samples_);
 
   // What `imufit fit -p PLAN -s SAMPLES -o CAL --limits L --report R --store S` does.
   const FitRunOptions options = FitOptions();
@@ -119,9 +119,8 @@ TEST_P(CertifyTest, FitReportAndStoreReadTheSamplesAtMostTwice) {
   unit.samples_sha256 = unit.fit->run.samples_sha256;
   ASSERT_TRUE(CertifyUnit(settings, {Path("calibration.yaml"), Path("report.html")}, &unit)) << unit.message;
 
-  const long long reads = TimesOpenedForReading(samples_) - reads_before;
-  EXPECT_LE(reads, 2) << "imufit fit --report --store reads the samples at most twice";
-  EXPECT_EQ(reads, Reads());
+  EXPECT_LE(reads.count(), 2) << "imufit fit --report --store reads the samples at most twice";
+  EXPECT_EQ(reads.count(), Reads());
 
   // The hash made while reading is the file's; the calibration, the certificate and the store
   // record it.
@@ -175,9 +174,9 @@ TEST_P(CertifyTest, TheStretchHandedOnIsTheOneInTheFile) {
   sources.inputs = {{"samples", samples_, fit.run.samples_sha256}};
   const Certificate handed_on = MakeCertificate(sources);
   sources.run.static_stretch.reset();
-  const long long reads_before = TimesOpenedForReading(samples_);
+  const FileReadCounter reads(samples_);
   const Certificate read_again = MakeCertificate(sources);
-  EXPECT_EQ(TimesOpenedForReading(samples_) - reads_before, 1) << "without the stretch, it is read";
+  EXPECT_EQ(reads.count(), 1) << "without the stretch, it is read";
   ASSERT_TRUE(handed_on.noise.computed) << handed_on.noise.why_not;
   EXPECT_EQ(handed_on.noise.segment, read_again.noise.segment);
   EXPECT_EQ(handed_on.noise.temp_c, read_again.noise.temp_c);
@@ -193,9 +192,9 @@ TEST_P(CertifyTest, TheStretchHandedOnIsTheOneInTheFile) {
 // A run read into windows alone (imufit report, the benchmarks) is read as often, and its hash is
 // the file's.
 TEST_P(CertifyTest, ReadingARunHashesItOnTheWay) {
-  const long long reads_before = TimesOpenedForReading(samples_);
+  const FileReadCounter reads(samples_);
   const RunWindows run = ReadRunWindows(plan_, samples_, WindowOptions());
-  EXPECT_EQ(TimesOpenedForReading(samples_) - reads_before, Reads());
+  EXPECT_EQ(reads.count(), Reads());
   EXPECT_EQ(run.samples_sha256, Sha256OfFile(samples_));
   EXPECT_FALSE(run.static_stretch.has_value()) << "kept only when asked";
 }

@@ -907,18 +907,18 @@ TEST_F(IoTest, ACsvReaderHashesTheFileAsItReadsIt) {
       }
       writer.Commit();
     }
-    const long long opened = TimesOpenedForReading(path);
+    const FileReadCounter reads(path);
     Sha256 digest;
     SamplesReader reader(path, true, std::nullopt, &digest);
     Sample sample;
     long long samples = 0;
     while (reader.Next(&sample)) ++samples;
     EXPECT_EQ(samples, 200000);
-    EXPECT_EQ(TimesOpenedForReading(path), opened + 1) << name;
+    EXPECT_EQ(reads.count(), 1) << name;
     EXPECT_EQ(digest.HexDigest(), Sha256OfFile(path)) << name;
-    EXPECT_EQ(TimesOpenedForReading(path), opened + 2) << name << ": Sha256OfFile opens it too";
+    EXPECT_EQ(reads.count(), 2) << name << ": Sha256OfFile opens it too";
   }
-  EXPECT_EQ(TimesOpenedForReading((dir_ / "missing.csv").string()), 0);
+  EXPECT_THROW(FileReadCounter((dir_ / "missing.csv").string()), InputError);
 }
 
 TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
