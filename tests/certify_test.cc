@@ -15,7 +15,7 @@
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certify.h"
 #include "imufit/factory/store.h"
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/file_reads.h"
 #include "imufit/io/plan.h"

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "imufit/fit/segmentation.h"
+#include "imufit/run/segmentation.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/sample.h"
 #include "imufit/pipeline/segment_run.h"
