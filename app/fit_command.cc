@@ -131,6 +131,7 @@ int FinishFactory(const FitArguments& args, const FitRunOptions& options, const 
                       {"limits", args.limits, ""},
                       {"station", args.station, ""}};
     sources.station = station;
+    ReadCertificateFiles(&sources);
     certificate = MakeCertificate(sources);
     WarnIfNoSerial(*certificate, args.samples);
   }

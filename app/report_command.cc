@@ -74,6 +74,7 @@ int RunReport(const ReportArguments& args) {
                     {"samples", args.samples, ""},
                     {"limits", args.limits, ""},
                     {"station", args.station, ""}};
+  ReadCertificateFiles(&sources);
   const Certificate certificate = MakeCertificate(sources);
   WarnIfNoSerial(certificate, args.calibration);
   WriteCertificate(args.output, certificate);

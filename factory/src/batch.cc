@@ -16,6 +16,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/lot_summary.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/error.h"
@@ -252,8 +253,8 @@ UnitOutcome ProcessUnit(Shared& shared, const fs::path& unit_dir) {
     }
     outcome.fit = std::move(result);
     if (outcome.status == "fitted" && options.write_reports) {
-      const Certificate certificate = MakeCertificate(outcome, options.limits_path, shared.limits,
-                                                      calibration_path, options.fit, shared.station);
+      const Certificate certificate = MakeCertificate(UnitCertificateSources(
+          outcome, options.limits_path, shared.limits, calibration_path, options.fit, shared.station));
       // The certificate judges with the noise it measured itself: its verdict is the unit's.
       if (certificate.verdict) {
         outcome.verdict_detail = *certificate.verdict;

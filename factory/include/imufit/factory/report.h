@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/lot_summary.h"
 #include "imufit/factory/plot.h"
 
 namespace imufit {
