@@ -63,8 +63,8 @@ struct CertificateSources {
 };
 
 // What MakeCertificate() takes from files, read into `sources`: the SHA-256 of every listed input
-// that has none (the station's file listed first when it is not), and, unless `noise` is given,
-// the noise section measured on the samples input.
+// that has none (the station's file added to the inputs when it is not among them), and, unless
+// `noise` is given, the noise section measured on the samples input (MeasureGyroNoise).
 void ReadCertificateFiles(CertificateSources* sources);
 
 struct KeyFigureRow {
@@ -80,7 +80,7 @@ struct KeyFigureRow {
 
 // One window's own estimate of a coefficient at the window's temperature T_w: the value of that
 // one coefficient that explains the window's mean output exactly on the coefficient's row, every
-// other coefficient at its fitted value (a partial residual; equations in certificate.cc). It
+// other coefficient at its fitted value (a partial residual; equations in coefficient_curves.cc). It
 // scatters about the polynomial by the window's noise alone, so the points show what the data say
 // where the curve only shows what the fit made of them.
 struct CoefficientPoint {
@@ -146,12 +146,13 @@ struct ValidationRow {
   bool order_lowered = false;
 };
 
-// The fit's settings and diagnostics, from the calibration's `fit:` block (known = false without).
+// The fit's settings and diagnostics, from the calibration's fit record (Calibration::fit; known =
+// false without).
 struct FitSettings {
   bool known = false;
   std::string loss;
   // Why the solver stopped: the first sentence of Ceres's message ("Function tolerance reached.");
-  // the tolerances it quotes after it are in the calibration's `fit:` block.
+  // the tolerances it quotes after it are in the calibration's fit record.
   std::string termination;
   int iterations = 0, windows_used = 0, windows_downweighted = 0;
   int gyro_temp_order = 3, accel_temp_order = 3;
