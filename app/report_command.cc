@@ -77,6 +77,7 @@ int RunReport(const ReportArguments& args) {
                     {"samples", args.samples, sources.run.samples_sha256},
                     {"limits", args.limits, ""},
                     {"station", args.station, ""}};
+  ReadCertificateFiles(&sources);
   const Certificate certificate = MakeCertificate(sources);
   WarnIfNoSerial(certificate.serial, args.calibration);
   WriteCertificate(args.output, certificate);

@@ -14,6 +14,7 @@
 
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/lot_history.h"
+#include "imufit/factory/lot_summary.h"
 #include "imufit/factory/plot.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"

@@ -355,6 +355,7 @@ class CertificateTest : public FactoryTest {
     EXPECT_TRUE(InputMismatches(sources.calibration, plan_path, samples).empty());
     EXPECT_FALSE(
         InputMismatches(sources.calibration, plan_path, kFixtures + "/mems_6pos_noiseless.csv.gz").empty());
+    ReadCertificateFiles(&sources);
     return MakeCertificate(sources);
   }
   // The certificate of a fit from its run alone (no limits, no files to hash).
@@ -601,6 +602,7 @@ TEST_F(CertificateTest, TheNoiseSectionIsDrawnByTheAllanPlotModule) {
   sources.plan = fit.plan;
   sources.run = fit.run;
   sources.inputs = {{"samples", samples, ""}};
+  ReadCertificateFiles(&sources);
   const Certificate c = MakeCertificate(sources);
   ASSERT_TRUE(c.noise.computed) << c.noise.why_not;
   ASSERT_EQ(c.noise.columns.size(), 3u);
@@ -643,6 +645,74 @@ TEST_F(CertificateTest, TheNoiseSectionIsDrawnByTheAllanPlotModule) {
     for (const PlotNote& n : panel.notes) marked = marked || n.text.rfind(words, 0) == 0;
     EXPECT_TRUE(marked) << words;
   }
+}
+
+// The noise section streams the run: the longest static stretch (the first of equally long ones;
+// a transition or a rate segment ends a stretch) is analysed exactly as `imufit allan` analyses the
+// same rates held at once, and the section is the caller's to measure: MakeCertificate() takes it.
+TEST_F(CertificateTest, TheNoiseSectionStreamsTheLongestStaticStretch) {
+  const Plan plan = ReadPlan(kFixtures + "/plan_6pos.yaml");  // 1..6 static, 7.. rates
+  Calibration calibration;
+  calibration.model = SensorModel::Identity();
+  calibration.model.gyro[kScaleCoefficient * kPolynomialTerms] = 2.0;  // raw x = 2 * rate
+  LongestStaticStretch collector(plan);
+  std::vector<double> expected_x;  // the longest stretch's rates, rad/s
+  double t = 0.0;
+  uint64_t state = 7;
+  const auto noise = [&state] {  // a small deterministic generator (the values only need to differ)
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
+  };
+  const auto feed = [&](int segment, int count, double temp_c, bool keep) {
+    for (int i = 0; i < count; ++i, t += 1.0) {
+      Sample s;
+      s.time_s = t;
+      s.temp_c = temp_c;
+      s.segment = segment;
+      s.gyro = Eigen::Vector3d(noise(), noise(), noise());
+      if (keep) expected_x.push_back(s.gyro.x() / 2.0);
+      collector.Add(s);
+    }
+  };
+  feed(1, 50, 20.0, false);
+  feed(2, 80, 30.0, true);  // the longest: 79 s
+  feed(kTransitionSegment, 1, 30.0, false);
+  feed(2, 80, 40.0, false);   // as long, later
+  feed(7, 100, 40.0, false);  // a rate segment: no stretch
+  const NoiseSection section = GyroNoise(calibration, collector.Finish());
+  ASSERT_TRUE(section.computed) << section.why_not;
+  EXPECT_EQ(section.segment, 2);
+  EXPECT_EQ(section.duration_s, 79.0);
+  EXPECT_EQ(section.temp_c, 30.0);
+  ASSERT_EQ(section.columns.size(), 3u);
+  std::vector<int64_t> factors;
+  AveragingFactors(TauSpec(), AllanEstimator::kOadev, 80, 1.0, &factors);
+  AllanOptions options;
+  options.threads = 1;
+  const ColumnAnalysis held = AnalyseColumn("gyro_x", ColumnKind::kGyro, expected_x, 1.0, factors, options);
+  ASSERT_EQ(section.columns[0].allan.points.size(), held.allan.points.size());
+  for (size_t i = 0; i < held.allan.points.size(); ++i) {
+    EXPECT_EQ(section.columns[0].allan.points[i].dev, held.allan.points[i].dev) << i;  // bit for bit
+  }
+
+  // A samples file that cannot be read is said in the section, not thrown.
+  const NoiseSection unreadable =
+      MeasureGyroNoise(calibration, plan, (dir_ / "missing.csv").string(), SamplesInput(), std::nullopt);
+  EXPECT_FALSE(unreadable.computed);
+  EXPECT_NE(unreadable.why_not.find("missing.csv"), std::string::npos) << unreadable.why_not;
+  // The section comes in with the sources: MakeCertificate() reads no file.
+  const FitRunResult fit =
+      FitRun(kFixtures + "/plan_6pos.yaml", kFixtures + "/mems_6pos_soak.csv.gz", FitRunOptions());
+  ASSERT_TRUE(fit.calibration.has_value());
+  CertificateSources sources;
+  sources.calibration = *fit.calibration;
+  sources.plan = fit.plan;
+  sources.run = fit.run;
+  sources.inputs = {{"samples", (dir_ / "missing.csv").string(), std::string(64, '0')}};
+  sources.noise = section;
+  const Certificate c = MakeCertificate(sources);
+  EXPECT_EQ(c.noise.segment, 2);
+  EXPECT_EQ(c.inputs[0].sha256, std::string(64, '0'));
 }
 
 // A plan of many segments (the 24-position tactical soak: 36 segments) prints the segments with

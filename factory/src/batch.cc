@@ -16,6 +16,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/lot_summary.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/error.h"

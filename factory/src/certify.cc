@@ -34,6 +34,7 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
                     {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
                     {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
   sources.station = settings.station;
+  ReadCertificateFiles(&sources);  // only what is not known yet: the run kept its static stretch
   return MakeCertificate(sources);
 }
 

@@ -46,6 +46,46 @@ class UndeterminedError(FitError):
 class PlanMismatchError(FitError):
     """A samples file without a segment column does not match its plan (the message says where)."""
 
+class FitRecord:
+    """What the fit did and on which files: the calibration's `fit:` block, each key an attribute
+    (None when the file does not say). Read-only; SI units as the names say."""
+
+    plan: str | None  # the plan file, as given
+    samples: str | None  # the samples file, as given
+    plan_sha256: str | None  # SHA-256 of the plan file
+    samples_sha256: str | None  # SHA-256 of the samples file
+    samples_read: int | None  # samples in the file
+    segments_found_in_data: int | None  # a file without a segment column: the segments found in the data
+    plan_passes_found: int | None  # a file without a segment column: complete passes through the plan
+    windows_used: int | None  # windows the fit used
+    windows_downweighted: int | None  # windows the robust loss down-weighted
+    distinct_temperatures_c: list[float] | None  # the distinct temperatures of the windows, degC
+    iterations: int | None  # solver iterations over all passes
+    termination: str | None  # why the solver stopped, in its own words
+    gyro_residual_rms_radps: float | None  # RMS of the gyro residuals, rad/s
+    accel_residual_rms_mps2: float | None  # RMS of the accelerometer residuals, m/s^2
+    gyro_reduced_chi2: float | None  # reduced chi-square of the gyro residuals
+    accel_reduced_chi2: float | None  # reduced chi-square of the accelerometer residuals
+    gyro_temp_order: int | None  # order of the gyro's temperature polynomials
+    accel_temp_order: int | None  # order of the accelerometer's temperature polynomials
+    g_sensitivity_fitted: bool | None  # whether the gyro g-sensitivity was fitted (else held at zero)
+    fitted: list[str] | None  # the coefficient groups the fit estimated, e.g. gyro.bias
+    held: list[str] | None  # the groups held at their stated values (sigma 0)
+    held_values: str | None  # where the held values came from: prior, or scale 1, others 0
+    loss: str | None  # the robust loss
+    gyro_bias_stability_radps: float | None  # the gyro bias stability in the sigmas, rad/s (0: white noise)
+    accel_bias_stability_mps2: float | None  # the accelerometer bias stability in the sigmas, m/s^2
+    bias_correlation_s: float | None  # correlation time of that bias wander, s
+    segments_without_windows: list[int] | None  # plan segments without a single usable window
+    missing_segments: int | None  # how many segments that is
+
+class CheckRecord:
+    """The errors on a held-out run (`imufit fit --check-samples`): the `check:` block."""
+
+    samples: str | None  # the held-out samples file, as given
+    gyro_error_rms_radps: float | None  # RMS of the gyro errors over it, rad/s
+    accel_error_rms_mps2: float | None  # RMS of the accelerometer errors, m/s^2
+
 class Calibration:
     """A calibration (calibration.yaml): the shared model's coefficients and their 1-sigma."""
 
@@ -75,6 +115,12 @@ class Calibration:
     @property
     def sigma(self) -> dict[str, dict[str, FloatArray]] | None:
         """1-sigma of every coefficient, {"gyro": ..., "accel": ...} as above; None if the file has none."""
+    @property
+    def fit(self) -> FitRecord | None:
+        """What the fit did and on which files; None if the file has no `fit:` block."""
+    @property
+    def check(self) -> CheckRecord | None:
+        """The errors on a held-out run; None if the fit had none."""
     def parameters(self, sensor: str) -> FloatArray:
         """Flat parameters of "gyro" (84,) or "accel" (48,): coefficient i, term k at 4 i + k."""
     def set_coefficients(self, sensor: str, group: str, values: ArrayLike) -> None:

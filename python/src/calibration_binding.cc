@@ -1,5 +1,5 @@
 // imufit Python module: Calibration (io's reader and writer, the shared model's correction and
-// forward form, evaluation at temperatures) and samples files as numpy arrays.
+// forward form, evaluation at temperatures, the fit's record) and samples files as numpy arrays.
 #include <algorithm>
 #include <cstdint>
 #include <sstream>
@@ -239,19 +239,36 @@ void WriteSamples(const py::object& path, const py::dict& samples, const std::st
   writer.Commit();
 }
 
-}  // namespace
+// ---------------------------------------------------------------- the bindings, by part
 
-void BindCalibration(py::module_& m) {
-  py::class_<Calibration>(
-      m, "Calibration",
-      "A calibration (calibration.yaml): the coefficients of the shared model, each a cubic "
-      "in dT = T - reference_temp_c, with their 1-sigma when the fit wrote them.")
-      .def(py::init([] {
-             Calibration calibration;
-             calibration.model = SensorModel::Identity();
-             return calibration;
-           }),
-           "The identity calibration: unit scale factors, no bias, misalignment or g-sensitivity.")
+// The fit's record (io/fit_record.h): one read-only attribute per key of its table, None when the
+// file does not say.
+void BindFitRecords(py::module_& m) {
+#define IMUFIT_RECORD_ATTRIBUTE(type, key, description) .def_readonly(#key, &Record::key, description)
+  {
+    using Record = FitRecord;
+    py::class_<Record>(m, "FitRecord",
+                       "What the fit did and on which files: the calibration's `fit:` block, each key an "
+                       "attribute (None when the file does not say).")
+        IMUFIT_FIT_RECORD_FIELDS(IMUFIT_RECORD_ATTRIBUTE);
+  }
+  {
+    using Record = CheckRecord;
+    py::class_<Record>(m, "CheckRecord",
+                       "The calibration's errors on a held-out run (`imufit fit --check-samples`): its "
+                       "`check:` block.") IMUFIT_CHECK_RECORD_FIELDS(IMUFIT_RECORD_ATTRIBUTE);
+  }
+#undef IMUFIT_RECORD_ATTRIBUTE
+}
+
+// The file: reading, writing, and what it says besides the coefficients.
+void BindCalibrationFile(py::class_<Calibration>& c) {
+  c.def(py::init([] {
+          Calibration calibration;
+          calibration.model = SensorModel::Identity();
+          return calibration;
+        }),
+        "The identity calibration: unit scale factors, no bias, misalignment or g-sensitivity.")
       .def_static(
           "load", [](const py::object& path) { return ReadCalibration(PathString(path)); }, py::arg("path"),
           "Reads a calibration YAML file; raises InputError (file:line:column) on bad input.")
@@ -270,11 +287,18 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly(
           "reference_temp_c", [](const Calibration& c) { return c.model.basis.center_c; },
           "The temperature at which dT = 0, degC (25 in files imufit writes).")
-      .def_property_readonly(
-          "gyro",
-          [](const Calibration& c) { return CoefficientArrays(c.model.gyro.data(), kGyroCoefficients); },
-          "Gyro coefficients (copies): {bias: (3, 4) raw, scale: (3, 4) raw per rad/s, misalignment: (6, 4), "
-          "g_sensitivity: (9, 4) raw per m/s^2}; columns c0..c3 of powers of dT.")
+      .def_readonly("fit", &Calibration::fit,
+                    "What the fit did and on which files (FitRecord), or None when the file does not say.")
+      .def_readonly("check", &Calibration::check,
+                    "The errors on a held-out run (CheckRecord), or None when the fit had none.");
+}
+
+// The coefficients: named arrays, the flat parameter layout, their values at temperatures.
+void BindCoefficients(py::class_<Calibration>& c) {
+  c.def_property_readonly(
+       "gyro", [](const Calibration& c) { return CoefficientArrays(c.model.gyro.data(), kGyroCoefficients); },
+       "Gyro coefficients (copies): {bias: (3, 4) raw, scale: (3, 4) raw per rad/s, misalignment: (6, 4), "
+       "g_sensitivity: (9, 4) raw per m/s^2}; columns c0..c3 of powers of dT.")
       .def_property_readonly(
           "accel",
           [](const Calibration& c) { return CoefficientArrays(c.model.accel.data(), kAccelCoefficients); },
@@ -309,39 +333,45 @@ void BindCalibration(py::module_& m) {
           "array of shape (count, 4).")
       .def("evaluate", &Evaluate, py::arg("temp_c"),
            "The coefficients at temperatures temp_c (degC; a number or shape (N,)): {gyro: {bias (N, 3) raw, "
-           "scale (N, 3), misalignment (N, 3, 3), g_sensitivity (N, 3, 3)}, accel: {...}}.")
-      .def(
-          "correct",
-          [](const Calibration& c, const py::object& temp_c, const py::object& gyro_raw,
-             const py::object& accel_raw) {
-            const SensorModel& model = c.model;
-            return MapSamples(
-                "imufit.Calibration.correct", temp_c, gyro_raw, accel_raw, "gyro_raw", "accel_raw",
-                [&model](double t, const Eigen::Vector3d& g, const Eigen::Vector3d& a, Eigen::Vector3d* omega,
-                         Eigen::Vector3d* f) { model.Correct(t, g, a, omega, f); });
-          },
-          py::arg("temp_c"), py::arg("gyro_raw"), py::arg("accel_raw"),
-          "Corrects raw samples: (omega_hat_radps, a_hat_mps2), each (N, 3), bit for bit what `imufit apply` "
-          "writes. temp_c degC, shape (N,) or a number; gyro_raw, accel_raw raw, shape (N, 3) (or (3,)).")
-      .def(
-          "forward",
-          [](const Calibration& c, const py::object& temp_c, const py::object& omega,
-             const py::object& accel) {
-            const SensorModel& model = c.model;
-            return MapSamples(
-                "imufit.Calibration.forward", temp_c, omega, accel, "omega_true_radps", "a_true_mps2",
-                [&model](double t, const Eigen::Vector3d& w, const Eigen::Vector3d& a, Eigen::Vector3d* gyro,
-                         Eigen::Vector3d* f) { model.Forward(t, w, a, gyro, f); });
-          },
-          py::arg("temp_c"), py::arg("omega_true_radps"), py::arg("a_true_mps2"),
-          "The raw outputs (gyro_raw, accel_raw) of a unit with this calibration for true rates (rad/s) and "
-          "specific forces (m/s^2): the exact inverse of correct().")
+           "scale (N, 3), misalignment (N, 3, 3), g_sensitivity (N, 3, 3)}, accel: {...}}.");
+}
+
+// A method of Calibration that maps arrays of samples through the model's `map` (Correct or
+// Forward), the argument names its own.
+using ModelMap = void (SensorModel::*)(double, const Eigen::Vector3d&, const Eigen::Vector3d&,
+                                       Eigen::Vector3d*, Eigen::Vector3d*) const;
+auto SampleMethod(const char* where, const char* gyro_name, const char* accel_name, ModelMap map) {
+  return
+      [=](const Calibration& c, const py::object& temp_c, const py::object& gyro, const py::object& accel) {
+        const SensorModel& model = c.model;
+        return MapSamples(where, temp_c, gyro, accel, gyro_name, accel_name,
+                          [&model, map](double t, const Eigen::Vector3d& g, const Eigen::Vector3d& a,
+                                        Eigen::Vector3d* g_out,
+                                        Eigen::Vector3d* a_out) { (model.*map)(t, g, a, g_out, a_out); });
+      };
+}
+
+// The shared model's correction and its inverse on arrays of samples.
+void BindCorrection(py::class_<Calibration>& c) {
+  c.def("correct", SampleMethod("imufit.Calibration.correct", "gyro_raw", "accel_raw", &SensorModel::Correct),
+        py::arg("temp_c"), py::arg("gyro_raw"), py::arg("accel_raw"),
+        "Corrects raw samples: (omega_hat_radps, a_hat_mps2), each (N, 3), bit for bit what `imufit apply` "
+        "writes. temp_c degC, shape (N,) or a number; gyro_raw, accel_raw raw, shape (N, 3) (or (3,)).")
+      .def("forward",
+           SampleMethod("imufit.Calibration.forward", "omega_true_radps", "a_true_mps2",
+                        &SensorModel::Forward),
+           py::arg("temp_c"), py::arg("omega_true_radps"), py::arg("a_true_mps2"),
+           "The raw outputs (gyro_raw, accel_raw) of a unit with this calibration for true rates (rad/s) and "
+           "specific forces (m/s^2): the exact inverse of correct().")
       .def("__repr__", [](const Calibration& c) {
         return "<imufit.Calibration serial=" + py::repr(py::str(c.serial)).cast<std::string>() +
                " fit_temp_range_c=(" + FormatDouble(c.fit_temp_range_c[0]) + ", " +
                FormatDouble(c.fit_temp_range_c[1]) + ")" + (c.sigma ? " with sigma" : "") + ">";
       });
+}
 
+// The coefficient names and the samples files as arrays.
+void BindSamplesFiles(py::module_& m) {
   py::list names;
   for (const CoefficientName& name : kCoefficientNames) {
     names.append(std::string(name.group) + "." + name.axis);
@@ -354,6 +384,20 @@ void BindCalibration(py::module_& m) {
   m.def("write_samples", &WriteSamples, py::arg("path"), py::arg("samples"), py::arg("comment") = "",
         "Writes samples ({time_s, temp_c, [segment], gyro, accel}) atomically in the samples layout, every "
         "number in its shortest round-trip form.");
+}
+
+}  // namespace
+
+void BindCalibration(py::module_& m) {
+  BindFitRecords(m);
+  py::class_<Calibration> calibration(
+      m, "Calibration",
+      "A calibration (calibration.yaml): the coefficients of the shared model, each a cubic "
+      "in dT = T - reference_temp_c, with their 1-sigma when the fit wrote them.");
+  BindCalibrationFile(calibration);
+  BindCoefficients(calibration);
+  BindCorrection(calibration);
+  BindSamplesFiles(m);
 }
 
 }  // namespace imufit::python

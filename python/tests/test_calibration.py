@@ -1,5 +1,7 @@
 """Calibration: file round trip, named coefficients, evaluation, and correct() against `imufit apply`."""
 
+import pathlib
+
 import numpy as np
 import pytest
 
@@ -133,3 +135,27 @@ def test_samples_round_trip(fixtures, tmp_path):
     assert set(again) == set(raw)
     for key in raw:
         assert raw[key].tobytes() == again[key].tobytes(), key
+
+
+def test_the_fit_record_is_typed_and_the_stub_names_every_key(fixtures, tmp_path):
+    import ast
+
+    result = imufit.fit(fixtures / "plan_6pos.yaml", fixtures / "mems_6pos_soak.csv.gz")
+    path = tmp_path / "cal.yaml"
+    result.calibration.save(path)
+    record = imufit.Calibration.load(path).fit
+    assert record.samples_read == result.diagnostics["samples"] == 26950
+    assert record.windows_used == result.diagnostics["windows_used"]
+    assert record.distinct_temperatures_c == result.diagnostics["distinct_temps_c"].tolist()
+    assert record.termination == result.diagnostics["termination"]
+    assert record.g_sensitivity_fitted is True and record.held == [] and record.held_values is None
+    assert len(record.samples_sha256) == 64 and record.missing_segments == 0
+    assert imufit.Calibration.load(path).check is None
+    # A calibration without a fit: block (a truth file) has no record.
+    assert imufit.Calibration.load(fixtures / "mems_truth.yaml").fit is None
+    # The stub declares the module's attributes, no more, no fewer.
+    stub = ast.parse((pathlib.Path(imufit.__file__).parent / "__init__.pyi").read_text())
+    for name in ("FitRecord", "CheckRecord"):
+        declared = next(node for node in stub.body if isinstance(node, ast.ClassDef) and node.name == name)
+        annotated = {n.target.id for n in declared.body if isinstance(n, ast.AnnAssign)}
+        assert annotated == {a for a in dir(getattr(imufit, name)) if not a.startswith("_")}, name

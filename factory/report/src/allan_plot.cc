@@ -76,6 +76,208 @@ std::string TermText(const ColumnAnalysis& r, int term, const char* name) {
   return text;
 }
 
+// ---------------------------------------------------------------- one panel, by stages
+
+// What one panel draws (the columns of one kind) and what it has learnt of its extent so far.
+struct Panel {
+  Plot plot;
+  ColumnKind kind = ColumnKind::kOther;
+  double scale = 1.0;            // plot units per SI unit
+  const char* random_walk = "";  // "ARW" or "VRW"
+  int columns = 0;               // columns of this kind in the panel
+  double lowest = INFINITY, highest = 0.0, shortest = INFINITY, longest = 0.0;
+  std::vector<PlotNote> floor_words;  // the bias instabilities in words, placed at the end
+};
+
+// The axes and titles of the panel of `kind`, for the curves of `estimator`.
+Panel OpenPanel(const std::vector<ColumnAnalysis>& results, ColumnKind kind, AllanEstimator estimator,
+                AllanPlotUnits units) {
+  Panel panel;
+  panel.kind = kind;
+  panel.scale = Scale(kind, units);
+  panel.random_walk = kind == ColumnKind::kAccel ? "VRW" : "ARW";
+  Plot& plot = panel.plot;
+  plot.log_x = plot.log_y = true;
+  plot.x_label = "averaging time \xcf\x84 (s)";
+  plot.y_label = std::string(LongName(estimator)) + " (" + UnitName(kind, units) +
+                 (estimator == AllanEstimator::kTdev ? "\xc2\xb7s" : "") + ")";
+  plot.title = kind == ColumnKind::kGyro    ? "Gyro"
+               : kind == ColumnKind::kAccel ? "Accelerometer"
+                                            : "Other columns";
+  plot.labels_at_bottom = true;
+  for (const ColumnAnalysis& r : results) panel.columns += r.kind == kind ? 1 : 0;
+  return panel;
+}
+
+// The measured curve with its confidence bars (points where the deviation is 0 are left out: a
+// constant column has nothing to show on a log scale).
+PlotSeries Curve(const ColumnAnalysis& r, int color, Panel* panel) {
+  PlotSeries curve;
+  curve.style = PlotSeries::Style::kErrorBars;
+  curve.title = r.name;
+  curve.color = PlotColor(color);
+  curve.point_size = 0.7;
+  const double scale = panel->scale;
+  for (const AllanPoint& p : r.curve.points) {
+    if (!(p.dev > 0.0)) continue;
+    curve.x.push_back(p.tau_s);
+    curve.y.push_back(p.dev * scale);
+    curve.lo.push_back((std::isfinite(p.dev_lo) && p.dev_lo > 0.0 ? p.dev_lo : p.dev) * scale);
+    curve.hi.push_back((std::isfinite(p.dev_hi) ? p.dev_hi : p.dev) * scale);
+    panel->lowest = std::min(panel->lowest, curve.lo.back());
+    panel->highest = std::max(panel->highest, curve.hi.back());
+    panel->shortest = std::min(panel->shortest, p.tau_s);
+    panel->longest = std::max(panel->longest, p.tau_s);
+  }
+  return curve;
+}
+
+// The fitted model (solid) over the curve's taus and its resolved terms (dashed, where they carry
+// at least kTermShownShare of the model's deviation); returns the tau of the model's minimum.
+double DrawModel(const ColumnAnalysis& r, const PlotSeries& curve, Panel* panel) {
+  PlotSeries model;
+  model.color = curve.color;
+  model.line_width = 2;
+  std::array<PlotSeries, kNoiseTerms> terms;
+  const double first = curve.x.front(), last = curve.x.back();
+  double floor_tau = first, floor_dev = INFINITY;
+  for (int i = 0; i <= kModelPoints; ++i) {
+    const double tau = first * std::pow(last / first, static_cast<double>(i) / kModelPoints);
+    const double dev = r.fit.ModelDeviation(tau);
+    model.x.push_back(tau);
+    model.y.push_back(dev * panel->scale);
+    if (dev < floor_dev) floor_tau = tau, floor_dev = dev;
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      const double term = r.fit.TermDeviation(k, tau);
+      terms[k].x.push_back(tau);
+      terms[k].y.push_back(term >= kTermShownShare * dev ? term * panel->scale : NAN);  // NaN: a gap
+    }
+  }
+  panel->plot.series.push_back(model);
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    if (!IsResolved(r.fit, k)) continue;  // a term within its noise is no line to read
+    terms[k].color = curve.color;
+    terms[k].dashed = true;
+    terms[k].line_width = 1;
+    panel->plot.series.push_back(terms[k]);
+  }
+  return floor_tau;
+}
+
+// N where it is read: the -1/2 line at tau = 1 s (at the curve's end when 1 s is beyond it); the
+// first column's note on top.
+void MarkRandomWalk(const ColumnAnalysis& r, const PlotSeries& curve, const std::string& who, int column,
+                    Panel* panel) {
+  if (!IsResolved(r.fit, kRandomWalk)) {
+    panel->plot.labels.push_back({r.name + ": " + panel->random_walk + " not resolved"});
+    return;
+  }
+  PlotNote n;
+  n.x = std::clamp(1.0, curve.x.front(), curve.x.back());
+  n.y = r.fit.TermDeviation(kRandomWalk, n.x) * panel->scale;
+  n.text = who + TermText(r, kRandomWalk, panel->random_walk);
+  n.color = curve.color;
+  n.point_type = 7;
+  n.point_size = 1.3;
+  n.opaque = true;
+  n.dx_chars = 1.5;
+  n.dy_chars = 1.2 + 1.4 * (panel->columns - 1 - column);
+  panel->plot.notes.push_back(n);
+}
+
+// The bias-instability floor, 0.664 B, marked at the model's minimum; its words are stacked below
+// the panel's lowest floor later (PlaceFloorWords), so that they cross no floor line.
+void MarkBiasInstability(const ColumnAnalysis& r, const PlotSeries& curve, const std::string& who,
+                         double floor_tau, Panel* panel) {
+  if (!IsResolved(r.fit, kBiasInstability)) {
+    panel->plot.labels.push_back({r.name + ": bias instability not resolved"});
+    return;
+  }
+  PlotNote b;
+  b.x = floor_tau;
+  b.y = r.fit.TermDeviation(kBiasInstability, floor_tau) * panel->scale;
+  b.color = curve.color;
+  b.point_type = 13;
+  b.point_size = 1.6;
+  panel->plot.notes.push_back(b);
+  b.point_type = -1;
+  b.text = who + TermText(r, kBiasInstability, "bias instability");
+  b.opaque = true;
+  panel->floor_words.push_back(b);
+  panel->lowest = std::min(panel->lowest, b.y);
+}
+
+// One column of the panel: its curve, and over an Allan-variance curve its noise fit drawn and
+// annotated (otherwise said in words).
+void AddColumn(const ColumnAnalysis& r, int color, int column, bool draw_model, Panel* panel) {
+  const PlotSeries curve = Curve(r, color, panel);
+  panel->plot.series.push_back(curve);
+  if (!r.fit.fitted) {
+    panel->plot.labels.push_back({r.name + ": no noise fit (" + r.fit.message + ")"});
+    return;
+  }
+  if (!draw_model || curve.x.empty()) {
+    // The terms belong to the overlapping Allan deviation, not to this curve: words only.
+    const bool arw = IsResolved(r.fit, kRandomWalk), bias = IsResolved(r.fit, kBiasInstability);
+    panel->plot.labels.push_back(
+        {r.name + ": " + (arw ? TermText(r, kRandomWalk, panel->random_walk) : "ARW not resolved") + ", " +
+         (bias ? TermText(r, kBiasInstability, "bias instability") : "bias instability not resolved") +
+         " (IEEE 952 fit to oadev)"});
+    return;
+  }
+  const double floor_tau = DrawModel(r, curve, panel);
+  const std::string who = panel->columns > 1 ? r.name + " " : "";
+  MarkRandomWalk(r, curve, who, column, panel);
+  MarkBiasInstability(r, curve, who, floor_tau, panel);
+}
+
+// The bias instabilities in words: anchored at the lowest floor, under the rightmost mark, towards
+// the middle of the panel, one under the other.
+void PlaceFloorWords(Panel* panel) {
+  if (panel->floor_words.empty()) return;
+  double x = 0.0, y = INFINITY, taus_lo = INFINITY, taus_hi = 0.0;
+  for (const PlotNote& b : panel->floor_words) x = std::max(x, b.x), y = std::min(y, b.y);
+  for (const PlotSeries& s : panel->plot.series) {
+    if (!s.x.empty()) taus_lo = std::min(taus_lo, s.x.front()), taus_hi = std::max(taus_hi, s.x.back());
+  }
+  const bool right_half = x > std::sqrt(taus_lo * taus_hi);
+  for (size_t i = 0; i < panel->floor_words.size(); ++i) {
+    PlotNote& b = panel->floor_words[i];
+    b.x = x;
+    b.y = y;
+    b.align = right_half ? PlotNote::Align::kRight : PlotNote::Align::kLeft;
+    b.dx_chars = right_half ? 1.0 : -1.0;
+    b.dy_chars = -1.4 - 1.4 * i;
+    panel->plot.notes.push_back(b);
+  }
+}
+
+// Key entries for what the lines are (series without points draw nothing but their key).
+void KeyTheLines(Plot* plot) {
+  PlotSeries fit_key, term_key;
+  fit_key.title = "IEEE 952 fit";
+  term_key.title = "its terms";
+  fit_key.color = term_key.color = kKeyGrey;
+  fit_key.line_width = 2;
+  term_key.dashed = true;
+  term_key.line_width = 1;
+  plot->series.push_back(fit_key);
+  plot->series.push_back(term_key);
+}
+
+// Axes of whole decades around what the panel shows (kRoomBelow, kRoomAbove, kRoomRight).
+void FrameTheAxes(Panel* panel) {
+  if (panel->highest > 0.0 && std::isfinite(panel->lowest) && panel->lowest > 0.0) {
+    panel->plot.y_range =
+        std::array<double, 2>{std::pow(10.0, std::floor(std::log10(panel->lowest / kRoomBelow))),
+                              std::pow(10.0, std::ceil(std::log10(panel->highest * kRoomAbove)))};
+  }
+  if (panel->longest > 0.0 && std::isfinite(panel->shortest)) {
+    panel->plot.x_range = std::array<double, 2>{std::pow(10.0, std::floor(std::log10(panel->shortest))),
+                                                panel->longest * kRoomRight};
+  }
+}
+
 }  // namespace
 
 bool ParseAllanPlotUnits(const std::string& text, AllanPlotUnits* units) {
@@ -109,159 +311,15 @@ PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::stri
   const bool draw_model = estimator == AllanEstimator::kOadev || estimator == AllanEstimator::kAdev ||
                           estimator == AllanEstimator::kTotdev;
   for (ColumnKind kind : kinds) {
-    const double scale = Scale(kind, units);
-    Plot plot;
-    plot.log_x = plot.log_y = true;
-    plot.x_label = "averaging time \xcf\x84 (s)";
-    plot.y_label = std::string(LongName(estimator)) + " (" + UnitName(kind, units) +
-                   (estimator == AllanEstimator::kTdev ? "\xc2\xb7s" : "") + ")";
-    plot.title = kind == ColumnKind::kGyro    ? "Gyro"
-                 : kind == ColumnKind::kAccel ? "Accelerometer"
-                                              : "Other columns";
-    plot.labels_at_bottom = true;
-    const char* random_walk = kind == ColumnKind::kAccel ? "VRW" : "ARW";
-    int in_panel = 0;
-    for (const ColumnAnalysis& r : results) in_panel += r.kind == kind ? 1 : 0;
-    double lowest = INFINITY, highest = 0.0, shortest = INFINITY, longest = 0.0;
-    int column = 0;                     // this column's place in the panel: its labels stack in that order
-    std::vector<PlotNote> floor_words;  // the bias instabilities in words
+    Panel panel = OpenPanel(results, kind, estimator, units);
+    int column = 0;  // this column's place in the panel: its labels stack in that order
     for (size_t c = 0; c < results.size(); ++c) {
-      const ColumnAnalysis& r = results[c];
-      if (r.kind != kind) continue;
-      const std::string who = in_panel > 1 ? r.name + " " : "";
-      PlotSeries curve;
-      curve.style = PlotSeries::Style::kErrorBars;
-      curve.title = r.name;
-      curve.color = PlotColor(static_cast<int>(c));
-      curve.point_size = 0.7;
-      for (const AllanPoint& p : r.curve.points) {
-        if (!(p.dev > 0.0)) continue;  // a constant column has nothing to show on a log scale
-        curve.x.push_back(p.tau_s);
-        curve.y.push_back(p.dev * scale);
-        curve.lo.push_back((std::isfinite(p.dev_lo) && p.dev_lo > 0.0 ? p.dev_lo : p.dev) * scale);
-        curve.hi.push_back((std::isfinite(p.dev_hi) ? p.dev_hi : p.dev) * scale);
-        lowest = std::min(lowest, curve.lo.back());
-        highest = std::max(highest, curve.hi.back());
-        shortest = std::min(shortest, p.tau_s);
-        longest = std::max(longest, p.tau_s);
-      }
-      plot.series.push_back(curve);
-      if (!r.fit.fitted) {
-        plot.labels.push_back({r.name + ": no noise fit (" + r.fit.message + ")"});
-        ++column;
-        continue;
-      }
-      const bool arw = IsResolved(r.fit, kRandomWalk), bias = IsResolved(r.fit, kBiasInstability);
-      if (!draw_model || curve.x.empty()) {
-        // The terms belong to the overlapping Allan deviation, not to this curve: words only.
-        plot.labels.push_back(
-            {r.name + ": " + (arw ? TermText(r, kRandomWalk, random_walk) : "ARW not resolved") + ", " +
-             (bias ? TermText(r, kBiasInstability, "bias instability") : "bias instability not resolved") +
-             " (IEEE 952 fit to oadev)"});
-        ++column;
-        continue;
-      }
-      PlotSeries model;
-      model.color = curve.color;
-      model.line_width = 2;
-      std::array<PlotSeries, kNoiseTerms> terms;
-      const double first = curve.x.front(), last = curve.x.back();
-      double floor_tau = first, floor_dev = INFINITY;
-      for (int i = 0; i <= kModelPoints; ++i) {
-        const double tau = first * std::pow(last / first, static_cast<double>(i) / kModelPoints);
-        const double dev = r.fit.ModelDeviation(tau);
-        model.x.push_back(tau);
-        model.y.push_back(dev * scale);
-        if (dev < floor_dev) floor_tau = tau, floor_dev = dev;
-        for (int k = 0; k < kNoiseTerms; ++k) {
-          const double term = r.fit.TermDeviation(k, tau);
-          terms[k].x.push_back(tau);
-          terms[k].y.push_back(term >= kTermShownShare * dev ? term * scale : NAN);  // NaN: a gap
-        }
-      }
-      plot.series.push_back(model);
-      for (int k = 0; k < kNoiseTerms; ++k) {
-        if (!IsResolved(r.fit, k)) continue;  // a term within its noise is no line to read
-        terms[k].color = curve.color;
-        terms[k].dashed = true;
-        terms[k].line_width = 1;
-        plot.series.push_back(terms[k]);
-      }
-      // N where it is read: the -1/2 line at tau = 1 s (at the curve's end when 1 s is beyond it).
-      if (arw) {
-        PlotNote n;
-        n.x = std::clamp(1.0, first, last);
-        n.y = r.fit.TermDeviation(kRandomWalk, n.x) * scale;
-        n.text = who + TermText(r, kRandomWalk, random_walk);
-        n.color = curve.color;
-        n.point_type = 7;
-        n.point_size = 1.3;
-        n.opaque = true;
-        n.dx_chars = 1.5;
-        n.dy_chars = 1.2 + 1.4 * (in_panel - 1 - column);  // the first column on top
-        plot.notes.push_back(n);
-      } else {
-        plot.labels.push_back({r.name + ": " + random_walk + " not resolved"});
-      }
-      // The bias-instability floor, 0.664 B, marked at the model's minimum; its words are stacked
-      // below the panel's lowest floor (after the loop), so that they cross no floor line.
-      if (bias) {
-        PlotNote b;
-        b.x = floor_tau;
-        b.y = r.fit.TermDeviation(kBiasInstability, floor_tau) * scale;
-        b.color = curve.color;
-        b.point_type = 13;
-        b.point_size = 1.6;
-        plot.notes.push_back(b);
-        b.point_type = -1;
-        b.text = who + TermText(r, kBiasInstability, "bias instability");
-        b.opaque = true;
-        floor_words.push_back(b);
-        lowest = std::min(lowest, b.y);
-      } else {
-        plot.labels.push_back({r.name + ": bias instability not resolved"});
-      }
-      ++column;
+      if (results[c].kind == kind) AddColumn(results[c], static_cast<int>(c), column++, draw_model, &panel);
     }
-    if (!floor_words.empty()) {
-      // Anchored at the lowest floor, under the rightmost mark; towards the middle of the panel.
-      double x = 0.0, y = INFINITY, taus_lo = INFINITY, taus_hi = 0.0;
-      for (const PlotNote& b : floor_words) x = std::max(x, b.x), y = std::min(y, b.y);
-      for (const PlotSeries& s : plot.series) {
-        if (!s.x.empty()) taus_lo = std::min(taus_lo, s.x.front()), taus_hi = std::max(taus_hi, s.x.back());
-      }
-      const bool right_half = x > std::sqrt(taus_lo * taus_hi);
-      for (size_t i = 0; i < floor_words.size(); ++i) {
-        PlotNote& b = floor_words[i];
-        b.x = x;
-        b.y = y;
-        b.align = right_half ? PlotNote::Align::kRight : PlotNote::Align::kLeft;
-        b.dx_chars = right_half ? 1.0 : -1.0;
-        b.dy_chars = -1.4 - 1.4 * i;
-        plot.notes.push_back(b);
-      }
-    }
-    if (draw_model) {
-      // Key entries for what the lines are (series without points draw nothing but their key).
-      PlotSeries fit_key, term_key;
-      fit_key.title = "IEEE 952 fit";
-      term_key.title = "its terms";
-      fit_key.color = term_key.color = kKeyGrey;
-      fit_key.line_width = 2;
-      term_key.dashed = true;
-      term_key.line_width = 1;
-      plot.series.push_back(fit_key);
-      plot.series.push_back(term_key);
-    }
-    if (highest > 0.0 && std::isfinite(lowest) && lowest > 0.0) {
-      plot.y_range = std::array<double, 2>{std::pow(10.0, std::floor(std::log10(lowest / kRoomBelow))),
-                                           std::pow(10.0, std::ceil(std::log10(highest * kRoomAbove)))};
-    }
-    if (longest > 0.0 && std::isfinite(shortest)) {
-      plot.x_range =
-          std::array<double, 2>{std::pow(10.0, std::floor(std::log10(shortest))), longest * kRoomRight};
-    }
-    figure.panels.push_back(plot);
+    PlaceFloorWords(&panel);
+    if (draw_model) KeyTheLines(&panel.plot);
+    FrameTheAxes(&panel);
+    figure.panels.push_back(std::move(panel.plot));
   }
   return figure;
 }

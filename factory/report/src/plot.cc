@@ -165,6 +165,154 @@ double TickStep(double lo, double hi, int most) {
   return 10.0 * power;
 }
 
+// ---------------------------------------------------------------- a panel's script, by stages
+
+// Title, axis labels, log scales and tick formats.
+void WriteAxes(std::ostream& gp, const Plot& plot) {
+  gp << "reset\nset encoding utf8\nset grid lc rgb '#dddddd'\nset border lc rgb '#444444'\n";
+  gp << "set bars small\n";
+  gp << "set title " << Quote(plot.title) << "\n";
+  gp << "set xlabel " << Quote(plot.x_label) << "\nset ylabel " << Quote(plot.y_label) << "\n";
+  if (plot.log_x)
+    gp << "set logscale x\nset format x '%g'\nset mxtics 10\n";
+  else
+    gp << "set format x '%g'\n";
+  if (plot.log_y)
+    gp << "set logscale y\nset format y '%g'\nset mytics 10\n";
+  else
+    gp << "set format y '%g'\n";
+  if (!plot.y_tics) gp << "unset ytics\n";
+  if (plot.y_tics && plot.y_tic_step > 0.0) gp << "set ytics " << plot.y_tic_step << "\n";
+  if (!plot.y_format.empty()) gp << "set format y " << Quote(plot.y_format) << "\n";
+  if (!plot.x_tics.empty()) {
+    gp << "set xtics (";
+    for (size_t t = 0; t < plot.x_tics.size(); ++t) {
+      gp << (t ? ", " : "") << Quote(plot.x_tics[t].label) << " " << plot.x_tics[t].value;
+    }
+    gp << ")"
+       << (plot.x_tic_rotate_deg ? " rotate by " + std::to_string(plot.x_tic_rotate_deg) + " right" : "")
+       << "\n";
+  }
+}
+
+// Fixed ranges, the margins around the data otherwise, and the key.
+void WriteRangesAndKey(std::ostream& gp, const Plot& plot) {
+  if (plot.x_range) gp << "set xrange [" << (*plot.x_range)[0] << ":" << (*plot.x_range)[1] << "]\n";
+  if (plot.y_range) gp << "set yrange [" << (*plot.y_range)[0] << ":" << (*plot.y_range)[1] << "]\n";
+  if (!plot.x_range) {
+    gp << "set offsets graph " << kXMargin << ", graph " << kXMargin << ", graph " << kYMargin << ", graph "
+       << (plot.y_from_zero ? 0.0 : kYMargin) << "\n";
+  }
+  if (plot.y_from_zero && !plot.y_range) gp << "set yrange [0:*]\n";
+  if (!plot.key) {
+    gp << "unset key\n";
+  } else {
+    gp << (plot.key_above ? "set key outside center top horizontal samplen 1.5 spacing 0.9\n"
+                          : "set key outside right top samplen 1.5 spacing 0.9\n");
+  }
+}
+
+// At most max_x_tics / max_y_tics tick labels on a linear axis; the axis ends where the data end.
+void WriteTickSteps(std::ostream& gp, const Plot& plot) {
+  for (const bool y_axis : {false, true}) {
+    const int most = y_axis ? plot.max_y_tics : plot.max_x_tics;
+    const bool log = y_axis ? plot.log_y : plot.log_x;
+    const bool fixed = y_axis ? plot.y_range.has_value() : plot.x_range.has_value();
+    double lo = 0.0, hi = 0.0;
+    if (most <= 1 || log || (y_axis && !plot.y_tics) || !DataExtent(plot, y_axis, &lo, &hi)) continue;
+    if (fixed) {
+      lo = (y_axis ? *plot.y_range : *plot.x_range)[0];
+      hi = (y_axis ? *plot.y_range : *plot.x_range)[1];
+    } else {
+      // The axis ends where the data end (with the margins of the offsets above), not at the next
+      // tick: a few labels on a small panel must not leave half of it empty.
+      const double margin = (hi - lo) * (y_axis ? kYMargin : kXMargin);
+      lo = y_axis && plot.y_from_zero ? 0.0 : lo - margin;
+      hi += margin;
+    }
+    if (!fixed && !(hi > lo)) {  // one value (a run at one temperature): a unit either side
+      const double half = std::max(1.0, 0.01 * std::abs(lo));
+      lo -= half;
+      hi += half;
+    }
+    const double step = TickStep(lo, hi, most);
+    if (!(step > 0.0)) continue;
+    const char* axis = y_axis ? "y" : "x";
+    gp << "set " << axis << "tics " << step << "\n";
+    if (!fixed) gp << "set " << axis << "range [" << lo << ":" << hi << "]\n";
+  }
+}
+
+// Markers, stacked labels and notes, numbered as gnuplot's arrows and labels from 1.
+void WriteAnnotations(std::ostream& gp, const Plot& plot) {
+  int object = 1;
+  size_t right_label = 0;  // the longest label of a horizontal marker, right of the panel
+  for (const PlotMarker& m : plot.markers) {
+    if (!m.vertical) right_label = std::max(right_label, m.label.size());
+  }
+  if (right_label > 0 && !plot.key) gp << "set rmargin " << right_label + 3 << "\n";
+  for (const PlotMarker& m : plot.markers) {
+    if (m.vertical) {
+      gp << "set arrow " << object << " from first " << m.value << ", graph 0 to first " << m.value
+         << ", graph 1 nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
+      gp << "set label " << object << " " << Quote(m.label) << " at first " << m.value
+         << ", graph 1.02 center textcolor rgb '" << m.color << "'\n";
+    } else {
+      gp << "set arrow " << object << " from graph 0, first " << m.value << " to graph 1, first " << m.value
+         << " nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
+      gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first " << m.value
+         << " left textcolor rgb '" << m.color << "'\n";
+    }
+    ++object;
+  }
+  constexpr double kLabelStep = 0.06;  // graph units between stacked labels
+  for (size_t l = 0; l < plot.labels.size(); ++l) {
+    const double y =
+        plot.labels_at_bottom ? 0.05 + kLabelStep * (plot.labels.size() - 1 - l) : 0.94 - kLabelStep * l;
+    gp << "set label " << object++ << " " << Quote(plot.labels[l].text) << " at graph 0.03, graph " << y
+       << " left front\n";
+  }
+  gp << "set style textbox opaque noborder margins 0.5, 0.5\n";
+  for (const PlotNote& n : plot.notes) {
+    gp << "set label " << object++ << " " << Quote(n.text) << " at first " << n.x << ", first " << n.y
+       << (n.align == PlotNote::Align::kLeft     ? " left"
+           : n.align == PlotNote::Align::kCenter ? " center"
+                                                 : " right")
+       << (n.opaque ? " boxed" : "") << " front textcolor rgb '" << n.color << "' offset character "
+       << n.dx_chars << ", " << n.dy_chars;
+    if (n.point_type >= 0)
+      gp << " point pt " << n.point_type << " ps " << n.point_size << " lc rgb '" << n.color << "'";
+    gp << "\n";
+  }
+}
+
+// The plot command over the panel's data blocks ($d<panel>_<series>).
+void WritePlotCommand(std::ostream& gp, const Plot& plot, size_t p) {
+  gp << "plot ";
+  if (plot.series.empty()) gp << "NaN notitle";
+  for (size_t s = 0; s < plot.series.size(); ++s) {
+    gp << (s ? ", \\\n  " : "") << "$d" << p << "_" << s << " " << With(plot.series[s]);
+  }
+  gp << "\n";
+}
+
+// The terminal (text is UTF-8, drawn as it is: noenhanced; enhanced text's {/Symbol t} asks for the
+// Symbol font, which pngcairo maps to a tau but the SVG names with a Latin t, which browsers and
+// librsvg draw as "t"), and the output.
+void WriteTerminal(std::ostream& gp, const PlotFigure& figure, const std::string& terminal,
+                   const std::string& output) {
+  gp << "set encoding utf8\n";
+  const std::string size = std::to_string(figure.width_px) + "," + std::to_string(figure.height_px);
+  if (terminal == "png") {
+    gp << "set terminal pngcairo size " << size
+       << " noenhanced font 'DejaVu Sans,10' background rgb 'white'\n";
+  } else {
+    gp << "set terminal svg size " << size
+       << " dynamic noenhanced font 'DejaVu Sans,10' background rgb 'white'\n";
+  }
+  gp << "set output " << Quote(output) << "\n";
+}
+
 }  // namespace
 
 AxisScale NiceAxis(double lo, double hi, int tics) {
@@ -221,19 +369,7 @@ const char* PlotColor(int index) {
 std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal, const std::string& output) {
   std::ostringstream gp;
   gp.precision(12);
-  // Text is UTF-8 (tau, sigma, degree signs) and drawn as it is (noenhanced). Enhanced text's
-  // {/Symbol t} asks for the Symbol font: pngcairo maps it to a tau, but the SVG names font-family
-  // "Symbol" with a Latin t, which browsers and librsvg draw as "t".
-  gp << "set encoding utf8\n";
-  const std::string size = std::to_string(figure.width_px) + "," + std::to_string(figure.height_px);
-  if (terminal == "png") {
-    gp << "set terminal pngcairo size " << size
-       << " noenhanced font 'DejaVu Sans,10' background rgb 'white'\n";
-  } else {
-    gp << "set terminal svg size " << size
-       << " dynamic noenhanced font 'DejaVu Sans,10' background rgb 'white'\n";
-  }
-  gp << "set output " << Quote(output) << "\n";
+  WriteTerminal(gp, figure, terminal, output);
   for (size_t p = 0; p < figure.panels.size(); ++p) {
     for (size_t s = 0; s < figure.panels[p].series.size(); ++s) {
       WriteData(gp, "$d" + std::to_string(p) + "_" + std::to_string(s), figure.panels[p].series[s]);
@@ -247,115 +383,11 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
   }
   for (size_t p = 0; p < figure.panels.size(); ++p) {
     const Plot& plot = figure.panels[p];
-    gp << "reset\nset encoding utf8\nset grid lc rgb '#dddddd'\nset border lc rgb '#444444'\n";
-    gp << "set bars small\n";
-    gp << "set title " << Quote(plot.title) << "\n";
-    gp << "set xlabel " << Quote(plot.x_label) << "\nset ylabel " << Quote(plot.y_label) << "\n";
-    if (plot.log_x)
-      gp << "set logscale x\nset format x '%g'\nset mxtics 10\n";
-    else
-      gp << "set format x '%g'\n";
-    if (plot.log_y)
-      gp << "set logscale y\nset format y '%g'\nset mytics 10\n";
-    else
-      gp << "set format y '%g'\n";
-    if (!plot.y_tics) gp << "unset ytics\n";
-    if (plot.y_tics && plot.y_tic_step > 0.0) gp << "set ytics " << plot.y_tic_step << "\n";
-    if (!plot.y_format.empty()) gp << "set format y " << Quote(plot.y_format) << "\n";
-    if (!plot.x_tics.empty()) {
-      gp << "set xtics (";
-      for (size_t t = 0; t < plot.x_tics.size(); ++t) {
-        gp << (t ? ", " : "") << Quote(plot.x_tics[t].label) << " " << plot.x_tics[t].value;
-      }
-      gp << ")"
-         << (plot.x_tic_rotate_deg ? " rotate by " + std::to_string(plot.x_tic_rotate_deg) + " right" : "")
-         << "\n";
-    }
-    if (plot.x_range) gp << "set xrange [" << (*plot.x_range)[0] << ":" << (*plot.x_range)[1] << "]\n";
-    if (plot.y_range) gp << "set yrange [" << (*plot.y_range)[0] << ":" << (*plot.y_range)[1] << "]\n";
-    if (!plot.x_range) {
-      gp << "set offsets graph " << kXMargin << ", graph " << kXMargin << ", graph " << kYMargin << ", graph "
-         << (plot.y_from_zero ? 0.0 : kYMargin) << "\n";
-    }
-    if (plot.y_from_zero && !plot.y_range) gp << "set yrange [0:*]\n";
-    if (!plot.key) {
-      gp << "unset key\n";
-    } else {
-      gp << (plot.key_above ? "set key outside center top horizontal samplen 1.5 spacing 0.9\n"
-                            : "set key outside right top samplen 1.5 spacing 0.9\n");
-    }
-    for (const bool y_axis : {false, true}) {
-      const int most = y_axis ? plot.max_y_tics : plot.max_x_tics;
-      const bool log = y_axis ? plot.log_y : plot.log_x;
-      const bool fixed = y_axis ? plot.y_range.has_value() : plot.x_range.has_value();
-      double lo = 0.0, hi = 0.0;
-      if (most <= 1 || log || (y_axis && !plot.y_tics) || !DataExtent(plot, y_axis, &lo, &hi)) continue;
-      if (fixed) {
-        lo = (y_axis ? *plot.y_range : *plot.x_range)[0];
-        hi = (y_axis ? *plot.y_range : *plot.x_range)[1];
-      } else {
-        // The axis ends where the data end (with the margins of the offsets above), not at the next
-        // tick: a few labels on a small panel must not leave half of it empty.
-        const double margin = (hi - lo) * (y_axis ? kYMargin : kXMargin);
-        lo = y_axis && plot.y_from_zero ? 0.0 : lo - margin;
-        hi += margin;
-      }
-      if (!fixed && !(hi > lo)) {  // one value (a run at one temperature): a unit either side
-        const double half = std::max(1.0, 0.01 * std::abs(lo));
-        lo -= half;
-        hi += half;
-      }
-      const double step = TickStep(lo, hi, most);
-      if (!(step > 0.0)) continue;
-      const char* axis = y_axis ? "y" : "x";
-      gp << "set " << axis << "tics " << step << "\n";
-      if (!fixed) gp << "set " << axis << "range [" << lo << ":" << hi << "]\n";
-    }
-    int object = 1;
-    size_t right_label = 0;  // the longest label of a horizontal marker, right of the panel
-    for (const PlotMarker& m : plot.markers) {
-      if (!m.vertical) right_label = std::max(right_label, m.label.size());
-    }
-    if (right_label > 0 && !plot.key) gp << "set rmargin " << right_label + 3 << "\n";
-    for (const PlotMarker& m : plot.markers) {
-      if (m.vertical) {
-        gp << "set arrow " << object << " from first " << m.value << ", graph 0 to first " << m.value
-           << ", graph 1 nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
-        gp << "set label " << object << " " << Quote(m.label) << " at first " << m.value
-           << ", graph 1.02 center textcolor rgb '" << m.color << "'\n";
-      } else {
-        gp << "set arrow " << object << " from graph 0, first " << m.value << " to graph 1, first " << m.value
-           << " nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
-        gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first " << m.value
-           << " left textcolor rgb '" << m.color << "'\n";
-      }
-      ++object;
-    }
-    constexpr double kLabelStep = 0.06;  // graph units between stacked labels
-    for (size_t l = 0; l < plot.labels.size(); ++l) {
-      const double y =
-          plot.labels_at_bottom ? 0.05 + kLabelStep * (plot.labels.size() - 1 - l) : 0.94 - kLabelStep * l;
-      gp << "set label " << object++ << " " << Quote(plot.labels[l].text) << " at graph 0.03, graph " << y
-         << " left front\n";
-    }
-    gp << "set style textbox opaque noborder margins 0.5, 0.5\n";
-    for (const PlotNote& n : plot.notes) {
-      gp << "set label " << object++ << " " << Quote(n.text) << " at first " << n.x << ", first " << n.y
-         << (n.align == PlotNote::Align::kLeft     ? " left"
-             : n.align == PlotNote::Align::kCenter ? " center"
-                                                   : " right")
-         << (n.opaque ? " boxed" : "") << " front textcolor rgb '" << n.color << "' offset character "
-         << n.dx_chars << ", " << n.dy_chars;
-      if (n.point_type >= 0)
-        gp << " point pt " << n.point_type << " ps " << n.point_size << " lc rgb '" << n.color << "'";
-      gp << "\n";
-    }
-    gp << "plot ";
-    if (plot.series.empty()) gp << "NaN notitle";
-    for (size_t s = 0; s < plot.series.size(); ++s) {
-      gp << (s ? ", \\\n  " : "") << "$d" << p << "_" << s << " " << With(plot.series[s]);
-    }
-    gp << "\n";
+    WriteAxes(gp, plot);
+    WriteRangesAndKey(gp, plot);
+    WriteTickSteps(gp, plot);
+    WriteAnnotations(gp, plot);
+    WritePlotCommand(gp, plot, p);
   }
   if (multi) gp << "unset multiplot\n";
   gp << "unset output\n";

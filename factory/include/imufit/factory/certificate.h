@@ -1,9 +1,11 @@
-// imufit — what a unit's calibration certificate and a lot page say, computed in one place.
+// imufit — what a unit's calibration certificate says, computed in one place.
 //
-// MakeCertificate() turns a calibration, the run it was fitted to, the fit's validation and the
-// acceptance verdict into a Certificate: every number a quality engineer reads, already in
-// engineering units (io/units.h) and rounded nowhere. The renderer (report.h) only formats and
-// draws it; tests assert on this struct. Likewise MakeLotSummary() for a batch's lot page.
+// MakeCertificate() turns a calibration, the run it was fitted to, the fit's validation, the
+// acceptance verdict and the noise measured on the run into a Certificate: every number a quality
+// engineer reads, already in engineering units (engineering_units.h) and rounded nowhere. It reads
+// no file: the caller hands in the inputs' hashes and the noise section (ReadCertificateFiles()
+// reads them). The renderer (certificate_page.h) only formats and draws it; tests assert on this
+// struct. A batch's lot page is lot_summary.h's.
 //
 // Figures are quoted at 25 degC through the model's polynomial (whatever the calibration's
 // reference temperature); expanded uncertainties are k = 2 times the 1-sigma. Curves against
@@ -19,25 +21,22 @@
 
 #include "imufit/factory/acceptance.h"
 #include "imufit/factory/batch.h"
-#include "imufit/factory/lot_history.h"
+#include "imufit/factory/gyro_noise.h"
 #include "imufit/fit/validation.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/station.h"
-#include "imufit/noise/column_analysis.h"
 #include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
 
 inline constexpr double kCoverageFactor = 2.0;  // k of the expanded uncertainty
-// The certificate's Allan section needs a static stretch at least this long, s.
-inline constexpr double kMinAllanStretchS = 60.0;
 
 struct ReportInput {
-  std::string role;  // "calibration", "plan", "samples", "limits", "station"
-  std::string path;
-  std::string sha256;  // computed from the file when empty
+  std::string role;    // "calibration", "plan", "samples", "limits", "station"
+  std::string path;    // empty: not listed
+  std::string sha256;  // ReadCertificateFiles() computes it from the file when empty
 };
 
 // Everything a certificate is computed from.
@@ -49,7 +48,7 @@ struct CertificateSources {
   Calibration calibration;
   Plan plan;
   // run.segmentation: the labels of a file without a segment column; run.static_stretch: the noise
-  // section's samples (else read from the samples input).
+  // section's samples, kept while the run was read (else ReadCertificateFiles reads the file).
   RunWindows run;
   WindowOptions windows;            // how the run was cut into windows (trim, ...)
   SamplesInput samples_input;       // how the samples file is read (--temp-c for a file without temp_c)
@@ -58,12 +57,20 @@ struct CertificateSources {
   // Acceptance limits: judged here, with the ARW and bias instability this certificate measures
   // taking the place of a `noise:` block's.
   std::optional<Limits> limits;
-  std::vector<ReportInput> inputs;    // files to hash and list
+  // The files listed, each with its SHA-256 (MakeCertificate checks that every listed one has it).
+  std::vector<ReportInput> inputs;
   std::vector<std::string> warnings;  // from the caller (e.g. a mismatch the user allowed)
-  // Where and by whom (a station file, --station): listed among the inputs (role "station") when
-  // the caller has not.
+  // Where and by whom (a station file, --station); its file is among the inputs (role "station").
   std::optional<Station> station;
+  // The Allan section, measured on the static stretch the run's reading kept (GyroNoise), or on
+  // the samples input (MeasureGyroNoise); nullopt only when no samples input is listed.
+  std::optional<NoiseSection> noise;
 };
+
+// What MakeCertificate() takes from files, read into `sources`: the SHA-256 of every listed input
+// that has none (the station's file added to the inputs when it is not among them), and, unless
+// `noise` is given, the noise section measured on the samples input (MeasureGyroNoise).
+void ReadCertificateFiles(CertificateSources* sources);
 
 struct KeyFigureRow {
   std::string name;  // e.g. "gyro_bias_dps.x"
@@ -78,7 +85,7 @@ struct KeyFigureRow {
 
 // One window's own estimate of a coefficient at the window's temperature T_w: the value of that
 // one coefficient that explains the window's mean output exactly on the coefficient's row, every
-// other coefficient at its fitted value (a partial residual; equations in certificate.cc). It
+// other coefficient at its fitted value (a partial residual; equations in coefficient_curves.cc). It
 // scatters about the polynomial by the window's noise alone, so the points show what the data say
 // where the curve only shows what the fit made of them.
 struct CoefficientPoint {
@@ -133,28 +140,6 @@ struct ResidualRow {
   double accel_rms_before_mg = 0.0, accel_rms_mg = 0.0, accel_max_mg = 0.0;
 };
 
-struct NoiseAxis {
-  std::string axis;
-  bool fitted = false;
-  std::string why_not;
-  double arw_deg_per_sqrt_hr = 0.0, arw_sigma = 0.0;
-  bool arw_resolved = false;
-  double bias_instability_dph = 0.0, bias_instability_sigma = 0.0;
-  bool bias_instability_resolved = false;
-  int points = 0;
-};
-struct NoiseSection {
-  bool computed = false;
-  std::string why_not;
-  int segment = -1;
-  double duration_s = 0.0;
-  double temp_c = 0.0;
-  std::vector<NoiseAxis> axes;
-  // Per gyro axis ("gyro_x", ...), in rad/s: the overlapping Allan deviation and its IEEE 952 fit
-  // as `imufit allan` computes them, drawn by the same plot (allan_plot.h) in deg/h.
-  std::vector<ColumnAnalysis> columns;
-};
-
 struct ValidationRow {
   double temp_c = 0.0;
   bool fitted = false;
@@ -166,12 +151,13 @@ struct ValidationRow {
   bool order_lowered = false;
 };
 
-// The fit's settings and diagnostics, from the calibration's `fit:` block (known = false without).
+// The fit's settings and diagnostics, from the calibration's fit record (Calibration::fit; known =
+// false without).
 struct FitSettings {
   bool known = false;
   std::string loss;
   // Why the solver stopped: the first sentence of Ceres's message ("Function tolerance reached.");
-  // the tolerances it quotes after it are in the calibration's `fit:` block.
+  // the tolerances it quotes after it are in the calibration's fit record.
   std::string termination;
   int iterations = 0, windows_used = 0, windows_downweighted = 0;
   int gyro_temp_order = 3, accel_temp_order = 3;
@@ -222,8 +208,9 @@ struct Certificate {
   std::vector<ValidationRow> validation;  // empty: not run
 };
 
-// Computes the certificate; reads the samples input once more for the Allan section unless
-// sources.run kept the static stretch. Throws InputError when an input file cannot be read.
+// Computes the certificate from `sources` alone (no file is read). A listed input without its
+// SHA-256, or a samples input without the noise section, is a programmer error (aborts): call
+// ReadCertificateFiles() first.
 Certificate MakeCertificate(const CertificateSources& sources);
 
 // The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
@@ -233,63 +220,6 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate);
 // block): one message per mismatch, empty when they belong together or the calibration does not say.
 std::vector<std::string> InputMismatches(const Calibration& calibration, const std::string& plan_path,
                                          const std::string& samples_path);
-
-// ---------------------------------------------------------------- the lot page
-
-// Outliers: robust z = 0.6745 (x - median) / MAD beyond kOutlierRobustZ, and (when the unit's own
-// 1-sigma is known) more than kOutlierOwnSigmas of its own sigmas from the median, so that noise
-// between identical units is not flagged.
-inline constexpr double kOutlierRobustZ = 3.5;
-inline constexpr double kOutlierOwnSigmas = 3.0;
-struct RobustZ {
-  double z = 0.0;
-  bool outlier = false;
-};
-// Robust z-scores of `values` (all 0 and no outliers with fewer than 3 values or a zero MAD);
-// `sigmas` (each unit's own 1-sigma, < 0 unknown) may be empty.
-std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std::vector<double>& sigmas = {});
-
-struct LotUnitRow {
-  std::string unit, serial, status, verdict, message;
-  bool has_report = false;
-  std::string label;  // the unit without the prefix all units share ("unit-07" -> "07"): axis labels
-};
-
-struct LotFigure {
-  std::string name, unit;
-  std::vector<std::string> units;  // per point: the unit folder
-  std::vector<int> row;            // per point: the unit's index in LotSummary::rows (a strip plot's x)
-  std::vector<double> value, sigma;
-  std::vector<RobustZ> z;
-  std::vector<bool> failed;          // the unit failed its limits (any criterion)
-  std::vector<bool> outside_limits;  // this value itself lies outside this figure's limits
-  double mean = 0.0, stdev = 0.0;
-  std::array<double, 2> three_sigma{0.0, 0.0};  // mean -+ 3 stdev: where the lot's units fall
-  double stdev_within = 0.0;                    // mean moving range / 1.128 (lot_history.h)
-  std::optional<LimitInterval> limits;          // what the limits allow this figure; nullopt: no limit on it
-  std::optional<double> ppk, cpk;               // against `limits` (lot_history.h)
-  FigureView view;  // what a strip plot shows: the values, mean +- 3 sigma, the limits in reach
-};
-
-struct LotOutlier {
-  std::string unit, serial, figure, figure_unit;
-  double value = 0.0, z = 0.0;
-};
-
-struct LotSummary {
-  std::string lot, written_utc, software, git_revision;
-  std::string limits_name;  // the limits file's name, or its path; empty without limits
-  int units = 0, passed = 0, failed = 0, not_fitted = 0, errors = 0;
-  double yield_pct = 0.0;
-  std::vector<LotUnitRow> rows;
-  std::string unit_prefix;  // what every unit's name starts with and the labels leave out
-  std::vector<LotFigure> figures;
-  std::vector<LotOutlier> outliers;
-  std::optional<LotHistory> history;  // every lot of the results store, when the batch had one
-};
-
-LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, const std::string& software,
-                          const std::optional<Limits>& limits);
 
 }  // namespace imufit
 

@@ -1,0 +1,76 @@
+// imufit — what a batch's lot page says, computed in one place: MakeLotSummary() turns a batch's
+// outcomes (and, with a results store, every lot's history) into a LotSummary of every number the
+// page shows; the renderer (lot_page.h) only formats and draws it, and tests assert on this struct.
+// Key figures are the units' figures at 25 degC (acceptance.h); outliers are judged robustly.
+#ifndef IMUFIT_FACTORY_LOT_SUMMARY_H_
+#define IMUFIT_FACTORY_LOT_SUMMARY_H_
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imufit/factory/batch.h"
+#include "imufit/factory/lot_history.h"
+#include "imufit/io/limits.h"
+
+namespace imufit {
+
+// Outliers: robust z = 0.6745 (x - median) / MAD beyond kOutlierRobustZ, and (when the unit's own
+// 1-sigma is known) more than kOutlierOwnSigmas of its own sigmas from the median, so that noise
+// between identical units is not flagged.
+inline constexpr double kOutlierRobustZ = 3.5;
+inline constexpr double kOutlierOwnSigmas = 3.0;
+struct RobustZ {
+  double z = 0.0;
+  bool outlier = false;
+};
+// Robust z-scores of `values` (all 0 and no outliers with fewer than 3 values or a zero MAD);
+// `sigmas` (each unit's own 1-sigma, < 0 unknown) may be empty.
+std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std::vector<double>& sigmas = {});
+
+struct LotUnitRow {
+  std::string unit, serial, status, verdict, message;
+  bool has_report = false;
+  std::string label;  // the unit without the prefix all units share ("unit-07" -> "07"): axis labels
+};
+
+struct LotFigure {
+  std::string name, unit;
+  std::vector<std::string> units;  // per point: the unit folder
+  std::vector<int> row;            // per point: the unit's index in LotSummary::rows (a strip plot's x)
+  std::vector<double> value, sigma;
+  std::vector<RobustZ> z;
+  std::vector<bool> failed;          // the unit failed its limits (any criterion)
+  std::vector<bool> outside_limits;  // this value itself lies outside this figure's limits
+  double mean = 0.0, stdev = 0.0;
+  std::array<double, 2> three_sigma{0.0, 0.0};  // mean -+ 3 stdev: where the lot's units fall
+  double stdev_within = 0.0;                    // mean moving range / 1.128 (lot_history.h)
+  std::optional<LimitInterval> limits;          // what the limits allow this figure; nullopt: no limit on it
+  std::optional<double> ppk, cpk;               // against `limits` (lot_history.h)
+  FigureView view;  // what a strip plot shows: the values, mean +- 3 sigma, the limits in reach
+};
+
+struct LotOutlier {
+  std::string unit, serial, figure, figure_unit;
+  double value = 0.0, z = 0.0;
+};
+
+struct LotSummary {
+  std::string lot, written_utc, software, git_revision;
+  std::string limits_name;  // the limits file's name, or its path; empty without limits
+  int units = 0, passed = 0, failed = 0, not_fitted = 0, errors = 0;
+  double yield_pct = 0.0;
+  std::vector<LotUnitRow> rows;
+  std::string unit_prefix;  // what every unit's name starts with and the labels leave out
+  std::vector<LotFigure> figures;
+  std::vector<LotOutlier> outliers;
+  std::optional<LotHistory> history;  // every lot of the results store, when the batch had one
+};
+
+LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, const std::string& software,
+                          const std::optional<Limits>& limits);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FACTORY_LOT_SUMMARY_H_
