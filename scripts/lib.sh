@@ -9,7 +9,8 @@ IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
                      libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
                      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
-                     python3-matplotlib python3-setuptools python3-wheel python3-pip clang libfuzzer-14-dev chromium poppler-utils ccache)
+                     python3-matplotlib python3-setuptools python3-wheel python3-pip clang libfuzzer-14-dev chromium poppler-utils ccache
+                     gcc-arm-none-eabi libnewlib-arm-none-eabi)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {
@@ -71,7 +72,7 @@ imufit_build() {
   [[ $# -gt 0 ]] && shift
   cmake_args=("$@")
   if command -v ccache >/dev/null 2>&1; then
-    cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
     # Paths below the checkout count as relative, so another clone (CI's) reuses the cache.
     export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$IMUFIT_ROOT}
   fi
