@@ -203,8 +203,8 @@ ExportResult ExportC(const Calibration& calibration, const ExportOptions& option
 ExportResult ExportBin(const Calibration& calibration, const ExportOptions& options,
                        const Envelope& envelope) {
   ExportResult result;
-  result.content = CalibrationBlob(calibration, options.calibration_sha256);
   MeasureRuntimes(calibration, envelope, &result);
+  result.content = CalibrationBlob(calibration, options.calibration_sha256);
   return result;
 }
 

@@ -91,17 +91,17 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
   LowerTimesRotation(g_gyro * c_i_b.transpose(), &m_gyro, &c_gyro_i);
   const Eigen::Matrix3d a_gyro = gyro.g_sensitivity / k_gyro * c_i_b.transpose() * c_gyro_i.transpose();
 
-  const std::string noise = "accelerometer_noise_density: " +
-                            DoubleText(NoiseFigure(calibration, "accelerometer_noise_density"), "") +
-                            "  # m/s^2/sqrt(Hz)\naccelerometer_random_walk: " +
-                            DoubleText(NoiseFigure(calibration, "accelerometer_random_walk"), "") +
-                            "  # m/s^3/sqrt(Hz)\ngyroscope_noise_density: " +
-                            DoubleText(NoiseFigure(calibration, "gyroscope_noise_density"), "") +
-                            "  # rad/s/sqrt(Hz)\ngyroscope_random_walk: " +
-                            DoubleText(NoiseFigure(calibration, "gyroscope_random_walk"), "") +
-                            "  # rad/s^2/sqrt(Hz)\nrostopic: " + options.rostopic +
-                            "\nupdate_rate: " + DoubleText(NoiseFigure(calibration, "update_rate"), "") +
-                            "  # Hz\n";
+  // Kalibr's keys in its order, read one by one: a missing figure is named in that order too.
+  std::string noise;
+  for (const auto& [key, unit] : {std::pair{"accelerometer_noise_density", "m/s^2/sqrt(Hz)"},
+                                  {"accelerometer_random_walk", "m/s^3/sqrt(Hz)"},
+                                  {"gyroscope_noise_density", "rad/s/sqrt(Hz)"},
+                                  {"gyroscope_random_walk", "rad/s^2/sqrt(Hz)"}}) {
+    noise += std::string(key) + ": " + DoubleText(NoiseFigure(calibration, key), key) + "  # " + unit + "\n";
+  }
+  noise += "rostopic: " + options.rostopic +
+           "\nupdate_rate: " + DoubleText(NoiseFigure(calibration, "update_rate"), "update_rate") +
+           "  # Hz\n";
   KalibrImu imu;
   const std::string intrinsics =
       "model: scale-misalignment\naccelerometers:\n  M: " + MatrixText(m_accel, "M_accel", "", &imu.m_accel) +
