@@ -10,7 +10,7 @@ IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev
                      libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
                      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
                      python3-matplotlib python3-setuptools python3-wheel python3-pip clang libfuzzer-14-dev chromium poppler-utils ccache
-                     gcc-arm-none-eabi libnewlib-arm-none-eabi)
+                     gcc-arm-none-eabi libnewlib-arm-none-eabi python3-jsonschema)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {
