@@ -46,6 +46,7 @@ void LowerTimesRotation(const Eigen::Matrix3d& g, Eigen::Matrix3d* lower, Eigen:
     }
   }
   *lower = r.transpose();
+  lower->triangularView<Eigen::StrictlyUpper>().setZero();  // +0, not the -0 of a flipped sign
   *rotation = q.transpose();
 }
 
