@@ -430,6 +430,14 @@ TEST_F(ExportTest, JsonReadsBackBitForBitAndAppliesIdentically) {
       0);
   ASSERT_EQ(Run({"apply", "-q", "-c", Path("unit.json"), "-s", samples, "-o", Path("b.csv")}).status, 0);
   EXPECT_EQ(ReadBytes(Path("a.csv")), ReadBytes(Path("b.csv")));
+  // Further keys keep their types; JSON has no NaN.
+  std::ofstream(Path("extra.yaml"), std::ios::binary)
+      << ReadBytes(kFixtures + "/mems_truth.yaml") << "fit:\n  note: \"12\"\n  rms: .nan\n  windows: 12\n";
+  ASSERT_EQ(Run({"export", "-c", Path("extra.yaml"), "-f", "json", "-o", Path("extra.json")}).status, 0);
+  const std::string extra = ReadBytes(Path("extra.json"));
+  EXPECT_NE(extra.find("\"note\": \"12\""), std::string::npos) << extra;
+  EXPECT_NE(extra.find("\"rms\": null"), std::string::npos) << extra;
+  EXPECT_NE(extra.find("\"windows\": 12"), std::string::npos) << extra;
   // A JSON export of the JSON export: the same calibration, one provenance block.
   ASSERT_EQ(Run({"export", "-c", Path("unit.json"), "-f", "json", "-o", Path("again.json")}).status, 0);
   const std::string again = ReadBytes(Path("again.json"));

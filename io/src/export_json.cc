@@ -101,8 +101,17 @@ void AppendJson(const YAML::Node& node, const std::string& indent, std::string* 
 ExportResult ExportJson(const Calibration& calibration, const ExportOptions& options) {
   ExportResult result;
   result.consumer = kConsumer;
-  YAML::Node root = YAML::Load(CalibrationToYaml(calibration));
-  root.remove("export");  // a calibration read back from a JSON export: its provenance is replaced
+  // The coefficients as the calibration file writes them; the further keys as they were read, so
+  // that a quoted "12" stays a string (an emitted and re-read YAML would lose the quotes).
+  Calibration coefficients = calibration;
+  coefficients.extra.reset(YAML::Node(YAML::NodeType::Map));  // rebinds; `=` would empty the shared node
+  YAML::Node root = YAML::Load(CalibrationToYaml(coefficients));
+  if (calibration.extra.IsMap()) {
+    for (const auto& entry : calibration.extra) {
+      // A calibration read back from a JSON export: its provenance is replaced.
+      if (entry.first.Scalar() != "export") root.force_insert(entry.first.Scalar(), entry.second);
+    }
+  }
   const std::vector<std::string> lines = ProvenanceLines(calibration, options, result);
   std::string out;
   AppendJson(root, "", &out);
