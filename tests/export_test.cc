@@ -481,6 +481,11 @@ TEST_F(ExportTest, BadInvocationsAndUnexportableCalibrations) {
   EXPECT_EQ(r.status, 2);
   r = Run({"export", "-c", cal, "-f", "json", "-o", Path("x.json"), "--full-scale-dps", "-5"});
   EXPECT_EQ(r.status, 2);
+  r = Run({"export", "-c", cal, "-f", "ardupilot", "-o", Path("x.parm"), "--gyro-raw-per-radps", "0"});
+  EXPECT_EQ(r.status, 2);
+  r = Run({"export", "-c", cal, "-f", "imucal", "-o", Path("x.json"), "--temp-c", "100"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("outside the calibration's fitted range [-40, 85] degC"), std::string::npos) << r.err;
   std::ofstream(Path("broken.yaml")) << "format: imufit-calibration\nversion: 1\ngyro: [1, 2\n";
   r = Run({"export", "-c", Path("broken.yaml"), "-f", "json", "-o", Path("x.json")});
   EXPECT_EQ(r.status, 2);

@@ -2,6 +2,7 @@
 #include "imufit/io/export.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "export_internal.h"
@@ -52,6 +53,19 @@ std::string ExportFormatNames() {
 ExportResult ExportCalibration(const Calibration& calibration, const ExportOptions& options) {
   using namespace export_internal;
   const Envelope envelope = EnvelopeOf(calibration, options);
+  for (const auto& [name, value] : {std::pair{"--gyro-raw-per-radps", options.gyro_raw_per_radps},
+                                    {"--accel-raw-per-mps2", options.accel_raw_per_mps2}}) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw InputError(name, "the driver's scale must be a positive number, not " + FormatDouble(value));
+    }
+  }
+  if (options.temp_c && !(*options.temp_c >= calibration.fit_temp_range_c[0] &&
+                          *options.temp_c <= calibration.fit_temp_range_c[1])) {
+    throw InputError("--temp-c", FormatDouble(*options.temp_c) +
+                                     " degC is outside the calibration's fitted range [" +
+                                     FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                                     FormatDouble(calibration.fit_temp_range_c[1]) + "] degC");
+  }
   switch (options.format) {
     case ExportFormat::kC:
       return ExportC(calibration, options, envelope);
