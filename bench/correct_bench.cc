@@ -1,10 +1,17 @@
-// imufit — benchmark of the correction core that `imufit apply` runs per row (issue 11): the shared
+// imufit — benchmark of the correction core that `imufit apply` runs per row: the shared
 // model's SensorModel::Correct over N samples held in memory (no CSV), in the (N,) / (N, 3) layout
 // of numpy arrays, so that bench/python_correct_bench.py can compare imufit.Calibration.correct
 // with it. Best of three runs, one core. Figures are measured, never asserted.
 //
+// Side by side in the same run, the C runtime for firmware (model/c/imufit_runtime.h) on the same
+// samples: its double build on the same arrays, its float build on float copies of them (what a
+// firmware holds), both loaded from the calibration's blob (`imufit export --format bin`). The
+// three alternate round by round, so that a machine shared with other work slows them alike.
+//
 // Usage: correct_bench [N] [calibration.yaml]   (default 1e7, fixtures/mems_truth.yaml)
-// Prints one line: "correct_bench N seconds ns_per_sample checksum".
+// Prints "correct_bench N seconds ns_per_sample checksum" (the C++ core: the line
+// bench/python_correct_bench.py reads), then the same for c_runtime_double and c_runtime_float,
+// each with its time as a fraction of the C++ core's.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,6 +20,35 @@
 #include <vector>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/export.h"
+#include "imufit_runtime.h"
+#define IMUFIT_RUNTIME_FLOAT
+#include "imufit_runtime.h"  // the float build: imufit_calibration_f, imufit_correct_f
+
+namespace {
+
+// The smaller of best_s and the wall time of one call of `correct`, seconds.
+template <typename Correct>
+double BestSeconds(const Correct& correct, double best_s) {
+  const auto start = std::chrono::steady_clock::now();
+  correct();
+  return std::min(best_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
+template <typename Real>
+double Checksum(const std::vector<Real>& omega, const std::vector<Real>& a) {
+  double checksum = 0.0;
+  for (size_t i = 0; i < omega.size(); i += 9973) checksum += omega[i] + a[i];
+  return checksum;
+}
+
+void Print(const char* name, long long n, double seconds, double checksum, double cpp_seconds) {
+  std::printf("%s %lld %.6f %.3f %.17g", name, n, seconds, seconds / static_cast<double>(n) * 1e9, checksum);
+  if (cpp_seconds > 0.0) std::printf(" %.3f", seconds / cpp_seconds);
+  std::printf("\n");
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   const long long n = argc > 1 ? std::atoll(argv[1]) : 10000000LL;
@@ -30,9 +66,21 @@ int main(int argc, char** argv) {
       accel[3 * i + k] = k == 2 ? 2048.0 + static_cast<double>(i % 7) : static_cast<double>(i % 11) - 5.0;
     }
   }
-  double best_s = 1e300;
-  for (int run = 0; run < 3; ++run) {
-    const auto start = std::chrono::steady_clock::now();
+  const std::string blob = imufit::CalibrationBlob(calibration, "");
+  const auto* blob_bytes = reinterpret_cast<const unsigned char*>(blob.data());
+  imufit_calibration runtime{};
+  imufit_calibration_f runtime_f{};
+  if (imufit_load_blob(blob_bytes, blob.size(), &runtime) != IMUFIT_OK ||
+      imufit_load_blob_f(blob_bytes, blob.size(), &runtime_f) != IMUFIT_OK) {
+    std::fprintf(stderr, "correct_bench: the runtime refused the calibration's blob\n");
+    return 1;
+  }
+  const std::vector<float> temp_f(temp_c.begin(), temp_c.end()), gyro_f(gyro.begin(), gyro.end()),
+      accel_f(accel.begin(), accel.end());
+  std::vector<double> omega_c(3 * n), a_c(3 * n);
+  std::vector<float> omega_f(3 * n), a_f(3 * n);
+
+  const auto cpp_core = [&] {
     Eigen::Vector3d omega_hat, a_hat;
     for (long long i = 0; i < n; ++i) {
       model.Correct(temp_c[i], Eigen::Vector3d(&gyro[3 * i]), Eigen::Vector3d(&accel[3 * i]), &omega_hat,
@@ -40,12 +88,25 @@ int main(int argc, char** argv) {
       std::copy(omega_hat.data(), omega_hat.data() + 3, &omega[3 * i]);
       std::copy(a_hat.data(), a_hat.data() + 3, &a[3 * i]);
     }
-    best_s =
-        std::min(best_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  };
+  const auto c_double = [&] {
+    for (long long i = 0; i < n; ++i) {
+      imufit_correct(&runtime, temp_c[i], &gyro[3 * i], &accel[3 * i], &omega_c[3 * i], &a_c[3 * i]);
+    }
+  };
+  const auto c_float = [&] {
+    for (long long i = 0; i < n; ++i) {
+      imufit_correct_f(&runtime_f, temp_f[i], &gyro_f[3 * i], &accel_f[3 * i], &omega_f[3 * i], &a_f[3 * i]);
+    }
+  };
+  double cpp_s = 1e300, double_s = 1e300, float_s = 1e300;
+  for (int run = 0; run < 3; ++run) {
+    cpp_s = BestSeconds(cpp_core, cpp_s);
+    double_s = BestSeconds(c_double, double_s);
+    float_s = BestSeconds(c_float, float_s);
   }
-  double checksum = 0.0;
-  for (long long i = 0; i < 3 * n; i += 9973) checksum += omega[i] + a[i];
-  std::printf("correct_bench %lld %.6f %.3f %.17g\n", n, best_s, best_s / static_cast<double>(n) * 1e9,
-              checksum);
+  Print("correct_bench", n, cpp_s, Checksum(omega, a), 0.0);
+  Print("c_runtime_double", n, double_s, Checksum(omega_c, a_c), cpp_s);
+  Print("c_runtime_float", n, float_s, Checksum(omega_f, a_f), cpp_s);
   return 0;
 }

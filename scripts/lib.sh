@@ -10,7 +10,8 @@ IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev
                      libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
                      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
                      python3-matplotlib python3-setuptools python3-wheel python3-pip clang clang-format
-                     libfuzzer-14-dev chromium poppler-utils ccache)
+                     libfuzzer-14-dev chromium poppler-utils ccache gcc-arm-none-eabi libnewlib-arm-none-eabi
+                     python3-jsonschema)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {
@@ -72,7 +73,7 @@ imufit_build() {
   [[ $# -gt 0 ]] && shift
   cmake_args=("$@")
   if command -v ccache >/dev/null 2>&1; then
-    cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
     # Paths below the checkout count as relative, so another clone (CI's) reuses the cache.
     export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$IMUFIT_ROOT}
   fi

@@ -7,6 +7,11 @@
 // input had it, gyro in rad/s, accel in m/s^2) to `output_path`, atomically; CorrectSamples hands
 // each corrected sample to a caller, so that what `imufit allan --calibration` analyses is, bit
 // for bit, what `imufit apply` writes.
+//
+// Temperatures are not clamped: a sample beyond the fitted range is corrected by extrapolating the
+// cubics (counted in the report, warned about by the command) and a correction that is not finite
+// is refused. The C runtime for firmware (model/c/imufit_runtime.h) clamps to the fitted range
+// instead (docs/export.md).
 #ifndef IMUFIT_IO_CORRECT_FILE_H_
 #define IMUFIT_IO_CORRECT_FILE_H_
 

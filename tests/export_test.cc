@@ -1,0 +1,499 @@
+// imufit export end to end: every format's golden file (fixtures/golden/export), every lossy
+// format's round trip (the consumer's equations, written here from its documentation, applied to
+// a simulated raw run and compared with `imufit apply` within the loss the export reported), the
+// JSON and blob read back bit for bit, the refusal beyond --max-loss and the error paths.
+//
+// IMUFIT_UPDATE_GOLDEN=1 in the environment rewrites the golden files instead of comparing.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <Eigen/Dense>
+
+#include "imufit/io/calibration.h"
+#include "imufit/io/samples.h"
+#include "imufit_runtime.h"
+#include "run_program.h"
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadBytes;
+using testing::RunProgram;
+using testing::RunResult;
+
+const std::string kFixtures = IMUFIT_FIXTURES_DIR;
+constexpr double kGravity = 9.80665;
+constexpr double kDegPerRad = 180.0 / M_PI;
+// The reported loss is printed to 3 significant digits and measured on a grid: a run's samples
+// lie inside the envelope but between its points.
+constexpr double kLossReportMargin = 1.01;
+// Where the loss is float32 rounding alone, a sample between the grid's points may round a little
+// worse than any of them: a few units of float32 rounding of the sample's own value are allowed.
+constexpr double kFloat32Rounding = 4 * 0x1p-24;
+
+// The driver's scale of the MEMS unit (fixtures/README.md): 16.4 LSB per deg/s, 2048 LSB per g.
+const std::vector<std::string> kDriver = {"--gyro-raw-per-radps", "939.65", "--accel-raw-per-mps2",
+                                          "208.838"};
+
+// A noise block, as `imufit allan --noise-yaml` writes its Kalibr figures, appended to a unit.
+constexpr const char* kNoiseBlock = R"(noise:
+  format: imufit-noise
+  version: 1
+  kalibr:
+    gyroscope_noise_density: 0.00026
+    gyroscope_random_walk: 2.1e-05
+    accelerometer_noise_density: 0.0023
+    accelerometer_random_walk: 0.00011
+    update_rate: 50
+)";
+
+struct Format {
+  const char* name;
+  const char* calibration;  // in fixtures/, or mems_truth_noise.yaml (written by the test)
+  const char* golden;       // in fixtures/golden/export/
+  std::vector<std::string> args;
+};
+
+std::vector<std::string> Plus(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+const std::vector<Format>& Formats() {
+  static const std::vector<Format> formats = {
+      {"c", "mems_truth.yaml", "mems_truth.h", {}},
+      {"bin", "mems_truth.yaml", "mems_truth.bin", {}},
+      {"px4", "mems_truth.yaml", "mems_truth.params", Plus(kDriver, {"--device-id", "2621474", "--force"})},
+      {"ardupilot", "mems_truth.yaml", "mems_truth.parm", Plus(kDriver, {"--force"})},
+      {"kalibr", "mems_truth_noise.yaml", "mems_truth_noise_kalibr.yaml", Plus(kDriver, {"--force"})},
+      {"imucal", "mems_truth.yaml", "mems_truth_imucal.json", {"--force"}},
+      {"json", "mems_truth.yaml", "mems_truth.json", {}}};
+  return formats;
+}
+
+// The worst-case loss per axis an export printed: gyro deg/s, accel mg.
+struct ReportedLoss {
+  Eigen::Vector3d gyro_dps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mg = Eigen::Vector3d::Zero();
+};
+
+ReportedLoss ParseLoss(const std::string& out) {
+  ReportedLoss loss;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    double x, y, z;
+    if (std::sscanf(line.c_str(), " gyro worst x %lf y %lf z %lf", &x, &y, &z) == 3)
+      loss.gyro_dps = {x, y, z};
+    if (std::sscanf(line.c_str(), " accel worst x %lf y %lf z %lf", &x, &y, &z) == 3)
+      loss.accel_mg = {x, y, z};
+  }
+  return loss;
+}
+
+// A consumer's correction of one raw sample: rad/s and m/s^2 in imufit's body frame.
+struct Corrected {
+  Eigen::Vector3d omega_radps, a_mps2;
+};
+using Consumer = std::function<Corrected(const Sample& raw)>;
+
+class ExportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("imufit_export_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(Path("mems_truth_noise.yaml"), std::ios::binary)
+        << ReadBytes(kFixtures + "/mems_truth.yaml") << kNoiseBlock;
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string CalibrationPath(const std::string& name) const {
+    return name == "mems_truth_noise.yaml" ? Path(name) : kFixtures + "/" + name;
+  }
+  RunResult Run(const std::vector<std::string>& args) const {
+    return RunProgram(IMUFIT_EXE, args, Path("stdout.txt"), Path("stderr.txt"));
+  }
+  // Exports `format` to `output`; the run's result.
+  RunResult Export(const Format& format, const std::string& output) const {
+    return Run(Plus({"export", "-c", CalibrationPath(format.calibration), "-f", format.name, "-o", output},
+                    format.args));
+  }
+  const Format& FormatNamed(const std::string& name) const {
+    for (const Format& f : Formats()) {
+      if (name == f.name) return f;
+    }
+    throw std::logic_error(name);
+  }
+
+  // The raw noiseless ramp of fixtures/ and `imufit apply`'s correction of it with `calibration`.
+  void ReadRun(const std::string& calibration, std::vector<Sample>* raw,
+               std::vector<Sample>* corrected) const {
+    const std::string samples = kFixtures + "/mems_6pos_noiseless.csv.gz";
+    const RunResult apply =
+        Run({"apply", "-q", "-c", calibration, "-s", samples, "-o", Path("corrected.csv")});
+    ASSERT_EQ(apply.status, 0) << apply.err;
+    for (const auto& [path, out] : {std::pair{samples, raw}, std::pair{Path("corrected.csv"), corrected}}) {
+      SamplesReader reader(path, false);
+      for (Sample s; reader.Next(&s);) out->push_back(s);
+    }
+    ASSERT_EQ(raw->size(), corrected->size());
+    ASSERT_GT(raw->size(), 1000u);
+  }
+
+  // Exports `format` (of `calibration`, mems_truth.yaml by default), builds its consumer from the
+  // file and checks it against `imufit apply` on the run within the loss the export reported;
+  // returns that loss.
+  ReportedLoss ExpectRoundTrip(const std::string& name,
+                               const std::function<Consumer(const std::string& file)>& consumer_of,
+                               std::string calibration = "") {
+    const Format& format = FormatNamed(name);
+    if (calibration.empty()) calibration = CalibrationPath(format.calibration);
+    const std::string output = Path("export." + name);
+    const RunResult result =
+        Run(Plus({"export", "-c", calibration, "-f", format.name, "-o", output}, format.args));
+    EXPECT_EQ(result.status, 0) << result.err;
+    const ReportedLoss loss = ParseLoss(result.out);
+    const Consumer consumer = consumer_of(output);
+    std::vector<Sample> raw, corrected;
+    ReadRun(calibration, &raw, &corrected);
+    int beyond = 0;
+    std::string first;
+    for (size_t i = 0; i < raw.size(); ++i) {
+      const Corrected c = consumer(raw[i]);
+      const Eigen::Vector3d gyro_error = (c.omega_radps - corrected[i].gyro).cwiseAbs() * kDegPerRad;
+      const Eigen::Vector3d accel_error = (c.a_mps2 - corrected[i].accel).cwiseAbs() / kGravity * 1e3;
+      const Eigen::Vector3d gyro_allowed =
+          loss.gyro_dps * kLossReportMargin + kFloat32Rounding * corrected[i].gyro.cwiseAbs() * kDegPerRad;
+      const Eigen::Vector3d accel_allowed = loss.accel_mg * kLossReportMargin +
+                                            kFloat32Rounding * corrected[i].accel.cwiseAbs() / kGravity * 1e3;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (gyro_error(axis) > gyro_allowed(axis) || accel_error(axis) > accel_allowed(axis)) {
+          if (beyond++ == 0) {
+            first = "sample " + std::to_string(i) + " axis " + std::to_string(axis) + ": gyro " +
+                    std::to_string(gyro_error(axis)) + " deg/s (allowed " +
+                    std::to_string(gyro_allowed(axis)) + "), accel " + std::to_string(accel_error(axis)) +
+                    " mg (allowed " + std::to_string(accel_allowed(axis)) + ")";
+          }
+        }
+      }
+    }
+    EXPECT_EQ(beyond, 0) << name << ": errors beyond the reported loss, first " << first;
+    return loss;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ExportTest, EveryFormatMatchesItsGoldenFile) {
+  const bool update = std::getenv("IMUFIT_UPDATE_GOLDEN") != nullptr;
+  for (const Format& format : Formats()) {
+    const std::string golden = kFixtures + "/golden/export/" + format.golden;
+    const std::string output = update ? golden : Path(format.golden);
+    const RunResult result = Export(format, output);
+    ASSERT_EQ(result.status, 0) << format.name << ": " << result.err;
+    if (!update)
+      EXPECT_EQ(ReadBytes(output), ReadBytes(golden)) << format.name << ": differs from " << golden;
+  }
+}
+
+// --- The consumers, from their documentation (the exporters' sources cite the same) -----------
+
+// Name -> value of a PX4 .params (tab-separated: vehicle, component, name, value, type) or an
+// ArduPilot .parm (NAME VALUE); every value read as the float32 the autopilot stores.
+std::map<std::string, float> ReadParameters(const std::string& path, bool px4) {
+  std::map<std::string, float> parameters;
+  std::istringstream lines(ReadBytes(path));
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string vehicle, component, name, value;
+    if (px4) {
+      std::getline(fields, vehicle, '\t');
+      std::getline(fields, component, '\t');
+      std::getline(fields, name, '\t');
+      std::getline(fields, value, '\t');
+    } else {
+      fields >> name >> value;
+    }
+    parameters[name] = std::strtof(value.c_str(), nullptr);
+  }
+  return parameters;
+}
+
+Consumer Px4Consumer(const std::string& file) {
+  std::map<std::string, float> p = ReadParameters(file, true);
+  EXPECT_EQ(p["TC_G0_ID"], 2621474.0f);
+  return [p](const Sample& raw) mutable {
+    // TemperatureCompensation::calc_thermal_offsets_3D, then the calibration's Correct().
+    const auto offsets = [&](const std::string& s) {
+      const float t = static_cast<float>(raw.temp_c);
+      const float tmax = p["TC_" + s + "0_TMAX"], tmin = p["TC_" + s + "0_TMIN"],
+                  tref = p["TC_" + s + "0_TREF"];
+      const float dt = t > tmax ? tmax - tref : t < tmin ? tmin - tref : t - tref;
+      Eigen::Vector3f offset;
+      for (int i = 0; i < 3; ++i) {
+        const std::string axis = std::to_string(i);
+        offset(i) = p["TC_" + s + "0_X0_" + axis] + p["TC_" + s + "0_X1_" + axis] * dt +
+                    p["TC_" + s + "0_X2_" + axis] * (dt * dt) +
+                    p["TC_" + s + "0_X3_" + axis] * (dt * dt * dt);
+      }
+      return offset;
+    };
+    const Eigen::Vector3f gyro_offset = offsets("G"), accel_offset = offsets("A");
+    Corrected c;
+    for (int i = 0; i < 3; ++i) {
+      const std::string xyz(1, "XYZ"[i]);
+      const float gyro = static_cast<float>(raw.gyro(i) / 939.65),
+                  accel = static_cast<float>(raw.accel(i) / 208.838);
+      c.omega_radps(i) = gyro - gyro_offset(i) - p["CAL_GYRO0_" + xyz + "OFF"];
+      c.a_mps2(i) = (accel - accel_offset(i) - p["CAL_ACC0_" + xyz + "OFF"]) * p["CAL_ACC0_" + xyz + "SCALE"];
+    }
+    return c;
+  };
+}
+
+Consumer ArduPilotConsumer(const std::string& file) {
+  std::map<std::string, float> p = ReadParameters(file, false);
+  EXPECT_EQ(p["INS_TCAL1_ENABLE"], 1.0f);
+  return [p](const Sample& raw) mutable {
+    // AP_InertialSensor::TCal::correct_sensor: no constant term, 35 degC reference, x1e6.
+    const float tmin = p["INS_TCAL1_TMIN"], tmax = p["INS_TCAL1_TMAX"];
+    const auto clamp = [&](float t) { return std::min(std::max(t, tmin), tmax); };
+    const auto tcal = [&](const std::string& s, int i, float t) {
+      const std::string axis = "_" + std::string(1, "XYZ"[i]);
+      const float c1 = p["INS_TCAL1_" + s + "1" + axis], c2 = p["INS_TCAL1_" + s + "2" + axis],
+                  c3 = p["INS_TCAL1_" + s + "3" + axis];
+      const float tdiff = static_cast<float>(t - 35.0);
+      return (c1 + (c2 + c3 * tdiff) * tdiff) * tdiff * static_cast<float>(1.0e-6);
+    };
+    const float t = clamp(static_cast<float>(raw.temp_c));
+    Corrected c;
+    for (int i = 0; i < 3; ++i) {
+      const std::string xyz(1, "XYZ"[i]);
+      float accel = static_cast<float>(raw.accel(i) / 208.838),
+            gyro = static_cast<float>(raw.gyro(i) / 939.65);
+      accel -= tcal("ACC", i, t);
+      accel += tcal("ACC", i, clamp(p["INS_ACC1_CALTEMP"]));
+      gyro -= tcal("GYR", i, t);
+      gyro += tcal("GYR", i, clamp(p["INS_GYR1_CALTEMP"]));
+      c.a_mps2(i) = (accel - p["INS_ACCOFFS_" + xyz]) * p["INS_ACCSCAL_" + xyz];
+      c.omega_radps(i) = gyro - p["INS_GYROFFS_" + xyz];
+    }
+    return c;
+  };
+}
+
+Eigen::Matrix3d Matrix(const YAML::Node& node) {
+  Eigen::Matrix3d m;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) m(row, col) = node[row][col].as<double>();
+  }
+  return m;
+}
+
+Eigen::Vector3d Vector(const YAML::Node& node) {
+  return {node[0].as<double>(), node[1].as<double>(), node[2].as<double>()};
+}
+
+Consumer KalibrConsumer(const std::string& file) {
+  const YAML::Node imu = YAML::LoadFile(file);
+  EXPECT_EQ(imu["model"].as<std::string>(), "scale-misalignment");
+  EXPECT_GT(imu["gyroscope_noise_density"].as<double>(), 0.0);
+  const std::string text = ReadBytes(file), marker = "# C_i_b: ";
+  const size_t at = text.find(marker);
+  EXPECT_NE(at, std::string::npos);
+  const Eigen::Matrix3d c_i_b =
+      Matrix(YAML::Load(text.substr(at + marker.size(), text.find('\n', at) - at - marker.size())));
+  const Eigen::Matrix3d m_a = Matrix(imu["accelerometers"]["M"]), m_g = Matrix(imu["gyroscopes"]["M"]),
+                        a_g = Matrix(imu["gyroscopes"]["A"]),
+                        c_gyro_i = Matrix(imu["gyroscopes"]["C_gyro_i"]);
+  const Eigen::Vector3d b_a = Vector(imu["accelerometers"]["b"]), b_g = Vector(imu["gyroscopes"]["b"]);
+  EXPECT_EQ(m_a(0, 1), 0.0);  // Kalibr's matrices are lower triangular
+  EXPECT_EQ(m_g(1, 2), 0.0);
+  return [=](const Sample& raw) {
+    // IccScaledMisalignedImu: alpha = M_a a_i + b_a, omega = M_g C_gyro_i w_i + A C_gyro_i a_i + b_g.
+    const Eigen::Vector3d a_i = m_a.inverse() * (raw.accel / 208.838 - b_a);
+    const Eigen::Vector3d w_i =
+        c_gyro_i.transpose() * (m_g.inverse() * (raw.gyro / 939.65 - b_g - a_g * c_gyro_i * a_i));
+    return Corrected{c_i_b.transpose() * w_i, c_i_b.transpose() * a_i};
+  };
+}
+
+Consumer ImucalConsumer(const std::string& file) {
+  const YAML::Node cal = YAML::LoadFile(file);  // JSON is YAML
+  EXPECT_EQ(cal["cal_type"].as<std::string>(), "Ferraris");
+  EXPECT_EQ(cal["gyr_unit"].as<std::string>(), "deg/s");
+  const Eigen::Matrix3d acc_mat = Matrix(cal["R_a"]).inverse() * Matrix(cal["K_a"]).inverse();
+  const Eigen::Matrix3d gyr_mat = Matrix(cal["R_g"]).inverse() * Matrix(cal["K_g"]).inverse();
+  const Eigen::Matrix3d k_ga = Matrix(cal["K_ga"]);
+  const Eigen::Vector3d b_a = Vector(cal["b_a"]), b_g = Vector(cal["b_g"]);
+  return [=](const Sample& raw) {
+    // FerrarisCalibrationInfo._calibrate_acc and ._calibrate_gyr.
+    const Eigen::Vector3d acc = acc_mat * (raw.accel - b_a);
+    const Eigen::Vector3d gyr_dps = gyr_mat * (raw.gyro - (k_ga * acc + b_g));
+    return Corrected{gyr_dps / kDegPerRad, acc};
+  };
+}
+
+Consumer RuntimeConsumer(const std::string& file) {
+  const std::string blob = ReadBytes(file);
+  imufit_calibration runtime{};
+  EXPECT_EQ(imufit_load_blob(reinterpret_cast<const unsigned char*>(blob.data()), blob.size(), &runtime),
+            IMUFIT_OK);
+  return [runtime](const Sample& raw) {
+    Corrected c;
+    imufit_correct(&runtime, raw.temp_c, raw.gyro.data(), raw.accel.data(), c.omega_radps.data(),
+                   c.a_mps2.data());
+    return c;
+  };
+}
+
+TEST_F(ExportTest, Px4RoundTripStaysWithinTheReportedLoss) { ExpectRoundTrip("px4", Px4Consumer); }
+
+TEST_F(ExportTest, ArduPilotRoundTripStaysWithinTheReportedLoss) {
+  ExpectRoundTrip("ardupilot", ArduPilotConsumer);
+}
+
+TEST_F(ExportTest, KalibrRoundTripStaysWithinTheReportedLoss) { ExpectRoundTrip("kalibr", KalibrConsumer); }
+
+TEST_F(ExportTest, ImucalRoundTripStaysWithinTheReportedLoss) { ExpectRoundTrip("imucal", ImucalConsumer); }
+
+TEST_F(ExportTest, BlobRoundTripThroughTheRuntimeStaysWithinTheReportedLoss) {
+  ExpectRoundTrip("bin", RuntimeConsumer);
+}
+
+// Units whose model the consumer can hold: for the autopilots the bias cubics and a constant
+// accelerometer scale (the gyro scale the driver's, no misalignment, no g-sensitivity); for the
+// one-temperature formats any model without temperature dependence. Their loss is rounding alone,
+// and the round trip through the consumer's equations shows it: the equations, signs, reference
+// temperatures and re-expansions are right, not just within a large loss.
+TEST_F(ExportTest, LossIsRoundingAloneWhereTheConsumerHoldsTheModel) {
+  constexpr double kFloat32LossDps = 1e-3, kFloat32LossMg = 1e-2;  // worst case, float32 consumers
+  constexpr double kDoubleLoss = 1e-9;                             // deg/s or mg, double consumers
+  const Calibration unit = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  Calibration autopilot = unit;
+  for (int i = kScaleCoefficient * kPolynomialTerms; i < kGyroParameters; ++i) autopilot.model.gyro[i] = 0.0;
+  for (int i = kScaleCoefficient * kPolynomialTerms; i < kAccelParameters; ++i)
+    autopilot.model.accel[i] = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    autopilot.model.gyro[(kScaleCoefficient + axis) * kPolynomialTerms] = 939.65;
+    autopilot.model.accel[(kScaleCoefficient + axis) * kPolynomialTerms] =
+        unit.model.accel[(kScaleCoefficient + axis) * kPolynomialTerms];
+  }
+  WriteCalibration(Path("autopilot.yaml"), autopilot);
+  for (const auto& [name, consumer] : {std::pair{"px4", Px4Consumer}, {"ardupilot", ArduPilotConsumer}}) {
+    const ReportedLoss loss = ExpectRoundTrip(name, consumer, Path("autopilot.yaml"));
+    EXPECT_LT(loss.gyro_dps.maxCoeff(), kFloat32LossDps) << name;
+    EXPECT_LT(loss.accel_mg.maxCoeff(), kFloat32LossMg) << name;
+  }
+  Calibration constant = unit;
+  for (int i = 0; i < kGyroParameters; ++i) constant.model.gyro[i] *= i % kPolynomialTerms == 0;
+  for (int i = 0; i < kAccelParameters; ++i) constant.model.accel[i] *= i % kPolynomialTerms == 0;
+  std::ofstream(Path("constant.yaml"), std::ios::binary) << CalibrationToYaml(constant) << kNoiseBlock;
+  for (const auto& [name, consumer] : {std::pair{"kalibr", KalibrConsumer}, {"imucal", ImucalConsumer}}) {
+    const ReportedLoss loss = ExpectRoundTrip(name, consumer, Path("constant.yaml"));
+    EXPECT_LT(loss.gyro_dps.maxCoeff(), kDoubleLoss) << name;
+    EXPECT_LT(loss.accel_mg.maxCoeff(), kDoubleLoss) << name;
+  }
+}
+
+TEST_F(ExportTest, JsonReadsBackBitForBitAndAppliesIdentically) {
+  const RunResult exported = Export(FormatNamed("json"), Path("unit.json"));
+  ASSERT_EQ(exported.status, 0) << exported.err;
+  const Calibration original = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  const Calibration read_back = ReadCalibration(Path("unit.json"));
+  EXPECT_EQ(read_back.model.gyro, original.model.gyro);
+  EXPECT_EQ(read_back.model.accel, original.model.accel);
+  EXPECT_EQ(read_back.model.basis.center_c, original.model.basis.center_c);
+  EXPECT_EQ(read_back.fit_temp_range_c, original.fit_temp_range_c);
+  EXPECT_EQ(read_back.serial, original.serial);
+  EXPECT_TRUE(read_back.extra["export"]) << "the provenance is kept as a further key";
+  const std::string samples = kFixtures + "/mems_6pos_noiseless.csv.gz";
+  ASSERT_EQ(
+      Run({"apply", "-q", "-c", kFixtures + "/mems_truth.yaml", "-s", samples, "-o", Path("a.csv")}).status,
+      0);
+  ASSERT_EQ(Run({"apply", "-q", "-c", Path("unit.json"), "-s", samples, "-o", Path("b.csv")}).status, 0);
+  EXPECT_EQ(ReadBytes(Path("a.csv")), ReadBytes(Path("b.csv")));
+  // Further keys keep their types; JSON has no NaN.
+  std::ofstream(Path("extra.yaml"), std::ios::binary)
+      << ReadBytes(kFixtures + "/mems_truth.yaml") << "fit:\n  note: \"12\"\n  rms: .nan\n  windows: 12\n";
+  ASSERT_EQ(Run({"export", "-c", Path("extra.yaml"), "-f", "json", "-o", Path("extra.json")}).status, 0);
+  const std::string extra = ReadBytes(Path("extra.json"));
+  EXPECT_NE(extra.find("\"note\": \"12\""), std::string::npos) << extra;
+  EXPECT_NE(extra.find("\"rms\": null"), std::string::npos) << extra;
+  EXPECT_NE(extra.find("\"windows\": 12"), std::string::npos) << extra;
+  // A JSON export of the JSON export: the same calibration, one provenance block.
+  ASSERT_EQ(Run({"export", "-c", Path("unit.json"), "-f", "json", "-o", Path("again.json")}).status, 0);
+  const std::string again = ReadBytes(Path("again.json"));
+  EXPECT_EQ(again.find("\"export\""), again.rfind("\"export\""));
+}
+
+TEST_F(ExportTest, RefusesALossyExportBeyondMaxLossSayingByHowMuch) {
+  const std::vector<std::string> px4 = Plus({"export", "-c", kFixtures + "/mems_truth.yaml", "-f", "px4",
+                                             "-o", Path("unit.params"), "--device-id", "7"},
+                                            kDriver);
+  const RunResult refused = Run(px4);
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("px4 export refused: the gyro's worst-case loss"), std::string::npos)
+      << refused.err;
+  EXPECT_NE(refused.err.find("exceeds the bound 0.5 deg/s by "), std::string::npos) << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_FALSE(fs::exists(Path("unit.params")));
+  // Within a looser bound, it is written.
+  const RunResult written = Run(Plus(px4, {"--max-loss", "20,50"}));
+  EXPECT_EQ(written.status, 0) << written.err;
+  EXPECT_TRUE(fs::exists(Path("unit.params")));
+  // The C runtime's float build loses far less than any sensible bound.
+  EXPECT_EQ(Run({"export", "-c", kFixtures + "/mems_truth.yaml", "-f", "c", "-o", Path("unit.h"),
+                 "--max-loss", "0.001,0.01"})
+                .status,
+            0);
+}
+
+TEST_F(ExportTest, BadInvocationsAndUnexportableCalibrations) {
+  const std::string cal = kFixtures + "/mems_truth.yaml";
+  RunResult r = Run({"export", "-c", cal, "-f", "px4", "-o", Path("x.params")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--device-id"), std::string::npos) << r.err;
+  r = Run({"export", "-c", cal, "-f", "mavlink", "-o", Path("x")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("c, bin, px4, ardupilot, kalibr, imucal, json"), std::string::npos) << r.err;
+  r = Run({"export", "-c", cal, "-f", "kalibr", "-o", Path("x.yaml"), "--force"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("noise.kalibr.accelerometer_noise_density"), std::string::npos) << r.err;
+  r = Run({"export", "-c", cal, "-f", "c", "-o", Path("x.h"), "--c-name", "2bad"});
+  EXPECT_EQ(r.status, 2);
+  r = Run({"export", "-c", cal, "-f", "json", "-o", Path("x.json"), "--full-scale-dps", "-5"});
+  EXPECT_EQ(r.status, 2);
+  r = Run({"export", "-c", cal, "-f", "ardupilot", "-o", Path("x.parm"), "--gyro-raw-per-radps", "0"});
+  EXPECT_EQ(r.status, 2);
+  r = Run({"export", "-c", cal, "-f", "imucal", "-o", Path("x.json"), "--temp-c", "100"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("outside the calibration's fitted range [-40, 85] degC"), std::string::npos) << r.err;
+  std::ofstream(Path("broken.yaml")) << "format: imufit-calibration\nversion: 1\ngyro: [1, 2\n";
+  r = Run({"export", "-c", Path("broken.yaml"), "-f", "json", "-o", Path("x.json")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("broken.yaml:"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("x.json")));
+  r = Run({"export", "-c", cal, "-f", "json", "-o", cal});
+  EXPECT_EQ(r.status, 2) << "an output that names the input is refused";
+}
+
+}  // namespace
+}  // namespace imufit
