@@ -26,17 +26,13 @@ struct FitArguments {
   std::string plan;
   std::string samples;
   std::string output;
-  std::string check_plan;
-  std::string check_samples;
-  bool validate = false;
   bool quiet = false;
   std::string limits;  // acceptance limits: verdict table, exit 3 when they fail
   std::string report;  // certificate HTML to write
   std::string store;   // results store to record the fit in
   std::string serial;  // the unit's serial; empty: the samples header's, else the plan's
   std::string station;  // station file shown on the certificate (with --report)
-  bool allow_mismatch = false;  // --serial may contradict the samples header (a warning)
-  FitRunArguments run;          // the fit options, shared with imufit batch
+  FitRunArguments run;  // the fit options, shared with imufit batch
 };
 
 // A value and its 1-sigma: the sigma goes through the same unit conversion as the value, whose
@@ -162,11 +158,13 @@ int FinishFactory(const FitArguments& args, const FitRunOptions& options, const 
 }
 
 int RunFit(FitArguments args) {
-  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples,
-                                        args.limits, args.run.prior});
+  const std::string check_plan = args.run.options.GivenText("check_plan");
+  const std::string check_samples = args.run.options.GivenText("check_samples");
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, check_plan, check_samples, args.limits,
+                                        args.run.options.GivenText("prior")});
   if (!args.report.empty()) {
-    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples,
-                                          args.limits, args.output, args.station});
+    RefuseToOverwriteInputs(args.report,
+                            {args.plan, args.samples, check_plan, check_samples, args.limits, args.output, args.station});
   }
   // A bad limits or station file is reported before any work.
   std::optional<Limits> limits;
@@ -177,12 +175,8 @@ int RunFit(FitArguments args) {
     station = ReadStation(args.station);
   }
   FitRunOptions options = args.run.Resolve();
-  options.validate = args.validate;
-  options.check_samples = args.check_samples;
-  options.check_plan = args.check_plan;
   options.software = SoftwareVersion();
   options.serial = args.serial;
-  options.allow_serial_mismatch = args.allow_mismatch;
   if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("imufit fit", problem);
 
   const FitRunResult result = FitRun(args.plan, args.samples, options);
@@ -261,7 +255,7 @@ int RunFit(FitArguments args) {
         : options.fit.gyro_bias_stability_radps == 0.0 ? " for the gyro"
                                                        : " for the accelerometer");
   }
-  if (args.validate) {
+  if (options.validate) {
     std::printf("  leave-one-temperature-out validation:\n");
     if (result.folds.empty()) std::printf("    not enough temperatures (needs at least 3 groups)\n");
     for (const HeldOutGroup& g : result.folds) {
@@ -279,7 +273,7 @@ int RunFit(FitArguments args) {
     }
   }
   if (!result.check_errors.empty()) {
-    PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
+    PrintErrors(("held-out run " + options.check_samples + ":").c_str(), result.check_errors);
   }
   return FinishFactory(args, options, limits, station, result, &outputs);
 }
@@ -297,11 +291,6 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
   command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
   AddFitRunOptions(command, &args->run);
-  command->add_option("--threads", args->run.fit.num_threads, "solver threads")->capture_default_str();
-  command->add_flag("--validate", args->validate,
-                    "leave each interior temperature out in turn, refit, and report the errors on it");
-  command->add_option("--check-samples", args->check_samples, "a held-out run to report the calibration's errors on");
-  command->add_option("--check-plan", args->check_plan, "the plan of --check-samples (default: --plan)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   command->add_option("--limits,-l", args->limits,
                       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
@@ -309,9 +298,6 @@ CommandRunner AddFitCommand(CLI::App* root) {
       "--serial", args->serial,
       "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial); one "
       "that contradicts the samples header is refused (exit 2) unless --allow-mismatch");
-  command->add_flag("--allow-mismatch", args->allow_mismatch,
-                    "fit even when --serial names another unit than the samples header (a warning, also on "
-                    "the certificate)");
   command->add_option("--report", args->report, "write the unit's calibration certificate (self-contained HTML)");
   command->add_option(
       "--station", args->station,
