@@ -51,14 +51,16 @@ OptionTable<FitOptions> MakeFitOptionTable() {
       });
   fit.fingerprint = Fingerprint::kCustom;
   fit.describe = [](const O& o) { return "fitted=" + Joined(o.Groups(true)); };
-  t.Number("gyro_temp_order", "--gyro-temp-order",
-           "order of the gyro temperature polynomials (0 with one temperature for the whole run, temp_c)", "",
-           &O::gyro_temp_order, Between(0, 3));
-  t.Number("accel_temp_order", "--accel-temp-order",
-           "order of the accel temperature polynomials (0 with one temperature for the whole run, temp_c)",
-           "", &O::accel_temp_order, Between(0, 3));
+  t.Number(
+      "gyro_temp_order", "--gyro-temp-order",
+      "order of the gyro temperature polynomials (0 when temp_c gives one temperature for the whole run)", "",
+      &O::gyro_temp_order, Between(0, 3));
+  t.Number(
+      "accel_temp_order", "--accel-temp-order",
+      "order of the accel temperature polynomials (0 when temp_c gives one temperature for the whole run)",
+      "", &O::accel_temp_order, Between(0, 3));
   OptionEntry<O>& g_sensitivity =
-      t.Flag("fit_g_sensitivity", "--no-g-sensitivity", "fit the gyro g-sensitivity (off: held at zero)",
+      t.Flag("fit_g_sensitivity", "--no-g-sensitivity", "fit the gyro g-sensitivity (held at zero when off)",
              &O::fit_g_sensitivity, /*cli_negates=*/true);
   g_sensitivity.fingerprint = Fingerprint::kCustom;  // in `fitted`
   g_sensitivity.describe = [](const O&) { return std::string(); };
@@ -85,9 +87,8 @@ OptionTable<FitOptions> MakeFitOptionTable() {
   t.Number("max_iterations", "--max-iterations", "solver iterations at most, per pass", "",
            &O::max_iterations, AtLeast(1));
   t.Flag("closed_form_start", "--nominal-start",
-         "start from the closed-form solution (off: from nominal scale factors, slower; to check that the "
-         "solver "
-         "converges from a poor start)",
+         "start from the closed-form solution (when off: from nominal scale factors, slower; to check that "
+         "the solver converges from a poor start)",
          &O::closed_form_start, /*cli_negates=*/true);
   t.Number("threads", "--threads", "solver threads", "", &O::num_threads, AtLeast(1)).fingerprint =
       Fingerprint::kNone;

@@ -88,7 +88,7 @@ std::string SimulationOptions::Validate() const {
   }
   if (!(time_jitter_s < 0.5 / rate_hz)) {
     return "time_jitter_s = " + OptionNumberText(time_jitter_s) +
-           ": must lie in [0, half the sample interval)";
+           ": the time jitter must lie in [0, half the sample interval)";
   }
   return "";
 }

@@ -56,3 +56,18 @@ def test_new_options_reach_the_fit(fixtures, tmp_path):
     np.testing.assert_allclose(result.calibration.gyro["bias"], prior.gyro["bias"], rtol=1e-9, atol=1e-15)
     np.testing.assert_allclose(result.calibration.gyro["scale"], prior.gyro["scale"], rtol=1e-9)
     assert imufit.simulate_options()["ramp_c"][0] is None
+
+
+def test_the_command_offers_the_table_options(fixtures, tmp_path, run_imufit):
+    # Options the command line lacked before the options had one table.
+    fit_help = run_imufit("fit", "--help").stdout
+    for flag in ("--turn-margin", "--segment-noise-quantile", "--segment-threshold-factor", "--rank-tolerance",
+                 "--threads", "--check-samples", "--prior", "--no-g-sensitivity"):
+        assert flag in fit_help, flag
+    batch_help = run_imufit("batch", "--help").stdout
+    assert "--turn-margin" in batch_help and "--validate" in batch_help
+    assert "--threads" not in batch_help and "--check-samples" not in batch_help
+    bad = run_imufit("fit", "--plan", fixtures / "plan_6pos.yaml", "--samples", fixtures / "mems_6pos_soak.csv.gz",
+                     "-o", tmp_path / "cal.yaml", "--turn-margin", "-1", check=False)
+    assert bad.returncode == 2
+    assert "turn_margin_s = -1: must be >= 0" in bad.stderr, bad.stderr
