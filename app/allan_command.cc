@@ -18,6 +18,7 @@
 #include "imufit/io/series_reader.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
+#include "imufit/model/enum_names.h"
 
 namespace imufit {
 namespace {
@@ -54,13 +55,20 @@ std::string Number(double value, int digits = 4) {
   return text;
 }
 
+// The units of the time column (model/enum_names.h), as seconds per unit.
+struct TimeUnitName {
+  double value;
+  const char* name;
+};
+constexpr TimeUnitName kTimeUnitNames[] = {{1.0, "s"}, {1e-3, "ms"}, {1e-6, "us"}, {1e-9, "ns"}};
+
 // Seconds per unit of the time column.
 double SecondsPer(const std::string& unit) {
-  if (unit == "s") return 1.0;
-  if (unit == "ms") return 1e-3;
-  if (unit == "us") return 1e-6;
-  if (unit == "ns") return 1e-9;
-  BadInvocation("--time-unit " + QuoteForMessage(unit) + " is not one of: s, ms, us, ns");
+  double seconds = 0.0;
+  if (!ValueOf(kTimeUnitNames, unit, &seconds)) {
+    BadInvocation("--time-unit " + QuoteForMessage(unit) + " is not one of: " + AllNames(kTimeUnitNames));
+  }
+  return seconds;
 }
 
 // A static gyro reads Earth rate and its bias: far below 1 rad/s (57 deg/s) in rad/s. A larger
@@ -346,7 +354,7 @@ CommandRunner AddAllanCommand(CLI::App* root) {
               "does (then the columns are among gyro_*, accel_* and temp_c)")
           ->excludes(scale);
   AddTempOption(command, &args->input);
-  args->input.temp_c_option->needs(calibration);  // a temperature only matters to the correction
+  args->input.TempOption()->needs(calibration);  // a temperature only matters to the correction
   command->add_option("--threads", args->threads, "worker threads (default 0: all cores)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
   return [args] { return RunAllan(*args); };

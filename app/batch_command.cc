@@ -16,8 +16,6 @@ namespace {
 struct BatchArguments {
   BatchOptions batch;
   FitRunArguments run;  // every unit is fitted with these, as imufit fit would fit it
-  bool validate = false;
-  bool allow_mismatch = false;
   bool no_report = false;
   bool quiet = false;
 };
@@ -45,8 +43,6 @@ void ShowProgress(const BatchProgress& p, bool terminal) {
 int RunBatchCommand(BatchArguments args) {
   BatchOptions& options = args.batch;
   options.fit = args.run.Resolve();
-  options.fit.validate = args.validate;
-  options.fit.allow_serial_mismatch = args.allow_mismatch;
   options.fit.software = SoftwareVersion();
   options.fit.fit.num_threads = 1;  // parallel over units instead
   const bool terminal = isatty(STDERR_FILENO) != 0;
@@ -110,12 +106,8 @@ CommandRunner AddBatchCommand(CLI::App* root) {
                    "stop after fitting this many units (0: all); a later run resumes the lot")
       ->capture_default_str();
   command->add_flag("--no-report", args->no_report, "write no report.html per unit");
-  command->add_flag("--validate", args->validate,
-                    "leave each interior temperature out in turn, refit, and put the errors in the reports");
-  command->add_flag("--allow-mismatch", args->allow_mismatch,
-                    "fit a unit even when its serial.txt names another unit than its samples header (a "
-                    "warning, also on the certificate); without it such a unit is an error");
-  AddFitRunOptions(command, &args->run);
+  // Not --threads (units run in parallel instead) nor a check run (a lot has no held-out runs).
+  AddFitRunOptions(command, &args->run, {"threads", "check_samples", "check_plan"});
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunBatchCommand(*args); };
 }

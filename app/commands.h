@@ -1,15 +1,18 @@
 // imufit — the subcommands of the `imufit` program. Each Add*Command registers its options on
 // `root` and returns the function that runs it once the command line has been parsed; that
 // function returns the exit status of docs/spec.md section 4 (0 done, 1 could not be done, 2 bad
-// input; 3 done but failed acceptance limits) and lets InputError escape to main(), which prints it and returns 2.
+// input; 3 done but failed acceptance limits) and lets InputError escape to main(), which prints it and
+// returns 2.
 #ifndef IMUFIT_APP_COMMANDS_H_
 #define IMUFIT_APP_COMMANDS_H_
 
 #include <functional>
+#include <set>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "cli_options.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/segment_run.h"
 
@@ -27,54 +30,48 @@ CommandRunner AddReportCommand(CLI::App* root);
 CommandRunner AddSegmentCommand(CLI::App* root);
 CommandRunner AddExportCommand(CLI::App* root);
 
-// How a command reads samples files without a temp_c or segment column (segment_command.cc).
+// How a command reads samples files without a temp_c or segment column: the options of
+// SamplesInputOptionTable() (segment_command.cc).
 struct SamplesInputArguments {
-  double temp_c = 25.0;
-  CLI::Option* temp_c_option = nullptr;
-  SamplesInput input;
-  bool HasTemp() const { return temp_c_option != nullptr && temp_c_option->count() > 0; }
+  CliOptions<SamplesInput> options;
+  bool HasTemp() const { return options.Given("temp_c"); }
+  CLI::Option* TempOption() const { return options.Find("temp_c"); }  // after AddTempOption
   SamplesInput Get() const {
-    SamplesInput result = input;
-    if (HasTemp()) result.temp_c = temp_c;
-    return result;
+    SamplesInput input;
+    options.Apply(&input);
+    return input;
   }
 };
 // --temp-c.
 void AddTempOption(CLI::App* command, SamplesInputArguments* args);
-// --segment-window, --min-steady, --direction-tolerance, --rate-tolerance.
+// The segmentation options: --segment-window, --min-steady, --direction-tolerance, ...
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
 
 // How a run is read into windows: what a certificate must read as the fit read it.
 struct RunReadingArguments {
-  WindowOptions windows;
+  CliOptions<WindowOptions> windows;
   SamplesInputArguments input;
+  WindowOptions Windows() const {
+    WindowOptions options;
+    windows.Apply(&options);
+    return options;
+  }
 };
-// --trim, --window-temp-span, --window-max-duration, --window-min-samples, --max-turn-gap, --temp-c
-// and the segmentation options (fit, batch and report: run_options.cc).
+// The options of WindowOptionTable() (--trim, --window-temp-span, ...), --temp-c and the
+// segmentation options (report: run_options.cc).
 void AddRunReadingOptions(CLI::App* command, RunReadingArguments* args);
 
-// The options of a unit's fit, defined once for `imufit fit` and `imufit batch` so that the two
-// cannot drift apart (run_options.cc).
+// The options of a unit's fit, FitRunOptionTable(), defined once for `imufit fit` and `imufit
+// batch` so that the two cannot drift apart (run_options.cc).
 struct FitRunArguments {
-  RunReadingArguments run;
-  FitOptions fit;  // the options CLI11 fills directly
-  std::string loss = "huber";
-  bool no_g_sensitivity = false;
-  std::string groups = "all";  // --fit
-  std::string prior;           // --prior: the held groups' values
-  double gyro_bias_stability_dph = 0.0;
-  double accel_bias_stability_ug = 0.0;
-  CLI::Option* gyro_order_option = nullptr;
-  CLI::Option* accel_order_option = nullptr;
+  CliOptions<FitRunOptions> options;
 
-  // The FitRunOptions these options give (fit, windows, input): parses --loss and --fit, reads
-  // --prior, converts to SI, and with --temp-c makes the temperature orders 0. Throws InputError.
+  // The FitRunOptions these options give: converted to SI, --prior read, and with --temp-c the
+  // temperature orders 0. Throws InputError.
   FitRunOptions Resolve() const;
 };
-// The fit options, and AddRunReadingOptions: --fit, --prior, --loss, --loss-scale,
-// --gyro-temp-order, --accel-temp-order, --no-g-sensitivity, the bias stabilities,
-// --bias-correlation, --max-iterations.
-void AddFitRunOptions(CLI::App* command, FitRunArguments* args);
+// Every option of FitRunOptionTable() but those whose keys are in `except`.
+void AddFitRunOptions(CLI::App* command, FitRunArguments* args, const std::set<std::string>& except = {});
 
 struct Calibration;
 struct CorrectFileReport;

@@ -20,16 +20,12 @@ struct FitArguments {
   std::string plan;
   std::string samples;
   std::string output;
-  std::string check_plan;
-  std::string check_samples;
-  bool validate = false;
   bool quiet = false;
   std::string limits;           // acceptance limits: verdict table, exit 3 when they fail
   std::string report;           // certificate HTML to write
   std::string store;            // results store to record the fit in
   std::string serial;           // the unit's serial; empty: the samples header's, else the plan's
   std::string station;          // station file shown on the certificate (with --report)
-  bool allow_mismatch = false;  // --serial may contradict the samples header (a warning)
   FitRunArguments run;          // the fit options, shared with imufit batch
 };
 
@@ -98,12 +94,8 @@ void PrintErrors(const char* title, const std::vector<ErrorStats>& stats) {
 // The fit's options from the command line.
 FitRunOptions ResolveOptions(const FitArguments& args) {
   FitRunOptions options = args.run.Resolve();
-  options.validate = args.validate;
-  options.check_samples = args.check_samples;
-  options.check_plan = args.check_plan;
   options.software = SoftwareVersion();
   options.serial = args.serial;
-  options.allow_serial_mismatch = args.allow_mismatch;
   options.keep_static_stretch = !args.report.empty();  // the certificate's noise section
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit", problem);
@@ -244,11 +236,13 @@ int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool reco
 }
 
 int RunFit(const FitArguments& args) {
-  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, args.check_plan, args.check_samples,
-                                        args.limits, args.run.prior});
+  const std::string check_plan = args.run.options.GivenText("check_plan");
+  const std::string check_samples = args.run.options.GivenText("check_samples");
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, check_plan, check_samples, args.limits,
+                                        args.run.options.GivenText("prior")});
   if (!args.report.empty()) {
-    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, args.check_plan, args.check_samples,
-                                          args.limits, args.output, args.station});
+    RefuseToOverwriteInputs(args.report,
+                            {args.plan, args.samples, check_plan, check_samples, args.limits, args.output, args.station});
   }
   if (!args.station.empty() && args.report.empty()) {
     throw InputError("--station", "is shown on the certificate: give --report too");
@@ -274,9 +268,9 @@ int RunFit(const FitArguments& args) {
   }
   if (!args.quiet) {
     PrintFit(options, result);
-    if (args.validate) PrintValidation(result.folds);
+    if (options.validate) PrintValidation(result.folds);
     if (!result.check_errors.empty()) {
-      PrintErrors(("held-out run " + args.check_samples + ":").c_str(), result.check_errors);
+      PrintErrors(("held-out run " + options.check_samples + ":").c_str(), result.check_errors);
     }
   }
   unit.serial = result.serial;
@@ -301,12 +295,6 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
   command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
   AddFitRunOptions(command, &args->run);
-  command->add_option("--threads", args->run.fit.num_threads, "solver threads")->capture_default_str();
-  command->add_flag("--validate", args->validate,
-                    "leave each interior temperature out in turn, refit, and report the errors on it");
-  command->add_option("--check-samples", args->check_samples,
-                      "a held-out run to report the calibration's errors on");
-  command->add_option("--check-plan", args->check_plan, "the plan of --check-samples (default: --plan)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   command->add_option(
       "--limits,-l", args->limits,
@@ -315,9 +303,6 @@ CommandRunner AddFitCommand(CLI::App* root) {
       "--serial", args->serial,
       "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial); one "
       "that contradicts the samples header is refused (exit 2) unless --allow-mismatch");
-  command->add_flag("--allow-mismatch", args->allow_mismatch,
-                    "fit even when --serial names another unit than the samples header (a warning, also on "
-                    "the certificate)");
   command->add_option("--report", args->report,
                       "write the unit's calibration certificate (self-contained HTML)");
   command->add_option(

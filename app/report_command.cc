@@ -32,7 +32,7 @@ struct ReportArguments {
 int RunReport(const ReportArguments& args) {
   RefuseToOverwriteInputs(args.output,
                           {args.calibration, args.plan, args.samples, args.limits, args.station});
-  const WindowOptions& windows = args.run.windows;
+  const WindowOptions windows = args.run.Windows();
   const SamplesInput input = args.run.input.Get();
   if (std::string problem = windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   if (std::string problem = input.Validate(); !problem.empty()) throw InputError("imufit report", problem);

@@ -47,33 +47,11 @@ int RunSegment(const SegmentArguments& args) {
 }  // namespace
 
 void AddTempOption(CLI::App* command, SamplesInputArguments* args) {
-  args->temp_c_option = command->add_option(
-      "--temp-c", args->temp_c,
-      "the temperature of every sample, degC, for samples without a temp_c column (a run without a "
-      "thermometer); a file with the column is refused");
+  args->options.AddOne(command, SamplesInputOptionTable(), "temp_c");
 }
 
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args) {
-  SegmentationOptions& o = args->input.segmentation;
-  command
-      ->add_option("--segment-window", o.window_s,
-                   "without a segment column: sliding window whose variance tells rest from motion, s")
-      ->capture_default_str();
-  command
-      ->add_option("--min-steady", o.min_steady_s,
-                   "without a segment column: rests and constant rates shorter than this count as motion, s")
-      ->capture_default_str();
-  command
-      ->add_option("--direction-tolerance", o.direction_tolerance_deg,
-                   "without a segment column: how far a measured gravity direction or rotation axis may be "
-                   "from the plan's, deg")
-      ->capture_default_str();
-  command
-      ->add_option(
-          "--rate-tolerance", o.rate_tolerance,
-          "without a segment column: how far the raw size of a rate or turn may be from the others', "
-          "relative")
-      ->capture_default_str();
+  args->options.Add(command, SamplesInputOptionTable(), {"temp_c"});
 }
 
 CommandRunner AddSegmentCommand(CLI::App* root) {

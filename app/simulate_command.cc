@@ -21,13 +21,11 @@ struct SimulateArguments {
   std::string calibration;
   std::string output;
   std::string truth_output;
-  std::vector<double> soak_temps_c;
-  std::vector<double> ramp_c;
   std::string serial;  // written into both files' header comments (empty: none)
   bool quiet = false;
-  bool no_segment_column = false;  // an unlabelled log (the truth file keeps the labels)
-  bool no_temp_column = false;     // a log without a thermometer
-  SimulationOptions options;
+  bool no_segment_column = false;         // an unlabelled log (the truth file keeps the labels)
+  bool no_temp_column = false;            // a log without a thermometer
+  CliOptions<SimulationOptions> options;  // SimulationOptionTable()
 };
 
 int RunSimulate(SimulateArguments args) {
@@ -43,14 +41,8 @@ int RunSimulate(SimulateArguments args) {
       throw InputError(args.output, "--truth must differ from --output");
     }
   }
-  SimulationOptions& options = args.options;
-  if (!args.ramp_c.empty()) {
-    options.ramp = true;
-    options.ramp_from_c = args.ramp_c[0];
-    options.ramp_to_c = args.ramp_c[1];
-  } else if (!args.soak_temps_c.empty()) {
-    options.soak_temps_c = args.soak_temps_c;
-  }
+  SimulationOptions options;
+  args.options.Apply(&options);
   if (const std::string problem = options.Validate(); !problem.empty()) {
     throw InputError("imufit simulate", problem);
   }
@@ -74,16 +66,17 @@ int RunSimulate(SimulateArguments args) {
         "true angular rate (rad/s) and specific force (m/s^2) of " + args.output + serial_line, &outputs);
   }
   long long count = 0;
-  SimulateRun(options, plan.site, plan.segments, truth.model, [&](const Sample& raw, const SegmentTruth& truth_of) {
-    samples.Write(raw);
-    if (truth_samples) {
-      Sample true_sample = raw;
-      true_sample.gyro = truth_of.omega_radps;
-      true_sample.accel = truth_of.a_mps2;
-      truth_samples->Write(true_sample);
-    }
-    ++count;
-  });
+  SimulateRun(options, plan.site, plan.segments, truth.model,
+              [&](const Sample& raw, const SegmentTruth& truth_of) {
+                samples.Write(raw);
+                if (truth_samples) {
+                  Sample true_sample = raw;
+                  true_sample.gyro = truth_of.omega_radps;
+                  true_sample.accel = truth_of.a_mps2;
+                  truth_samples->Write(true_sample);
+                }
+                ++count;
+              });
   samples.Commit();
   if (truth_samples) truth_samples->Commit();
   outputs.Commit();
@@ -98,78 +91,28 @@ int RunSimulate(SimulateArguments args) {
 
 CommandRunner AddSimulateCommand(CLI::App* root) {
   auto args = std::make_shared<SimulateArguments>();
-  SimulationOptions& o = args->options;
   CLI::App* command = root->add_subcommand(
       "simulate",
       "Write a rate-table run for a plan from a known calibration (the truth), with noise, a "
       "temperature schedule and a seed. Noise densities are in Kalibr's units.");
   command->add_option("--plan,-p", args->plan, "plan YAML")->required();
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML used as the truth")->required();
+  command->add_option("--calibration,-c", args->calibration, "calibration YAML used as the truth")
+      ->required();
   command->add_option("--output,-o", args->output, "samples CSV to write (.gz compresses)")->required();
   command->add_option("--truth", args->truth_output,
                       "also write the true rate (rad/s) and specific force (m/s^2) of every sample, in "
                       "the corrected-samples layout");
-  auto* soak = command->add_option("--temps", args->soak_temps_c,
-                                   "soak temperatures, degC, comma-separated: one pass through the plan at each")
-                   ->delimiter(',')
-                   ->default_str("25");
-  auto* ramp = command->add_option("--ramp", args->ramp_c, "a linear temperature ramp FROM,TO in degC across --passes passes")
-                   ->delimiter(',')
-                   ->expected(2)
-                   ->excludes(soak);
-  command->add_option("--passes", o.passes, "passes through the plan during a ramp")->capture_default_str()->needs(ramp);
-  command->add_option("--dwell", o.dwell_s, "seconds in each segment")->capture_default_str();
-  command->add_option("--transition", o.transition_s, "seconds the table moves between segments (segment -1)")
-      ->capture_default_str();
-  command->add_option("--rate", o.rate_hz, "sample rate, Hz")->capture_default_str();
-  command->add_option("--start-time", o.start_time_s, "time_s of the first sample")->capture_default_str();
-  command->add_option("--gyro-noise-density", o.gyro_noise_density, "gyro white noise, rad/s/sqrt(Hz)")
-      ->capture_default_str();
-  command->add_option("--accel-noise-density", o.accel_noise_density, "accel white noise, m/s^2/sqrt(Hz)")
-      ->capture_default_str();
-  command->add_option("--gyro-random-walk", o.gyro_random_walk, "gyro bias random walk, rad/s^2/sqrt(Hz)")
-      ->capture_default_str();
-  command->add_option("--accel-random-walk", o.accel_random_walk, "accel bias random walk, m/s^3/sqrt(Hz)")
-      ->capture_default_str();
-  command->add_option("--gyro-bias-instability", o.gyro_bias_instability,
-                      "gyro Gauss-Markov bias, steady-state sigma, rad/s")
-      ->capture_default_str();
-  command->add_option("--accel-bias-instability", o.accel_bias_instability,
-                      "accel Gauss-Markov bias, steady-state sigma, m/s^2")
-      ->capture_default_str();
-  command->add_option("--bias-correlation", o.bias_correlation_s, "correlation time of the Gauss-Markov bias, s")
-      ->capture_default_str();
-  command->add_option("--temp-noise", o.temp_noise_c, "white noise of the temperature reading, degC")
-      ->capture_default_str();
-  command->add_flag("--quantize", o.quantize, "round raw outputs to integer counts");
+  args->options.Add(command, SimulationOptionTable());
+  args->options.Find("ramp_c")->excludes(args->options.Find("soak_temps_c"));
+  args->options.Find("passes")->needs(args->options.Find("ramp_c"));
   command->add_flag("--no-segment-column", args->no_segment_column,
                     "leave the segment column out (an unlabelled log; --truth keeps the true labels)");
-  command->add_flag("--no-temp-column", args->no_temp_column,
-                    "leave the temp_c column out (a log without a thermometer; --truth keeps the temperatures)");
-  command->add_option("--time-jitter-s", o.time_jitter_s,
-                      "time stamps off their nominal times by up to this much (uniform), s; below half the "
-                      "sample interval")
-      ->capture_default_str();
-  command
-      ->add_option("--drop-probability", o.drop_probability,
-                   "probability that a sample starts a loss of --drop-burst samples (as a serial link loses "
-                   "frames): the lost samples are not written")
-      ->capture_default_str();
-  command->add_option("--drop-burst", o.drop_burst, "samples lost in a row at each loss")
-      ->capture_default_str();
-  command
-      ->add_option(
-          "--gyro-full-scale", o.gyro_full_scale_raw,
-          "clip the raw gyro outputs to +- this, raw units, as a saturated converter does (0: no clip)")
-      ->capture_default_str();
-  command
-      ->add_option("--accel-full-scale", o.accel_full_scale_raw,
-                   "clip the raw accelerometer outputs to +- this, raw units (0: no clip)")
-      ->capture_default_str();
+  command->add_flag(
+      "--no-temp-column", args->no_temp_column,
+      "leave the temp_c column out (a log without a thermometer; --truth keeps the temperatures)");
   command->add_option("--serial", args->serial,
                       "the unit's serial, written into the header of the samples (and --truth) as "
                       "'# serial: SERIAL', where fit, report and batch find it");
-  command->add_option("--seed", o.seed, "random seed: the same seed gives the same file")->capture_default_str();
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
   return [args] { return RunSimulate(*args); };
 }

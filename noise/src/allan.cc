@@ -8,17 +8,14 @@
 #include <thread>
 
 #include "imufit/model/check.h"
+#include "imufit/model/enum_names.h"
 #include "imufit/noise/statistics.h"
 
 namespace imufit {
 namespace {
 
-// Name tables of the enums users type; `value` and `name` are what the helpers below read.
-struct EstimatorName {
-  AllanEstimator value;
-  const char* name;
-};
-constexpr EstimatorName kEstimatorNames[] = {
+// Name tables of the enums users type (model/enum_names.h).
+constexpr EnumName<AllanEstimator> kEstimatorNames[] = {
     {AllanEstimator::kAdev, "adev"},   {AllanEstimator::kOadev, "oadev"}, {AllanEstimator::kMdev, "mdev"},
     {AllanEstimator::kTdev, "tdev"},   {AllanEstimator::kHdev, "hdev"},   {AllanEstimator::kOhdev, "ohdev"},
     {AllanEstimator::kTotdev, "totdev"}};
@@ -31,32 +28,6 @@ struct EdfNoiseName {
 constexpr EdfNoiseName kEdfNoiseNames[] = {{EdfNoise::kIdentify, "auto", 0},      {EdfNoise::kWhitePm, "wpm", 2},
                                            {EdfNoise::kFlickerPm, "fpm", 1},      {EdfNoise::kWhiteFm, "wfm", 0},
                                            {EdfNoise::kFlickerFm, "ffm", -1},     {EdfNoise::kRandomWalkFm, "rwfm", -2}};
-
-template <typename Entry, size_t kCount, typename Value>
-const char* NameOf(const Entry (&table)[kCount], Value value) {
-  for (const Entry& entry : table) {
-    if (entry.value == value) return entry.name;
-  }
-  return "?";
-}
-
-template <typename Entry, size_t kCount, typename Value>
-bool ValueOf(const Entry (&table)[kCount], std::string_view text, Value* value) {
-  for (const Entry& entry : table) {
-    if (text == entry.name) {
-      *value = entry.value;
-      return true;
-    }
-  }
-  return false;
-}
-
-template <typename Entry, size_t kCount>
-std::string AllNames(const Entry (&table)[kCount]) {
-  std::string names;
-  for (const Entry& entry : table) names += (names.empty() ? "" : ", ") + std::string(entry.name);
-  return names;
-}
 
 // Work below this many terms per thread is not worth a thread.
 constexpr int64_t kMinTermsPerThread = 1 << 16;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "imufit/model/enum_names.h"
+
 namespace imufit {
 namespace {
 
@@ -127,17 +129,21 @@ bool SolveSubset(const Whitened& problem, unsigned mask, Eigen::Matrix<double, 5
   return true;
 }
 
+constexpr EnumName<int> kNoiseTermNames[kNoiseTerms] = {{kQuantization, "quantization"},
+                                                       {kRandomWalk, "random_walk"},
+                                                       {kBiasInstability, "bias_instability"},
+                                                       {kRateRandomWalk, "rate_random_walk"},
+                                                       {kRateRamp, "rate_ramp"}};
+
 double SqrtSigma(double v, double s) {
   return 0.5 * (std::sqrt(std::max(v, 0.0) + s) - std::sqrt(std::max(v - s, 0.0)));
 }
 
 }  // namespace
 
-const char* NoiseTermName(int term) {
-  static constexpr const char* kNames[kNoiseTerms] = {"quantization", "random_walk", "bias_instability",
-                                                      "rate_random_walk", "rate_ramp"};
-  return (term >= 0 && term < kNoiseTerms) ? kNames[term] : "?";
-}
+const char* NoiseTermName(int term) { return NameOf(kNoiseTermNames, term); }
+bool ParseNoiseTerm(std::string_view name, int* term) { return ValueOf(kNoiseTermNames, name, term); }
+std::string NoiseTermNames() { return AllNames(kNoiseTermNames); }
 
 double NoiseTermBasis(int term, double tau_s) {
   switch (term) {

@@ -1,7 +1,6 @@
 #include "imufit/pipeline/fit_run.h"
 
 #include <set>
-#include <sstream>
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
@@ -82,67 +81,6 @@ Calibration MakeCalibration(const FitRunResult& result, const FitRunOptions& opt
 }
 
 }  // namespace
-
-std::string FitRunOptions::Validate() const {
-  if (std::string problem = fit.Validate(); !problem.empty()) return problem;
-  if (std::string problem = windows.Validate(); !problem.empty()) return problem;
-  if (std::string problem = input.Validate(); !problem.empty()) return problem;
-  if (check_samples.empty() && !check_plan.empty()) return "a check plan needs check samples";
-  return "";
-}
-
-std::string FitRunOptions::Describe() const {
-  std::ostringstream text;
-  const auto add = [&text](const char* key, const std::string& value) {
-    text << (text.tellp() > 0 ? "; " : "") << key << "=" << value;
-  };
-  const auto number = [](double value) { return FormatDouble(value); };
-  std::string fitted;
-  for (const std::string& group : fit.Groups(true)) fitted += (fitted.empty() ? "" : ",") + group;
-  add("fitted", fitted);
-  if (!fit.Groups(false).empty()) {
-    std::string held = "nominal";
-    if (fit.held) {
-      std::string values = number(fit.held->basis.center_c) + " " + number(fit.held->basis.half_range_c);
-      for (double value : fit.held->gyro) values += " " + number(value);
-      for (double value : fit.held->accel) values += " " + number(value);
-      held = "prior " + Sha256Hex(values);
-    }
-    add("held", held);
-  }
-  add("gyro_temp_order", std::to_string(fit.gyro_temp_order));
-  add("accel_temp_order", std::to_string(fit.accel_temp_order));
-  add("loss", RobustLossName(fit.loss));
-  add("loss_scale", number(fit.loss_scale));
-  add("gyro_bias_stability_radps", number(fit.gyro_bias_stability_radps));
-  add("accel_bias_stability_mps2", number(fit.accel_bias_stability_mps2));
-  add("bias_correlation_s", number(fit.bias_correlation_s));
-  add("max_iterations", std::to_string(fit.max_iterations));
-  add("closed_form_start", fit.closed_form_start ? "true" : "false");
-  add("distinct_temp_c", number(fit.distinct_temp_c));
-  add("min_excitation_rate_radps", number(fit.min_excitation_rate_radps));
-  add("rank_tolerance", number(fit.rank_tolerance));
-  add("trim_s", number(windows.trim_s));
-  add("window_temp_span_c", number(windows.max_temp_span_c));
-  add("window_max_duration_s", number(windows.max_duration_s));
-  add("window_min_samples", std::to_string(windows.min_samples));
-  add("max_turn_gap_s", number(windows.max_turn_gap_s));
-  add("gyro_full_scale_raw", number(windows.gyro_full_scale_raw));
-  add("accel_full_scale_raw", number(windows.accel_full_scale_raw));
-  add("temp_c", input.temp_c ? number(*input.temp_c) : "column");
-  const SegmentationOptions& segmentation = input.segmentation;
-  add("segment_window_s", number(segmentation.window_s));
-  add("segment_noise_quantile", number(segmentation.noise_quantile));
-  add("segment_threshold_factor", number(segmentation.threshold_factor));
-  add("min_steady_s", number(segmentation.min_steady_s));
-  add("direction_tolerance_deg", number(segmentation.direction_tolerance_deg));
-  add("rate_tolerance", number(segmentation.rate_tolerance));
-  add("turn_margin_s", number(segmentation.turn_margin_s));
-  add("validate", validate ? "true" : "false");
-  if (!check_samples.empty()) add("check", check_samples + " " + check_plan);
-  add("allow_serial_mismatch", allow_serial_mismatch ? "true" : "false");
-  return text.str();
-}
 
 FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
                     const FitRunOptions& options) {

@@ -9,7 +9,7 @@ columns c0..c3 of powers of dT. See docs/python.md and docs/conventions.md.
 import dataclasses
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any, overload
+from typing import Any, TypedDict, Unpack, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -159,32 +159,88 @@ class FitResult:
     with a known specific force, over which the accel figures are), gyro_rms_radps, ...}},
     check_errors."""
 
-def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Any) -> FitResult:
+class _FitOptions(TypedDict, total=False):
+    """The keyword options of fit(): the keys of fit_options(), SI (tests/test_options.py checks
+    that the two agree). Defaults and descriptions: fit_options()."""
+
+    fit: str  # "all" | "gyro" | "gyro-bias" | "accel" | "accel-bias", comma-separated; the rest held
+    prior: PathLike  # calibration YAML whose values the held groups keep
+    gyro_temp_order: int  # 0..3
+    accel_temp_order: int  # 0..3
+    fit_g_sensitivity: bool
+    loss: str  # "none" | "huber" | "cauchy"
+    loss_scale: float
+    gyro_bias_stability_radps: float  # rad/s
+    accel_bias_stability_mps2: float  # m/s^2
+    bias_correlation_s: float  # s
+    max_iterations: int
+    closed_form_start: bool
+    threads: int
+    distinct_temp_c: float  # degC
+    min_excitation_rate_radps: float  # rad/s
+    rank_tolerance: float
+    trim_s: float  # s
+    window_temp_span_c: float  # degC
+    window_max_duration_s: float  # s
+    window_min_samples: int
+    max_turn_gap_s: float  # s
+    gyro_full_scale_raw: float  # raw
+    accel_full_scale_raw: float  # raw
+    temp_c: float | None  # degC, for a run without a temp_c column
+    segment_window_s: float  # s; this and the next six: finding the segments of a run without a segment column
+    segment_noise_quantile: float
+    segment_threshold_factor: float
+    min_steady_s: float  # s
+    direction_tolerance_deg: float  # deg
+    rate_tolerance: float
+    turn_margin_s: float  # s
+    validate: bool
+    check_samples: PathLike
+    check_plan: PathLike
+    allow_serial_mismatch: bool
+
+def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Unpack[_FitOptions]) -> FitResult:
     """Fits the thermal model to a run, as `imufit fit` does. plan: plan YAML path; samples: a path
-    or arrays as simulate() returns. Options (SI; defaults from fit_options()):
-    gyro_temp_order, accel_temp_order (0..3), fit_g_sensitivity, loss ("none" | "huber" |
-    "cauchy"), loss_scale, gyro_bias_stability_radps, accel_bias_stability_mps2,
-    bias_correlation_s, max_iterations, closed_form_start, threads, distinct_temp_c,
-    min_excitation_rate_radps, rank_tolerance, trim_s, window_temp_span_c, window_max_duration_s,
-    window_min_samples, max_turn_gap_s, gyro_full_scale_raw, accel_full_scale_raw, temp_c (degC for a run without a temp_c column), segment_window_s,
-    segment_noise_quantile, segment_threshold_factor, min_steady_s, direction_tolerance_deg,
-    rate_tolerance (finding the segments of a run without a segment column), validate,
-    check_samples, check_plan.
-    Raises InputError, UndeterminedError (what is missing), PlanMismatchError, FitError (not converged)."""
+    or arrays as simulate() returns. Options: _FitOptions (SI; defaults and descriptions from
+    fit_options()). Raises InputError, UndeterminedError (what is missing), PlanMismatchError,
+    FitError (not converged)."""
 
 def fit_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of fit()."""
 
-def simulate(plan: PathLike, truth: Calibration | PathLike, **options: Any) -> dict[str, FloatArray | IntArray]:
+class _SimulateOptions(TypedDict, total=False):
+    """The keyword options of simulate(): the keys of simulate_options() (tests/test_options.py
+    checks that the two agree). Defaults and descriptions: simulate_options()."""
+
+    soak_temps_c: Sequence[float]  # degC: one pass through the plan at each
+    ramp_c: tuple[float, float] | None  # (from, to) degC across `passes` passes; None: soaks
+    passes: int
+    dwell_s: float  # s
+    transition_s: float  # s
+    rate_hz: float  # Hz
+    start_time_s: float  # s
+    gyro_noise_density: float  # rad/s/sqrt(Hz)
+    accel_noise_density: float  # m/s^2/sqrt(Hz)
+    gyro_random_walk: float  # rad/s^2/sqrt(Hz)
+    accel_random_walk: float  # m/s^3/sqrt(Hz)
+    gyro_bias_instability: float  # rad/s
+    accel_bias_instability: float  # m/s^2
+    bias_correlation_s: float  # s
+    temp_noise_c: float  # degC
+    quantize: bool
+    time_jitter_s: float  # s
+    drop_probability: float  # lost samples: the arrays are then shorter
+    drop_burst: int
+    gyro_full_scale_raw: float  # outputs clipped
+    accel_full_scale_raw: float
+    seed: int
+
+def simulate(
+    plan: PathLike, truth: Calibration | PathLike, **options: Unpack[_SimulateOptions]
+) -> dict[str, FloatArray | IntArray]:
     """The run `imufit simulate` writes, sample for sample: {time_s, temp_c, segment, gyro, accel
-    (raw), omega_true_radps (rad/s), a_true_mps2 (m/s^2)}. Options (defaults from simulate_options()):
-    soak_temps_c (degC list), ramp_c ((from, to) degC), passes, dwell_s, transition_s, rate_hz,
-    start_time_s, gyro_noise_density (rad/s/sqrt(Hz)), accel_noise_density (m/s^2/sqrt(Hz)),
-    gyro_random_walk (rad/s^2/sqrt(Hz)), accel_random_walk (m/s^3/sqrt(Hz)),
-    gyro_bias_instability (rad/s), accel_bias_instability (m/s^2), bias_correlation_s,
-    time_jitter_s, drop_probability and drop_burst (lost samples: the arrays are then shorter),
-    gyro_full_scale_raw, accel_full_scale_raw (outputs clipped),
-    temp_noise_c, quantize, seed."""
+    (raw), omega_true_radps (rad/s), a_true_mps2 (m/s^2)}. Options: _SimulateOptions (defaults and
+    descriptions from simulate_options())."""
 
 def simulate_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of simulate()."""

@@ -1,198 +1,20 @@
 // imufit Python module: the fit (pipeline's FitRun, exactly what `imufit fit` runs) and the
 // simulator (fit/simulator.h, what `imufit simulate` runs).
 //
-// Keyword options map onto the libraries' option structs through one table per function
-// (FitOptionTable, SimulateOptionTable): a new option of FitOptions, WindowOptions or
-// FitRunOptions is one line there. Names are the structs' own, SI units, as the stub lists them.
-#include <functional>
+// Keyword options are those of the libraries' option tables (FitRunOptionTable(),
+// SimulationOptionTable(); keyword_options.h): SI units, as the stub lists them.
 #include <optional>
 
 #include "binding.h"
 #include "imufit/sim/simulator.h"
 #include "imufit/io/plan.h"
 #include "imufit/pipeline/fit_run.h"
+#include "keyword_options.h"
 
 namespace imufit::python {
 namespace {
 
-// Keyword options of one function, each a name, a line of documentation and how it reads and
-// writes the options struct.
-template <typename Options>
-class OptionTable {
- public:
-  struct Entry {
-    std::string name;
-    std::string doc;
-    std::function<void(const py::handle&, Options*)> set;
-    std::function<py::object(const Options&)> get;
-  };
-
-  // An option that is a field of Options (or of a struct inside it) of a type pybind11 converts.
-  template <typename T>
-  OptionTable& Field(const char* name, const char* doc, std::function<T&(Options&)> field) {
-    entries_.push_back({name, doc,
-                        [field](const py::handle& value, Options* o) { field(*o) = value.cast<T>(); },
-                        [field](const Options& o) { return py::cast(field(const_cast<Options&>(o))); }});
-    return *this;
-  }
-  OptionTable& Custom(const char* name, const char* doc, std::function<void(const py::handle&, Options*)> set,
-                      std::function<py::object(const Options&)> get) {
-    entries_.push_back({name, doc, std::move(set), std::move(get)});
-    return *this;
-  }
-
-  // Sets the options named in `kwargs`. An unknown name is a TypeError (as for any Python
-  // function); a value of the wrong type an InputError naming the option.
-  void Apply(const std::string& function, const py::dict& kwargs, Options* options) const {
-    for (const auto& [key, value] : kwargs) {
-      const std::string name = py::str(key);
-      const Entry* entry = Find(name);
-      if (entry == nullptr) {
-        std::string names;
-        for (const Entry& e : entries_) names += (names.empty() ? "" : ", ") + e.name;
-        throw py::type_error(function + "() got an unexpected keyword argument '" + name +
-                             "'; the options are: " + names);
-      }
-      try {
-        entry->set(value, options);
-      } catch (const py::cast_error&) {
-        ThrowBadArgument(function, name + "=" + std::string(py::str(py::repr(value))) +
-                                       " has the wrong type (" + entry->doc + ")");
-      }
-    }
-  }
-
-  // {name: (default, doc)}.
-  py::dict Describe(const Options& defaults) const {
-    py::dict described;
-    for (const Entry& e : entries_) described[py::str(e.name)] = py::make_tuple(e.get(defaults), e.doc);
-    return described;
-  }
-
- private:
-  const Entry* Find(const std::string& name) const {
-    for (const Entry& e : entries_) {
-      if (e.name == name) return &e;
-    }
-    return nullptr;
-  }
-  std::vector<Entry> entries_;
-};
-
 // --------------------------------------------------------------------------------------- fit
-
-const OptionTable<FitRunOptions>& FitOptionTable() {
-  using O = FitRunOptions;
-  static const OptionTable<O>* table = [] {
-    auto* t = new OptionTable<O>();
-    t->Field<int>("gyro_temp_order", "order of the gyro temperature polynomials, 0..3",
-                  [](O& o) -> int& { return o.fit.gyro_temp_order; })
-        .Field<int>("accel_temp_order", "order of the accelerometer temperature polynomials, 0..3",
-                    [](O& o) -> int& { return o.fit.accel_temp_order; })
-        .Field<bool>("fit_g_sensitivity", "fit the gyro g-sensitivity (False: held at zero)",
-                     [](O& o) -> bool& { return o.fit.fit_g_sensitivity; })
-        .Custom(
-            "loss", "robust loss: 'none', 'huber' or 'cauchy'",
-            [](const py::handle& value, O* o) {
-              std::string error;
-              if (!ParseRobustLoss(value.cast<std::string>(), &o->fit.loss, &error))
-                ThrowBadArgument("imufit.fit", error);
-            },
-            [](const O& o) { return py::cast(RobustLossName(o.fit.loss)); })
-        .Custom(
-            "fit",
-            "what to fit, comma-separated: 'all', 'gyro', 'gyro-bias', 'accel', 'accel-bias' (the rest held)",
-            [](const py::handle& value, O* o) {
-              std::string error;
-              if (!ParseFitGroups(value.cast<std::string>(), &o->fit, &error))
-                ThrowBadArgument("imufit.fit", error);
-            },
-            [](const O& o) {
-              const auto name = [](SensorFit fit, const char* sensor) -> std::string {
-                if (fit == SensorFit::kNone) return "";
-                return std::string(sensor) + (fit == SensorFit::kBias ? "-bias" : "");
-              };
-              const std::string gyro = name(o.fit.gyro_fit, "gyro"), accel = name(o.fit.accel_fit, "accel");
-              if (gyro == "gyro" && accel == "accel") return py::cast(std::string("all"));
-              return py::cast(gyro + (gyro.empty() || accel.empty() ? "" : ",") + accel);
-            })
-        .Field<double>("loss_scale",
-                       "where the robust loss acts, in robust spreads of the normalised residuals",
-                       [](O& o) -> double& { return o.fit.loss_scale; })
-        .Field<double>("gyro_bias_stability_radps", "the unit's in-run gyro bias stability, rad/s 1-sigma",
-                       [](O& o) -> double& { return o.fit.gyro_bias_stability_radps; })
-        .Field<double>("accel_bias_stability_mps2", "the unit's in-run accel bias stability, m/s^2 1-sigma",
-                       [](O& o) -> double& { return o.fit.accel_bias_stability_mps2; })
-        .Field<double>("bias_correlation_s", "seconds over which the wandering bias is taken as constant",
-                       [](O& o) -> double& { return o.fit.bias_correlation_s; })
-        .Field<int>("max_iterations", "solver iterations at most, per pass",
-                    [](O& o) -> int& { return o.fit.max_iterations; })
-        .Field<bool>("closed_form_start", "start from the closed-form solution (False: from nominal scales)",
-                     [](O& o) -> bool& { return o.fit.closed_form_start; })
-        .Field<int>("threads", "solver threads", [](O& o) -> int& { return o.fit.num_threads; })
-        .Field<double>("distinct_temp_c", "temperatures within this span count as one, degC",
-                       [](O& o) -> double& { return o.fit.distinct_temp_c; })
-        .Field<double>("min_excitation_rate_radps", "a rate segment excites an axis from this rate, rad/s",
-                       [](O& o) -> double& { return o.fit.min_excitation_rate_radps; })
-        .Field<double>("rank_tolerance", "relative singular value below which a direction is undetermined",
-                       [](O& o) -> double& { return o.fit.rank_tolerance; })
-        .Field<double>("trim_s", "seconds dropped at the start of each segment occurrence",
-                       [](O& o) -> double& { return o.windows.trim_s; })
-        .Field<double>("window_temp_span_c", "a window closes when its temperature has moved this far, degC",
-                       [](O& o) -> double& { return o.windows.max_temp_span_c; })
-        .Field<double>("window_max_duration_s", "a window closes after this many seconds (0: never)",
-                       [](O& o) -> double& { return o.windows.max_duration_s; })
-        .Field<int>("window_min_samples", "windows with fewer samples are dropped",
-                    [](O& o) -> int& { return o.windows.min_samples; })
-        .Field<double>("max_turn_gap_s",
-                       "a turn with a longer gap in its time stamps (lost samples), s, is dropped",
-                       [](O& o) -> double& { return o.windows.max_turn_gap_s; })
-        .Field<double>("gyro_full_scale_raw",
-                       "the gyro's full scale, raw (0: not given): clipped windows are left out",
-                       [](O& o) -> double& { return o.windows.gyro_full_scale_raw; })
-        .Field<double>("accel_full_scale_raw", "the accel's full scale, raw (0: not given)",
-                       [](O& o) -> double& { return o.windows.accel_full_scale_raw; })
-        .Custom(
-            "temp_c",
-            "the temperature of every sample, degC, for samples without a temp_c column (None: read it)",
-            [](const py::handle& value, O* o) {
-              o->input.temp_c = value.is_none() ? std::nullopt : std::optional<double>(value.cast<double>());
-            },
-            [](const O& o) { return o.input.temp_c ? py::cast(*o.input.temp_c) : py::none(); })
-        .Field<double>("segment_window_s",
-                       "without a segment column: sliding window whose variance tells rest from motion, s",
-                       [](O& o) -> double& { return o.input.segmentation.window_s; })
-        .Field<double>("segment_noise_quantile",
-                       "without a segment column: the noise level is this quantile of the windows' variances",
-                       [](O& o) -> double& { return o.input.segmentation.noise_quantile; })
-        .Field<double>("segment_threshold_factor",
-                       "without a segment column: steady below this multiple of the noise level",
-                       [](O& o) -> double& { return o.input.segmentation.threshold_factor; })
-        .Field<double>("min_steady_s",
-                       "without a segment column: shorter rests and constant rates count as motion, s",
-                       [](O& o) -> double& { return o.input.segmentation.min_steady_s; })
-        .Field<double>("direction_tolerance_deg",
-                       "without a segment column: how far a measured direction may be from the plan's, deg",
-                       [](O& o) -> double& { return o.input.segmentation.direction_tolerance_deg; })
-        .Field<double>(
-            "rate_tolerance",
-            "without a segment column: how far the raw size of a rate or turn may be from the others', "
-            "relative",
-            [](O& o) -> double& { return o.input.segmentation.rate_tolerance; })
-        .Field<bool>("validate", "leave each interior temperature out in turn and report the errors on it",
-                     [](O& o) -> bool& { return o.validate; })
-        .Custom(
-            "check_samples", "a held-out run (path) to report the calibration's errors on",
-            [](const py::handle& value, O* o) { o->check_samples = PathString(value); },
-            [](const O& o) { return py::cast(o.check_samples); })
-        .Custom(
-            "check_plan", "the plan (path) of check_samples (default: the fitted run's)",
-            [](const py::handle& value, O* o) { o->check_plan = PathString(value); },
-            [](const O& o) { return py::cast(o.check_plan); });
-    return t;
-  }();
-  return *table;
-}
 
 py::array_t<double> Triads(const std::vector<Eigen::Vector3d>& vectors) {
   py::array_t<double> array = NewArray(static_cast<py::ssize_t>(vectors.size()), 3);
@@ -332,7 +154,7 @@ py::dict Diagnostics(const FitRunResult& result) {
 py::dict Fit(const py::object& plan, const py::object& samples, const py::dict& kwargs) {
   FitRunOptions options;
   options.software = std::string("imufit ") + IMUFIT_VERSION;
-  FitOptionTable().Apply("imufit.fit", kwargs, &options);
+  ApplyKeywords(FitRunOptionTable(), "imufit.fit", kwargs, &options);
   if (const std::string problem = options.Validate(); !problem.empty())
     ThrowBadArgument("imufit.fit", problem);
   const std::string plan_path = PathString(plan);
@@ -370,76 +192,9 @@ py::dict Fit(const py::object& plan, const py::object& samples, const py::dict& 
 
 // ---------------------------------------------------------------------------------- simulate
 
-const OptionTable<SimulationOptions>& SimulateOptionTable() {
-  using O = SimulationOptions;
-  static const OptionTable<O>* table = [] {
-    auto* t = new OptionTable<O>();
-    t->Custom(
-         "soak_temps_c", "soak temperatures, degC: one pass through the plan at each",
-         [](const py::handle& value, O* o) { o->soak_temps_c = value.cast<std::vector<double>>(); },
-         [](const O& o) { return py::cast(o.soak_temps_c); })
-        .Custom(
-            "ramp_c", "(from, to): a linear temperature ramp across `passes` passes, degC (None: soaks)",
-            [](const py::handle& value, O* o) {
-              if (value.is_none()) {
-                o->ramp = false;
-                return;
-              }
-              const auto range = value.cast<std::array<double, 2>>();
-              o->ramp = true;
-              o->ramp_from_c = range[0];
-              o->ramp_to_c = range[1];
-            },
-            [](const O& o) -> py::object {
-              if (!o.ramp) return py::none();
-              return py::make_tuple(o.ramp_from_c, o.ramp_to_c);
-            })
-        .Field<int>("passes", "passes through the plan during a ramp", [](O& o) -> int& { return o.passes; })
-        .Field<double>("dwell_s", "seconds in each segment", [](O& o) -> double& { return o.dwell_s; })
-        .Field<double>("transition_s", "seconds the table moves between segments (segment -1)",
-                       [](O& o) -> double& { return o.transition_s; })
-        .Field<double>("rate_hz", "sample rate, Hz", [](O& o) -> double& { return o.rate_hz; })
-        .Field<double>("start_time_s", "time_s of the first sample",
-                       [](O& o) -> double& { return o.start_time_s; })
-        .Field<double>("gyro_noise_density", "gyro white noise, rad/s/sqrt(Hz)",
-                       [](O& o) -> double& { return o.gyro_noise_density; })
-        .Field<double>("accel_noise_density", "accel white noise, m/s^2/sqrt(Hz)",
-                       [](O& o) -> double& { return o.accel_noise_density; })
-        .Field<double>("gyro_random_walk", "gyro bias random walk, rad/s^2/sqrt(Hz)",
-                       [](O& o) -> double& { return o.gyro_random_walk; })
-        .Field<double>("accel_random_walk", "accel bias random walk, m/s^3/sqrt(Hz)",
-                       [](O& o) -> double& { return o.accel_random_walk; })
-        .Field<double>("gyro_bias_instability", "gyro Gauss-Markov bias, steady-state sigma, rad/s",
-                       [](O& o) -> double& { return o.gyro_bias_instability; })
-        .Field<double>("accel_bias_instability", "accel Gauss-Markov bias, steady-state sigma, m/s^2",
-                       [](O& o) -> double& { return o.accel_bias_instability; })
-        .Field<double>("bias_correlation_s", "correlation time of the Gauss-Markov bias, s",
-                       [](O& o) -> double& { return o.bias_correlation_s; })
-        .Field<double>("time_jitter_s",
-                       "uniform jitter of the time stamps, +- s (less than half the interval)",
-                       [](O& o) -> double& { return o.time_jitter_s; })
-        .Field<double>("drop_probability", "probability that a sample starts a loss of drop_burst samples",
-                       [](O& o) -> double& { return o.drop_probability; })
-        .Field<int>("drop_burst", "samples lost in a row at each loss",
-                    [](O& o) -> int& { return o.drop_burst; })
-        .Field<double>("gyro_full_scale_raw", "clip the raw gyro outputs to +- this (0: no clip)",
-                       [](O& o) -> double& { return o.gyro_full_scale_raw; })
-        .Field<double>("accel_full_scale_raw", "clip the raw accel outputs to +- this (0: no clip)",
-                       [](O& o) -> double& { return o.accel_full_scale_raw; })
-        .Field<double>("temp_noise_c", "white noise of the temperature reading, degC",
-                       [](O& o) -> double& { return o.temp_noise_c; })
-        .Field<bool>("quantize", "round raw outputs to integer counts",
-                     [](O& o) -> bool& { return o.quantize; })
-        .Field<std::uint64_t>("seed", "random seed: the same seed gives the same samples",
-                              [](O& o) -> std::uint64_t& { return o.seed; });
-    return t;
-  }();
-  return *table;
-}
-
 py::dict Simulate(const py::object& plan_path, const py::object& truth, const py::dict& kwargs) {
   SimulationOptions options;
-  SimulateOptionTable().Apply("imufit.simulate", kwargs, &options);
+  ApplyKeywords(SimulationOptionTable(), "imufit.simulate", kwargs, &options);
   if (const std::string problem = options.Validate(); !problem.empty())
     ThrowBadArgument("imufit.simulate", problem);
   const Plan plan = ReadPlan(PathString(plan_path));
@@ -494,7 +249,7 @@ void BindFit(py::module_& m) {
   m.def("_fit", &Fit, py::arg("plan"), py::arg("samples"), py::arg("options"),
         "imufit.fit() without the conversion of in-memory samples: paths only.");
   m.def(
-      "fit_options", [] { return FitOptionTable().Describe(FitRunOptions()); },
+      "fit_options", [] { return DescribeKeywords(FitRunOptionTable()); },
       "{name: (default, description)} of every keyword option of imufit.fit().");
   m.def(
       "simulate",
@@ -507,7 +262,7 @@ void BindFit(py::module_& m) {
       "simulate_options(). Returns {time_s, temp_c, segment, gyro, accel (raw), omega_true_radps, "
       "a_true_mps2}.");
   m.def(
-      "simulate_options", [] { return SimulateOptionTable().Describe(SimulationOptions()); },
+      "simulate_options", [] { return DescribeKeywords(SimulationOptionTable()); },
       "{name: (default, description)} of every keyword option of imufit.simulate().");
 }
 

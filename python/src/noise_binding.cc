@@ -3,6 +3,7 @@
 // ComputeAllan, and FitNoiseModel on the overlapping Allan deviation.
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "binding.h"
 #include "imufit/io/error.h"
@@ -65,11 +66,15 @@ AllanResult Allan(const std::string& where, std::vector<double> rates, double ta
   return result;
 }
 
-template <typename T, typename Field>
-py::array_t<T> PointArray(const AllanResult& result, Field field) {
-  py::array_t<T> array(static_cast<py::ssize_t>(result.points.size()));
-  for (size_t i = 0; i < result.points.size(); ++i) array.mutable_data()[i] = field(result.points[i]);
-  return array;
+// The getter of one field of every AllanPoint as an array (int64 for whole numbers, else float64).
+template <typename T>
+auto PointArray(T AllanPoint::*field) {
+  using Element = std::conditional_t<std::is_integral_v<T>, int64_t, double>;
+  return [field](const AllanResult& result) {
+    py::array_t<Element> array(static_cast<py::ssize_t>(result.points.size()));
+    for (size_t i = 0; i < result.points.size(); ++i) array.mutable_data()[i] = result.points[i].*field;
+    return array;
+  };
 }
 
 py::dict PerTerm(const std::array<double, kNoiseTerms>& values) {
@@ -88,11 +93,8 @@ NoiseFitSummary NoiseTerms(const py::object& data, const py::object& tau0_s, con
     for (const py::handle& term : terms) {
       const std::string name = py::str(term);
       int k = 0;
-      while (k < kNoiseTerms && name != NoiseTermName(k)) ++k;
-      if (k == kNoiseTerms) {
-        std::string names;
-        for (int j = 0; j < kNoiseTerms; ++j) names += std::string(j ? ", " : "") + NoiseTermName(j);
-        ThrowBadArgument(where, "term \"" + name + "\" is not one of: " + names);
+      if (!ParseNoiseTerm(name, &k)) {
+        ThrowBadArgument(where, "term \"" + name + "\" is not one of: " + NoiseTermNames());
       }
       options.enabled[k] = true;
     }
@@ -118,9 +120,26 @@ NoiseFitSummary NoiseTerms(const py::object& data, const py::object& tau0_s, con
   return FitNoiseModel(allan.points, allan.n_samples, options);
 }
 
-}  // namespace
+// imufit.allan(): the Allan computation of `imufit allan` for one column, options by name.
+AllanResult AllanOfRates(const py::object& y, double tau0_s, const std::string& estimator,
+                         const py::object& taus, double confidence, const std::string& edf_noise,
+                         int threads) {
+  const std::string where = "imufit.allan";
+  AllanOptions options;
+  if (!ParseAllanEstimator(estimator, &options.estimator)) {
+    ThrowBadArgument(where,
+                     "estimator " + QuoteForMessage(estimator) + " is not one of: " + AllanEstimatorNames());
+  }
+  if (!ParseEdfNoise(edf_noise, &options.edf_noise)) {
+    ThrowBadArgument(where, "edf_noise " + QuoteForMessage(edf_noise) + " is not one of: " + EdfNoiseNames());
+  }
+  options.confidence = confidence;
+  options.threads = threads;
+  return Allan(where, Rates(where, y), tau0_s, Taus(where, taus), options);
+}
 
-void BindNoise(py::module_& m) {
+// The points of an AllanResult as arrays, one property per field of AllanPoint.
+void BindAllanResult(py::module_& m) {
   py::class_<AllanResult>(
       m, "AllanResult",
       "An Allan-family deviation at several taus, with confidence intervals (NIST SP 1065).")
@@ -129,85 +148,28 @@ void BindNoise(py::module_& m) {
       .def_readonly("tau0_s", &AllanResult::tau0_s, "sample interval, s")
       .def_readonly("n_samples", &AllanResult::n_samples)
       .def_readonly("mean", &AllanResult::mean, "the mean of y that was removed, units of y")
-      .def_property_readonly(
-          "m",
-          [](const AllanResult& r) {
-            return PointArray<int64_t>(r, [](const AllanPoint& p) { return p.m; });
-          },
-          "averaging factors, tau / tau0")
-      .def_property_readonly(
-          "tau_s",
-          [](const AllanResult& r) {
-            return PointArray<double>(r, [](const AllanPoint& p) { return p.tau_s; });
-          },
-          "averaging times, s")
-      .def_property_readonly(
-          "terms",
-          [](const AllanResult& r) {
-            return PointArray<int64_t>(r, [](const AllanPoint& p) { return p.terms; });
-          },
-          "number of terms of the estimator at each tau")
-      .def_property_readonly(
-          "dev",
-          [](const AllanResult& r) {
-            return PointArray<double>(r, [](const AllanPoint& p) { return p.dev; });
-          },
-          "the deviation, units of y (tdev: units of y times s)")
-      .def_property_readonly(
-          "dev_lo",
-          [](const AllanResult& r) {
-            return PointArray<double>(r, [](const AllanPoint& p) { return p.dev_lo; });
-          },
-          "lower bound of the confidence interval (nan when no edf)")
-      .def_property_readonly(
-          "dev_hi",
-          [](const AllanResult& r) {
-            return PointArray<double>(r, [](const AllanPoint& p) { return p.dev_hi; });
-          },
-          "upper bound of the confidence interval (nan when no edf)")
-      .def_property_readonly(
-          "edf",
-          [](const AllanResult& r) {
-            return PointArray<double>(r, [](const AllanPoint& p) { return p.edf; });
-          },
-          "equivalent degrees of freedom")
-      .def_property_readonly(
-          "alpha",
-          [](const AllanResult& r) {
-            return PointArray<int64_t>(r, [](const AllanPoint& p) { return p.alpha; });
-          },
-          "noise exponent used for the edf")
+      .def_property_readonly("m", PointArray(&AllanPoint::m), "averaging factors, tau / tau0")
+      .def_property_readonly("tau_s", PointArray(&AllanPoint::tau_s), "averaging times, s")
+      .def_property_readonly("terms", PointArray(&AllanPoint::terms),
+                             "number of terms of the estimator at each tau")
+      .def_property_readonly("dev", PointArray(&AllanPoint::dev),
+                             "the deviation, units of y (tdev: units of y times s)")
+      .def_property_readonly("dev_lo", PointArray(&AllanPoint::dev_lo),
+                             "lower bound of the confidence interval (nan when no edf)")
+      .def_property_readonly("dev_hi", PointArray(&AllanPoint::dev_hi),
+                             "upper bound of the confidence interval (nan when no edf)")
+      .def_property_readonly("edf", PointArray(&AllanPoint::edf), "equivalent degrees of freedom")
+      .def_property_readonly("alpha", PointArray(&AllanPoint::alpha), "noise exponent used for the edf")
       .def("__len__", [](const AllanResult& r) { return r.points.size(); })
       .def("__repr__", [](const AllanResult& r) {
         return "<imufit.AllanResult " + std::string(ToString(r.estimator)) + ", " +
                std::to_string(r.points.size()) + " taus, " + std::to_string(r.n_samples) + " samples at " +
                FormatDouble(r.tau0_s) + " s>";
       });
+}
 
-  m.def(
-      "allan",
-      [](const py::object& y, double tau0_s, const std::string& estimator, const py::object& taus,
-         double confidence, const std::string& edf_noise, int threads) {
-        const std::string where = "imufit.allan";
-        AllanOptions options;
-        if (!ParseAllanEstimator(estimator, &options.estimator)) {
-          ThrowBadArgument(
-              where, "estimator " + QuoteForMessage(estimator) + " is not one of: " + AllanEstimatorNames());
-        }
-        if (!ParseEdfNoise(edf_noise, &options.edf_noise)) {
-          ThrowBadArgument(where,
-                           "edf_noise " + QuoteForMessage(edf_noise) + " is not one of: " + EdfNoiseNames());
-        }
-        options.confidence = confidence;
-        options.threads = threads;
-        return Allan(where, Rates(where, y), tau0_s, Taus(where, taus), options);
-      },
-      py::arg("y"), py::arg("tau0_s"), py::arg("estimator") = "oadev", py::arg("taus") = "octave",
-      py::arg("confidence") = 0.683, py::arg("edf_noise") = "auto", py::arg("threads") = 0,
-      "Allan deviation (or a relative: adev, oadev, mdev, tdev, hdev, ohdev, totdev) of rates y (shape (N,), "
-      "e.g. rad/s) sampled every tau0_s seconds, at taus 'octave', 'decade', 'all', 'per-decade:K' or a "
-      "sequence of taus in s, with confidence intervals. What `imufit allan` writes for one column.");
-
+// The IEEE 952 terms of a fit, read-only, SI.
+void BindNoiseTerms(py::module_& m) {
   py::class_<NoiseFitSummary>(
       m, "NoiseTerms",
       "The IEEE Std 952 noise model fitted to an Allan variance: sigma^2(tau) = 3 Q^2/tau^2 "
@@ -266,9 +228,9 @@ void BindNoise(py::module_& m) {
           "term_deviation",
           [](const NoiseFitSummary& s, const std::string& term, const py::object& tau_s) {
             int k = 0;
-            while (k < kNoiseTerms && term != NoiseTermName(k)) ++k;
-            if (k == kNoiseTerms)
+            if (!ParseNoiseTerm(term, &k)) {
               ThrowBadArgument("imufit.NoiseTerms.term_deviation", "no term \"" + term + "\"");
+            }
             return py::vectorize([&s, k](double tau) { return s.TermDeviation(k, tau); })(tau_s);
           },
           py::arg("term"), py::arg("tau_s"), "One term's share of the fitted Allan deviation at tau_s.")
@@ -278,7 +240,21 @@ void BindNoise(py::module_& m) {
                " B=" + FormatDouble(s.value[kBiasInstability]) +
                " K=" + FormatDouble(s.value[kRateRandomWalk]) + ">";
       });
+}
 
+}  // namespace
+
+void BindNoise(py::module_& m) {
+  BindAllanResult(m);
+  m.def(
+      "allan", &AllanOfRates, py::arg("y"), py::arg("tau0_s"), py::arg("estimator") = "oadev",
+      py::arg("taus") = "octave", py::arg("confidence") = 0.683, py::arg("edf_noise") = "auto",
+      py::arg("threads") = 0,
+      "Allan deviation (or a relative: adev, oadev, mdev, tdev, hdev, ohdev, totdev) of rates y (shape (N,), "
+      "e.g. rad/s) sampled every tau0_s seconds, at taus 'octave', 'decade', 'all', 'per-decade:K' or a "
+      "sequence of taus in s, with confidence intervals. What `imufit allan` writes for one column.");
+
+  BindNoiseTerms(m);
   m.def(
       "noise_terms", &NoiseTerms, py::arg("data"), py::arg("tau0_s") = py::none(), py::arg("taus") = "octave",
       py::arg("min_clusters") = 8.0, py::arg("terms") = py::none(),

@@ -7,9 +7,16 @@
 
 #include "imufit/io/noise_file.h"
 #include "imufit/io/units.h"
+#include "imufit/model/enum_names.h"
 
 namespace imufit {
 namespace {
+
+// "rad/s" is the native unit of a gyro column: an alias.
+constexpr EnumName<AllanPlotUnits> kAllanPlotUnitsNames[] = {{AllanPlotUnits::kNative, "native"},
+                                                             {AllanPlotUnits::kNative, "rad/s"},
+                                                             {AllanPlotUnits::kDegPerSecond, "deg/s"},
+                                                             {AllanPlotUnits::kDegPerHour, "deg/h"}};
 
 constexpr int kModelPoints = 120;  // taus at which the model and its terms are drawn
 // A term is drawn where its deviation is at least this share of the model's (a hundredth of the
@@ -281,19 +288,13 @@ void FrameTheAxes(Panel* panel) {
 }  // namespace
 
 bool ParseAllanPlotUnits(const std::string& text, AllanPlotUnits* units) {
-  if (text == "native" || text == "rad/s") {
-    *units = AllanPlotUnits::kNative;
-  } else if (text == "deg/s") {
-    *units = AllanPlotUnits::kDegPerSecond;
-  } else if (text == "deg/h") {
-    *units = AllanPlotUnits::kDegPerHour;
-  } else {
-    return false;
-  }
-  return true;
+  return ValueOf(kAllanPlotUnitsNames, text, units);
 }
 
-const char* AllanPlotUnitsNames() { return "native, rad/s, deg/s, deg/h"; }
+const char* AllanPlotUnitsNames() {
+  static const std::string names = AllNames(kAllanPlotUnitsNames);
+  return names.c_str();
+}
 
 PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::string& title,
                      AllanPlotUnits units) {

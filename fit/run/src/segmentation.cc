@@ -390,19 +390,6 @@ std::vector<Eigen::Vector3d> SignPatterns(bool all) {
 
 }  // namespace
 
-std::string SegmentationOptions::Validate() const {
-  if (!(window_s > 0.0)) return "the segmentation window must be positive";
-  if (!(noise_quantile > 0.0 && noise_quantile < 1.0)) return "the noise quantile must lie between 0 and 1";
-  if (!(threshold_factor > 1.0)) return "the steadiness threshold factor must exceed 1";
-  if (!(min_steady_s >= 0.0)) return "the minimum steady time cannot be negative";
-  if (!(direction_tolerance_deg > 0.0 && direction_tolerance_deg < 90.0)) {
-    return "the direction tolerance must lie between 0 and 90 degrees";
-  }
-  if (!(rate_tolerance > 0.0)) return "the rate tolerance must be positive";
-  if (!(turn_margin_s >= 0.0)) return "the turn margin cannot be negative";
-  return "";
-}
-
 MotionDetector::MotionDetector(const SegmentationOptions& options) : options_(options) {}
 
 void MotionDetector::Add(const Sample& sample) {

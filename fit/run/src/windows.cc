@@ -37,17 +37,6 @@ std::string TimeStampNote(const WindowStats& stats) {
   return note;
 }
 
-std::string WindowOptions::Validate() const {
-  if (!(trim_s >= 0.0)) return "the trim time cannot be negative";
-  if (!(max_temp_span_c > 0.0)) return "the window temperature span must be positive";
-  if (!(max_duration_s >= 0.0)) return "the window duration cannot be negative";
-  if (min_samples < 2) return "a window needs at least 2 samples";
-  if (!(max_turn_gap_s >= 0.0)) return "the longest gap allowed in a turn cannot be negative";
-  if (!(gyro_full_scale_raw >= 0.0) || !(accel_full_scale_raw >= 0.0))
-    return "a full scale cannot be negative";
-  return "";
-}
-
 WindowBuilder::WindowBuilder(const WindowOptions& options) : options_(options) {
   stats_.max_turn_gap_s = options.max_turn_gap_s;
 }

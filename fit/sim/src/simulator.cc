@@ -146,36 +146,6 @@ SegmentTruth MovingTruth(const TableSite& site, const TableSegment& segment, dou
 
 }  // namespace
 
-std::string SimulationOptions::Validate() const {
-  if (!(rate_hz > 0.0)) return "the sample rate must be positive";
-  if (!(dwell_s > 0.0)) return "the dwell time must be positive";
-  if (!(transition_s >= 0.0)) return "the transition time cannot be negative";
-  if (ramp && passes < 1) return "a ramp needs at least one pass";
-  if (!ramp && soak_temps_c.empty()) return "give at least one soak temperature";
-  // A temperature that is not a number would make every sample NaN.
-  std::vector<double> temps = soak_temps_c;
-  if (ramp) temps = {ramp_from_c, ramp_to_c};
-  for (const double t : temps) {
-    if (!(t >= -273.15 && t <= 1000.0)) return "temperatures must be numbers between -273.15 and 1000 degC";
-  }
-  if (!std::isfinite(rate_hz) || !std::isfinite(dwell_s) || !std::isfinite(transition_s)) {
-    return "the sample rate, dwell and transition times must be finite";
-  }
-  if (!(bias_correlation_s > 0.0)) return "the bias correlation time must be positive";
-  for (double v : {gyro_noise_density, accel_noise_density, gyro_random_walk, accel_random_walk,
-                   gyro_bias_instability, accel_bias_instability, temp_noise_c}) {
-    if (!(v >= 0.0)) return "noise figures cannot be negative";
-  }
-  if (!(time_jitter_s >= 0.0 && time_jitter_s < 0.5 / rate_hz)) {
-    return "the time jitter must lie in [0, half the sample interval)";
-  }
-  if (!(drop_probability >= 0.0 && drop_probability < 1.0)) return "the drop probability must lie in [0, 1)";
-  if (drop_burst < 1) return "a loss takes at least one sample";
-  if (!(gyro_full_scale_raw >= 0.0) || !(accel_full_scale_raw >= 0.0))
-    return "a full scale cannot be negative";
-  return "";
-}
-
 long long SimulationOptions::SampleCount(size_t segment_count) const {
   const long long dwell = std::llround(dwell_s * rate_hz);
   const long long move = std::llround(transition_s * rate_hz);

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "imufit/run/windows.h"
+#include "imufit/model/option_table.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 
@@ -99,7 +100,7 @@ struct FitOptions {
   // is below this fraction of the largest is undetermined.
   double rank_tolerance = 1e-8;
 
-  // An empty string when usable, else what is wrong.
+  // An empty string when usable, else what is wrong (naming the option and its value).
   std::string Validate() const;
   // Whether coefficient `coefficient` (sensor_model.h layout) of the gyro or the accelerometer is
   // fitted (true) or held at its stated value (false).
@@ -112,6 +113,12 @@ struct FitOptions {
 // Parses `imufit fit --fit`: a comma-separated list of "all", "gyro", "gyro-bias", "accel",
 // "accel-bias" (what is not named is held). On failure returns false and sets `error`.
 bool ParseFitGroups(const std::string& list, FitOptions* options, std::string* error);
+// The --fit text of what `options` fits: "all", "gyro-bias,accel", ...
+std::string FitGroupsText(const FitOptions& options);
+
+// Every option above, described once (model/option_table.h): the command's options, the Python
+// keywords, the fingerprint and Validate() derive from it (fit_options.cc).
+const OptionTable<FitOptions>& FitOptionTable();
 
 // The residual of one window after the fit, SI units, body frame.
 struct WindowResidual {

@@ -38,6 +38,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "imufit/noise/allan.h"
@@ -48,6 +49,10 @@ enum NoiseTerm { kQuantization = 0, kRandomWalk = 1, kBiasInstability = 2, kRate
 inline constexpr int kNoiseTerms = 5;
 // "quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp".
 const char* NoiseTermName(int term);
+// Parses a name; false (and `term` untouched) for anything else.
+bool ParseNoiseTerm(std::string_view name, int* term);
+// Every name, comma-separated.
+std::string NoiseTermNames();
 
 // The basis function of term k at tau: the variance it contributes per unit coefficient.
 double NoiseTermBasis(int term, double tau_s);

@@ -54,13 +54,20 @@ struct FitRunOptions {
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
-  // Every option above that can change what a fit of the same files gives (the calibration, its
-  // validation, an error), as one line of text; not the software, the serial or the hashes. The
-  // held values of a prior are named by a SHA-256 of their numbers, so that a prior file that is
-  // edited counts as changed and a copy elsewhere does not. The batch manifest compares it to decide
-  // whether a unit is unchanged.
+  // Every option of FitRunOptionTable() that can change what a fit of the same files gives (the
+  // calibration, its validation, an error), as one line of "key=value" items; not the threads, the
+  // software, the serial or the hashes. The held values of a prior are named by a SHA-256 of their
+  // numbers, so that a prior file that is edited counts as changed and a copy elsewhere does not.
+  // The batch manifest compares it to decide whether a unit is unchanged.
   std::string Describe() const;
 };
+
+// Every option a user sets of a unit's fit (those of FitOptions, WindowOptions and SamplesInput
+// included, then the prior, validation, check run and serial mismatch), described once
+// (model/option_table.h; run_options.cc): `imufit fit`, `batch`, the Python keywords of
+// imufit.fit() and Describe() derive from it. Not in it: software, serial and the hashes, which
+// the caller fills.
+const OptionTable<FitRunOptions>& FitRunOptionTable();
 
 struct FitRunResult {
   // The unit's serial as FitRunOptions::serial resolves it (also when the fit fails); empty when

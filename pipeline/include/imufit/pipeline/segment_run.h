@@ -21,9 +21,12 @@ struct SamplesInput {
   // How the segments are found in a file without a segment column.
   SegmentationOptions segmentation;
 
-  // An empty string when usable, else what is wrong.
-  std::string Validate() const { return segmentation.Validate(); }
+  // An empty string when usable, else what is wrong (naming the option and its value).
+  std::string Validate() const;
 };
+
+// Every option of SamplesInput, described once (model/option_table.h; run_options.cc).
+const OptionTable<SamplesInput>& SamplesInputOptionTable();
 
 // Pass 1 over `samples_path` and the match with `plan` (its segment column, if any, is ignored).
 // Throws InputError for bad input and PlanMismatchError when the log and the plan disagree.

@@ -52,6 +52,7 @@
 
 #include <Eigen/Core>
 
+#include "imufit/model/option_table.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sample.h"
 
@@ -79,9 +80,12 @@ struct SegmentationOptions {
   // start and end of a turn lie below the detection threshold, and the turn's integral must be whole.
   double turn_margin_s = 2.0;
 
-  // An empty string when usable, else what is wrong.
+  // An empty string when usable, else what is wrong (naming the option and its value).
   std::string Validate() const;
 };
+
+// Every option of SegmentationOptions, described once (model/option_table.h; segmentation_options.cc).
+const OptionTable<SegmentationOptions>& SegmentationOptionTable();
 
 enum class PieceKind {
   kSteady,      // gyro and accelerometer steady: a rest, or a constant rate about the vertical

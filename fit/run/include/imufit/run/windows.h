@@ -45,6 +45,7 @@
 
 #include <Eigen/Core>
 
+#include "imufit/model/option_table.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sample.h"
 #include "imufit/run/sample_clock.h"
@@ -71,9 +72,12 @@ struct WindowOptions {
   double gyro_full_scale_raw = 0.0;
   double accel_full_scale_raw = 0.0;
 
-  // An empty string when usable, else what is wrong.
+  // An empty string when usable, else what is wrong (naming the option and its value).
   std::string Validate() const;
 };
+
+// Every option of WindowOptions, described once (model/option_table.h; window_options.cc).
+const OptionTable<WindowOptions>& WindowOptionTable();
 
 // The statistics of one window.
 struct Window {

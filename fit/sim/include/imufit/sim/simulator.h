@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "imufit/model/option_table.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sample.h"
 #include "imufit/model/sensor_model.h"
@@ -77,11 +78,14 @@ struct SimulationOptions {
   double accel_full_scale_raw = 0.0;
   std::uint64_t seed = 1;
 
-  // An empty string when the options are usable, else what is wrong.
+  // An empty string when the options are usable, else what is wrong (naming the option and its value).
   std::string Validate() const;
   // Number of samples the run will have (without losses; with drop_probability, at most this many).
   long long SampleCount(size_t segment_count) const;
 };
+
+// Every option of SimulationOptions, described once (model/option_table.h; simulation_options.cc).
+const OptionTable<SimulationOptions>& SimulationOptionTable();
 
 // Called for every sample, in time order: the raw sample and its truth.
 using SimulationSink = std::function<void(const Sample& raw, const SegmentTruth& truth)>;

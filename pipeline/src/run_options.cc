@@ -1,0 +1,144 @@
+// The option tables of a run (SamplesInput, FitRunOptions), FitRunOptions::Validate() and its
+// fingerprint, Describe(): all derived from the tables (model/option_table.h).
+#include <type_traits>
+
+#include "imufit/io/calibration.h"
+#include "imufit/io/output_file.h"
+#include "imufit/io/sha256.h"
+#include "imufit/pipeline/fit_run.h"
+
+namespace imufit {
+namespace {
+
+OptionTable<SamplesInput> MakeSamplesInputOptionTable() {
+  OptionTable<SamplesInput> t;
+  t.OptionalNumber("temp_c", "--temp-c",
+                   "the temperature of every sample, for samples without a temp_c column (a run without a "
+                   "thermometer); a file with the column is refused",
+                   "degC", &SamplesInput::temp_c, OptionRange{}, "column");
+  t.Include(SegmentationOptionTable(), &SamplesInput::segmentation);
+  return t;
+}
+
+// The held groups' values: "nominal", or a prior named by a SHA-256 of its numbers, so that an
+// edited prior file counts as changed and a copy elsewhere does not.
+std::string HeldText(const FitOptions& fit) {
+  if (!fit.held) return "nominal";
+  std::string values =
+      FormatDouble(fit.held->basis.center_c) + " " + FormatDouble(fit.held->basis.half_range_c);
+  for (double value : fit.held->gyro) values += " " + FormatDouble(value);
+  for (double value : fit.held->accel) values += " " + FormatDouble(value);
+  return "prior " + Sha256Hex(values);
+}
+
+// The accessors of a path option kept as given.
+auto PathGetter(std::string FitRunOptions::*member) {
+  return [member](const FitRunOptions& o) { return o.*member; };
+}
+auto PathSetter(std::string FitRunOptions::*member) {
+  return [member](const std::string& path, FitRunOptions* o) {
+    o->*member = path;
+    return std::string();
+  };
+}
+
+OptionTable<FitRunOptions> MakeFitRunOptionTable() {
+  using O = FitRunOptions;
+  OptionTable<O> t;
+  t.Include(FitOptionTable(), &O::fit);
+  OptionEntry<O>& prior = t.Text(
+      "prior", "--prior", "calibration YAML whose values the held groups keep (default: scale 1, the rest 0)",
+      [](const O&) { return std::string(); },
+      [](const std::string& path, O* o) {
+        o->fit.held = path.empty() ? std::nullopt : std::optional<SensorModel>(ReadCalibration(path).model);
+        return std::string();
+      },
+      /*path=*/true);
+  prior.fingerprint = Fingerprint::kCustom;
+  prior.describe = [](const O& o) { return o.fit.Groups(false).empty() ? "" : "held=" + HeldText(o.fit); };
+  t.MoveAfter("prior", "fit");
+  t.Include(WindowOptionTable(), &O::windows);
+  t.Include(SamplesInputOptionTable(), &O::input);
+  t.Flag("validate", "--validate",
+         "leave each interior temperature out in turn, refit, and report the errors on it", &O::validate);
+  OptionEntry<O>& check =
+      t.Text("check_samples", "--check-samples", "a held-out run to report the calibration's errors on",
+             PathGetter(&O::check_samples), PathSetter(&O::check_samples), /*path=*/true);
+  check.fingerprint = Fingerprint::kCustom;
+  check.describe = [](const O& o) {
+    return o.check_samples.empty() ? "" : "check=" + o.check_samples + " " + o.check_plan;
+  };
+  OptionEntry<O>& check_plan =
+      t.Text("check_plan", "--check-plan", "the plan of check_samples (default: the fitted run's)",
+             PathGetter(&O::check_plan), PathSetter(&O::check_plan), /*path=*/true);
+  check_plan.fingerprint = Fingerprint::kCustom;  // in `check`
+  check_plan.describe = [](const O&) { return std::string(); };
+  t.Flag("allow_serial_mismatch", "--allow-mismatch",
+         "fit even when the stated serial (--serial, a batch unit's serial.txt) names another unit than the "
+         "samples header (a warning, also on the certificate); without it such a unit is refused",
+         &O::allow_serial_mismatch);
+  return t;
+}
+
+// An option's value as the fingerprint writes it: numbers as the shortest text that reads back
+// the same double.
+template <typename Options>
+std::string ValueText(const OptionEntry<Options>& entry, const Options& options) {
+  return std::visit(
+      [&options](const auto& kind) -> std::string {
+        using Kind = std::decay_t<decltype(kind)>;
+        if constexpr (std::is_same_v<Kind, NumberOption<Options, double>>) {
+          return FormatDouble(kind.Get(options));
+        } else if constexpr (std::is_same_v<Kind, NumberOption<Options, int>> ||
+                             std::is_same_v<Kind, NumberOption<Options, std::uint64_t>>) {
+          return std::to_string(kind.Get(options));
+        } else if constexpr (std::is_same_v<Kind, FlagOption<Options>>) {
+          return kind.Get(options) ? "true" : "false";
+        } else if constexpr (std::is_same_v<Kind, OptionalNumberOption<Options>>) {
+          const std::optional<double> value = kind.Get(options);
+          return value ? FormatDouble(*value) : kind.absent;
+        } else if constexpr (std::is_same_v<Kind, NumbersOption<Options>>) {
+          std::string text;
+          for (double value : kind.Get(options)) text += (text.empty() ? "" : ",") + FormatDouble(value);
+          return text;
+        } else {
+          return kind.Get(options);
+        }
+      },
+      entry.value);
+}
+
+}  // namespace
+
+const OptionTable<SamplesInput>& SamplesInputOptionTable() {
+  static const OptionTable<SamplesInput> table = MakeSamplesInputOptionTable();
+  return table;
+}
+
+const OptionTable<FitRunOptions>& FitRunOptionTable() {
+  static const OptionTable<FitRunOptions> table = MakeFitRunOptionTable();
+  return table;
+}
+
+std::string SamplesInput::Validate() const { return ValidateOptions(SamplesInputOptionTable(), *this); }
+
+std::string FitRunOptions::Validate() const {
+  if (std::string problem = fit.Validate(); !problem.empty()) return problem;
+  if (std::string problem = windows.Validate(); !problem.empty()) return problem;
+  if (std::string problem = input.Validate(); !problem.empty()) return problem;
+  if (check_samples.empty() && !check_plan.empty()) return "a check plan needs check samples";
+  return "";
+}
+
+std::string FitRunOptions::Describe() const {
+  std::string text;
+  for (const OptionEntry<FitRunOptions>& entry : FitRunOptionTable().entries()) {
+    std::string item;
+    if (entry.fingerprint == Fingerprint::kValue) item = entry.key + "=" + ValueText(entry, *this);
+    if (entry.fingerprint == Fingerprint::kCustom) item = entry.describe(*this);
+    if (!item.empty()) text += (text.empty() ? "" : "; ") + item;
+  }
+  return text;
+}
+
+}  // namespace imufit
