@@ -9,7 +9,7 @@
 #include <string>
 #include <type_traits>
 
-#include "imufit/fit/simulator.h"
+#include "imufit/sim/simulator.h"
 #include "imufit/model/enum_names.h"
 #include "imufit/pipeline/fit_run.h"
 
