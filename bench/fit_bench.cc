@@ -20,12 +20,12 @@
 #include <string>
 #include <vector>
 
-#include "imufit/sim/simulator.h"
-#include "imufit/run/windows.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/pipeline/run_windows.h"
+#include "imufit/run/windows.h"
+#include "imufit/sim/simulator.h"
 
 namespace fs = std::filesystem;
 

@@ -5,10 +5,11 @@
 #include <cmath>
 #include <limits>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // sqrt(2 ln 2 / pi): the flicker floor of the Allan deviation is 0.664 B.
 const double kFlickerFloor = std::sqrt(2.0 * std::log(2.0) / kPi);
 // A read-out slope must be within kReadoutSlopeTolerance of its target (-1/2 or +1/2) to count;

@@ -5,10 +5,11 @@
 #include <limits>
 #include <vector>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRelativeEpsilon = 1e-16;
 constexpr int kMaxGammaIterations = 100000000;
 

@@ -8,9 +8,9 @@
 #include <optional>
 
 #include "binding.h"
-#include "imufit/sim/simulator.h"
 #include "imufit/io/plan.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/sim/simulator.h"
 
 namespace imufit::python {
 namespace {

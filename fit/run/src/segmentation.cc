@@ -9,10 +9,11 @@
 
 #include <Eigen/Geometry>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Pass 1 keeps this many samples before it fixes the block length from their mean interval.
 constexpr size_t kHeadSamples = 32;
 // A window holds at least this many samples (slow logs widen it).

@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
@@ -22,9 +24,9 @@ class NormalSource {
     const double u1 = Uniform();
     const double u2 = Uniform();
     const double radius = std::sqrt(-2.0 * std::log(u1));
-    spare_ = radius * std::sin(2.0 * M_PI * u2);
+    spare_ = radius * std::sin(2.0 * kPi * u2);
     has_spare_ = true;
-    return radius * std::cos(2.0 * M_PI * u2);
+    return radius * std::cos(2.0 * kPi * u2);
   }
   Eigen::Vector3d Next3() {
     const double x = Next();
@@ -127,8 +129,8 @@ SegmentTruth MovingTruth(const TableSite& site, const TableSegment& segment, dou
     const double motion_s = (1.0 - 2.0 * kTurnRestFraction) * dwell_s;
     const double tau = std::clamp((t_s - kTurnRestFraction * dwell_s) / motion_s, 0.0, 1.0);
     // s(tau) = tau - sin(2 pi tau) / (2 pi): rate 1 - cos(2 pi tau), zero with zero slope at both ends.
-    angle = *segment.angle_rad * (tau - std::sin(2.0 * M_PI * tau) / (2.0 * M_PI));
-    rate = *segment.angle_rad * (1.0 - std::cos(2.0 * M_PI * tau)) / motion_s;
+    angle = *segment.angle_rad * (tau - std::sin(2.0 * kPi * tau) / (2.0 * kPi));
+    rate = *segment.angle_rad * (1.0 - std::cos(2.0 * kPi * tau)) / motion_s;
   } else {
     angle = segment.rate_radps * t_s;
   }

@@ -38,9 +38,9 @@
 #include <string>
 #include <vector>
 
-#include "imufit/run/windows.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
+#include "imufit/run/windows.h"
 
 namespace imufit {
 

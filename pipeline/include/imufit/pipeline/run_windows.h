@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "imufit/run/segmentation.h"
-#include "imufit/run/windows.h"
 #include "imufit/io/plan.h"
 #include "imufit/pipeline/segment_run.h"
+#include "imufit/run/segmentation.h"
+#include "imufit/run/windows.h"
 
 namespace imufit {
 

@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "imufit/run/segmentation.h"
 #include "imufit/io/plan.h"
+#include "imufit/run/segmentation.h"
 
 namespace imufit {
 
