@@ -39,11 +39,16 @@ struct CorrelationModel {
 };
 CorrelationModel CorrelationFor(int alpha) {
   switch (alpha) {
-    case 2: return {0.45, 10.0, 1.5};
-    case 1: return {0.30, 0.60, 1.5};
-    case 0: return {0.0, 0.63, 1.4};
-    case -1: return {0.0, 0.30, 1.55};
-    default: return {0.0, 0.128, 1.7};
+    case 2:
+      return {0.45, 10.0, 1.5};
+    case 1:
+      return {0.30, 0.60, 1.5};
+    case 0:
+      return {0.0, 0.63, 1.4};
+    case -1:
+      return {0.0, 0.30, 1.55};
+    default:
+      return {0.0, 0.128, 1.7};
   }
 }
 
@@ -134,19 +139,18 @@ double SqrtSigma(double v, double s) {
 
 }  // namespace
 
-const char* NoiseTermName(int term) {
-  static constexpr const char* kNames[kNoiseTerms] = {"quantization", "random_walk", "bias_instability",
-                                                      "rate_random_walk", "rate_ramp"};
-  return (term >= 0 && term < kNoiseTerms) ? kNames[term] : "?";
-}
-
 double NoiseTermBasis(int term, double tau_s) {
   switch (term) {
-    case kQuantization: return 3.0 / (tau_s * tau_s);
-    case kRandomWalk: return 1.0 / tau_s;
-    case kBiasInstability: return kFlickerFloor * kFlickerFloor;
-    case kRateRandomWalk: return tau_s / 3.0;
-    case kRateRamp: return 0.5 * tau_s * tau_s;
+    case kQuantization:
+      return 3.0 / (tau_s * tau_s);
+    case kRandomWalk:
+      return 1.0 / tau_s;
+    case kBiasInstability:
+      return kFlickerFloor * kFlickerFloor;
+    case kRateRandomWalk:
+      return tau_s / 3.0;
+    case kRateRamp:
+      return 0.5 * tau_s * tau_s;
   }
   return 0.0;
 }
@@ -173,15 +177,16 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
   std::vector<Point> points;
   for (const AllanPoint& p : all_points) {
     const double clusters = static_cast<double>(n_samples) / static_cast<double>(p.m);
-    if (clusters < options.min_clusters || !(p.dev > 0.0) || !std::isfinite(p.edf) || !(p.edf > 0.0)) continue;
+    if (clusters < options.min_clusters || !(p.dev > 0.0) || !std::isfinite(p.edf) || !(p.edf > 0.0))
+      continue;
     points.push_back({p.tau_s, p.dev * p.dev, p.edf, p.alpha});
   }
   summary.points_used = static_cast<int>(points.size());
 
   // Classic read-outs from the measured curve.
   if (!points.empty()) {
-    const auto lowest = std::min_element(points.begin(), points.end(),
-                                         [](const Point& a, const Point& b) { return a.variance < b.variance; });
+    const auto lowest = std::min_element(
+        points.begin(), points.end(), [](const Point& a, const Point& b) { return a.variance < b.variance; });
     summary.readout_bias_instability = std::sqrt(lowest->variance) / kFlickerFloor;
     summary.readout_bias_tau_s = lowest->tau_s;
     // Among the segments whose slope is near the target, the one with the most degrees of
@@ -212,7 +217,8 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
       const double dev = std::sqrt(points[i].variance);
       const double edf = std::min(points[i].edf, points[i + 1].edf);
       arw.Offer(std::fabs(slope + 0.5), edf, dev * std::sqrt(points[i].tau_s));  // sigma = N / sqrt(tau)
-      rrw.Offer(std::fabs(slope - 0.5), edf, dev * std::sqrt(3.0 / points[i].tau_s));  // sigma = K sqrt(tau/3)
+      rrw.Offer(std::fabs(slope - 0.5), edf,
+                dev * std::sqrt(3.0 / points[i].tau_s));  // sigma = K sqrt(tau/3)
     }
     summary.readout_random_walk = arw.Value();
     summary.readout_rate_random_walk = rrw.Value();
@@ -231,8 +237,8 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
     return summary;
   }
   if (points.size() < 2) {
-    summary.message = "too few points for a noise fit (" + std::to_string(points.size()) +
-                      " with at least " + std::to_string(static_cast<int>(options.min_clusters)) +
+    summary.message = "too few points for a noise fit (" + std::to_string(points.size()) + " with at least " +
+                      std::to_string(static_cast<int>(options.min_clusters)) +
                       " averaging intervals in the record)";
     return summary;
   }
@@ -288,9 +294,8 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
       Eigen::Matrix<double, 5, 1> c;
       Eigen::Matrix<double, 5, 5> covariance;
       double cost = 0.0;
-      variance_of_c = SolveSubset(problem, best_mask | (1u << k), &c, &covariance, &cost)
-                          ? covariance(k, k)
-                          : std::nan("");
+      variance_of_c = SolveSubset(problem, best_mask | (1u << k), &c, &covariance, &cost) ? covariance(k, k)
+                                                                                          : std::nan("");
     }
     summary.variance_sigma[k] = std::sqrt(std::max(0.0, variance_of_c) * inflate);
     summary.value[k] = std::sqrt(summary.variance[k]);
