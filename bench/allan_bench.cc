@@ -1,4 +1,4 @@
-// imufit — benchmark of the Allan deviation (issue 4): oadev at octave taus over 1e7 and 1e8
+// imufit — benchmark of the Allan deviation: oadev at octave taus over 1e7 and 1e8
 // samples, in memory (1e8 doubles = 800 MB).
 //
 // Prints, per size: one plain streaming pass over the array (a sum of squares, one core: the

@@ -1,4 +1,4 @@
-// imufit — benchmark of the correction core that `imufit apply` runs per row (issue 11): the shared
+// imufit — benchmark of the correction core that `imufit apply` runs per row: the shared
 // model's SensorModel::Correct over N samples held in memory (no CSV), in the (N,) / (N, 3) layout
 // of numpy arrays, so that bench/python_correct_bench.py can compare imufit.Calibration.correct
 // with it. Best of three runs, one core. Figures are measured, never asserted.

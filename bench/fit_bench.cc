@@ -1,4 +1,4 @@
-// imufit — benchmark of `imufit fit` on a factory-sized run (issue 3):
+// imufit — benchmark of `imufit fit` on a factory-sized run:
 //
 //   7 soak temperatures x 18 segments x 30 s at 800 Hz, about 3 million samples.
 //
