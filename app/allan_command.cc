@@ -1,7 +1,8 @@
 // imufit allan — Allan deviation (and relatives) of columns of a samples file, their confidence
 // intervals, the IEEE 952 noise terms, a noise YAML file and a plot (docs/spec.md section 4,
 // docs/allan.md). Thin: the per-column analysis is noise/column_analysis.h, the files are
-// io/noise_file.h (engineer units: io/units.h), the plot is factory/allan_plot.h.
+// io/noise_file.h (filled from the analysis here; engineer units: io/units.h), the plot is
+// factory/allan_plot.h.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +20,8 @@
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 #include "imufit/model/enum_names.h"
+#include "imufit/noise/allan.h"
+#include "imufit/noise/column_analysis.h"
 
 namespace imufit {
 namespace {
@@ -173,17 +176,25 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
   }
 }
 
-int RunAllan(const AllanArguments& args) {
+// The analysis and what it needs, parsed and checked before anything is read.
+struct AllanSettings {
   AllanOptions options;
-  if (!ParseAllanEstimator(args.estimator, &options.estimator)) {
+  NoiseFitOptions fit_options;
+  TauSpec tau_spec;
+  double seconds_per_unit = 1.0;  // of the time column
+  AllanPlotUnits plot_units = AllanPlotUnits::kNative;
+};
+
+AllanSettings ParseSettings(const AllanArguments& args) {
+  AllanSettings settings;
+  if (!ParseAllanEstimator(args.estimator, &settings.options.estimator)) {
     BadInvocation("--estimator " + QuoteForMessage(args.estimator) +
                   " is not one of: " + AllanEstimatorNames());
   }
-  if (!ParseEdfNoise(args.edf_noise, &options.edf_noise)) {
+  if (!ParseEdfNoise(args.edf_noise, &settings.options.edf_noise)) {
     BadInvocation("--edf-noise " + QuoteForMessage(args.edf_noise) + " is not one of: " + EdfNoiseNames());
   }
-  TauSpec tau_spec;
-  if (const std::string problem = ParseTauSpec(args.taus, &tau_spec); !problem.empty()) {
+  if (const std::string problem = ParseTauSpec(args.taus, &settings.tau_spec); !problem.empty()) {
     BadInvocation("--taus: " + problem);
   }
   if (args.kind != "auto" && args.kind != "gyro" && args.kind != "accel" && args.kind != "other") {
@@ -192,14 +203,18 @@ int RunAllan(const AllanArguments& args) {
   if (args.gaps != "error" && args.gaps != "bridge") {
     BadInvocation("--gaps " + QuoteForMessage(args.gaps) + " is not one of: error, bridge");
   }
-  options.confidence = args.confidence;
-  options.threads = args.threads;
-  if (const std::string problem = options.Validate(); !problem.empty()) BadInvocation(problem);
-  NoiseFitOptions fit_options;
-  fit_options.min_clusters = args.min_clusters;
-  if (const std::string problem = fit_options.Validate(); !problem.empty()) BadInvocation(problem);
+  settings.options.confidence = args.confidence;
+  settings.options.threads = args.threads;
+  if (const std::string problem = settings.options.Validate(); !problem.empty()) BadInvocation(problem);
+  settings.fit_options.min_clusters = args.min_clusters;
+  if (const std::string problem = settings.fit_options.Validate(); !problem.empty()) BadInvocation(problem);
+  return settings;
+}
 
-  // Outputs: never an input, never each other; a plot needs gnuplot — all checked before reading.
+// The outputs, checked before anything is read: never an input, never each other; then the time
+// unit, the scale and the plot's units and format. False (having said why) when a plot is asked
+// for and gnuplot is missing.
+bool CheckOutputs(const AllanArguments& args, AllanSettings* settings) {
   std::vector<std::string> outputs = {args.output};
   if (!args.noise_yaml.empty()) outputs.push_back(args.noise_yaml);
   if (!args.plot.empty()) outputs.push_back(args.plot);
@@ -209,25 +224,28 @@ int RunAllan(const AllanArguments& args) {
       if (outputs[i] == outputs[j]) throw InputError(outputs[i], "named for two outputs");
     }
   }
-  const double seconds_per_unit = SecondsPer(args.time_unit);
+  settings->seconds_per_unit = SecondsPer(args.time_unit);
   if (!(args.scale > 0.0) || !std::isfinite(args.scale)) BadInvocation("--scale must be a positive number");
-  AllanPlotUnits plot_units = AllanPlotUnits::kNative;
-  if (!ParseAllanPlotUnits(args.plot_units, &plot_units)) {
+  if (!ParseAllanPlotUnits(args.plot_units, &settings->plot_units)) {
     BadInvocation("--plot-units " + QuoteForMessage(args.plot_units) +
                   " is not one of: " + AllanPlotUnitsNames());
   }
-  if (!args.plot.empty()) {
-    if (!HasSuffix(args.plot, ".svg") && !HasSuffix(args.plot, ".png")) {
-      throw InputError(args.plot, "--plot must end in .svg or .png");
-    }
-    if (!GnuplotAvailable()) {
-      std::fprintf(stderr,
-                   "imufit: error: --plot needs gnuplot, which is not on PATH (Debian: apt-get install "
-                   "gnuplot-nox); nothing was written\n");
-      return 1;
-    }
+  if (args.plot.empty()) return true;
+  if (!HasSuffix(args.plot, ".svg") && !HasSuffix(args.plot, ".png")) {
+    throw InputError(args.plot, "--plot must end in .svg or .png");
   }
+  if (!GnuplotAvailable()) {
+    std::fprintf(stderr,
+                 "imufit: error: --plot needs gnuplot, which is not on PATH (Debian: apt-get install "
+                 "gnuplot-nox); nothing was written\n");
+    return false;
+  }
+  return true;
+}
 
+// The columns asked for, uniformly sampled, times in seconds: as they are, or corrected through
+// the calibration (the samples imufit apply would write, without the file).
+UniformSeries ReadSeries(const AllanArguments& args, double seconds_per_unit) {
   UniformSeriesOptions series_options;
   series_options.time_tolerance = args.time_tolerance;
   series_options.bridge_gaps = args.gaps == "bridge";
@@ -235,7 +253,6 @@ int RunAllan(const AllanArguments& args) {
   if (args.calibration.empty()) {
     series = ReadUniformSeries(args.samples, args.columns, series_options);
   } else {
-    // The samples imufit apply would write, without the file: a raw log analysed directly.
     const Calibration calibration = ReadCalibration(args.calibration);
     CorrectFileReport correction;
     series = ReadCorrectedSeries(args.samples, calibration, args.input.Get().temp_c, args.columns,
@@ -246,48 +263,103 @@ int RunAllan(const AllanArguments& args) {
   series.start_time_s *= seconds_per_unit;
   series.end_time_s *= seconds_per_unit;
   series.bridged_time_s *= seconds_per_unit;
-  const int64_t n = static_cast<int64_t>(series.columns[0].size());
+  return series;
+}
+
+// Every column analysed, its samples moved out of `series` (memory is reused for the phase).
+std::vector<ColumnAnalysis> AnalyseColumns(const AllanArguments& args, const AllanSettings& settings,
+                                           UniformSeries* series) {
+  const int64_t n = static_cast<int64_t>(series->columns[0].size());
   std::vector<int64_t> factors;
-  if (const std::string problem =
-          AveragingFactors(tau_spec, options.estimator, n, series.sample_interval_s, &factors);
+  if (const std::string problem = AveragingFactors(settings.tau_spec, settings.options.estimator, n,
+                                                   series->sample_interval_s, &factors);
       !problem.empty()) {
     throw InputError(args.samples, problem);
   }
-
   std::vector<ColumnAnalysis> results;
-  for (size_t c = 0; c < series.names.size(); ++c) {
-    std::vector<double> rates = std::move(series.columns[c]);
-    series.columns[c] = std::vector<double>();
+  for (size_t c = 0; c < series->names.size(); ++c) {
+    std::vector<double> rates = std::move(series->columns[c]);
+    series->columns[c] = std::vector<double>();
     if (args.scale != 1.0) {
       for (double& rate : rates) rate /= args.scale;
     }
-    results.push_back(AnalyseColumn(series.names[c], ColumnKindOf(series.names[c], args.kind),
-                                    std::move(rates), series.sample_interval_s, factors, options,
-                                    fit_options));
+    results.push_back(AnalyseColumn(series->names[c], ColumnKindOf(series->names[c], args.kind),
+                                    std::move(rates), series->sample_interval_s, factors, settings.options,
+                                    settings.fit_options));
   }
-  PlausibilityWarnings(args, series, results);
+  return results;
+}
 
-  OutputTransaction written;  // the curves, the noise YAML and the plot together, or none
-  WriteAllanCsv(args.output, results, &written);
-  NoiseRecord record;
-  record.software = SoftwareVersion();
-  record.samples = args.samples;
-  if (!args.calibration.empty()) {
-    record.calibration = args.calibration;
-    record.calibration_sha256 = Sha256OfFile(args.calibration);
+// A column's curve and noise terms as the files hold them (io/noise_file.h).
+AllanCurveRecord CurveRecord(const ColumnAnalysis& analysis) {
+  AllanCurveRecord curve;
+  curve.column = analysis.name;
+  curve.estimator = ToString(analysis.curve.estimator);
+  for (const AllanPoint& point : analysis.curve.points) {
+    curve.points.push_back(
+        {point.tau_s, static_cast<long long>(point.terms), point.dev, point.dev_lo, point.dev_hi});
   }
-  record.sample_interval_s = series.sample_interval_s;
-  record.sample_count = n;
-  record.duration_s = series.end_time_s - series.start_time_s - series.bridged_time_s;
-  if (!args.noise_yaml.empty()) WriteNoiseYaml(args.noise_yaml, record, results, &written);
+  return curve;
+}
+
+NoiseColumnRecord NoiseColumn(const ColumnAnalysis& analysis) {
+  const NoiseFitSummary& fit = analysis.fit;
+  NoiseColumnRecord column;
+  column.name = analysis.name;
+  column.kind = analysis.kind;
+  column.fitted = fit.fitted;
+  column.reason = fit.message;
+  column.points_used = fit.points_used;
+  column.reduced_chi_square = fit.reduced_chi_square;
+  column.value = fit.value;
+  column.sigma = fit.sigma;
+  for (int k = 0; k < kNoiseTerms; ++k) column.resolved[k] = IsResolved(fit, k);
+  column.readout_random_walk = fit.readout_random_walk;
+  column.readout_bias_instability = fit.readout_bias_instability;
+  column.readout_bias_tau_s = fit.readout_bias_tau_s;
+  column.readout_rate_random_walk = fit.readout_rate_random_walk;
+  return column;
+}
+
+// The curves, the noise YAML and the plot: together, or none.
+void WriteOutputs(const AllanArguments& args, const AllanSettings& settings, const UniformSeries& series,
+                  int64_t sample_count, const std::vector<ColumnAnalysis>& results) {
+  OutputTransaction written;
+  std::vector<AllanCurveRecord> curves;
+  for (const ColumnAnalysis& analysis : results) curves.push_back(CurveRecord(analysis));
+  WriteAllanCsv(args.output, curves, &written);
+  if (!args.noise_yaml.empty()) {
+    NoiseRecord record;
+    record.software = SoftwareVersion();
+    record.samples = args.samples;
+    if (!args.calibration.empty()) {
+      record.calibration = args.calibration;
+      record.calibration_sha256 = Sha256OfFile(args.calibration);
+    }
+    record.sample_interval_s = series.sample_interval_s;
+    record.sample_count = sample_count;
+    record.duration_s = series.end_time_s - series.start_time_s - series.bridged_time_s;
+    for (const ColumnAnalysis& analysis : results) record.columns.push_back(NoiseColumn(analysis));
+    WriteNoiseYaml(args.noise_yaml, record, &written);
+  }
   if (!args.plot.empty()) {
     char title[512];
     std::snprintf(title, sizeof title, "%s: %s, tau0 = %g s, %lld samples, %.3g %% confidence",
                   Analysed(args).c_str(), ToString(results.front().curve.estimator), series.sample_interval_s,
-                  static_cast<long long>(n), 100.0 * args.confidence);
-    DrawFile(AllanPlot(results, title, plot_units), args.plot, &written);
+                  static_cast<long long>(sample_count), 100.0 * args.confidence);
+    DrawFile(AllanPlot(results, title, settings.plot_units), args.plot, &written);
   }
   written.Commit();
+}
+
+int RunAllan(const AllanArguments& args) {
+  AllanSettings settings = ParseSettings(args);
+  if (!CheckOutputs(args, &settings)) return 1;
+  UniformSeries series = ReadSeries(args, settings.seconds_per_unit);
+  const int64_t n = static_cast<int64_t>(series.columns[0].size());
+  const std::vector<ColumnAnalysis> results = AnalyseColumns(args, settings, &series);
+  PlausibilityWarnings(args, series, results);
+  WriteOutputs(args, settings, series, n, results);
   if (!args.quiet) PrintSummary(args, series, n, results);
   return 0;
 }

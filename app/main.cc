@@ -8,9 +8,9 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
-#include "imufit/run/segmentation.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
+#include "imufit/run/segmentation.h"
 
 namespace imufit {
 

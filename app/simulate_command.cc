@@ -6,12 +6,12 @@
 #include <sstream>
 
 #include "commands.h"
-#include "imufit/sim/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/sim/simulator.h"
 
 namespace imufit {
 namespace {

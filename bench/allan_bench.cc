@@ -1,4 +1,4 @@
-// imufit — benchmark of the Allan deviation (issue 4): oadev at octave taus over 1e7 and 1e8
+// imufit — benchmark of the Allan deviation: oadev at octave taus over 1e7 and 1e8
 // samples, in memory (1e8 doubles = 800 MB).
 //
 // Prints, per size: one plain streaming pass over the array (a sum of squares, one core: the
@@ -102,8 +102,8 @@ int main(int argc, char** argv) {
     const imufit::AllanResult result = imufit::ComputeAllan(y, tau0_s, factors, options);
     const double full = Seconds(start) + phase;
 
-    std::printf("%12lld %6zu %10.3f %10.3f %10.3f %10.3f %8.1f %8.1f\n", static_cast<long long>(n), factors.size(),
-                plain, phase, sweep, full, sweep / plain, full / plain);
+    std::printf("%12lld %6zu %10.3f %10.3f %10.3f %10.3f %8.1f %8.1f\n", static_cast<long long>(n),
+                factors.size(), plain, phase, sweep, full, sweep / plain, full / plain);
     std::printf("%12s oadev(tau0) = %.6g, oadev(tau_max = %g s) = %.6g [%.6g, %.6g]\n", "", devs.front(),
                 result.points.back().tau_s, result.points.back().dev, result.points.back().dev_lo,
                 result.points.back().dev_hi);

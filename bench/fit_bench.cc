@@ -1,4 +1,4 @@
-// imufit — benchmark of `imufit fit` on a factory-sized run (issue 3):
+// imufit — benchmark of `imufit fit` on a factory-sized run:
 //
 //   7 soak temperatures x 18 segments x 30 s at 800 Hz, about 3 million samples.
 //
@@ -20,12 +20,12 @@
 #include <string>
 #include <vector>
 
-#include "imufit/sim/simulator.h"
-#include "imufit/run/windows.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/pipeline/run_windows.h"
+#include "imufit/run/windows.h"
+#include "imufit/sim/simulator.h"
 
 namespace fs = std::filesystem;
 
@@ -128,18 +128,22 @@ int main(int argc, char** argv) {
   long max_rss_kb = 0;
   for (int trial = 0; trial < 3; ++trial) {
     long rss = 0;
-    fit_s = std::min(fit_s, RunChild({IMUFIT_BINARY, "fit", "--plan", plan_path, "--samples", samples_path, "-o", output}, &rss));
+    fit_s = std::min(
+        fit_s,
+        RunChild({IMUFIT_BINARY, "fit", "--plan", plan_path, "--samples", samples_path, "-o", output}, &rss));
     max_rss_kb = std::max(max_rss_kb, rss);
   }
 
   const double uncompressed_mb = static_cast<double>(bytes) / 1e6;
-  std::printf("factory run: %lld samples, %.1f MB on disk (%.1f MB of CSV)%s\n", samples, megabytes, uncompressed_mb,
-              gzip ? ", gzip" : "");
+  std::printf("factory run: %lld samples, %.1f MB on disk (%.1f MB of CSV)%s\n", samples, megabytes,
+              uncompressed_mb, gzip ? ", gzip" : "");
   std::printf("read + parse:          %7.3f s   %7.1f MB/s of CSV   (target >= 200 MB/s per core)\n", read_s,
               uncompressed_mb / read_s);
   std::printf("read + windows:        %7.3f s   %7.2f x read\n", window_s, window_s / read_s);
-  std::printf("imufit fit (whole):    %7.3f s   %7.2f x read          (target <= 1.5 x)\n", fit_s, fit_s / read_s);
-  std::printf("imufit fit peak memory: %6.1f MB                       (target < 100 MB)\n", max_rss_kb / 1024.0);
+  std::printf("imufit fit (whole):    %7.3f s   %7.2f x read          (target <= 1.5 x)\n", fit_s,
+              fit_s / read_s);
+  std::printf("imufit fit peak memory: %6.1f MB                       (target < 100 MB)\n",
+              max_rss_kb / 1024.0);
   if (temporary) fs::remove_all(dir);
   return 0;
 }

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark (issue 11): imufit.Calibration.correct on 10 million samples in numpy arrays against
+"""Benchmark: imufit.Calibration.correct on 10 million samples in numpy arrays against
 the C++ core that `imufit apply` runs per row (bench/correct_bench: SensorModel::Correct over
 arrays in memory, no CSV). Target: within 1.5x of the C++ core. Best of alternating runs; figures
 are measured, never asserted.

@@ -22,7 +22,6 @@
 #include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
-#include "imufit/sim/simulator.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
@@ -31,6 +30,7 @@
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/sim/simulator.h"
 #include "test_util.h"
 
 namespace imufit {

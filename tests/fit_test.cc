@@ -7,17 +7,16 @@
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
-#include "imufit/sim/simulator.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/fit/validation.h"
 #include "imufit/fit/window_cost.h"
+#include "imufit/model/constants.h"
 #include "imufit/run/windows.h"
+#include "imufit/sim/simulator.h"
 #include "test_models.h"
 
 namespace imufit {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Recovery: every 25 degC coefficient within this many of its reported sigmas (worst case).
 constexpr double kRecoverySigmas = 3.0;

@@ -6,21 +6,20 @@
 
 #include <gtest/gtest.h>
 
-#include "imufit/sim/simulator.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/model/constants.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/run_windows.h"
+#include "imufit/sim/simulator.h"
 #include "test_util.h"
 
 namespace imufit {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-constexpr double kStandardGravity = 9.80665;
 // Truth: every 25 degC coefficient within this many reported sigmas (worst case). 3.5 rather than
 // 3: the three runs have 99 coefficients at 25 degC between them, and one of 99 unit normals
 // exceeds 3 with probability 0.23, but 3.5 only with 0.045. And the RMS of (estimate - truth) /
@@ -56,7 +55,7 @@ TEST_P(FixtureRegression, RecoversTruthAndMatchesGolden) {
   const RunWindows run = ReadRunWindows(plan, Fixture(c.run), WindowOptions());
   FitOptions options;
   options.gyro_bias_stability_radps = c.gyro_bias_stability_dph / kRadToDeg / 3600.0;
-  options.accel_bias_stability_mps2 = c.accel_bias_stability_ug * 1e-6 * kStandardGravity;
+  options.accel_bias_stability_mps2 = c.accel_bias_stability_ug * 1e-6 * kStandardGravityMps2;
   options.bias_correlation_s = c.bias_correlation_s;
   const FitSummary fit = FitThermalModel(run.windows, plan.site, plan.segments, options);
   ASSERT_TRUE(fit.IsSolutionUsable()) << fit.FullReport();

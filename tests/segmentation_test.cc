@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include "imufit/model/constants.h"
 #include "imufit/run/segmentation.h"
 #include "imufit/sim/simulator.h"
 #include "test_models.h"
@@ -21,14 +22,13 @@
 namespace imufit {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 // A dwell of 5 s loses about half a window (0.5 s) at each end to the centred variance window;
 // at least this fraction of the truly labelled samples must get their label (worst case).
 constexpr double kMinLabelledFraction = 0.7;
 
 TableSite Site() {
   TableSite site;
-  site.gravity_mps2 = 9.80665;
+  site.gravity_mps2 = kStandardGravityMps2;
   site.latitude_rad = 45.0 * kDegToRad;
   return site;
 }

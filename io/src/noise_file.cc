@@ -28,11 +28,11 @@ std::string YamlString(const std::string& text) {
 
 // The largest fitted value of `term` over the columns of `kind` (Kalibr takes one number for all
 // three axes: the worst one is the safe choice), or nan when there is none.
-double WorstAxis(const std::vector<ColumnAnalysis>& results, ColumnKind kind, int term) {
+double WorstAxis(const std::vector<NoiseColumnRecord>& columns, ColumnKind kind, int term) {
   double worst = std::nan("");
-  for (const ColumnAnalysis& result : results) {
-    if (result.kind != kind || !result.fit.fitted) continue;
-    if (!(worst >= result.fit.value[term])) worst = result.fit.value[term];
+  for (const NoiseColumnRecord& column : columns) {
+    if (column.kind != kind || !column.fitted) continue;
+    if (!(worst >= column.value[term])) worst = column.value[term];
   }
   return worst;
 }
@@ -77,13 +77,13 @@ const NoiseTermUnits& UnitsOf(ColumnKind kind, int term) {
   return kOther[term];
 }
 
-void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results,
+void WriteAllanCsv(const std::string& path, const std::vector<AllanCurveRecord>& curves,
                    OutputTransaction* transaction) {
   OutputFile file(path, transaction);
   file.Write("column,estimator,tau_s,terms,dev,dev_lo,dev_hi\n");
-  for (const ColumnAnalysis& result : results) {
-    for (const AllanPoint& point : result.curve.points) {
-      file.Write(result.name + "," + ToString(result.curve.estimator) + ",");
+  for (const AllanCurveRecord& curve : curves) {
+    for (const AllanCurveRecord::Point& point : curve.points) {
+      file.Write(curve.column + "," + curve.estimator + ",");
       file.WriteNumber(point.tau_s);
       file.Write("," + std::to_string(point.terms) + ",");
       file.WriteNumber(point.dev);
@@ -97,7 +97,7 @@ void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& r
   file.Commit();
 }
 
-std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysis>& results) {
+std::string NoiseYaml(const NoiseRecord& record) {
   std::ostringstream yaml;
   yaml << "# Noise figures by imufit allan: the IEEE Std 952 model fitted to the overlapping Allan\n"
        << "# variance. Every figure is [value, 1-sigma uncertainty]. Merge into a calibration by\n"
@@ -116,35 +116,34 @@ std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysi
        << "  duration_s: " << YamlNumber(record.duration_s) << "\n"
        << "  model: \"sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2\"\n"
        << "  columns:\n";
-  for (const ColumnAnalysis& result : results) {
-    const NoiseFitSummary& fit = result.fit;
-    yaml << "    " << result.name << ":\n"
-         << "      kind: " << ToString(result.kind) << "\n"
-         << "      unit: " << YamlString(SiUnit(result.kind)) << "\n"
+  for (const NoiseColumnRecord& fit : record.columns) {
+    yaml << "    " << fit.name << ":\n"
+         << "      kind: " << ToString(fit.kind) << "\n"
+         << "      unit: " << YamlString(SiUnit(fit.kind)) << "\n"
          << "      fitted: " << (fit.fitted ? "true" : "false") << "\n";
     if (!fit.fitted) {
-      yaml << "      reason: " << YamlString(fit.message) << "\n";
+      yaml << "      reason: " << YamlString(fit.reason) << "\n";
       continue;
     }
     yaml << "      points_used: " << fit.points_used << "\n"
          << "      reduced_chi_square: " << YamlNumber(fit.reduced_chi_square) << "\n";
     for (int k = 0; k < kNoiseTerms; ++k) {
-      const NoiseTermUnits& units = UnitsOf(result.kind, k);
+      const NoiseTermUnits& units = UnitsOf(fit.kind, k);
       yaml << "      " << units.si_key << ": [" << YamlNumber(fit.value[k]) << ", "
            << YamlNumber(fit.sigma[k]) << "]\n";
     }
     for (int k = 0; k < kNoiseTerms; ++k) {
-      const NoiseTermUnits& units = UnitsOf(result.kind, k);
+      const NoiseTermUnits& units = UnitsOf(fit.kind, k);
       if (*units.engineer_key == '\0') continue;
       yaml << "      " << units.engineer_key << ": [" << YamlNumber(fit.value[k] * units.engineer_per_si)
            << ", " << YamlNumber(fit.sigma[k] * units.engineer_per_si) << "]\n";
     }
     for (int k = 0; k < kNoiseTerms; ++k) {
-      if (!IsResolved(fit, k)) yaml << "      " << UnitsOf(result.kind, k).si_key << "_resolved: false\n";
+      if (!fit.resolved[k]) yaml << "      " << UnitsOf(fit.kind, k).si_key << "_resolved: false\n";
     }
-    const NoiseTermUnits& n = UnitsOf(result.kind, kRandomWalk);
-    const NoiseTermUnits& b = UnitsOf(result.kind, kBiasInstability);
-    const NoiseTermUnits& k = UnitsOf(result.kind, kRateRandomWalk);
+    const NoiseTermUnits& n = UnitsOf(fit.kind, kRandomWalk);
+    const NoiseTermUnits& b = UnitsOf(fit.kind, kBiasInstability);
+    const NoiseTermUnits& k = UnitsOf(fit.kind, kRateRandomWalk);
     const bool engineer = *n.engineer_key != '\0';
     yaml << "      readout:  # IEEE 952 graphical read-outs of the measured curve\n"
          << "        " << (engineer ? n.engineer_key : n.si_key) << ": "
@@ -156,32 +155,33 @@ std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysi
          << YamlNumber(fit.readout_rate_random_walk * k.engineer_per_si) << "\n";
   }
   const auto has = [&](ColumnKind kind) {
-    return std::any_of(results.begin(), results.end(),
-                       [&](const ColumnAnalysis& r) { return r.kind == kind && r.fit.fitted; });
+    return std::any_of(record.columns.begin(), record.columns.end(),
+                       [&](const NoiseColumnRecord& c) { return c.kind == kind && c.fitted; });
   };
   const bool has_gyro = has(ColumnKind::kGyro), has_accel = has(ColumnKind::kAccel);
   if (has_gyro || has_accel) {
     yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor\n";
     if (has_gyro) {
       yaml << "    gyroscope_noise_density: "
-           << YamlNumber(WorstAxis(results, ColumnKind::kGyro, kRandomWalk)) << "  # rad/s/sqrt(Hz)\n"
+           << YamlNumber(WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk)) << "  # rad/s/sqrt(Hz)\n"
            << "    gyroscope_random_walk: "
-           << YamlNumber(WorstAxis(results, ColumnKind::kGyro, kRateRandomWalk)) << "  # rad/s^2/sqrt(Hz)\n";
+           << YamlNumber(WorstAxis(record.columns, ColumnKind::kGyro, kRateRandomWalk))
+           << "  # rad/s^2/sqrt(Hz)\n";
     }
     if (has_accel) {
       yaml << "    accelerometer_noise_density: "
-           << YamlNumber(WorstAxis(results, ColumnKind::kAccel, kRandomWalk)) << "  # m/s^2/sqrt(Hz)\n"
+           << YamlNumber(WorstAxis(record.columns, ColumnKind::kAccel, kRandomWalk)) << "  # m/s^2/sqrt(Hz)\n"
            << "    accelerometer_random_walk: "
-           << YamlNumber(WorstAxis(results, ColumnKind::kAccel, kRateRandomWalk)) << "  # m/s^3/sqrt(Hz)\n";
+           << YamlNumber(WorstAxis(record.columns, ColumnKind::kAccel, kRateRandomWalk))
+           << "  # m/s^3/sqrt(Hz)\n";
     }
     yaml << "    update_rate: " << YamlNumber(1.0 / record.sample_interval_s) << "  # Hz\n";
   }
   return yaml.str();
 }
 
-void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
-                    const std::vector<ColumnAnalysis>& results, OutputTransaction* transaction) {
-  WriteFileAtomically(path, NoiseYaml(record, results), transaction);
+void WriteNoiseYaml(const std::string& path, const NoiseRecord& record, OutputTransaction* transaction) {
+  WriteFileAtomically(path, NoiseYaml(record), transaction);
 }
 
 std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& extra, const std::string& column,

@@ -5,12 +5,12 @@
 #include <set>
 
 #include "imufit/io/error.h"
+#include "imufit/model/constants.h"
 #include "yaml_util.h"
 
 namespace imufit {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 // `north` may be this far from perpendicular to `up` (docs/spec.md: 1 degree).
 constexpr double kNorthToleranceRad = 1.0 * kDegToRad;
 // Local gravity anywhere on Earth's surface, with margin (9.76 .. 9.84 m/s^2).

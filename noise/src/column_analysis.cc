@@ -4,30 +4,6 @@
 
 namespace imufit {
 
-const char* ToString(ColumnKind kind) {
-  switch (kind) {
-    case ColumnKind::kGyro:
-      return "gyro";
-    case ColumnKind::kAccel:
-      return "accel";
-    case ColumnKind::kOther:
-      break;
-  }
-  return "other";
-}
-
-const char* SiUnit(ColumnKind kind) {
-  switch (kind) {
-    case ColumnKind::kGyro:
-      return "rad/s";
-    case ColumnKind::kAccel:
-      return "m/s^2";
-    case ColumnKind::kOther:
-      break;
-  }
-  return "unit";
-}
-
 ColumnKind ColumnKindOf(const std::string& column, const std::string& kind) {
   if (kind == "gyro" || (kind == "auto" && column.rfind("gyro", 0) == 0)) return ColumnKind::kGyro;
   if (kind == "accel" || (kind == "auto" && column.rfind("accel", 0) == 0)) return ColumnKind::kAccel;

@@ -6,11 +6,11 @@
 #include <limits>
 
 #include "imufit/model/enum_names.h"
+#include "imufit/model/constants.h"
 
 namespace imufit {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // sqrt(2 ln 2 / pi): the flicker floor of the Allan deviation is 0.664 B.
 const double kFlickerFloor = std::sqrt(2.0 * std::log(2.0) / kPi);
 // A read-out slope must be within kReadoutSlopeTolerance of its target (-1/2 or +1/2) to count;
@@ -40,11 +40,16 @@ struct CorrelationModel {
 };
 CorrelationModel CorrelationFor(int alpha) {
   switch (alpha) {
-    case 2: return {0.45, 10.0, 1.5};
-    case 1: return {0.30, 0.60, 1.5};
-    case 0: return {0.0, 0.63, 1.4};
-    case -1: return {0.0, 0.30, 1.55};
-    default: return {0.0, 0.128, 1.7};
+    case 2:
+      return {0.45, 10.0, 1.5};
+    case 1:
+      return {0.30, 0.60, 1.5};
+    case 0:
+      return {0.0, 0.63, 1.4};
+    case -1:
+      return {0.0, 0.30, 1.55};
+    default:
+      return {0.0, 0.128, 1.7};
   }
 }
 
@@ -129,29 +134,171 @@ bool SolveSubset(const Whitened& problem, unsigned mask, Eigen::Matrix<double, 5
   return true;
 }
 
-constexpr EnumName<int> kNoiseTermNames[kNoiseTerms] = {{kQuantization, "quantization"},
-                                                       {kRandomWalk, "random_walk"},
-                                                       {kBiasInstability, "bias_instability"},
-                                                       {kRateRandomWalk, "rate_random_walk"},
-                                                       {kRateRamp, "rate_ramp"}};
 
 double SqrtSigma(double v, double s) {
   return 0.5 * (std::sqrt(std::max(v, 0.0) + s) - std::sqrt(std::max(v - s, 0.0)));
 }
 
-}  // namespace
+// The points the fit may use: enough averaging intervals in the record, a positive deviation and
+// a known edf.
+std::vector<Point> UsablePoints(const std::vector<AllanPoint>& all_points, int64_t n_samples,
+                                const NoiseFitOptions& options) {
+  std::vector<Point> points;
+  for (const AllanPoint& p : all_points) {
+    const double clusters = static_cast<double>(n_samples) / static_cast<double>(p.m);
+    if (clusters < options.min_clusters || !(p.dev > 0.0) || !std::isfinite(p.edf) || !(p.edf > 0.0))
+      continue;
+    points.push_back({p.tau_s, p.dev * p.dev, p.edf, p.alpha});
+  }
+  return points;
+}
 
-const char* NoiseTermName(int term) { return NameOf(kNoiseTermNames, term); }
-bool ParseNoiseTerm(std::string_view name, int* term) { return ValueOf(kNoiseTermNames, name, term); }
-std::string NoiseTermNames() { return AllNames(kNoiseTermNames); }
+// The classic read-outs of the measured curve (see noise_model.h).
+void ReadOut(const std::vector<Point>& points, NoiseFitSummary* summary) {
+  if (points.empty()) return;
+  const auto lowest = std::min_element(
+      points.begin(), points.end(), [](const Point& a, const Point& b) { return a.variance < b.variance; });
+  summary->readout_bias_instability = std::sqrt(lowest->variance) / kFlickerFloor;
+  summary->readout_bias_tau_s = lowest->tau_s;
+  // Among the segments whose slope is near the target, the one with the most degrees of
+  // freedom (the shortest tau); failing that, the segment whose slope is nearest within the
+  // looser tolerance.
+  struct Choice {
+    double near_edf = 0.0;
+    double near_value = std::nan("");
+    double best_distance = kReadoutSlopeTolerance;
+    double best_value = std::nan("");
+    void Offer(double distance, double edf, double value) {
+      if (distance < kReadoutSlopeNear && edf > near_edf) {
+        near_edf = edf;
+        near_value = value;
+      }
+      if (distance < best_distance) {
+        best_distance = distance;
+        best_value = value;
+      }
+    }
+    double Value() const { return std::isfinite(near_value) ? near_value : best_value; }
+  };
+  Choice arw;
+  Choice rrw;
+  for (size_t i = 0; i + 1 < points.size(); ++i) {
+    const double slope = 0.5 * std::log(points[i + 1].variance / points[i].variance) /
+                         std::log(points[i + 1].tau_s / points[i].tau_s);
+    const double dev = std::sqrt(points[i].variance);
+    const double edf = std::min(points[i].edf, points[i + 1].edf);
+    arw.Offer(std::fabs(slope + 0.5), edf, dev * std::sqrt(points[i].tau_s));        // sigma = N / sqrt(tau)
+    rrw.Offer(std::fabs(slope - 0.5), edf, dev * std::sqrt(3.0 / points[i].tau_s));  // sigma = K sqrt(tau/3)
+  }
+  summary->readout_random_walk = arw.Value();
+  summary->readout_rate_random_walk = rrw.Value();
+}
+
+// Why the model cannot be fitted at all ("" when it can be tried).
+std::string WhyNoFit(const std::vector<AllanPoint>& all_points, size_t usable,
+                     const NoiseFitOptions& options) {
+  const bool constant = !all_points.empty() && std::all_of(all_points.begin(), all_points.end(),
+                                                           [](const AllanPoint& p) { return p.dev == 0.0; });
+  if (constant) {
+    return "the column is constant: every deviation is zero (a stuck sensor, or a signal finer than one "
+           "quantization step?)";
+  }
+  if (usable < 2) {
+    return "too few points for a noise fit (" + std::to_string(usable) + " with at least " +
+           std::to_string(static_cast<int>(options.min_clusters)) + " averaging intervals in the record)";
+  }
+  return "";
+}
+
+// The best feasible subset of the enabled terms (mask 0: none), after reweighting iterations, and
+// the whitened problem of the last iteration.
+struct SubsetFit {
+  unsigned mask = 0;
+  double cost = 0.0;
+  Eigen::Matrix<double, 5, 1> c = Eigen::Matrix<double, 5, 1>::Zero();
+  Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
+  Whitened problem;
+};
+
+SubsetFit BestSubset(const std::vector<Point>& points, const NoiseFitOptions& options) {
+  unsigned enabled_mask = 0;
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    if (options.enabled[k]) enabled_mask |= 1u << k;
+  }
+  SubsetFit best;
+  std::vector<double> model(points.size());
+  for (size_t i = 0; i < points.size(); ++i) model[i] = points[i].variance;
+  for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    best.problem = Whiten(points, model);
+    best.cost = std::numeric_limits<double>::infinity();
+    best.mask = 0;
+    for (unsigned mask = 1; mask < (1u << kNoiseTerms); ++mask) {
+      if ((mask & enabled_mask) != mask) continue;
+      Eigen::Matrix<double, 5, 1> c;
+      Eigen::Matrix<double, 5, 5> covariance;
+      double cost = 0.0;
+      if (!SolveSubset(best.problem, mask, &c, &covariance, &cost)) continue;
+      if ((c.array() < 0.0).any()) continue;
+      if (cost < best.cost) {
+        best.cost = cost;
+        best.mask = mask;
+        best.c = c;
+        best.covariance = covariance;
+      }
+    }
+    if (best.mask == 0) break;
+    for (size_t i = 0; i < points.size(); ++i) {
+      double v = 0.0;
+      for (int k = 0; k < kNoiseTerms; ++k) v += best.c(k) * NoiseTermBasis(k, points[i].tau_s);
+      model[i] = std::max(v, 1e-300);
+    }
+  }
+  return best;
+}
+
+// The terms and their uncertainties from the best subset; a term left at zero gets the
+// uncertainty it would have if freed alongside the others.
+void SetTerms(const SubsetFit& best, size_t usable, const NoiseFitOptions& options,
+              NoiseFitSummary* summary) {
+  int free_terms = 0;
+  for (int k = 0; k < kNoiseTerms; ++k) free_terms += (best.mask >> k) & 1u;
+  const int dof = static_cast<int>(usable) - free_terms;
+  summary->reduced_chi_square = dof > 0 ? best.cost / dof : std::nan("");
+  const double inflate = (dof > 0 && summary->reduced_chi_square > 1.0) ? summary->reduced_chi_square : 1.0;
+  summary->fitted = true;
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    summary->free[k] = (best.mask >> k) & 1u;
+    summary->variance[k] = best.c(k);
+    double variance_of_c = best.covariance(k, k);
+    if (!summary->free[k] && options.enabled[k]) {
+      Eigen::Matrix<double, 5, 1> c;
+      Eigen::Matrix<double, 5, 5> covariance;
+      double cost = 0.0;
+      variance_of_c = SolveSubset(best.problem, best.mask | (1u << k), &c, &covariance, &cost)
+                          ? covariance(k, k)
+                          : std::nan("");
+    }
+    summary->variance_sigma[k] = std::sqrt(std::max(0.0, variance_of_c) * inflate);
+    summary->value[k] = std::sqrt(summary->variance[k]);
+    summary->sigma[k] =
+        options.enabled[k] ? SqrtSigma(summary->variance[k], summary->variance_sigma[k]) : 0.0;
+  }
+}
+
+}  // namespace
 
 double NoiseTermBasis(int term, double tau_s) {
   switch (term) {
-    case kQuantization: return 3.0 / (tau_s * tau_s);
-    case kRandomWalk: return 1.0 / tau_s;
-    case kBiasInstability: return kFlickerFloor * kFlickerFloor;
-    case kRateRandomWalk: return tau_s / 3.0;
-    case kRateRamp: return 0.5 * tau_s * tau_s;
+    case kQuantization:
+      return 3.0 / (tau_s * tau_s);
+    case kRandomWalk:
+      return 1.0 / tau_s;
+    case kBiasInstability:
+      return kFlickerFloor * kFlickerFloor;
+    case kRateRandomWalk:
+      return tau_s / 3.0;
+    case kRateRamp:
+      return 0.5 * tau_s * tau_s;
   }
   return 0.0;
 }
@@ -175,132 +322,17 @@ double NoiseFitSummary::TermDeviation(int term, double tau_s) const {
 NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t n_samples,
                               const NoiseFitOptions& options) {
   NoiseFitSummary summary;
-  std::vector<Point> points;
-  for (const AllanPoint& p : all_points) {
-    const double clusters = static_cast<double>(n_samples) / static_cast<double>(p.m);
-    if (clusters < options.min_clusters || !(p.dev > 0.0) || !std::isfinite(p.edf) || !(p.edf > 0.0)) continue;
-    points.push_back({p.tau_s, p.dev * p.dev, p.edf, p.alpha});
-  }
+  const std::vector<Point> points = UsablePoints(all_points, n_samples, options);
   summary.points_used = static_cast<int>(points.size());
-
-  // Classic read-outs from the measured curve.
-  if (!points.empty()) {
-    const auto lowest = std::min_element(points.begin(), points.end(),
-                                         [](const Point& a, const Point& b) { return a.variance < b.variance; });
-    summary.readout_bias_instability = std::sqrt(lowest->variance) / kFlickerFloor;
-    summary.readout_bias_tau_s = lowest->tau_s;
-    // Among the segments whose slope is near the target, the one with the most degrees of
-    // freedom (the shortest tau); failing that, the segment whose slope is nearest within the
-    // looser tolerance.
-    struct Choice {
-      double near_edf = 0.0;
-      double near_value = std::nan("");
-      double best_distance = kReadoutSlopeTolerance;
-      double best_value = std::nan("");
-      void Offer(double distance, double edf, double value) {
-        if (distance < kReadoutSlopeNear && edf > near_edf) {
-          near_edf = edf;
-          near_value = value;
-        }
-        if (distance < best_distance) {
-          best_distance = distance;
-          best_value = value;
-        }
-      }
-      double Value() const { return std::isfinite(near_value) ? near_value : best_value; }
-    };
-    Choice arw;
-    Choice rrw;
-    for (size_t i = 0; i + 1 < points.size(); ++i) {
-      const double slope = 0.5 * std::log(points[i + 1].variance / points[i].variance) /
-                           std::log(points[i + 1].tau_s / points[i].tau_s);
-      const double dev = std::sqrt(points[i].variance);
-      const double edf = std::min(points[i].edf, points[i + 1].edf);
-      arw.Offer(std::fabs(slope + 0.5), edf, dev * std::sqrt(points[i].tau_s));  // sigma = N / sqrt(tau)
-      rrw.Offer(std::fabs(slope - 0.5), edf, dev * std::sqrt(3.0 / points[i].tau_s));  // sigma = K sqrt(tau/3)
-    }
-    summary.readout_random_walk = arw.Value();
-    summary.readout_rate_random_walk = rrw.Value();
-  }
-
-  unsigned enabled_mask = 0;
-  for (int k = 0; k < kNoiseTerms; ++k) {
-    if (options.enabled[k]) enabled_mask |= 1u << k;
-  }
-  const bool constant = !all_points.empty() && std::all_of(all_points.begin(), all_points.end(),
-                                                           [](const AllanPoint& p) { return p.dev == 0.0; });
-  if (constant) {
-    summary.message =
-        "the column is constant: every deviation is zero (a stuck sensor, or a signal finer than one "
-        "quantization step?)";
-    return summary;
-  }
-  if (points.size() < 2) {
-    summary.message = "too few points for a noise fit (" + std::to_string(points.size()) +
-                      " with at least " + std::to_string(static_cast<int>(options.min_clusters)) +
-                      " averaging intervals in the record)";
-    return summary;
-  }
-
-  Eigen::Matrix<double, 5, 1> best_c = Eigen::Matrix<double, 5, 1>::Zero();
-  Eigen::Matrix<double, 5, 5> best_covariance = Eigen::Matrix<double, 5, 5>::Zero();
-  unsigned best_mask = 0;
-  double best_cost = 0.0;
-  std::vector<double> model(points.size());
-  for (size_t i = 0; i < points.size(); ++i) model[i] = points[i].variance;
-  Whitened problem;
-  for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    problem = Whiten(points, model);
-    best_cost = std::numeric_limits<double>::infinity();
-    best_mask = 0;
-    for (unsigned mask = 1; mask < (1u << kNoiseTerms); ++mask) {
-      if ((mask & enabled_mask) != mask) continue;
-      Eigen::Matrix<double, 5, 1> c;
-      Eigen::Matrix<double, 5, 5> covariance;
-      double cost = 0.0;
-      if (!SolveSubset(problem, mask, &c, &covariance, &cost)) continue;
-      if ((c.array() < 0.0).any()) continue;
-      if (cost < best_cost) {
-        best_cost = cost;
-        best_mask = mask;
-        best_c = c;
-        best_covariance = covariance;
-      }
-    }
-    if (best_mask == 0) break;
-    for (size_t i = 0; i < points.size(); ++i) {
-      double v = 0.0;
-      for (int k = 0; k < kNoiseTerms; ++k) v += best_c(k) * NoiseTermBasis(k, points[i].tau_s);
-      model[i] = std::max(v, 1e-300);
-    }
-  }
-  if (best_mask == 0) {
+  ReadOut(points, &summary);
+  summary.message = WhyNoFit(all_points, points.size(), options);
+  if (!summary.message.empty()) return summary;
+  const SubsetFit best = BestSubset(points, options);
+  if (best.mask == 0) {
     summary.message = "the noise model could not be fitted (no feasible combination of terms)";
     return summary;
   }
-  int free_terms = 0;
-  for (int k = 0; k < kNoiseTerms; ++k) free_terms += (best_mask >> k) & 1u;
-  const int dof = static_cast<int>(points.size()) - free_terms;
-  summary.reduced_chi_square = dof > 0 ? best_cost / dof : std::nan("");
-  const double inflate = (dof > 0 && summary.reduced_chi_square > 1.0) ? summary.reduced_chi_square : 1.0;
-  summary.fitted = true;
-  for (int k = 0; k < kNoiseTerms; ++k) {
-    summary.free[k] = (best_mask >> k) & 1u;
-    summary.variance[k] = best_c(k);
-    double variance_of_c = best_covariance(k, k);
-    if (!summary.free[k] && options.enabled[k]) {
-      // The uncertainty this term would have if it were freed alongside the others.
-      Eigen::Matrix<double, 5, 1> c;
-      Eigen::Matrix<double, 5, 5> covariance;
-      double cost = 0.0;
-      variance_of_c = SolveSubset(problem, best_mask | (1u << k), &c, &covariance, &cost)
-                          ? covariance(k, k)
-                          : std::nan("");
-    }
-    summary.variance_sigma[k] = std::sqrt(std::max(0.0, variance_of_c) * inflate);
-    summary.value[k] = std::sqrt(summary.variance[k]);
-    summary.sigma[k] = options.enabled[k] ? SqrtSigma(summary.variance[k], summary.variance_sigma[k]) : 0.0;
-  }
+  SetTerms(best, points.size(), options, &summary);
   return summary;
 }
 

@@ -5,10 +5,11 @@
 #include <limits>
 #include <vector>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRelativeEpsilon = 1e-16;
 constexpr int kMaxGammaIterations = 100000000;
 
@@ -144,13 +145,20 @@ constexpr int kJMax = 100;
 double Sw(double t, int alpha) {
   const double at = std::fabs(t);
   switch (alpha) {
-    case 2: return -at;
-    case 1: return t == 0.0 ? 0.0 : t * t * std::log(at);
-    case 0: return at * at * at;
-    case -1: return t == 0.0 ? 0.0 : std::pow(t, 4) * std::log(at);
-    case -2: return std::pow(at, 5);
-    case -3: return t == 0.0 ? 0.0 : std::pow(t, 6) * std::log(at);
-    case -4: return std::pow(at, 7);
+    case 2:
+      return -at;
+    case 1:
+      return t == 0.0 ? 0.0 : t * t * std::log(at);
+    case 0:
+      return at * at * at;
+    case -1:
+      return t == 0.0 ? 0.0 : std::pow(t, 4) * std::log(at);
+    case -2:
+      return std::pow(at, 5);
+    case -3:
+      return t == 0.0 ? 0.0 : std::pow(t, 6) * std::log(at);
+    case -4:
+      return std::pow(at, 7);
   }
   return 0.0;
 }
@@ -199,12 +207,12 @@ struct Coefficients {
 };
 constexpr Coefficients kTable1Modified[7][3] = {
     {{2.0 / 3.0, 1.0 / 3.0}, {7.0 / 9.0, 1.0 / 2.0}, {22.0 / 25.0, 2.0 / 3.0}},  // alpha = 2
-    {{0.840, 0.345}, {0.997, 0.616}, {1.141, 0.843}},                         // 1
-    {{1.079, 0.368}, {1.033, 0.607}, {1.184, 0.848}},                         // 0
-    {{0, 0}, {1.048, 0.534}, {1.180, 0.816}},                                 // -1
-    {{0, 0}, {1.302, 0.535}, {1.175, 0.777}},                                 // -2
-    {{0, 0}, {0, 0}, {1.194, 0.703}},                                         // -3
-    {{0, 0}, {0, 0}, {1.489, 0.702}}};                                        // -4
+    {{0.840, 0.345}, {0.997, 0.616}, {1.141, 0.843}},                            // 1
+    {{1.079, 0.368}, {1.033, 0.607}, {1.184, 0.848}},                            // 0
+    {{0, 0}, {1.048, 0.534}, {1.180, 0.816}},                                    // -1
+    {{0, 0}, {1.302, 0.535}, {1.175, 0.777}},                                    // -2
+    {{0, 0}, {0, 0}, {1.194, 0.703}},                                            // -3
+    {{0, 0}, {0, 0}, {1.489, 0.702}}};                                           // -4
 constexpr Coefficients kTable2Unmodified[7][3] = {
     {{3.0 / 2.0, 1.0 / 2.0}, {35.0 / 18.0, 1.0}, {231.0 / 100.0, 3.0 / 2.0}},  // alpha = 2
     {{78.6, 25.2}, {790.0, 410.0}, {9950.0, 6520.0}},                          // 1

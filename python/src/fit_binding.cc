@@ -6,9 +6,9 @@
 #include <optional>
 
 #include "binding.h"
-#include "imufit/sim/simulator.h"
 #include "imufit/io/plan.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/sim/simulator.h"
 #include "keyword_options.h"
 
 namespace imufit::python {

@@ -2,9 +2,9 @@
 #include <exception>
 
 #include "binding.h"
-#include "imufit/run/segmentation.h"
 #include "imufit/io/error.h"
 #include "imufit/model/sensor_model.h"
+#include "imufit/run/segmentation.h"
 
 namespace imufit::python {
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
@@ -15,7 +17,7 @@ constexpr double kMinResultant = 0.15;
 double Resultant(const std::vector<double>& time_s, double interval_s, double* phase) {
   double re = 0.0, im = 0.0;
   for (double t : time_s) {
-    const double angle = 2.0 * M_PI * (t - time_s.front()) / interval_s;
+    const double angle = 2.0 * kPi * (t - time_s.front()) / interval_s;
     re += std::cos(angle);
     im += std::sin(angle);
   }
@@ -66,7 +68,7 @@ void SampleClock::Acquire() {
     double phase = 0.0;
     Resultant(t, best_s, &phase);
     // Slots from the grid, then the line through them; the first stamp's slot is 0.
-    const double start_s = t.front() + best_s * phase / (2.0 * M_PI);
+    const double start_s = t.front() + best_s * phase / (2.0 * kPi);
     const double first = std::round((t.front() - start_s) / best_s);
     ResetLine();
     double previous = -1.0;

@@ -9,10 +9,11 @@
 
 #include <Eigen/Geometry>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Pass 1 keeps this many samples before it fixes the block length from their mean interval.
 constexpr size_t kHeadSamples = 32;
 // A window holds at least this many samples (slow logs widen it).
@@ -132,6 +133,7 @@ class Matcher {
       : run_(run), segments_(segments), options_(options), facts_(facts) {
     result_.accel_signs = accel_signs;
     result_.gyro_signs = gyro_signs;
+    gyro_rest_ = facts_.gyro_rest;
   }
 
   // True when the whole run matched; else problem() says where it did not.
@@ -179,6 +181,18 @@ class Matcher {
   // Is pieces[p] (motion) the turn `segment`? Sets *hint when it nearly is.
   bool TurnFits(size_t p, const TableSegment& segment, int pass, std::string* hint);
 
+  // Run()'s stages. What pieces[p] is against the segment `expected` next: passed over (the table
+  // moving, settling or waiting), the segment found, or a disagreement (problem() says which).
+  enum class Step { kPassOver, kFound, kFailed };
+  Step MatchPiece(size_t p, const TableSegment& expected, int pass, std::string* hint);
+  Step MatchRest(const MotionPiece& piece, const TableSegment& expected, int pass, const std::string& hint);
+  Step MatchRate(const MotionPiece& piece, const Eigen::Vector3d& offset, const TableSegment& expected,
+                 int pass);
+  // After a whole pass: the rest of the run is the unit at rest where the last segment left it.
+  bool EndsAtRest(size_t first_piece) const;
+  // Why two segments in a row may not be told apart ("" when they can).
+  std::string SamePositionHint(size_t j) const;
+
   const DetectedRun& run_;
   const std::vector<TableSegment>& segments_;
   const SegmentationOptions& options_;
@@ -188,6 +202,8 @@ class Matcher {
   double reached_s_ = 0.0;
   double residual_deg_ = 0.0;
   std::optional<double> scale_;  // raw per rad/s (= raw * s per rad), from the rates and turns matched
+  std::optional<Eigen::Vector3d> gravity_now_;  // where gravity points now (body), when known
+  Eigen::Vector3d gyro_rest_;                   // raw, the rest before the piece at hand
 };
 
 bool Matcher::TurnFits(size_t p, const TableSegment& segment, int pass, std::string* hint) {
@@ -229,110 +245,132 @@ bool Matcher::TurnFits(size_t p, const TableSegment& segment, int pass, std::str
   return true;
 }
 
+std::string Where(const MotionPiece& piece) {
+  return "at t = " + Seconds(piece.start_s) + " .. " + Seconds(piece.end_s) + " s: ";
+}
+
+bool Matcher::EndsAtRest(size_t first_piece) const {
+  if (!gravity_now_) return false;
+  const std::vector<MotionPiece>& pieces = run_.pieces;
+  for (size_t p = first_piece; p < pieces.size(); ++p) {
+    if (!IsRest(pieces[p], gyro_rest_) ||
+        !(AngleDeg(Gravity(pieces[p]), *gravity_now_) <= options_.direction_tolerance_deg)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string Matcher::SamePositionHint(size_t j) const {
+  const TableSegment& expected = segments_[j];
+  const TableSegment& before = segments_[(j + segments_.size() - 1) % segments_.size()];
+  if (segments_.size() < 2 || !expected.IsStatic() || !before.IsStatic() ||
+      !(AngleDeg(before.up, expected.up) <= options_.direction_tolerance_deg)) {
+    return "";
+  }
+  return "; segment " + std::to_string(expected.id) + " follows segment " + std::to_string(before.id) +
+         " in the same position: without labels they are told apart only by a move between them (the table "
+         "turning about the vertical), and the log shows none";
+}
+
+Matcher::Step Matcher::MatchPiece(size_t p, const TableSegment& expected, int pass, std::string* hint) {
+  const MotionPiece& piece = run_.pieces[p];
+  const Eigen::Vector3d offset = piece.gyro_mean - gyro_rest_;
+  const bool turning = facts_.plan_has_rates && offset.norm() >= facts_.rate_threshold;
+  if (piece.kind == PieceKind::kMotion || (piece.kind == PieceKind::kSteadyGyro && !turning)) {
+    if (!expected.IsTurn() || !TurnFits(p, expected, pass, hint)) return Step::kPassOver;  // moving
+    gravity_now_ = UpAfter(expected);
+    return Step::kFound;
+  }
+  if (!turning) return MatchRest(piece, expected, pass, *hint);
+  return MatchRate(piece, offset, expected, pass);
+}
+
+Matcher::Step Matcher::MatchRest(const MotionPiece& piece, const TableSegment& expected, int pass,
+                                 const std::string& hint) {
+  const double tol = options_.direction_tolerance_deg;
+  const Eigen::Vector3d gravity = Gravity(piece);
+  const double error = AngleDeg(gravity, expected.up);
+  if (expected.IsStatic() && error <= tol) {
+    Add(expected, pass, piece, error,
+        "rest, gravity along body " + Vec(gravity) + ", " + Degrees(error) + " from up; raw accel " +
+            Vec(piece.accel_mean, "%.6g"));
+    gravity_now_ = expected.up;
+    gyro_rest_ = piece.gyro_mean;
+    return Step::kFound;
+  }
+  if (gravity_now_ && AngleDeg(gravity, *gravity_now_) <= tol) {
+    gyro_rest_ = piece.gyro_mean;  // settling after a move
+    return Step::kPassOver;
+  }
+  if (!expected.IsStatic() && error <= tol) {
+    gyro_rest_ = piece.gyro_mean;  // waiting in position for the next rate or turn
+    gravity_now_ = expected.up;
+    return Step::kPassOver;
+  }
+  Fail(&piece, Where(piece) + "a rest with gravity along body " + Vec(gravity) + " (raw accel " +
+                   Vec(piece.accel_mean, "%.6g") + ") where " + DescribeSegment(expected, pass) +
+                   " is expected; it is neither that position nor the one before" +
+                   (gravity_now_ ? " (up " + Vec(*gravity_now_, "%+.2g") + ")" : std::string()) +
+                   ": a segment is missing, extra or out of order" + hint);
+  return Step::kFailed;
+}
+
+Matcher::Step Matcher::MatchRate(const MotionPiece& piece, const Eigen::Vector3d& offset,
+                                 const TableSegment& expected, int pass) {
+  const double tol = options_.direction_tolerance_deg;
+  const Eigen::Vector3d offset_body = GyroBody(offset);
+  if (expected.IsStatic() || expected.IsTurn()) {
+    Fail(&piece, Where(piece) + "a constant rate about body " + Vec(offset_body.normalized()) +
+                     " (raw gyro offset " + Vec(offset, "%+.5g") + ") where " +
+                     DescribeSegment(expected, pass) +
+                     " is expected: a segment is missing, extra or out of order");
+    return Step::kFailed;
+  }
+  const Eigen::Vector3d axis = expected.RotationAxis() * (expected.rate_radps < 0.0 ? -1.0 : 1.0);
+  const double axis_error = AngleDeg(offset_body, axis);
+  const double scale = offset.norm() / std::abs(expected.rate_radps);
+  const std::optional<Eigen::Vector3d> up_after = UpAfter(expected);
+  const bool check_gravity = piece.kind == PieceKind::kSteady && up_after;
+  const double gravity_error = check_gravity ? AngleDeg(Gravity(piece), expected.up) : 0.0;
+  if (axis_error <= tol && ScaleFits(scale) && gravity_error <= tol) {
+    if (!scale_) scale_ = scale;
+    Add(expected, pass, piece, axis_error + gravity_error,
+        "constant rate: raw gyro offset " + Vec(offset, "%+.5g") + " about body " +
+            Vec(offset_body.normalized()) + ", " + Degrees(axis_error) + " from the axis" +
+            (check_gravity ? "; gravity " + Degrees(gravity_error) + " from up" : std::string()));
+    gravity_now_ = up_after;
+    return Step::kFound;
+  }
+  Fail(&piece,
+       Where(piece) + "a constant rate about body " + Vec(offset_body.normalized()) + " (raw gyro offset " +
+           Vec(offset, "%+.5g") + ", " + Degrees(axis_error) + " from the expected axis" +
+           (ScaleFits(scale) ? "" : ", its size out of proportion with the other rates") +
+           (gravity_error > tol ? ", gravity " + Degrees(gravity_error) + " from up" : "") + ") where " +
+           DescribeSegment(expected, pass) + " is expected: a segment is missing, extra or out of order");
+  return Step::kFailed;
+}
+
 bool Matcher::Run() {
   const std::vector<MotionPiece>& pieces = run_.pieces;
-  const double tol = options_.direction_tolerance_deg;
-  size_t k = 0;
-  size_t j = 0;
+  size_t k = 0;  // the first piece not yet matched
+  size_t j = 0;  // the segment expected next
   int pass = 0;
-  std::optional<Eigen::Vector3d> gravity_now;  // where gravity points now (body), when known
-  Eigen::Vector3d gyro_rest = facts_.gyro_rest;
   while (true) {
-    if (j == 0 && pass > 0 && segments_.size() > 1 && gravity_now) {
-      // A whole pass is done: a log that ends at rest where the last segment left the unit (the
-      // rest after a final turn) has no further pass in it.
-      bool settling = true;
-      for (size_t p = k; p < pieces.size() && settling; ++p) {
-        settling = IsRest(pieces[p], gyro_rest) && AngleDeg(Gravity(pieces[p]), *gravity_now) <= tol;
-      }
-      if (settling) break;
-    }
+    // A whole pass is done: a log that ends at rest where the last segment left the unit (the
+    // rest after a final turn) has no further pass in it.
+    if (j == 0 && pass > 0 && segments_.size() > 1 && EndsAtRest(k)) break;
     const TableSegment& expected = segments_[j];
-    const std::string wanted = DescribeSegment(expected, pass);
-    std::string hint;
-    const TableSegment& before = segments_[(j + segments_.size() - 1) % segments_.size()];
-    if (segments_.size() > 1 && expected.IsStatic() && before.IsStatic() &&
-        AngleDeg(before.up, expected.up) <= tol) {
-      hint =
-          "; segment " + std::to_string(expected.id) + " follows segment " + std::to_string(before.id) +
-          " in the same position: without labels they are told apart only by a move between them (the table "
-          "turning about the vertical), and the log shows none";
-    }
-    bool found = false;
+    std::string hint = SamePositionHint(j);
+    Step step = Step::kPassOver;
     size_t p = k;
-    for (; p < pieces.size() && !found; ++p) {
-      const MotionPiece& piece = pieces[p];
-      const Eigen::Vector3d offset = piece.gyro_mean - gyro_rest;
-      const bool turning = facts_.plan_has_rates && offset.norm() >= facts_.rate_threshold;
-      const std::string where = "at t = " + Seconds(piece.start_s) + " .. " + Seconds(piece.end_s) + " s: ";
-      if (piece.kind == PieceKind::kMotion || (piece.kind == PieceKind::kSteadyGyro && !turning)) {
-        found = expected.IsTurn() && TurnFits(p, expected, pass, &hint);
-        if (found) gravity_now = UpAfter(expected);
-        continue;  // else the table moving between segments
-      }
-      if (!turning) {  // a rest
-        const Eigen::Vector3d gravity = Gravity(piece);
-        const double error = AngleDeg(gravity, expected.up);
-        if (expected.IsStatic() && error <= tol) {
-          Add(expected, pass, piece, error,
-              "rest, gravity along body " + Vec(gravity) + ", " + Degrees(error) + " from up; raw accel " +
-                  Vec(piece.accel_mean, "%.6g"));
-          gravity_now = expected.up;
-          gyro_rest = piece.gyro_mean;
-          found = true;
-          continue;
-        }
-        if (gravity_now && AngleDeg(gravity, *gravity_now) <= tol) {
-          gyro_rest = piece.gyro_mean;  // settling after a move
-          continue;
-        }
-        if (!expected.IsStatic() && error <= tol) {
-          gyro_rest = piece.gyro_mean;  // waiting in position for the next rate or turn
-          gravity_now = expected.up;
-          continue;
-        }
-        return Fail(&piece, where + "a rest with gravity along body " + Vec(gravity) + " (raw accel " +
-                                Vec(piece.accel_mean, "%.6g") + ") where " + wanted +
-                                " is expected; it is neither that position nor the one before" +
-                                (gravity_now ? " (up " + Vec(*gravity_now, "%+.2g") + ")" : std::string()) +
-                                ": a segment is missing, extra or out of order" + hint);
-      }
-      // A constant rate.
-      const Eigen::Vector3d offset_body = GyroBody(offset);
-      if (!expected.IsStatic() && !expected.IsTurn()) {
-        const Eigen::Vector3d axis = expected.RotationAxis() * (expected.rate_radps < 0.0 ? -1.0 : 1.0);
-        const double axis_error = AngleDeg(offset_body, axis);
-        const double scale = offset.norm() / std::abs(expected.rate_radps);
-        const std::optional<Eigen::Vector3d> up_after = UpAfter(expected);
-        const bool check_gravity = piece.kind == PieceKind::kSteady && up_after;
-        const double gravity_error = check_gravity ? AngleDeg(Gravity(piece), expected.up) : 0.0;
-        if (axis_error <= tol && ScaleFits(scale) && gravity_error <= tol) {
-          if (!scale_) scale_ = scale;
-          Add(expected, pass, piece, axis_error + gravity_error,
-              "constant rate: raw gyro offset " + Vec(offset, "%+.5g") + " about body " +
-                  Vec(offset_body.normalized()) + ", " + Degrees(axis_error) + " from the axis" +
-                  (check_gravity ? "; gravity " + Degrees(gravity_error) + " from up" : std::string()));
-          gravity_now = up_after;
-          found = true;
-          continue;
-        }
-        return Fail(&piece,
-                    where + "a constant rate about body " + Vec(offset_body.normalized()) +
-                        " (raw gyro offset " + Vec(offset, "%+.5g") + ", " + Degrees(axis_error) +
-                        " from the expected axis" +
-                        (ScaleFits(scale) ? "" : ", its size out of proportion with the other rates") +
-                        (gravity_error > tol ? ", gravity " + Degrees(gravity_error) + " from up" : "") +
-                        ") where " + wanted + " is expected: a segment is missing, extra or out of order");
-      }
-      return Fail(&piece, where + "a constant rate about body " + Vec(offset_body.normalized()) +
-                              " (raw gyro offset " + Vec(offset, "%+.5g") + ") where " + wanted +
-                              " is expected: a segment is missing, extra or out of order");
-    }
-    if (!found) {
+    for (; p < pieces.size() && step == Step::kPassOver; ++p) step = MatchPiece(p, expected, pass, &hint);
+    if (step == Step::kFailed) return false;
+    if (step == Step::kPassOver) {
       if (j == 0 && pass > 0) break;  // the run ended after a whole pass
       const double end_s = pieces.empty() ? 0.0 : pieces.back().end_s;
       return Fail(nullptr,
-                  "the run ends (t = " + Seconds(end_s) + " s) before " + wanted +
+                  "the run ends (t = " + Seconds(end_s) + " s) before " + DescribeSegment(expected, pass) +
                       " was found: a segment is missing" + hint +
                       (pass > 0 || j > 0 ? " (or the last pass through the plan is incomplete)" : ""));
     }
@@ -455,11 +493,25 @@ DetectedRun MotionDetector::Finish() {
   run.sample_interval_s =
       samples_ > 1 ? (blocks_.back().last_s - blocks_.front().first_s) / static_cast<double>(samples_ - 1)
                    : 0.0;
+  std::vector<double> gyro_var;
+  std::vector<double> accel_var;
+  WindowVariances(&gyro_var, &accel_var);
+  SetNoiseLevels(gyro_var, accel_var, &run);
+  std::vector<PieceKind> kinds(blocks_.size());
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const bool gyro_steady = gyro_var[b] <= run.gyro_threshold_var;
+    const bool accel_steady = accel_var[b] <= run.accel_threshold_var;
+    kinds[b] = !gyro_steady ? PieceKind::kMotion : accel_steady ? PieceKind::kSteady : PieceKind::kSteadyGyro;
+  }
+  run.pieces = Pieces(kinds);
+  return run;
+}
 
-  // Variance over a window centred on each block: pooled from the blocks' means and deviations.
+void MotionDetector::WindowVariances(std::vector<double>* gyro_var, std::vector<double>* accel_var) const {
+  // Pooled from the means and deviations of the blocks of the window centred on each block.
   const int count = static_cast<int>(blocks_.size());
-  std::vector<double> gyro_var(blocks_.size(), 0.0);
-  std::vector<double> accel_var(blocks_.size(), 0.0);
+  gyro_var->assign(blocks_.size(), 0.0);
+  accel_var->assign(blocks_.size(), 0.0);
   for (int b = 0; b < count; ++b) {
     const int lo = std::max(0, b - kWindowHalfBlocks);
     const int hi = std::min(count - 1, b + kWindowHalfBlocks);
@@ -481,32 +533,33 @@ DetectedRun MotionDetector::Finish() {
       gyro_m2 += blocks_[i].gyro_m2 + ni * (blocks_[i].gyro_mean - gyro_mean).squaredNorm();
       accel_m2 += blocks_[i].accel_m2 + ni * (blocks_[i].accel_mean - accel_mean).squaredNorm();
     }
-    gyro_var[b] = gyro_m2 / (n - 1.0);
-    accel_var[b] = accel_m2 / (n - 1.0);
+    (*gyro_var)[b] = gyro_m2 / (n - 1.0);
+    (*accel_var)[b] = accel_m2 / (n - 1.0);
   }
+}
+
+void MotionDetector::SetNoiseLevels(const std::vector<double>& gyro_var, const std::vector<double>& accel_var,
+                                    DetectedRun* run) const {
   const double gyro_floor = std::max(integer_gyro_ ? kQuantisationVar : 0.0,
                                      kRelativeVarFloor * (1.0 + reference_.gyro.squaredNorm()));
   const double accel_floor = std::max(integer_accel_ ? kQuantisationVar : 0.0,
                                       kRelativeVarFloor * (1.0 + reference_.accel.squaredNorm()));
-  run.gyro_noise_var = std::max(Quantile(gyro_var, options_.noise_quantile), gyro_floor);
-  run.accel_noise_var = std::max(Quantile(accel_var, options_.noise_quantile), accel_floor);
-  run.gyro_threshold_var = options_.threshold_factor * run.gyro_noise_var;
-  run.accel_threshold_var = options_.threshold_factor * run.accel_noise_var;
+  run->gyro_noise_var = std::max(Quantile(gyro_var, options_.noise_quantile), gyro_floor);
+  run->accel_noise_var = std::max(Quantile(accel_var, options_.noise_quantile), accel_floor);
+  run->gyro_threshold_var = options_.threshold_factor * run->gyro_noise_var;
+  run->accel_threshold_var = options_.threshold_factor * run->accel_noise_var;
+}
 
-  // Classify the blocks, then join runs of one class into pieces: [first, last] block ranges.
-  std::vector<PieceKind> kinds(blocks_.size());
-  for (int b = 0; b < count; ++b) {
-    const bool gyro_steady = gyro_var[b] <= run.gyro_threshold_var;
-    const bool accel_steady = accel_var[b] <= run.accel_threshold_var;
-    kinds[b] = !gyro_steady ? PieceKind::kMotion : accel_steady ? PieceKind::kSteady : PieceKind::kSteadyGyro;
-  }
+std::vector<MotionPiece> MotionDetector::Pieces(const std::vector<PieceKind>& kinds) const {
+  // Runs of one kind as [first, last] block ranges; a steady run shorter than min_steady_s counts
+  // as motion, and joins the motion around it.
   struct Range {
     PieceKind kind;
     int first;
     int last;
   };
   std::vector<Range> ranges;
-  for (int b = 0; b < count; ++b) {
+  for (int b = 0; b < static_cast<int>(kinds.size()); ++b) {
     if (ranges.empty() || ranges.back().kind != kinds[b]) {
       ranges.push_back({kinds[b], b, b});
     } else {
@@ -525,6 +578,7 @@ DetectedRun MotionDetector::Finish() {
       merged.push_back(range);
     }
   }
+  std::vector<MotionPiece> pieces;
   for (const Range& range : merged) {
     MotionPiece piece;
     piece.kind = range.kind;
@@ -540,9 +594,9 @@ DetectedRun MotionDetector::Finish() {
     }
     piece.gyro_mean = piece.gyro_mean / static_cast<double>(piece.samples) + reference_.gyro;
     piece.accel_mean = piece.accel_mean / static_cast<double>(piece.samples) + reference_.accel;
-    run.pieces.push_back(piece);
+    pieces.push_back(piece);
   }
-  return run;
+  return pieces;
 }
 
 Segmentation MatchPlan(const DetectedRun& run, const std::vector<TableSegment>& segments,

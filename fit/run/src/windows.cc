@@ -50,113 +50,119 @@ WindowBuilder::WindowBuilder(const WindowOptions& options, const std::vector<Tab
 }
 
 void WindowBuilder::Add(const Sample& sample) {
-  if (stats_.samples == 0) {
-    stats_.min_temp_c = stats_.max_temp_c = sample.temp_c;
-    stats_.first_time_s = sample.time_s;
+  Channels value;
+  value << sample.gyro, sample.accel;
+  const long long lost = PlaceOnGrid(sample.time_s);
+  CountSample(sample, value);
+  if (sample.segment != occurrence_.segment) FollowOccurrence(sample.segment, sample.time_s);
+  if (sample.segment == kTransitionSegment) {
+    ++stats_.transition_samples;
+    return;
   }
-  // The sample's slot on the run's time grid; the empty slots it skips are lost samples (the first
-  // stamp's step is 1).
-  const long long step = clock_.Place(sample.time_s);
+  if (!occurrence_.whole && sample.time_s - occurrence_.start_s < options_.trim_s) {
+    ++stats_.trimmed_samples;
+    return;
+  }
+  if (window_.open && WindowIsFull(sample)) Close();
+  if (!window_.open) {
+    Open(sample);
+  } else if (lost > 0) {  // a gap inside the window
+    window_.lost += lost;
+    window_.longest_gap_s = std::max(window_.longest_gap_s, static_cast<double>(lost) * clock_.interval_s());
+  }
+  Accumulate(sample, value);
+}
+
+long long WindowBuilder::PlaceOnGrid(double time_s) {
+  // The empty slots a stamp skips are lost samples (the first stamp's step is 1).
+  const long long step = clock_.Place(time_s);
   slot_ += step;
   const long long lost = step - 1;
-  const double gap_s = static_cast<double>(lost) * clock_.interval_s();
   if (!clock_.on_grid()) ++stats_.off_grid_samples;
   if (lost > 0) {
     stats_.lost_samples += lost;
     ++stats_.gaps;
-    stats_.longest_gap_s = std::max(stats_.longest_gap_s, gap_s);
+    stats_.longest_gap_s = std::max(stats_.longest_gap_s, static_cast<double>(lost) * clock_.interval_s());
   }
-  Eigen::Matrix<double, 6, 1> value;
-  value << sample.gyro, sample.accel;
-  if (stats_.samples == 0) stats_.raw_min = stats_.raw_max = value;
+  return lost;
+}
+
+void WindowBuilder::CountSample(const Sample& sample, const Channels& value) {
+  if (stats_.samples == 0) {
+    stats_.min_temp_c = stats_.max_temp_c = sample.temp_c;
+    stats_.first_time_s = sample.time_s;
+    stats_.raw_min = stats_.raw_max = value;
+  }
   stats_.raw_min = stats_.raw_min.cwiseMin(value);
   stats_.raw_max = stats_.raw_max.cwiseMax(value);
   ++stats_.samples;
   stats_.last_time_s = sample.time_s;
   stats_.min_temp_c = std::min(stats_.min_temp_c, sample.temp_c);
   stats_.max_temp_c = std::max(stats_.max_temp_c, sample.temp_c);
+}
 
-  if (sample.segment != current_segment_) {
-    // A new occurrence starts (or a transition).
-    Close();
-    current_segment_ = sample.segment;
-    if (sample.segment != kTransitionSegment) {
-      auto it = std::find_if(occurrences_.begin(), occurrences_.end(),
-                             [&](const auto& entry) { return entry.first == sample.segment; });
-      if (it == occurrences_.end()) {
-        occurrences_.emplace_back(sample.segment, 0);
-        it = occurrences_.end() - 1;
-      }
-      current_occurrence_ = it->second++;
-      occurrence_start_s_ = sample.time_s;
-      whole_occurrence_ = std::find(turn_ids_.begin(), turn_ids_.end(), sample.segment) != turn_ids_.end();
-    }
+void WindowBuilder::FollowOccurrence(int segment, double time_s) {
+  Close();
+  occurrence_ = {};
+  occurrence_.segment = segment;
+  if (segment == kTransitionSegment) return;
+  auto it = std::find_if(occurrences_.begin(), occurrences_.end(),
+                         [&](const auto& entry) { return entry.first == segment; });
+  if (it == occurrences_.end()) {
+    occurrences_.emplace_back(segment, 0);
+    it = occurrences_.end() - 1;
   }
-  if (sample.segment == kTransitionSegment) {
-    ++stats_.transition_samples;
-    return;
-  }
-  if (!whole_occurrence_ && sample.time_s - occurrence_start_s_ < options_.trim_s) {
-    ++stats_.trimmed_samples;
-    return;
-  }
-  if (open_ && !whole_occurrence_ &&
-      (std::abs(sample.temp_c - window_first_temp_c_) > options_.max_temp_span_c ||
-       (options_.max_duration_s > 0.0 && sample.time_s - start_s_ >= options_.max_duration_s))) {
-    Close();
-  }
-  if (!open_) {
-    open_ = true;
-    n_ = 0;
-    start_s_ = sample.time_s;
-    window_first_temp_c_ = sample.temp_c;
-    temp_mean_ = 0.0;
-    temp_min_ = temp_max_ = sample.temp_c;
-    mean_.setZero();
-    m2_.setZero();
-    second_difference_sum_.setZero();
-    lost_ = 0;
-    longest_gap_s_ = 0.0;
-    off_grid_ = false;
-    clipped_channel_ = -1;
-    time_sum_ = 0.0;
-    index_time_sum_ = 0.0;
-    turn_slots_.clear();
-    turn_values_.clear();
-  } else if (lost > 0) {  // a gap inside the window
-    lost_ += lost;
-    longest_gap_s_ = std::max(longest_gap_s_, gap_s);
-  }
-  off_grid_ = off_grid_ || !clock_.on_grid();
-  ++n_;
-  end_s_ = sample.time_s;
-  time_sum_ += sample.time_s - start_s_;
-  index_time_sum_ += static_cast<double>(n_ - 1) * (sample.time_s - start_s_);
-  const double inv_n = 1.0 / static_cast<double>(n_);
-  temp_mean_ += (sample.temp_c - temp_mean_) * inv_n;
-  temp_min_ = std::min(temp_min_, sample.temp_c);
-  temp_max_ = std::max(temp_max_, sample.temp_c);
-  for (int c = 0; c < 6 && clipped_channel_ < 0; ++c) {
+  occurrence_.index = it->second++;
+  occurrence_.start_s = time_s;
+  occurrence_.whole = std::find(turn_ids_.begin(), turn_ids_.end(), segment) != turn_ids_.end();
+}
+
+bool WindowBuilder::WindowIsFull(const Sample& sample) const {
+  if (occurrence_.whole) return false;  // a turn's window closes with its occurrence
+  return std::abs(sample.temp_c - window_.first_temp_c) > options_.max_temp_span_c ||
+         (options_.max_duration_s > 0.0 && sample.time_s - window_.start_s >= options_.max_duration_s);
+}
+
+void WindowBuilder::Open(const Sample& sample) {
+  window_ = {};
+  window_.open = true;
+  window_.start_s = sample.time_s;
+  window_.first_temp_c = sample.temp_c;
+  window_.temp_min = window_.temp_max = sample.temp_c;
+}
+
+void WindowBuilder::Accumulate(const Sample& sample, const Channels& value) {
+  OpenWindow& w = window_;
+  w.off_grid = w.off_grid || !clock_.on_grid();
+  ++w.n;
+  w.end_s = sample.time_s;
+  w.time_sum += sample.time_s - w.start_s;
+  w.index_time_sum += static_cast<double>(w.n - 1) * (sample.time_s - w.start_s);
+  const double inv_n = 1.0 / static_cast<double>(w.n);
+  w.temp_mean += (sample.temp_c - w.temp_mean) * inv_n;
+  w.temp_min = std::min(w.temp_min, sample.temp_c);
+  w.temp_max = std::max(w.temp_max, sample.temp_c);
+  for (int c = 0; c < 6 && w.clipped_channel < 0; ++c) {
     const double full_scale = c < 3 ? options_.gyro_full_scale_raw : options_.accel_full_scale_raw;
     if (full_scale > 0.0 && std::abs(value(c)) >= full_scale) {
-      clipped_channel_ = c;
-      clipped_value_ = value(c);
+      w.clipped_channel = c;
+      w.clipped_value = value(c);
     }
   }
-  const Eigen::Matrix<double, 6, 1> delta = value - mean_;
-  mean_ += delta * inv_n;
-  m2_ += delta.cwiseProduct(value - mean_);
-  if (n_ >= 3) second_difference_sum_ += (value - 2.0 * previous_[1] + previous_[0]).cwiseAbs2();
-  previous_[0] = previous_[1];
-  previous_[1] = value;
-  if (whole_occurrence_) {
-    turn_slots_.push_back(slot_);
-    turn_values_.push_back(value);
+  const Channels delta = value - w.mean;
+  w.mean += delta * inv_n;
+  w.m2 += delta.cwiseProduct(value - w.mean);
+  if (w.n >= 3) w.second_difference_sum += (value - 2.0 * w.previous[1] + w.previous[0]).cwiseAbs2();
+  w.previous[0] = w.previous[1];
+  w.previous[1] = value;
+  if (occurrence_.whole) {
+    w.turn_slots.push_back(slot_);
+    w.turn_values.push_back(value);
   }
 }
 
 bool WindowBuilder::CloseTurn(Window* window) {
-  if (off_grid_) {  // one slot a sample (Close()), as if nothing were lost
+  if (window_.off_grid) {  // one slot a sample (Close()), as if nothing were lost
     ++stats_.turns_off_grid;
     return true;
   }
@@ -168,26 +174,26 @@ bool WindowBuilder::CloseTurn(Window* window) {
   // The mean over every slot, a lost one counted at the value interpolated linearly between its
   // neighbours: a gap of g slots adds (g - 1) (x_before + x_after) / 2. Noise from second
   // differences of three consecutive slots only: across a gap the signal's change would count.
-  Eigen::Matrix<double, 6, 1> slot_sum = Eigen::Matrix<double, 6, 1>::Zero();
-  Eigen::Matrix<double, 6, 1> second_difference_sum = Eigen::Matrix<double, 6, 1>::Zero();
+  const std::vector<long long>& slots = window_.turn_slots;
+  const std::vector<Channels>& values = window_.turn_values;
+  Channels slot_sum = Channels::Zero();
+  Channels second_difference_sum = Channels::Zero();
   long long second_differences = 0;
-  for (size_t i = 0; i < turn_values_.size(); ++i) {
-    slot_sum += turn_values_[i];
+  for (size_t i = 0; i < values.size(); ++i) {
+    slot_sum += values[i];
     if (i == 0) continue;
-    const long long step = turn_slots_[i] - turn_slots_[i - 1];
-    slot_sum += static_cast<double>(step - 1) * 0.5 * (turn_values_[i] + turn_values_[i - 1]);
-    if (i >= 2 && step == 1 && turn_slots_[i - 1] - turn_slots_[i - 2] == 1) {
-      second_difference_sum +=
-          (turn_values_[i] - 2.0 * turn_values_[i - 1] + turn_values_[i - 2]).cwiseAbs2();
+    const long long step = slots[i] - slots[i - 1];
+    slot_sum += static_cast<double>(step - 1) * 0.5 * (values[i] + values[i - 1]);
+    if (i >= 2 && step == 1 && slots[i - 1] - slots[i - 2] == 1) {
+      second_difference_sum += (values[i] - 2.0 * values[i - 1] + values[i - 2]).cwiseAbs2();
       ++second_differences;
     }
   }
-  const Eigen::Matrix<double, 6, 1> mean =
-      slot_sum / static_cast<double>(window->samples + window->lost_samples);
+  const Channels mean = slot_sum / static_cast<double>(window->samples + window->lost_samples);
   window->gyro_mean = mean.head<3>();
   window->accel_mean = mean.tail<3>();
   if (second_differences > 0) {
-    const Eigen::Matrix<double, 6, 1> noise =
+    const Channels noise =
         (second_difference_sum / (6.0 * static_cast<double>(second_differences))).cwiseSqrt();
     window->gyro_noise = noise.head<3>();
     window->accel_noise = noise.tail<3>();
@@ -196,51 +202,51 @@ bool WindowBuilder::CloseTurn(Window* window) {
 }
 
 void WindowBuilder::Close() {
-  if (!open_) return;
-  open_ = false;
-  if (n_ < options_.min_samples) {
+  if (!window_.open) return;
+  window_.open = false;
+  const OpenWindow& w = window_;
+  if (w.n < options_.min_samples) {
     ++stats_.short_windows;
     return;
   }
   Window window;
-  window.segment = current_segment_;
-  window.occurrence = current_occurrence_;
-  window.samples = n_;
-  window.start_s = start_s_;
-  window.end_s = end_s_;
+  window.segment = occurrence_.segment;
+  window.occurrence = occurrence_.index;
+  window.samples = w.n;
+  window.start_s = w.start_s;
+  window.end_s = w.end_s;
   // The run's grid interval: jitter of single time stamps averages out over the clock's memory,
   // where (end_s - start_s) / (n - 1) would carry the jitter of the two ends whole.
   window.interval_s = clock_.interval_s();
-  window.lost_samples = lost_;
-  window.longest_gap_s = longest_gap_s_;
-  if (off_grid_) {
+  window.lost_samples = w.lost;
+  window.longest_gap_s = w.longest_gap_s;
+  if (w.off_grid) {
     // The grid cannot be trusted here: one slot a sample, and the least-squares slope of the
     // window's stamps against their index.
-    const double n = static_cast<double>(n_);
-    window.interval_s = (index_time_sum_ - 0.5 * (n - 1.0) * time_sum_) / (n * (n * n - 1.0) / 12.0);
+    const double n = static_cast<double>(w.n);
+    window.interval_s = (w.index_time_sum - 0.5 * (n - 1.0) * w.time_sum) / (n * (n * n - 1.0) / 12.0);
     window.lost_samples = 0;
     window.longest_gap_s = 0.0;
   }
-  window.temp_c = temp_mean_;
-  window.min_temp_c = temp_min_;
-  window.max_temp_c = temp_max_;
-  const Eigen::Matrix<double, 6, 1> std_dev = (m2_ / static_cast<double>(n_ - 1)).cwiseSqrt();
-  window.gyro_mean = mean_.head<3>();
-  window.accel_mean = mean_.tail<3>();
+  window.temp_c = w.temp_mean;
+  window.min_temp_c = w.temp_min;
+  window.max_temp_c = w.temp_max;
+  const Channels std_dev = (w.m2 / static_cast<double>(w.n - 1)).cwiseSqrt();
+  window.gyro_mean = w.mean.head<3>();
+  window.accel_mean = w.mean.tail<3>();
   window.gyro_std = std_dev.head<3>();
   window.accel_std = std_dev.tail<3>();
-  if (n_ > 2) {
-    const Eigen::Matrix<double, 6, 1> noise =
-        (second_difference_sum_ / (6.0 * static_cast<double>(n_ - 2))).cwiseSqrt();
+  if (w.n > 2) {
+    const Channels noise = (w.second_difference_sum / (6.0 * static_cast<double>(w.n - 2))).cwiseSqrt();
     window.gyro_noise = noise.head<3>();
     window.accel_noise = noise.tail<3>();
   }
-  window.whole_occurrence = whole_occurrence_;
-  if (clipped_channel_ >= 0) {
-    NoteSaturation(window, clipped_channel_, clipped_value_);
+  window.whole_occurrence = occurrence_.whole;
+  if (w.clipped_channel >= 0) {
+    NoteSaturation(window, w.clipped_channel, w.clipped_value);
     return;
   }
-  if (whole_occurrence_ && !CloseTurn(&window)) return;
+  if (occurrence_.whole && !CloseTurn(&window)) return;
   windows_.push_back(window);
 }
 

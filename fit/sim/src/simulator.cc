@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "imufit/model/constants.h"
+
 namespace imufit {
 namespace {
 
@@ -22,9 +24,9 @@ class NormalSource {
     const double u1 = Uniform();
     const double u2 = Uniform();
     const double radius = std::sqrt(-2.0 * std::log(u1));
-    spare_ = radius * std::sin(2.0 * M_PI * u2);
+    spare_ = radius * std::sin(2.0 * kPi * u2);
     has_spare_ = true;
-    return radius * std::cos(2.0 * M_PI * u2);
+    return radius * std::cos(2.0 * kPi * u2);
   }
   Eigen::Vector3d Next3() {
     const double x = Next();
@@ -127,8 +129,8 @@ SegmentTruth MovingTruth(const TableSite& site, const TableSegment& segment, dou
     const double motion_s = (1.0 - 2.0 * kTurnRestFraction) * dwell_s;
     const double tau = std::clamp((t_s - kTurnRestFraction * dwell_s) / motion_s, 0.0, 1.0);
     // s(tau) = tau - sin(2 pi tau) / (2 pi): rate 1 - cos(2 pi tau), zero with zero slope at both ends.
-    angle = *segment.angle_rad * (tau - std::sin(2.0 * M_PI * tau) / (2.0 * M_PI));
-    rate = *segment.angle_rad * (1.0 - std::cos(2.0 * M_PI * tau)) / motion_s;
+    angle = *segment.angle_rad * (tau - std::sin(2.0 * kPi * tau) / (2.0 * kPi));
+    rate = *segment.angle_rad * (1.0 - std::cos(2.0 * kPi * tau)) / motion_s;
   } else {
     angle = segment.rate_radps * t_s;
   }
@@ -144,6 +146,148 @@ SegmentTruth MovingTruth(const TableSite& site, const TableSegment& segment, dou
   return truth;
 }
 
+// The stretches of the run in order: every pass through the plan, a move between two dwells.
+std::vector<Phase> PhasesOf(const SimulationOptions& options, size_t segment_count) {
+  const long long dwell_samples = std::llround(options.dwell_s * options.rate_hz);
+  const long long move_samples = std::llround(options.transition_s * options.rate_hz);
+  const int passes = options.ramp ? options.passes : static_cast<int>(options.soak_temps_c.size());
+  std::vector<Phase> phases;
+  for (int pass = 0; pass < passes; ++pass) {
+    const double soak_c = options.ramp ? 0.0 : options.soak_temps_c[pass];
+    for (int i = 0; i < static_cast<int>(segment_count); ++i) {
+      if (!phases.empty() && move_samples > 0) {
+        phases.push_back(Phase{phases.back().to, i, true, move_samples, soak_c});
+      }
+      phases.push_back(Phase{i, i, false, dwell_samples, soak_c});
+    }
+  }
+  return phases;
+}
+
+// What the table does to the unit: the truth of sample j of a phase, and its segment label.
+class TableMotion {
+ public:
+  TableMotion(const SimulationOptions& options, const TableSite& site,
+              const std::vector<TableSegment>& segments)
+      : options_(options), site_(site), segments_(segments) {
+    for (const TableSegment& segment : segments) dwell_truth_.push_back(TruthOf(site, segment));
+  }
+
+  SegmentTruth TruthAt(const Phase& phase, long long j, int* segment_id) const {
+    const double dt = 1.0 / options_.rate_hz;
+    if (phase.transition) {
+      *segment_id = kTransitionSegment;
+      const double u = (static_cast<double>(j) + 0.5) / static_cast<double>(phase.samples);
+      return TransitionTruth(site_, segments_[phase.from], segments_[phase.to], u, options_.transition_s);
+    }
+    const TableSegment& segment = segments_[phase.from];
+    *segment_id = segment.id;
+    return segment.SpecificForceIsKnown() && !segment.IsTurn()
+               ? dwell_truth_[phase.from]
+               : MovingTruth(site_, segment, static_cast<double>(j) * dt, options_.dwell_s);
+  }
+
+ private:
+  const SimulationOptions& options_;
+  const TableSite& site_;
+  const std::vector<TableSegment>& segments_;
+  std::vector<SegmentTruth> dwell_truth_;  // of the segments whose truth is constant
+};
+
+// The unit under test: its true calibration and noise, from the run's generator of normal deviates.
+class SimulatedUnit {
+ public:
+  SimulatedUnit(const SimulationOptions& options, const SensorModel& truth_model)
+      : options_(options),
+        truth_model_(truth_model),
+        normal_(options.seed),
+        gyro_noise_(options.gyro_noise_density, options.gyro_random_walk, options.gyro_bias_instability,
+                    options.bias_correlation_s, 1.0 / options.rate_hz),
+        accel_noise_(options.accel_noise_density, options.accel_random_walk, options.accel_bias_instability,
+                     options.bias_correlation_s, 1.0 / options.rate_hz) {
+    gyro_noise_.Start(&normal_, options.gyro_bias_instability);
+    accel_noise_.Start(&normal_, options.accel_bias_instability);
+  }
+
+  // The raw outputs and temperature reading of the unit at `true_temp_c` under `truth`: noise in SI
+  // units at the body frame, the forward model at the true temperature, then rounding and clipping
+  // as the converter does. The reading is noisy; the unit behaves according to the true temperature.
+  void Sense(const SegmentTruth& truth, double true_temp_c, Sample* raw) {
+    const Eigen::Vector3d omega_sensed = truth.omega_radps + gyro_noise_.Step(&normal_);
+    const Eigen::Vector3d a_sensed = truth.a_mps2 + accel_noise_.Step(&normal_);
+    raw->temp_c = true_temp_c;
+    if (options_.temp_noise_c > 0.0) raw->temp_c += options_.temp_noise_c * normal_.Next();
+    const double x = truth_model_.basis.Argument(true_temp_c);
+    const SensorCoefficients<double> accel = CoefficientsAt(truth_model_.accel.data(), kAccelCoefficients, x);
+    const SensorCoefficients<double> gyro = CoefficientsAt(truth_model_.gyro.data(), kGyroCoefficients, x);
+    Eigen::Vector3d accel_m = ForwardSensor(accel, a_sensed, Eigen::Vector3d::Zero().eval());
+    Eigen::Vector3d gyro_m = ForwardSensor(gyro, omega_sensed, truth.a_mps2);
+    if (options_.quantize) {
+      accel_m = accel_m.array().round();
+      gyro_m = gyro_m.array().round();
+    }
+    if (options_.gyro_full_scale_raw > 0.0) {
+      gyro_m = gyro_m.cwiseMax(-options_.gyro_full_scale_raw).cwiseMin(options_.gyro_full_scale_raw);
+    }
+    if (options_.accel_full_scale_raw > 0.0) {
+      accel_m = accel_m.cwiseMax(-options_.accel_full_scale_raw).cwiseMin(options_.accel_full_scale_raw);
+    }
+    raw->gyro = gyro_m;
+    raw->accel = accel_m;
+  }
+
+ private:
+  const SimulationOptions& options_;
+  const SensorModel& truth_model_;
+  NormalSource normal_;
+  NoiseProcess gyro_noise_;
+  NoiseProcess accel_noise_;
+};
+
+// The serial link: time stamps with their jitter, and lost samples. Each from its own generator
+// (seeded from the seed), so that neither changes the samples' values.
+class Link {
+ public:
+  explicit Link(const SimulationOptions& options)
+      : options_(options),
+        jitter_engine_(options.seed ^ 0x6a09e667f3bcc909ULL),
+        drop_engine_(options.seed ^ 0xbb67ae8584caa73bULL) {}
+
+  // The time stamp of sample k.
+  double TimeS(long long k) {
+    double time_s = options_.start_time_s + static_cast<double>(k) * (1.0 / options_.rate_hz);
+    if (options_.time_jitter_s > 0.0) {
+      const double u = static_cast<double>(jitter_engine_() >> 11) * 0x1.0p-53;  // [0, 1)
+      time_s += options_.time_jitter_s * (2.0 * u - 1.0);
+    }
+    return time_s;
+  }
+
+  // Whether the next sample is lost (a loss takes drop_burst samples in a row).
+  bool Loses() {
+    if (losing_ == 0 && options_.drop_probability > 0.0 &&
+        static_cast<double>(drop_engine_() >> 11) * 0x1.0p-53 < options_.drop_probability) {
+      losing_ = options_.drop_burst;
+    }
+    if (losing_ == 0) return false;
+    --losing_;
+    return true;
+  }
+
+ private:
+  const SimulationOptions& options_;
+  std::mt19937_64 jitter_engine_;
+  std::mt19937_64 drop_engine_;
+  int losing_ = 0;  // samples still to lose in the current loss
+};
+
+// The true temperature of sample k of `total`: the soak's, or along the ramp.
+double TrueTempC(const SimulationOptions& options, const Phase& phase, long long k, long long total) {
+  if (!options.ramp) return phase.soak_temp_c;
+  const double progress = total > 1 ? static_cast<double>(k) / static_cast<double>(total - 1) : 0.0;
+  return options.ramp_from_c + (options.ramp_to_c - options.ramp_from_c) * progress;
+}
+
 }  // namespace
 
 long long SimulationOptions::SampleCount(size_t segment_count) const {
@@ -157,100 +301,18 @@ long long SimulationOptions::SampleCount(size_t segment_count) const {
 void SimulateRun(const SimulationOptions& options, const TableSite& site,
                  const std::vector<TableSegment>& segments, const SensorModel& truth_model,
                  const SimulationSink& sink) {
-  const double dt = 1.0 / options.rate_hz;
-  const long long dwell_samples = std::llround(options.dwell_s * options.rate_hz);
-  const long long move_samples = std::llround(options.transition_s * options.rate_hz);
-  const int passes = options.ramp ? options.passes : static_cast<int>(options.soak_temps_c.size());
-
-  std::vector<Phase> phases;
-  for (int pass = 0; pass < passes; ++pass) {
-    const double soak_c = options.ramp ? 0.0 : options.soak_temps_c[pass];
-    for (int i = 0; i < static_cast<int>(segments.size()); ++i) {
-      if (!phases.empty() && move_samples > 0) {
-        phases.push_back(Phase{phases.back().to, i, true, move_samples, soak_c});
-      }
-      phases.push_back(Phase{i, i, false, dwell_samples, soak_c});
-    }
-  }
   const long long total = options.SampleCount(segments.size());
-
-  NormalSource normal(options.seed);
-  NoiseProcess gyro_noise(options.gyro_noise_density, options.gyro_random_walk, options.gyro_bias_instability,
-                          options.bias_correlation_s, dt);
-  NoiseProcess accel_noise(options.accel_noise_density, options.accel_random_walk,
-                           options.accel_bias_instability, options.bias_correlation_s, dt);
-  gyro_noise.Start(&normal, options.gyro_bias_instability);
-  accel_noise.Start(&normal, options.accel_bias_instability);
-
-  std::vector<SegmentTruth> dwell_truth;
-  for (const TableSegment& segment : segments) dwell_truth.push_back(TruthOf(site, segment));
-
-  // A separate generator for the jitter (seeded from the seed), so that jitter moves only the times.
-  std::mt19937_64 jitter_engine(options.seed ^ 0x6a09e667f3bcc909ULL);
-  // And one for the losses, so that losing samples changes nothing in the others.
-  std::mt19937_64 drop_engine(options.seed ^ 0xbb67ae8584caa73bULL);
-  int losing = 0;  // samples still to lose in the current loss
+  const TableMotion table(options, site, segments);
+  SimulatedUnit unit(options, truth_model);
+  Link link(options);
   long long k = 0;
   Sample raw;
-  for (const Phase& phase : phases) {
+  for (const Phase& phase : PhasesOf(options, segments.size())) {
     for (long long j = 0; j < phase.samples; ++j, ++k) {
-      raw.time_s = options.start_time_s + static_cast<double>(k) * dt;
-      if (options.time_jitter_s > 0.0) {
-        const double u = static_cast<double>(jitter_engine() >> 11) * 0x1.0p-53;  // [0, 1)
-        raw.time_s += options.time_jitter_s * (2.0 * u - 1.0);
-      }
-      if (options.ramp) {
-        const double progress = total > 1 ? static_cast<double>(k) / static_cast<double>(total - 1) : 0.0;
-        raw.temp_c = options.ramp_from_c + (options.ramp_to_c - options.ramp_from_c) * progress;
-      } else {
-        raw.temp_c = phase.soak_temp_c;
-      }
-      SegmentTruth truth;
-      if (phase.transition) {
-        const double u = (static_cast<double>(j) + 0.5) / static_cast<double>(phase.samples);
-        truth = TransitionTruth(site, segments[phase.from], segments[phase.to], u, options.transition_s);
-        raw.segment = kTransitionSegment;
-      } else {
-        const TableSegment& segment = segments[phase.from];
-        truth = segment.SpecificForceIsKnown() && !segment.IsTurn()
-                    ? dwell_truth[phase.from]
-                    : MovingTruth(site, segment, static_cast<double>(j) * dt, options.dwell_s);
-        raw.segment = segment.id;
-      }
-      const Eigen::Vector3d omega_sensed = truth.omega_radps + gyro_noise.Step(&normal);
-      const Eigen::Vector3d a_sensed = truth.a_mps2 + accel_noise.Step(&normal);
-      const double true_temp_c = raw.temp_c;
-      if (options.temp_noise_c > 0.0) raw.temp_c += options.temp_noise_c * normal.Next();
-      // The unit behaves according to its true temperature; it reports a noisy reading.
-      Eigen::Vector3d accel_m;
-      Eigen::Vector3d gyro_m;
-      const double x = truth_model.basis.Argument(true_temp_c);
-      const SensorCoefficients<double> accel =
-          CoefficientsAt(truth_model.accel.data(), kAccelCoefficients, x);
-      const SensorCoefficients<double> gyro = CoefficientsAt(truth_model.gyro.data(), kGyroCoefficients, x);
-      accel_m = ForwardSensor(accel, a_sensed, Eigen::Vector3d::Zero().eval());
-      gyro_m = ForwardSensor(gyro, omega_sensed, truth.a_mps2);
-      if (options.quantize) {
-        accel_m = accel_m.array().round();
-        gyro_m = gyro_m.array().round();
-      }
-      if (options.gyro_full_scale_raw > 0.0) {
-        gyro_m = gyro_m.cwiseMax(-options.gyro_full_scale_raw).cwiseMin(options.gyro_full_scale_raw);
-      }
-      if (options.accel_full_scale_raw > 0.0) {
-        accel_m = accel_m.cwiseMax(-options.accel_full_scale_raw).cwiseMin(options.accel_full_scale_raw);
-      }
-      raw.gyro = gyro_m;
-      raw.accel = accel_m;
-      if (losing == 0 && options.drop_probability > 0.0 &&
-          static_cast<double>(drop_engine() >> 11) * 0x1.0p-53 < options.drop_probability) {
-        losing = options.drop_burst;
-      }
-      if (losing > 0) {
-        --losing;
-        continue;
-      }
-      sink(raw, truth);
+      raw.time_s = link.TimeS(k);
+      const SegmentTruth truth = table.TruthAt(phase, j, &raw.segment);
+      unit.Sense(truth, TrueTempC(options, phase, k, total), &raw);
+      if (!link.Loses()) sink(raw, truth);
     }
   }
 }

@@ -38,10 +38,11 @@
 #include <string>
 #include <vector>
 
-#include "imufit/run/windows.h"
 #include "imufit/model/option_table.h"
+#include "imufit/run/windows.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
+#include "imufit/run/windows.h"
 
 namespace imufit {
 

@@ -8,10 +8,14 @@
 //              reason), points_used, reduced_chi_square, every term as [value, 1-sigma] in SI and in engineer
 //              units, `<term>_resolved: false` for a term the fit did not resolve, the graphical
 //              read-outs; then Kalibr's continuous-time densities (the worst axis of each sensor).
+//
+// io owns the format: the records below are plain, and the caller fills them from its analysis
+// (app/allan_command.cc from noise/column_analysis.h), so io does not depend on noise.
 #ifndef IMUFIT_IO_NOISE_FILE_H_
 #define IMUFIT_IO_NOISE_FILE_H_
 
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,7 +23,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/io/output_file.h"
-#include "imufit/noise/column_analysis.h"
+#include "imufit/model/noise_terms.h"
 
 namespace imufit {
 
@@ -34,11 +38,46 @@ struct NoiseTermUnits {
 };
 const NoiseTermUnits& UnitsOf(ColumnKind kind, int term);
 
-// Writes the Allan deviation CSV (each column's `curve`) atomically, in `transaction` when not null.
-void WriteAllanCsv(const std::string& path, const std::vector<ColumnAnalysis>& results,
+// One column's Allan-family deviation curve, as the CSV holds it.
+struct AllanCurveRecord {
+  struct Point {
+    double tau_s = 0.0;
+    long long terms = 0;
+    double dev = 0.0;  // and its confidence interval (nan when unknown)
+    double dev_lo = 0.0;
+    double dev_hi = 0.0;
+  };
+  std::string column;
+  std::string estimator;  // as the CSV names it: "oadev", ...
+  std::vector<Point> points;
+};
+
+// Writes the Allan deviation CSV atomically.
+// Writes it atomically, in `transaction` when not null.
+void WriteAllanCsv(const std::string& path, const std::vector<AllanCurveRecord>& curves,
                    OutputTransaction* transaction = nullptr);
 
-// What the noise block says about the record the columns came from.
+// One column of the noise block: the IEEE 952 terms fitted to its Allan variance, SI units of the
+// column (noise/noise_model.h), or why there are none.
+struct NoiseColumnRecord {
+  std::string name;
+  ColumnKind kind = ColumnKind::kOther;
+  bool fitted = false;
+  std::string reason;  // why not fitted
+  int points_used = 0;
+  double reduced_chi_square = std::nan("");
+  // Each term's value and 1-sigma, and whether the fit resolved it from zero.
+  std::array<double, kNoiseTerms> value = {0, 0, 0, 0, 0};
+  std::array<double, kNoiseTerms> sigma = {0, 0, 0, 0, 0};
+  std::array<bool, kNoiseTerms> resolved = {false, false, false, false, false};
+  // The graphical read-outs of the measured curve (nan when it has no such region).
+  double readout_random_walk = std::nan("");
+  double readout_bias_instability = std::nan("");
+  double readout_bias_tau_s = std::nan("");
+  double readout_rate_random_walk = std::nan("");
+};
+
+// The noise block: what it says about the record the columns came from, and the columns.
 struct NoiseRecord {
   std::string software;
   std::string samples;
@@ -50,12 +89,12 @@ struct NoiseRecord {
   double sample_interval_s = 0.0;
   long long sample_count = 0;
   double duration_s = 0.0;
+  std::vector<NoiseColumnRecord> columns;
 };
 // The text of the noise block (top-level key `noise:`).
-std::string NoiseYaml(const NoiseRecord& record, const std::vector<ColumnAnalysis>& results);
+std::string NoiseYaml(const NoiseRecord& record);
 // Writes it atomically, in `transaction` when not null.
-void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
-                    const std::vector<ColumnAnalysis>& results, OutputTransaction* transaction = nullptr);
+void WriteNoiseYaml(const std::string& path, const NoiseRecord& record, OutputTransaction* transaction = nullptr);
 
 // [value, 1-sigma] of noise.columns.<column>.<key> in a calibration's further keys (Calibration::
 // extra), when there and a pair of numbers.

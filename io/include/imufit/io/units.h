@@ -12,12 +12,13 @@
 #ifndef IMUFIT_IO_UNITS_H_
 #define IMUFIT_IO_UNITS_H_
 
+#include <cmath>
+
+#include "imufit/model/constants.h"
+#include "imufit/model/sensor_model.h"
+
 namespace imufit {
 
-inline constexpr double kPi = 3.14159265358979323846;
-inline constexpr double kRadToDeg = 180.0 / kPi;
-inline constexpr double kDegToRad = kPi / 180.0;
-inline constexpr double kStandardGravityMps2 = 9.80665;  // m/s^2 per g, for mg and deg/s/g
 inline constexpr double kSecondsPerHour = 3600.0;
 inline constexpr double kSqrtSecondsPerSqrtHour = 60.0;
 

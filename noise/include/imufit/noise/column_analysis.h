@@ -3,23 +3,21 @@
 // runs per column and what a certificate runs on each gyro axis of a static stretch.
 //
 // The rates are in the column's own unit (SI for a corrected file: rad/s, m/s^2); the kind says
-// which engineer units a writer uses (io/units.h, io/noise_file.h).
+// which engineer units a writer uses (io/noise_file.h).
 #ifndef IMUFIT_NOISE_COLUMN_ANALYSIS_H_
 #define IMUFIT_NOISE_COLUMN_ANALYSIS_H_
 
 #include <string>
 #include <vector>
 
+#include "imufit/model/noise_terms.h"
 #include "imufit/noise/allan.h"
 #include "imufit/noise/noise_model.h"
 
 namespace imufit {
 
-enum class ColumnKind { kGyro, kAccel, kOther };
+// ColumnKind, ToString(ColumnKind) and SiUnit() are model/noise_terms.h.
 
-const char* ToString(ColumnKind kind);  // "gyro", "accel", "other"
-// The SI unit of a column of this kind: "rad/s", "m/s^2", "unit".
-const char* SiUnit(ColumnKind kind);
 // `kind` is "auto", "gyro", "accel" or "other"; auto: gyro_* columns are gyros, accel_* are
 // accelerometers, others are other.
 ColumnKind ColumnKindOf(const std::string& column, const std::string& kind);

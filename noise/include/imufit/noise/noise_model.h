@@ -41,18 +41,13 @@
 #include <string_view>
 #include <vector>
 
+#include "imufit/model/noise_terms.h"
 #include "imufit/noise/allan.h"
 
 namespace imufit {
 
-enum NoiseTerm { kQuantization = 0, kRandomWalk = 1, kBiasInstability = 2, kRateRandomWalk = 3, kRateRamp = 4 };
-inline constexpr int kNoiseTerms = 5;
-// "quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp".
-const char* NoiseTermName(int term);
-// Parses a name; false (and `term` untouched) for anything else.
-bool ParseNoiseTerm(std::string_view name, int* term);
-// Every name, comma-separated.
-std::string NoiseTermNames();
+// The terms (NoiseTerm, kNoiseTerms, NoiseTermName, ParseNoiseTerm, NoiseTermNames) are
+// model/noise_terms.h.
 
 // The basis function of term k at tau: the variance it contributes per unit coefficient.
 double NoiseTermBasis(int term, double tau_s);
@@ -69,8 +64,8 @@ struct NoiseFitOptions {
 };
 
 struct NoiseFitSummary {
-  bool fitted = false;             // false: too few usable points (see message)
-  std::string message;             // why not fitted, or "" 
+  bool fitted = false;  // false: too few usable points (see message)
+  std::string message;  // why not fitted, or ""
   int points_used = 0;
   double reduced_chi_square = std::nan("");
   // Coefficients in SI units of the rate (see above) and their 1-sigma uncertainties.

@@ -14,13 +14,13 @@
 #include <string>
 #include <vector>
 
-#include "imufit/run/segmentation.h"
-#include "imufit/run/windows.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/pipeline/segment_run.h"
 #include "imufit/pipeline/static_stretch.h"
+#include "imufit/run/segmentation.h"
+#include "imufit/run/windows.h"
 
 namespace imufit {
 

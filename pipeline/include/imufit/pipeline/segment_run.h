@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "imufit/run/segmentation.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/run/segmentation.h"
 
 namespace imufit {
 

@@ -142,6 +142,13 @@ class MotionDetector {
   };
   void Start();
   void Accumulate(const Sample& sample);
+  // Finish()'s stages: each block's variance (sum over the axes, raw^2) over the window centred
+  // on it; the noise levels and thresholds from them; the blocks classified as `kinds`, joined
+  // into pieces.
+  void WindowVariances(std::vector<double>* gyro_var, std::vector<double>* accel_var) const;
+  void SetNoiseLevels(const std::vector<double>& gyro_var, const std::vector<double>& accel_var,
+                      DetectedRun* run) const;
+  std::vector<MotionPiece> Pieces(const std::vector<PieceKind>& kinds) const;
 
   SegmentationOptions options_;
   std::vector<Sample> head_;  // the first samples, until the sample interval is known

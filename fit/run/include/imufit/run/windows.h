@@ -143,12 +143,12 @@ struct WindowStats {
   // Each raw channel's extremes over the run (gyro x, y, z, accel x, y, z).
   Eigen::Matrix<double, 6, 1> raw_min = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> raw_max = Eigen::Matrix<double, 6, 1>::Zero();
-  int turns_off_grid = 0;            // turns with a stamp off the grid: one slot a sample
+  int turns_off_grid = 0;  // turns with a stamp off the grid: one slot a sample
 
   // Whether the time stamps lie on a uniform grid (at most one in a thousand off it), so that the
   // lost samples counted are real: bunched stamps make gaps of their own.
   bool StampsOnGrid() const { return off_grid_samples * 1000 <= samples; }
-  double min_temp_c = 0.0;           // over all samples
+  double min_temp_c = 0.0;  // over all samples
   double max_temp_c = 0.0;
   double first_time_s = 0.0;
   double last_time_s = 0.0;
@@ -174,6 +174,56 @@ class WindowBuilder {
   const WindowStats& stats() const { return stats_; }
 
  private:
+  using Channels = Eigen::Matrix<double, 6, 1>;  // gyro x, y, z, accel x, y, z
+
+  // The occurrence the last sample belongs to (reset as a whole when the segment id changes).
+  struct Occurrence {
+    int segment = kTransitionSegment;
+    int index = 0;         // Window::occurrence
+    double start_s = 0.0;  // time of its first sample
+    bool whole = false;    // a turn: the whole occurrence is one window
+  };
+
+  // The window being filled: running sums from which Close() makes a Window. Reset as a whole
+  // when a window opens (window_ = {}).
+  struct OpenWindow {
+    bool open = false;
+    long long n = 0;
+    double start_s = 0.0;
+    double end_s = 0.0;
+    double first_temp_c = 0.0;  // the temperature span is measured from here
+    double temp_mean = 0.0;
+    double temp_min = 0.0;
+    double temp_max = 0.0;
+    // Running mean and sum of squared deviations (Welford), per channel.
+    Channels mean = Channels::Zero();
+    Channels m2 = Channels::Zero();
+    // The last two samples and the sum of squared second differences.
+    Channels previous[2] = {Channels::Zero(), Channels::Zero()};
+    Channels second_difference_sum = Channels::Zero();
+    long long lost = 0;  // empty slots of the grid inside the window
+    double longest_gap_s = 0.0;
+    bool off_grid = false;     // a stamp of the window was off the grid
+    int clipped_channel = -1;  // a channel at or beyond its full scale
+    double clipped_value = 0.0;
+    // Sums of (t - start_s) and of k (t - start_s) over the window's samples k = 0, 1, ...: the
+    // interval of a window off the grid.
+    double time_sum = 0.0;
+    double index_time_sum = 0.0;
+    // A turn's samples (slot, gyro and accel), kept until it ends (CloseTurn()).
+    std::vector<long long> turn_slots;
+    std::vector<Channels> turn_values;
+  };
+
+  // Add()'s stages: the sample placed on the run's time grid (returns the slots lost before it),
+  // counted in the run's statistics, its occurrence followed, and added to the open window.
+  long long PlaceOnGrid(double time_s);
+  void CountSample(const Sample& sample, const Channels& value);
+  void FollowOccurrence(int segment, double time_s);
+  bool WindowIsFull(const Sample& sample) const;
+  void Open(const Sample& sample);
+  void Accumulate(const Sample& sample, const Channels& value);
+
   void Close();
   // Fills a turn's mean and noise from its kept samples; false when it is dropped for a gap.
   bool CloseTurn(Window* window);
@@ -186,38 +236,10 @@ class WindowBuilder {
   std::vector<Window> windows_;
   std::vector<std::pair<int, int>> occurrences_;  // segment id -> occurrences so far
   std::vector<int> turn_ids_;                     // segments whose occurrence is one window
-  bool whole_occurrence_ = false;                 // the current segment is a turn
-  // The open window: running mean and sum of squared deviations (Welford), per channel.
-  bool open_ = false;
-  int current_segment_ = kTransitionSegment;
-  int current_occurrence_ = 0;
-  double occurrence_start_s_ = 0.0;
-  double window_first_temp_c_ = 0.0;
-  long long n_ = 0;
-  double start_s_ = 0.0;
-  double end_s_ = 0.0;
-  double temp_mean_ = 0.0;
-  double temp_min_ = 0.0;
-  double temp_max_ = 0.0;
-  Eigen::Matrix<double, 6, 1> mean_ = Eigen::Matrix<double, 6, 1>::Zero();
-  Eigen::Matrix<double, 6, 1> m2_ = Eigen::Matrix<double, 6, 1>::Zero();
-  // The last two samples and the sum of squared second differences.
-  Eigen::Matrix<double, 6, 1> previous_[2];
-  Eigen::Matrix<double, 6, 1> second_difference_sum_ = Eigen::Matrix<double, 6, 1>::Zero();
   SampleClock clock_;
   long long slot_ = -1;  // the last sample's slot: its clock's steps summed
-  long long lost_ = 0;           // empty slots in the open window
-  double longest_gap_s_ = 0.0;
-  bool off_grid_ = false;  // a stamp of the open window was off the grid
-  int clipped_channel_ = -1;  // a channel of the open window at or beyond its full scale
-  double clipped_value_ = 0.0;
-  // Sums of (t - start_s) and of k (t - start_s) over the window's samples k = 0, 1, ...: the
-  // interval of a window off the grid.
-  double time_sum_ = 0.0;
-  double index_time_sum_ = 0.0;
-  // A turn's samples (slot, gyro and accel), kept until it ends (CloseTurn()).
-  std::vector<long long> turn_slots_;
-  std::vector<Eigen::Matrix<double, 6, 1>> turn_values_;
+  Occurrence occurrence_;
+  OpenWindow window_;
 };
 
 }  // namespace imufit
