@@ -10,12 +10,12 @@
 
 #include "coverage.h"
 #include "imufit/model/check.h"
+#include "imufit/model/constants.h"
 #include "thermal_fit_state.h"
 
 namespace imufit {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 }  // namespace
 
@@ -193,7 +193,7 @@ std::string FitSummary::BriefReport() const {
   std::snprintf(text, sizeof text,
                 "converged in %d iterations; residual RMS gyro %.3g deg/s%s, accel %.3g mg%s; %d windows (%d "
                 "down-weighted) over %zu temperatures",
-                iterations, gyro_rms_radps * kRadToDeg, gyro_note, accel_rms_mps2 / 9.80665 * 1e3, accel_note,
+                iterations, gyro_rms_radps * kRadToDeg, gyro_note, accel_rms_mps2 / kStandardGravityMps2 * 1e3, accel_note,
                 windows_used, windows_downweighted, distinct_temps_c.size());
   return text;
 }

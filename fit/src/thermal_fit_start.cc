@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "imufit/model/check.h"
+#include "imufit/model/constants.h"
 #include "thermal_fit_state.h"
 
 namespace imufit::internal {
@@ -86,7 +87,7 @@ Eigen::MatrixXd ScaleAndMisalignmentPolynomials(const Eigen::Matrix<double, 9, 4
   Eigen::MatrixXd values(kStartNodes, 9);
   for (int node = 0; node < kStartNodes; ++node) {
     const double x =
-        0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(M_PI * (node + 0.5) / kStartNodes);
+        0.5 * (x_min + x_max) + 0.5 * (x_max - x_min) * std::cos(kPi * (node + 0.5) / kStartNodes);
     Eigen::Matrix3d k_at;
     for (int e = 0; e < 9; ++e) {
       const Eigen::Vector4d c = K.row(e).transpose();

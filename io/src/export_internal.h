@@ -11,12 +11,10 @@
 #include <Eigen/Core>
 
 #include "imufit/io/export.h"
+#include "imufit/model/constants.h"
 #include "imufit/model/sensor_model.h"
 
 namespace imufit::export_internal {
-
-inline constexpr double kStandardGravityMps2 = 9.80665;  // 1 g, for mg
-inline constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // A consumer's correction of one sample, evaluated as the consumer evaluates it: raw outputs of
 // the unit in, angular rate (rad/s) and specific force (m/s^2) in imufit's body frame out.

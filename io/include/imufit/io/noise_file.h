@@ -52,8 +52,7 @@ struct AllanCurveRecord {
   std::vector<Point> points;
 };
 
-// Writes the Allan deviation CSV atomically.
-// Writes it atomically, in `transaction` when not null.
+// Writes the Allan deviation CSV atomically, in `transaction` when not null.
 void WriteAllanCsv(const std::string& path, const std::vector<AllanCurveRecord>& curves,
                    OutputTransaction* transaction = nullptr);
 
