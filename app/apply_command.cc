@@ -21,7 +21,8 @@ struct ApplyArguments {
 int RunApply(const ApplyArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
   const Calibration calibration = ReadCalibration(args.calibration);
-  const CorrectFileReport report = CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().temp_c);
+  const CorrectFileReport report =
+      CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().temp_c);
   WarnOutsideFitTempRange(calibration, report);
   if (!args.quiet) {
     std::printf("corrected %lld samples -> %s\n", report.samples, args.output.c_str());
@@ -49,9 +50,11 @@ CommandRunner AddApplyCommand(CLI::App* root) {
       "apply",
       "Correct raw samples with a calibration: writes time_s, temp_c, segment (if present), gyro in "
       "rad/s and accel in m/s^2, body frame.");
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")->required();
+  command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")
+      ->required();
   command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
-  command->add_option("--output,-o", args->output, "corrected samples CSV to write (.gz compresses)")->required();
+  command->add_option("--output,-o", args->output, "corrected samples CSV to write (.gz compresses)")
+      ->required();
   AddTempOption(command, &args->input);
   command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
   return [args] { return RunApply(*args); };

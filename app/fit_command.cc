@@ -21,12 +21,12 @@ struct FitArguments {
   std::string samples;
   std::string output;
   bool quiet = false;
-  std::string limits;           // acceptance limits: verdict table, exit 3 when they fail
-  std::string report;           // certificate HTML to write
-  std::string store;            // results store to record the fit in
-  std::string serial;           // the unit's serial; empty: the samples header's, else the plan's
-  std::string station;          // station file shown on the certificate (with --report)
-  FitRunArguments run;          // the fit options, shared with imufit batch
+  std::string limits;   // acceptance limits: verdict table, exit 3 when they fail
+  std::string report;   // certificate HTML to write
+  std::string store;    // results store to record the fit in
+  std::string serial;   // the unit's serial; empty: the samples header's, else the plan's
+  std::string station;  // station file shown on the certificate (with --report)
+  FitRunArguments run;  // the fit options, shared with imufit batch
 };
 
 // A value and its 1-sigma: the sigma goes through the same unit conversion as the value, whose
@@ -241,8 +241,8 @@ int RunFit(const FitArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.plan, args.samples, check_plan, check_samples, args.limits,
                                         args.run.options.GivenText("prior")});
   if (!args.report.empty()) {
-    RefuseToOverwriteInputs(args.report,
-                            {args.plan, args.samples, check_plan, check_samples, args.limits, args.output, args.station});
+    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, check_plan, check_samples, args.limits,
+                                          args.output, args.station});
   }
   if (!args.station.empty() && args.report.empty()) {
     throw InputError("--station", "is shown on the certificate: give --report too");

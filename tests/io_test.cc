@@ -264,11 +264,12 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   calibration.extra = YAML::Node(YAML::NodeType::Map);
   calibration.extra["noise"]["format"] = "imufit-noise";
   const std::string text = CalibrationToYaml(calibration);
-  for (const char* line :
-       {"\nfit:\n  plan: plan.yaml\n  samples: runs/unit 1.csv.gz\n", "\n  distinct_temperatures_c:\n    - -40.000955338170442\n",
-        "\n  fitted: [gyro.bias, accel.bias]\n  held: []\n  held_values: prior\n", "\n  gyro_reduced_chi2: .nan\n",
-        "\n  g_sensitivity_fitted: false\n", "\n  segments_without_windows: [3, 7]\n  missing_segments: 2\ncheck:\n",
-        "\ncheck:\n  samples: check.csv\n  gyro_error_rms_radps: 0.001\nnoise:\n"}) {
+  for (const char* line : {"\nfit:\n  plan: plan.yaml\n  samples: runs/unit 1.csv.gz\n",
+                           "\n  distinct_temperatures_c:\n    - -40.000955338170442\n",
+                           "\n  fitted: [gyro.bias, accel.bias]\n  held: []\n  held_values: prior\n",
+                           "\n  gyro_reduced_chi2: .nan\n", "\n  g_sensitivity_fitted: false\n",
+                           "\n  segments_without_windows: [3, 7]\n  missing_segments: 2\ncheck:\n",
+                           "\ncheck:\n  samples: check.csv\n  gyro_error_rms_radps: 0.001\nnoise:\n"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "\nin:\n" << text;
   }
   const Calibration read = ReadCalibration(Write("cal.yaml", text));
@@ -285,7 +286,7 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   ASSERT_TRUE(read.check.has_value());
   EXPECT_EQ(read.check->gyro_error_rms_radps, 1e-3);
   EXPECT_FALSE(read.check->accel_error_rms_mps2.has_value());  // not written: not set
-  EXPECT_EQ(read.extra.size(), 1u);  // noise
+  EXPECT_EQ(read.extra.size(), 1u);                            // noise
   EXPECT_EQ(CalibrationToYaml(read), text);
 
   // A key of the block this reader does not know is kept, after the others.
@@ -294,7 +295,8 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   const Calibration kept = ReadCalibration(Write("unknown.yaml", unknown));
   ASSERT_TRUE(kept.fit->extra.IsMap());
   EXPECT_EQ(kept.fit->extra["leave_one_out"].size(), 2u);
-  EXPECT_NE(CalibrationToYaml(kept).find("missing_segments: 2\n  leave_one_out: [1, 2]\ncheck:"), std::string::npos);
+  EXPECT_NE(CalibrationToYaml(kept).find("missing_segments: 2\n  leave_one_out: [1, 2]\ncheck:"),
+            std::string::npos);
 
   std::string wrong = text;
   wrong.replace(wrong.find("iterations: 7"), 13, "iterations: seven");

@@ -26,8 +26,9 @@ TEST(CheckDeathTest, AbortsInEveryBuildWithLocationAndMessage) {
   int evaluated = 0;
   IMUFIT_CHECK(++evaluated == 1, "evaluated once");
   EXPECT_EQ(evaluated, 1);
-  EXPECT_DEATH(IMUFIT_CHECK(evaluated == 2, "one Jacobian column per free parameter"),
-               "model_test.cc:[0-9]+: check failed: evaluated == 2 \\(one Jacobian column per free parameter\\)");
+  EXPECT_DEATH(
+      IMUFIT_CHECK(evaluated == 2, "one Jacobian column per free parameter"),
+      "model_test.cc:[0-9]+: check failed: evaluated == 2 \\(one Jacobian column per free parameter\\)");
 }
 
 TEST(TemperaturePolynomial, RebaseIsExact) {

@@ -12,8 +12,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -119,40 +119,68 @@ struct Stable32Table {
 const std::vector<Stable32Table>& Stable32Tables() {
   static const std::vector<Stable32Table> tables = {
       {AllanEstimator::kAdev,
-       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 499, 1.9787e-01, 2.0510e-01, 2.1319e-01},
-        {4, 249, 1.4201e-01, 1.4943e-01, 1.5815e-01}, {8, 124, 1.0254e-01, 1.1013e-01, 1.1971e-01},
-        {16, 61, 5.6510e-02, 6.2381e-02, 7.0567e-02}, {32, 30, 4.9153e-02, 5.6233e-02, 6.7635e-02},
-        {64, 14, 2.7109e-02, 3.2550e-02, 4.3537e-02}, {128, 6, 2.6481e-02, 3.3855e-02, 5.5744e-02}}},
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01},
+        {2, 499, 1.9787e-01, 2.0510e-01, 2.1319e-01},
+        {4, 249, 1.4201e-01, 1.4943e-01, 1.5815e-01},
+        {8, 124, 1.0254e-01, 1.1013e-01, 1.1971e-01},
+        {16, 61, 5.6510e-02, 6.2381e-02, 7.0567e-02},
+        {32, 30, 4.9153e-02, 5.6233e-02, 6.7635e-02},
+        {64, 14, 2.7109e-02, 3.2550e-02, 4.3537e-02},
+        {128, 6, 2.6481e-02, 3.3855e-02, 5.5744e-02}}},
       {AllanEstimator::kOadev,
-       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 997, 1.9520e-01, 2.0102e-01, 2.0738e-01},
-        {4, 993, 1.3931e-01, 1.4479e-01, 1.5098e-01}, {8, 985, 1.0038e-01, 1.0570e-01, 1.1198e-01},
-        {16, 969, 5.7696e-02, 6.1915e-02, 6.7217e-02}, {32, 937, 4.3654e-02, 4.8082e-02, 5.4202e-02},
-        {64, 873, 3.1755e-02, 3.6237e-02, 4.3377e-02}, {128, 745, 2.3045e-02, 2.7674e-02, 3.7027e-02}}},
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01},
+        {2, 997, 1.9520e-01, 2.0102e-01, 2.0738e-01},
+        {4, 993, 1.3931e-01, 1.4479e-01, 1.5098e-01},
+        {8, 985, 1.0038e-01, 1.0570e-01, 1.1198e-01},
+        {16, 969, 5.7696e-02, 6.1915e-02, 6.7217e-02},
+        {32, 937, 4.3654e-02, 4.8082e-02, 5.4202e-02},
+        {64, 873, 3.1755e-02, 3.6237e-02, 4.3377e-02},
+        {128, 745, 2.3045e-02, 2.7674e-02, 3.7027e-02}}},
       {AllanEstimator::kMdev,
-       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01}, {2, 996, 1.5336e-01, 1.5821e-01, 1.6355e-01},
-        {4, 990, 1.0322e-01, 1.0780e-01, 1.1304e-01}, {8, 978, 6.9840e-02, 7.4192e-02, 7.9481e-02},
-        {16, 954, 3.8022e-02, 4.1376e-02, 4.5809e-02}, {32, 906, 3.0466e-02, 3.4255e-02, 3.9933e-02},
-        {64, 810, 2.3687e-02, 2.7871e-02, 3.5511e-02}, {128, 618, 1.4874e-02, 1.8669e-02, 2.8584e-02}}},
+       {{1, 999, 2.8515e-01, 2.9223e-01, 2.9987e-01},
+        {2, 996, 1.5336e-01, 1.5821e-01, 1.6355e-01},
+        {4, 990, 1.0322e-01, 1.0780e-01, 1.1304e-01},
+        {8, 978, 6.9840e-02, 7.4192e-02, 7.9481e-02},
+        {16, 954, 3.8022e-02, 4.1376e-02, 4.5809e-02},
+        {32, 906, 3.0466e-02, 3.4255e-02, 3.9933e-02},
+        {64, 810, 2.3687e-02, 2.7871e-02, 3.5511e-02},
+        {128, 618, 1.4874e-02, 1.8669e-02, 2.8584e-02}}},
       {AllanEstimator::kTdev,
-       {{1, 999, 1.6463e-01, 1.6872e-01, 1.7313e-01}, {2, 996, 1.7709e-01, 1.8268e-01, 1.8885e-01},
-        {4, 990, 2.3838e-01, 2.4895e-01, 2.6106e-01}, {8, 978, 3.2258e-01, 3.4268e-01, 3.6710e-01},
-        {16, 954, 3.5123e-01, 3.8221e-01, 4.2317e-01}, {32, 906, 5.6287e-01, 6.3287e-01, 7.3777e-01},
-        {64, 810, 8.7525e-01, 1.0298e+00, 1.3122e+00}, {128, 618, 1.0992e+00, 1.3797e+00, 2.1124e+00}}},
+       {{1, 999, 1.6463e-01, 1.6872e-01, 1.7313e-01},
+        {2, 996, 1.7709e-01, 1.8268e-01, 1.8885e-01},
+        {4, 990, 2.3838e-01, 2.4895e-01, 2.6106e-01},
+        {8, 978, 3.2258e-01, 3.4268e-01, 3.6710e-01},
+        {16, 954, 3.5123e-01, 3.8221e-01, 4.2317e-01},
+        {32, 906, 5.6287e-01, 6.3287e-01, 7.3777e-01},
+        {64, 810, 8.7525e-01, 1.0298e+00, 1.3122e+00},
+        {128, 618, 1.0992e+00, 1.3797e+00, 2.1124e+00}}},
       {AllanEstimator::kHdev,
-       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01}, {2, 498, 1.9887e-01, 2.0716e-01, 2.1659e-01},
-        {4, 248, 1.4054e-01, 1.4890e-01, 1.5896e-01}, {8, 123, 1.0744e-01, 1.1649e-01, 1.2829e-01},
-        {16, 60, 5.3296e-02, 5.9589e-02, 6.8811e-02}, {32, 29, 4.6987e-02, 5.4697e-02, 6.8092e-02},
-        {64, 13, 2.4870e-02, 3.0569e-02, 4.3652e-02}, {128, 5, 2.8841e-02, 3.8060e-02, 7.3807e-02}}},
+       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01},
+        {2, 498, 1.9887e-01, 2.0716e-01, 2.1659e-01},
+        {4, 248, 1.4054e-01, 1.4890e-01, 1.5896e-01},
+        {8, 123, 1.0744e-01, 1.1649e-01, 1.2829e-01},
+        {16, 60, 5.3296e-02, 5.9589e-02, 6.8811e-02},
+        {32, 29, 4.6987e-02, 5.4697e-02, 6.8092e-02},
+        {64, 13, 2.4870e-02, 3.0569e-02, 4.3652e-02},
+        {128, 5, 2.8841e-02, 3.8060e-02, 7.3807e-02}}},
       {AllanEstimator::kOhdev,
-       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01}, {2, 995, 1.9491e-01, 2.0125e-01, 2.0825e-01},
-        {4, 989, 1.3777e-01, 1.4368e-01, 1.5043e-01}, {8, 977, 1.0388e-01, 1.0987e-01, 1.1704e-01},
-        {16, 953, 5.6173e-02, 6.0638e-02, 6.6369e-02}, {32, 905, 4.0664e-02, 4.5095e-02, 5.1382e-02},
-        {64, 809, 2.9271e-02, 3.3824e-02, 4.1477e-02}, {128, 617, 2.3761e-02, 2.9147e-02, 4.1367e-02}}},
+       {{1, 998, 2.8635e-01, 2.9439e-01, 3.0315e-01},
+        {2, 995, 1.9491e-01, 2.0125e-01, 2.0825e-01},
+        {4, 989, 1.3777e-01, 1.4368e-01, 1.5043e-01},
+        {8, 977, 1.0388e-01, 1.0987e-01, 1.1704e-01},
+        {16, 953, 5.6173e-02, 6.0638e-02, 6.6369e-02},
+        {32, 905, 4.0664e-02, 4.5095e-02, 5.1382e-02},
+        {64, 809, 2.9271e-02, 3.3824e-02, 4.1477e-02},
+        {128, 617, 2.3761e-02, 2.9147e-02, 4.1367e-02}}},
       {AllanEstimator::kTotdev,
-       {{1, 999, 2.8707e-01, 2.9223e-01, 2.9768e-01}, {2, 999, 1.9592e-01, 2.0089e-01, 2.0625e-01},
-        {4, 999, 1.3947e-01, 1.4444e-01, 1.4998e-01}, {8, 999, 1.0039e-01, 1.0540e-01, 1.1126e-01},
-        {16, 999, 5.7732e-02, 6.1788e-02, 6.6839e-02}, {32, 999, 4.4255e-02, 4.8580e-02, 5.4484e-02},
-        {64, 999, 3.1639e-02, 3.5905e-02, 4.2546e-02}, {128, 999, 2.6406e-02, 3.1259e-02, 4.0383e-02},
+       {{1, 999, 2.8707e-01, 2.9223e-01, 2.9768e-01},
+        {2, 999, 1.9592e-01, 2.0089e-01, 2.0625e-01},
+        {4, 999, 1.3947e-01, 1.4444e-01, 1.4998e-01},
+        {8, 999, 1.0039e-01, 1.0540e-01, 1.1126e-01},
+        {16, 999, 5.7732e-02, 6.1788e-02, 6.6839e-02},
+        {32, 999, 4.4255e-02, 4.8580e-02, 5.4484e-02},
+        {64, 999, 3.1639e-02, 3.5905e-02, 4.2546e-02},
+        {128, 999, 2.6406e-02, 3.1259e-02, 4.0383e-02},
         {256, 999, 1.0734e-02, 1.3369e-02, 1.9924e-02}}},
   };
   return tables;
@@ -184,7 +212,6 @@ TEST(NoiseReferenceTest, ConfidenceIntervalsMatchStable32) {
   }
 }
 
-
 // ---------------------------------------------------------------- statistics
 
 // Relative, worst case, for the chi-squared quantile against tabulated values (which carry 15
@@ -198,8 +225,8 @@ TEST(NoiseStatisticsTest, ChiSquaredQuantileMatchesTables) {
   // Standard tables (dof 10), closed forms (dof 1 is the square of a normal quantile, dof 2 is
   // exponential, x = -2 ln(1 - p)) and, for dof 100, an independent bisection on the series of
   // P(50, x / 2) in Python.
-  const Case cases[] = {{0.5, 1, 0.4549364231195727},   {0.8415, 1, 1.9884790397914103},
-                        {0.95, 10, 18.307038053275146}, {0.05, 10, 3.940299136119804},
+  const Case cases[] = {{0.5, 1, 0.4549364231195727},    {0.8415, 1, 1.9884790397914103},
+                        {0.95, 10, 18.307038053275146},  {0.05, 10, 3.940299136119804},
                         {0.975, 100, 129.5611971858363}, {0.01, 2, 0.0201006717070029},
                         {0.9, 2, 4.605170185988092}};
   for (const Case& c : cases) {
@@ -225,8 +252,8 @@ TEST(NoiseStatisticsTest, ChiSquaredQuantileInvertsTheDistribution) {
   // Large dof: the Cornish-Fisher expansion is exact to O(1/dof) there.
   const double dof = 1e8;
   const double z = NormalQuantile(0.8415);
-  const double cornish_fisher = dof + z * std::sqrt(2 * dof) + 2.0 * (z * z - 1) / 3.0 +
-                                (z * z * z - 7 * z) / (9 * std::sqrt(2 * dof));
+  const double cornish_fisher =
+      dof + z * std::sqrt(2 * dof) + 2.0 * (z * z - 1) / 3.0 + (z * z * z - 7 * z) / (9 * std::sqrt(2 * dof));
   EXPECT_NEAR(ChiSquaredQuantile(0.8415, dof) / cornish_fisher, 1.0, kQuantileTolerance);
 }
 
@@ -329,7 +356,8 @@ TEST(NoiseNumericsTest, LargeOffsetLosesNoDigits) {
   AllanOptions options;
   const AllanResult result = ComputeAllanFromRates(y, 1.0, factors, options);
   for (size_t i = 0; i < factors.size(); ++i) {
-    EXPECT_NEAR(result.points[i].dev / DirectOadev(y, factors[i], 100.0), 1.0, kStabilityTolerance) << factors[i];
+    EXPECT_NEAR(result.points[i].dev / DirectOadev(y, factors[i], 100.0), 1.0, kStabilityTolerance)
+        << factors[i];
   }
   EXPECT_NEAR(result.mean, 100.0, 1e-5);
 }
@@ -370,8 +398,10 @@ TEST(NoiseTauTest, SetsAndErrors) {
   EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("not a whole multiple"),
             std::string::npos);
   ASSERT_EQ(ParseTauSpec("6", &spec), "");
-  EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("too long"), std::string::npos);
-  EXPECT_NE(ParseTauSpec("weekly", &spec).find("allowed: octave, decade, all, per-decade:K"), std::string::npos);
+  EXPECT_NE(AveragingFactors(spec, AllanEstimator::kOadev, 1000, 0.01, &factors).find("too long"),
+            std::string::npos);
+  EXPECT_NE(ParseTauSpec("weekly", &spec).find("allowed: octave, decade, all, per-decade:K"),
+            std::string::npos);
   EXPECT_NE(AveragingFactors(TauSpec(), AllanEstimator::kOadev, 3, 0.01, &factors).find("too short"),
             std::string::npos);
   AllanEstimator estimator;
@@ -391,7 +421,8 @@ NoiseFitSummary FitRates(const std::vector<double>& y, double tau0, const char* 
   TauSpec spec;
   EXPECT_EQ(ParseTauSpec(taus, &spec), "");
   std::vector<int64_t> factors;
-  EXPECT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, static_cast<int64_t>(y.size()), tau0, &factors), "");
+  EXPECT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, static_cast<int64_t>(y.size()), tau0, &factors),
+            "");
   AllanOptions options;
   const AllanResult result = ComputeAllanFromRates(y, tau0, factors, options);
   return FitNoiseModel(result.points, static_cast<int64_t>(y.size()));
@@ -399,7 +430,8 @@ NoiseFitSummary FitRates(const std::vector<double>& y, double tau0, const char* 
 
 void ExpectRecovered(const NoiseFitSummary& fit, int term, double truth) {
   EXPECT_NEAR(fit.value[term], truth, kCoverageSigmas * fit.sigma[term])
-      << NoiseTermName(term) << ": fitted " << fit.value[term] << " +- " << fit.sigma[term] << ", truth " << truth;
+      << NoiseTermName(term) << ": fitted " << fit.value[term] << " +- " << fit.sigma[term] << ", truth "
+      << truth;
   EXPECT_LT(fit.sigma[term], kMaxRelativeUncertainty * truth) << NoiseTermName(term);
 }
 
@@ -429,7 +461,7 @@ TEST(NoiseFitTest, QuantizedAngleGivesItsQuantizationNoise) {
   // A rate-integrating gyro that outputs angle in steps of `step`: the rate is the difference of
   // quantized angles. Its angle error is uniform, so Q = step / sqrt(12).
   const double tau0 = 0.01;
-  const double step = 1e-5;  // rad
+  const double step = 1e-5;          // rad
   const double rate = 0.0123456789;  // rad/s, incommensurate with the step
   const int64_t n = 400000;
   // An angle random walk of half a step per sample: enough to make successive quantization
@@ -489,7 +521,6 @@ TEST(NoiseFitTest, TooFewPointsIsReportedNotFitted) {
   EXPECT_NE(fit.message.find("too few points"), std::string::npos);
 }
 
-
 // ---------------------------------------------------------------- imufit allan, end to end
 
 namespace fs = std::filesystem;
@@ -506,7 +537,8 @@ class AllanCliTest : public testing::TempDirTest {
     text << "# a comment line\ntime_s,temp_c,gyro_x,accel_y\n";
     text.precision(17);
     for (int i = 0; i < rows; ++i) {
-      text << (time_of ? time_of(i) : 1000.0 + i * interval) << ",25," << gyro[i] << "," << 9.8 + accel[i] << "\n";
+      text << (time_of ? time_of(i) : 1000.0 + i * interval) << ",25," << gyro[i] << "," << 9.8 + accel[i]
+           << "\n";
     }
     const std::string path = Path(name);
     if (name.size() > 3 && name.substr(name.size() - 3) == ".gz") {
@@ -524,8 +556,9 @@ class AllanCliTest : public testing::TempDirTest {
   // leaves stderr in error_.
   int Run(const std::string& args, const std::string& environment = "") {
     const std::string err = Path("stderr.txt");
-    const std::string command = (environment.empty() ? "" : "env " + environment + " ") + "'" IMUFIT_EXE "' " +
-                                args + " > '" + Path("stdout.txt") + "' 2> '" + err + "'";
+    const std::string command = (environment.empty() ? "" : "env " + environment + " ") +
+                                "'" IMUFIT_EXE "' " + args + " > '" + Path("stdout.txt") + "' 2> '" + err +
+                                "'";
     const int status = std::system(command.c_str());
     error_ = Read(err);
     output_ = Read(Path("stdout.txt"));
@@ -542,7 +575,8 @@ TEST_F(AllanCliTest, WritesTheCsvOfTheLibraryAndANoiseFile) {
   const std::string samples = WriteSamples("samples.csv", 20000);
   const std::string csv = Path("allan.csv");
   const std::string yaml = Path("noise.yaml");
-  ASSERT_EQ(Run("allan -s '" + samples + "' -c gyro_x,accel_y -o '" + csv + "' --noise-yaml '" + yaml + "'"), 0)
+  ASSERT_EQ(Run("allan -s '" + samples + "' -c gyro_x,accel_y -o '" + csv + "' --noise-yaml '" + yaml + "'"),
+            0)
       << error_;
   EXPECT_NE(output_.find("angle random walk"), std::string::npos) << output_;
   EXPECT_NE(output_.find("velocity random walk"), std::string::npos) << output_;
@@ -594,8 +628,10 @@ TEST_F(AllanCliTest, WritesTheCsvOfTheLibraryAndANoiseFile) {
 TEST_F(AllanCliTest, GzipInputGivesTheSameResult) {
   const std::string plain = WriteSamples("samples.csv", 5000);
   const std::string gz = WriteSamples("samples.csv.gz", 5000);
-  ASSERT_EQ(Run("allan -q -s '" + plain + "' -c gyro_x -e mdev -t decade -o '" + Path("a.csv") + "'"), 0) << error_;
-  ASSERT_EQ(Run("allan -q -s '" + gz + "' -c gyro_x -e mdev -t decade -o '" + Path("b.csv") + "'"), 0) << error_;
+  ASSERT_EQ(Run("allan -q -s '" + plain + "' -c gyro_x -e mdev -t decade -o '" + Path("a.csv") + "'"), 0)
+      << error_;
+  ASSERT_EQ(Run("allan -q -s '" + gz + "' -c gyro_x -e mdev -t decade -o '" + Path("b.csv") + "'"), 0)
+      << error_;
   EXPECT_EQ(Read(Path("a.csv")), Read(Path("b.csv")));
   EXPECT_NE(Read(Path("a.csv")).find("gyro_x,mdev,0.01,"), std::string::npos);
 }
@@ -606,23 +642,28 @@ TEST_F(AllanCliTest, BadInputIsExitTwoWithALocatedMessage) {
   const std::string common = " -o '" + out + "'";
   // A column that does not exist: the header line (line 2, after the comment).
   EXPECT_EQ(Run("allan -s '" + samples + "' -c gyro_q" + common), 2);
-  EXPECT_NE(error_.find(samples + ":2: no column \"gyro_q\" in the header (it has: time_s,temp_c,gyro_x,accel_y)"),
-            std::string::npos)
+  EXPECT_NE(
+      error_.find(samples + ":2: no column \"gyro_q\" in the header (it has: time_s,temp_c,gyro_x,accel_y)"),
+      std::string::npos)
       << error_;
   // A gap: sample 1000 comes two intervals late; it sits on line 1000 + 3.
-  const std::string gap = WriteSamples("gap.csv", 2000, 0.01, [](int i) { return i < 1000 ? i * 0.01 : (i + 1) * 0.01; });
+  const std::string gap =
+      WriteSamples("gap.csv", 2000, 0.01, [](int i) { return i < 1000 ? i * 0.01 : (i + 1) * 0.01; });
   EXPECT_EQ(Run("allan -s '" + gap + "' -c gyro_x" + common), 2);
-  EXPECT_NE(error_.find(gap + ":1003:1: time_s: a gap in time: 10.01 s follows 9.99"), std::string::npos) << error_;
+  EXPECT_NE(error_.find(gap + ":1003:1: time_s: a gap in time: 10.01 s follows 9.99"), std::string::npos)
+      << error_;
   // ... which --gaps bridge joins knowingly.
   EXPECT_EQ(Run("allan -s '" + gap + "' -c gyro_x --gaps bridge" + common), 0) << error_;
   EXPECT_NE(output_.find("bridged 1 gap"), std::string::npos) << output_;
   fs::remove(out);
   // Jitter beyond the tolerance.
-  const std::string jitter = WriteSamples("jitter.csv", 2000, 0.01, [](int i) { return i * 0.01 + (i == 500 ? 0.002 : 0.0); });
+  const std::string jitter =
+      WriteSamples("jitter.csv", 2000, 0.01, [](int i) { return i * 0.01 + (i == 500 ? 0.002 : 0.0); });
   EXPECT_EQ(Run("allan -s '" + jitter + "' -c gyro_x --time-tolerance 0.1" + common), 2);
   EXPECT_NE(error_.find(jitter + ":503:1: time_s:"), std::string::npos) << error_;
   // Time that goes backwards.
-  const std::string backwards = WriteSamples("back.csv", 100, 0.01, [](int i) { return i == 50 ? 0.3 : i * 0.01; });
+  const std::string backwards =
+      WriteSamples("back.csv", 100, 0.01, [](int i) { return i == 50 ? 0.3 : i * 0.01; });
   EXPECT_EQ(Run("allan -s '" + backwards + "' -c gyro_x" + common), 2);
   EXPECT_NE(error_.find(":53:1: time_s: 0.3 s does not increase"), std::string::npos) << error_;
   // Too short.
@@ -635,7 +676,8 @@ TEST_F(AllanCliTest, BadInputIsExitTwoWithALocatedMessage) {
             std::string::npos)
       << error_;
   EXPECT_EQ(Run("allan -s '" + samples + "' -t 0.015" + common), 2);
-  EXPECT_NE(error_.find("tau 0.015 s is not a whole multiple of the sample interval"), std::string::npos) << error_;
+  EXPECT_NE(error_.find("tau 0.015 s is not a whole multiple of the sample interval"), std::string::npos)
+      << error_;
   EXPECT_EQ(Run("allan -s '" + samples + "' -t weekly" + common), 2);
   EXPECT_NE(error_.find("allowed: octave, decade, all, per-decade:K"), std::string::npos) << error_;
   EXPECT_EQ(Run("allan -s '" + samples + "' --confidence 1.5" + common), 2);

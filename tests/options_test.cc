@@ -9,9 +9,9 @@
 #include <string>
 #include <type_traits>
 
-#include "imufit/sim/simulator.h"
 #include "imufit/model/enum_names.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/sim/simulator.h"
 
 namespace imufit {
 namespace {

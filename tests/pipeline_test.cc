@@ -71,12 +71,14 @@ TEST_P(FixtureRegression, RecoversTruthAndMatchesGolden) {
       ++count;
       if (i % kPolynomialTerms == 0) {
         const CoefficientName& name = kCoefficientNames[i / kPolynomialTerms];
-        EXPECT_LE(std::abs(z), kTruthSigmas) << sensor << " " << name.group << " " << name.axis << " at 25 degC";
+        EXPECT_LE(std::abs(z), kTruthSigmas)
+            << sensor << " " << name.group << " " << name.axis << " at 25 degC";
       }
     }
   };
   check("gyro", kGyroCoefficients, fit.model.gyro.data(), fit.sigma.gyro.data(), truth.model.gyro.data());
-  check("accel", kAccelCoefficients, fit.model.accel.data(), fit.sigma.accel.data(), truth.model.accel.data());
+  check("accel", kAccelCoefficients, fit.model.accel.data(), fit.sigma.accel.data(),
+        truth.model.accel.data());
   const double z_rms = std::sqrt(sum_z2 / count);
   EXPECT_GT(z_rms, kZRmsLow);
   EXPECT_LT(z_rms, kZRmsHigh);
@@ -84,20 +86,25 @@ TEST_P(FixtureRegression, RecoversTruthAndMatchesGolden) {
   const Calibration golden = ReadCalibration(Fixture(std::string("golden/") + c.name + ".yaml"));
   ASSERT_TRUE(golden.sigma.has_value());
   for (int i = 0; i < kGyroParameters; ++i) {
-    EXPECT_NEAR(fit.model.gyro[i], golden.model.gyro[i], kGoldenSigmaFraction * golden.sigma->gyro[i]) << "gyro " << i;
+    EXPECT_NEAR(fit.model.gyro[i], golden.model.gyro[i], kGoldenSigmaFraction * golden.sigma->gyro[i])
+        << "gyro " << i;
     EXPECT_NEAR(fit.sigma.gyro[i], golden.sigma->gyro[i], 1e-6 * golden.sigma->gyro[i]) << "gyro sigma " << i;
   }
   for (int i = 0; i < kAccelParameters; ++i) {
-    EXPECT_NEAR(fit.model.accel[i], golden.model.accel[i], kGoldenSigmaFraction * golden.sigma->accel[i]) << "accel " << i;
-    EXPECT_NEAR(fit.sigma.accel[i], golden.sigma->accel[i], 1e-6 * golden.sigma->accel[i]) << "accel sigma " << i;
+    EXPECT_NEAR(fit.model.accel[i], golden.model.accel[i], kGoldenSigmaFraction * golden.sigma->accel[i])
+        << "accel " << i;
+    EXPECT_NEAR(fit.sigma.accel[i], golden.sigma->accel[i], 1e-6 * golden.sigma->accel[i])
+        << "accel sigma " << i;
   }
   EXPECT_EQ(fit.temp_range_c, golden.fit_temp_range_c);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Fixtures, FixtureRegression,
-    ::testing::Values(FixtureCase{"mems_6pos_soak", "plan_6pos.yaml", "mems_6pos_soak.csv.gz", "mems_truth.yaml", 7.5, 73.0, 100.0},
-                      FixtureCase{"mems_6pos_ramp", "plan_6pos.yaml", "mems_6pos_ramp.csv.gz", "mems_truth.yaml", 7.5, 73.0, 100.0},
+    ::testing::Values(FixtureCase{"mems_6pos_soak", "plan_6pos.yaml", "mems_6pos_soak.csv.gz",
+                                  "mems_truth.yaml", 7.5, 73.0, 100.0},
+                      FixtureCase{"mems_6pos_ramp", "plan_6pos.yaml", "mems_6pos_ramp.csv.gz",
+                                  "mems_truth.yaml", 7.5, 73.0, 100.0},
                       FixtureCase{"tactical_24pos_soak", "plan_24pos.yaml", "tactical_24pos_soak.csv.gz",
                                   "tactical_truth.yaml", 0.8, 3.2, 300.0}),
     [](const ::testing::TestParamInfo<FixtureCase>& info) { return std::string(info.param.name); });
@@ -110,8 +117,9 @@ TEST(ReadRunWindows, RefusesASegmentThePlanDoesNotHave) {
     ReadRunWindows(smaller, Fixture("mems_6pos_soak.csv.gz"), WindowOptions());
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(e.message().find("segment: segment " + std::to_string(plan.segments[3].id) + " is not in the plan"),
-              std::string::npos)
+    EXPECT_NE(
+        e.message().find("segment: segment " + std::to_string(plan.segments[3].id) + " is not in the plan"),
+        std::string::npos)
         << e.what();
     EXPECT_GT(e.line(), 1);
     EXPECT_GT(e.column(), 0);

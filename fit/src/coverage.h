@@ -14,8 +14,8 @@ namespace imufit::internal {
 struct FitWindow {
   const Window* window = nullptr;
   SegmentTruth truth;
-  double x = 0.0;            // temperature in the fit basis
-  bool accel_known = true;   // the specific force is known (truth.a_mps2): the accelerometer is fitted here
+  double x = 0.0;           // temperature in the fit basis
+  bool accel_known = true;  // the specific force is known (truth.a_mps2): the accelerometer is fitted here
 };
 
 // Findings (empty when the run covers the model that `options` asks for).

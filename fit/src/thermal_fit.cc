@@ -14,10 +14,7 @@
 #include "thermal_fit_state.h"
 
 namespace imufit {
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 namespace internal {
 
@@ -193,8 +190,9 @@ std::string FitSummary::BriefReport() const {
   std::snprintf(text, sizeof text,
                 "converged in %d iterations; residual RMS gyro %.3g deg/s%s, accel %.3g mg%s; %d windows (%d "
                 "down-weighted) over %zu temperatures",
-                iterations, gyro_rms_radps * kRadToDeg, gyro_note, accel_rms_mps2 / kStandardGravityMps2 * 1e3, accel_note,
-                windows_used, windows_downweighted, distinct_temps_c.size());
+                iterations, gyro_rms_radps * kRadToDeg, gyro_note,
+                accel_rms_mps2 / kStandardGravityMps2 * 1e3, accel_note, windows_used, windows_downweighted,
+                distinct_temps_c.size());
   return text;
 }
 

@@ -59,8 +59,9 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, std::option
                        e.message() + "; for a run without a thermometer give its temperature (--temp-c)");
     }
   } else if (csv_.FindColumn("temp_c")) {
-    throw InputError(csv_.path(), "has a temp_c column: a fixed temperature (--temp-c) is only for samples "
-                                  "without one (leave it out to use the readings)");
+    throw InputError(csv_.path(),
+                     "has a temp_c column: a fixed temperature (--temp-c) is only for samples "
+                     "without one (leave it out to use the readings)");
   } else {
     fixed_temp_c_ = *temp_c;
   }
@@ -93,8 +94,8 @@ bool SamplesReader::Next(Sample* sample) {
   if (segment_column_ >= 0) {
     const long segment = csv_.Integer(segment_column_, kTransitionSegment);
     if (segment < kTransitionSegment || segment > 1000000000L) {
-      csv_.Fail(segment_column_, std::to_string(segment) +
-                                     " is not a segment id (an id >= 0, or -1 while the table moves)");
+      csv_.Fail(segment_column_,
+                std::to_string(segment) + " is not a segment id (an id >= 0, or -1 while the table moves)");
     }
     sample->segment = static_cast<int>(segment);
   }

@@ -147,7 +147,8 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
       if (StartsWith(name, "gyro_") || StartsWith(name, "accel_")) names.push_back(name);
     }
     if (names.empty()) {
-      throw InputError(path, header_line, 0, "no columns named: give --columns (no gyro_* or accel_* column in the header)");
+      throw InputError(path, header_line, 0,
+                       "no columns named: give --columns (no gyro_* or accel_* column in the header)");
     }
   }
   const int time_column = csv.RequireColumn("time_s");

@@ -16,8 +16,8 @@ namespace {
 
 // Name tables of the enums users type (model/enum_names.h).
 constexpr EnumName<AllanEstimator> kEstimatorNames[] = {
-    {AllanEstimator::kAdev, "adev"},   {AllanEstimator::kOadev, "oadev"}, {AllanEstimator::kMdev, "mdev"},
-    {AllanEstimator::kTdev, "tdev"},   {AllanEstimator::kHdev, "hdev"},   {AllanEstimator::kOhdev, "ohdev"},
+    {AllanEstimator::kAdev, "adev"},    {AllanEstimator::kOadev, "oadev"}, {AllanEstimator::kMdev, "mdev"},
+    {AllanEstimator::kTdev, "tdev"},    {AllanEstimator::kHdev, "hdev"},   {AllanEstimator::kOhdev, "ohdev"},
     {AllanEstimator::kTotdev, "totdev"}};
 
 struct EdfNoiseName {
@@ -25,9 +25,10 @@ struct EdfNoiseName {
   const char* name;
   int alpha;
 };
-constexpr EdfNoiseName kEdfNoiseNames[] = {{EdfNoise::kIdentify, "auto", 0},      {EdfNoise::kWhitePm, "wpm", 2},
-                                           {EdfNoise::kFlickerPm, "fpm", 1},      {EdfNoise::kWhiteFm, "wfm", 0},
-                                           {EdfNoise::kFlickerFm, "ffm", -1},     {EdfNoise::kRandomWalkFm, "rwfm", -2}};
+constexpr EdfNoiseName kEdfNoiseNames[] = {
+    {EdfNoise::kIdentify, "auto", 0},  {EdfNoise::kWhitePm, "wpm", 2},
+    {EdfNoise::kFlickerPm, "fpm", 1},  {EdfNoise::kWhiteFm, "wfm", 0},
+    {EdfNoise::kFlickerFm, "ffm", -1}, {EdfNoise::kRandomWalkFm, "rwfm", -2}};
 
 // Work below this many terms per thread is not worth a thread.
 constexpr int64_t kMinTermsPerThread = 1 << 16;
@@ -78,7 +79,7 @@ double SumOf(const double* y, int64_t count) {
 #endif
 
 IMUFIT_VECTOR_CLONES double SecondDifferenceSquares(const double* p0, const double* p1, const double* p2,
-                                                     int64_t count) {
+                                                    int64_t count) {
   double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   int64_t k = 0;
   for (; k + 8 <= count; k += 8) {
@@ -95,7 +96,7 @@ IMUFIT_VECTOR_CLONES double SecondDifferenceSquares(const double* p0, const doub
 }
 
 IMUFIT_VECTOR_CLONES double ThirdDifferenceSquares(const double* p0, const double* p1, const double* p2,
-                                                    const double* p3, int64_t count) {
+                                                   const double* p3, int64_t count) {
   double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   int64_t k = 0;
   for (; k + 8 <= count; k += 8) {
@@ -217,8 +218,8 @@ struct OhdevKernel {  // third differences at stride 1
 struct MdevKernel {
   const double* x;
   const std::vector<int64_t>* m;
-  std::vector<double> z;         // window sum at next[t]
-  std::vector<int64_t> next;     // the term index z belongs to; -2 = not started
+  std::vector<double> z;      // window sum at next[t]
+  std::vector<int64_t> next;  // the term index z belongs to; -2 = not started
   double D(int64_t i, int64_t s) const { return x[i + 2 * s] - 2.0 * x[i + s] + x[i]; }
   double Window(int64_t j, int64_t s) const {
     double sum = 0.0;
@@ -234,7 +235,7 @@ struct MdevKernel {
     // z[t] holds the window at next[t]; the last term's window is never slid past (it would read
     // beyond X_n).
     double w = (next[t] == begin - 1 && s > kBlock / 4) ? z[t] + D(begin - 1 + s, s) - D(begin - 1, s)
-                                                       : Window(begin, s);
+                                                        : Window(begin, s);
     double sum = 0.0;
     for (int64_t j = begin; j < end; ++j) {
       sum += w * w;
@@ -282,13 +283,19 @@ int DifferenceOrder(AllanEstimator estimator) {
 
 std::optional<double> Edf(AllanEstimator estimator, int alpha, int64_t m, int64_t n_phase) {
   switch (estimator) {
-    case AllanEstimator::kAdev: return GreenhallEdf(alpha, 2, m, false, false, n_phase);
-    case AllanEstimator::kOadev: return GreenhallEdf(alpha, 2, m, false, true, n_phase);
+    case AllanEstimator::kAdev:
+      return GreenhallEdf(alpha, 2, m, false, false, n_phase);
+    case AllanEstimator::kOadev:
+      return GreenhallEdf(alpha, 2, m, false, true, n_phase);
     case AllanEstimator::kMdev:
-    case AllanEstimator::kTdev: return GreenhallEdf(alpha, 2, m, true, true, n_phase);
-    case AllanEstimator::kHdev: return GreenhallEdf(alpha, 3, m, false, false, n_phase);
-    case AllanEstimator::kOhdev: return GreenhallEdf(alpha, 3, m, false, true, n_phase);
-    case AllanEstimator::kTotdev: return TotdevEdf(alpha, m, n_phase);
+    case AllanEstimator::kTdev:
+      return GreenhallEdf(alpha, 2, m, true, true, n_phase);
+    case AllanEstimator::kHdev:
+      return GreenhallEdf(alpha, 3, m, false, false, n_phase);
+    case AllanEstimator::kOhdev:
+      return GreenhallEdf(alpha, 3, m, false, true, n_phase);
+    case AllanEstimator::kTotdev:
+      return TotdevEdf(alpha, m, n_phase);
   }
   return std::nullopt;
 }
@@ -351,13 +358,19 @@ std::string ParseTauSpec(std::string_view text, TauSpec* spec) {
 int64_t EstimatorTerms(AllanEstimator estimator, int64_t m, int64_t n) {
   if (m < 1 || n < 1) return 0;
   switch (estimator) {
-    case AllanEstimator::kAdev: return n / m - 1;
-    case AllanEstimator::kOadev: return n + 1 - 2 * m;
+    case AllanEstimator::kAdev:
+      return n / m - 1;
+    case AllanEstimator::kOadev:
+      return n + 1 - 2 * m;
     case AllanEstimator::kMdev:
-    case AllanEstimator::kTdev: return n + 2 - 3 * m;
-    case AllanEstimator::kHdev: return n / m - 2;
-    case AllanEstimator::kOhdev: return n + 1 - 3 * m;
-    case AllanEstimator::kTotdev: return 2 * m <= n ? n - 1 : 0;
+    case AllanEstimator::kTdev:
+      return n + 2 - 3 * m;
+    case AllanEstimator::kHdev:
+      return n / m - 2;
+    case AllanEstimator::kOhdev:
+      return n + 1 - 3 * m;
+    case AllanEstimator::kTotdev:
+      return 2 * m <= n ? n - 1 : 0;
   }
   return 0;
 }
@@ -366,11 +379,14 @@ int64_t MaxAveragingFactor(AllanEstimator estimator, int64_t n) {
   switch (estimator) {
     case AllanEstimator::kAdev:
     case AllanEstimator::kOadev:
-    case AllanEstimator::kTotdev: return n / 2;
+    case AllanEstimator::kTotdev:
+      return n / 2;
     case AllanEstimator::kMdev:
-    case AllanEstimator::kTdev: return (n + 1) / 3;
+    case AllanEstimator::kTdev:
+      return (n + 1) / 3;
     case AllanEstimator::kHdev:
-    case AllanEstimator::kOhdev: return n / 3;
+    case AllanEstimator::kOhdev:
+      return n / 3;
   }
   return 0;
 }
@@ -419,15 +435,16 @@ std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int6
         const double f = std::round(ratio);
         char message[320];
         if (f < 1.0 || std::fabs(ratio - f) > kTauMultipleTolerance) {
-          std::snprintf(message, sizeof message,
-                        "tau %g s is not a whole multiple of the sample interval %.9g s (it is %.6g intervals)",
-                        tau, tau0_s, ratio);
+          std::snprintf(
+              message, sizeof message,
+              "tau %g s is not a whole multiple of the sample interval %.9g s (it is %.6g intervals)", tau,
+              tau0_s, ratio);
           return message;
         }
         if (f > static_cast<double>(max_factor)) {
           std::snprintf(message, sizeof message,
-                        "tau %g s is too long for %lld samples at %.9g s: %s reaches at most tau = %.9g s", tau,
-                        static_cast<long long>(n), tau0_s, ToString(estimator),
+                        "tau %g s is too long for %lld samples at %.9g s: %s reaches at most tau = %.9g s",
+                        tau, static_cast<long long>(n), tau0_s, ToString(estimator),
                         static_cast<double>(max_factor) * tau0_s);
           return message;
         }
@@ -440,10 +457,9 @@ std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int6
   }
   if (m.empty()) {
     char message[256];
-    std::snprintf(message, sizeof message,
-                  "too short: %lld samples are not enough for %s (at least %d are needed)",
-                  static_cast<long long>(n), ToString(estimator),
-                  estimator == AllanEstimator::kTotdev ? 2 : 4);
+    std::snprintf(
+        message, sizeof message, "too short: %lld samples are not enough for %s (at least %d are needed)",
+        static_cast<long long>(n), ToString(estimator), estimator == AllanEstimator::kTotdev ? 2 : 4);
     return message;
   }
   *factors = std::move(m);
@@ -452,7 +468,8 @@ std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int6
 
 std::string AllanOptions::Validate() const {
   if (!(confidence > 0.0 && confidence < 1.0)) {
-    return "confidence must lie strictly between 0 and 1 (0.683 is one sigma), not " + std::to_string(confidence);
+    return "confidence must lie strictly between 0 and 1 (0.683 is one sigma), not " +
+           std::to_string(confidence);
   }
   if (threads < 0) return "threads must be 0 (all) or positive";
   if (max_noise_id_points < kMinNoiseIdPoints) {
@@ -464,8 +481,8 @@ std::string AllanOptions::Validate() const {
 double RatesToPhase(std::vector<double>* samples, int threads) {
   std::vector<double>& y = *samples;
   const int64_t n = static_cast<int64_t>(y.size());
-  const int workers =
-      static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(ResolveThreads(threads), n / kMinTermsPerThread)));
+  const int workers = static_cast<int>(
+      std::max<int64_t>(1, std::min<int64_t>(ResolveThreads(threads), n / kMinTermsPerThread)));
   // Pass 1: chunk sums, hence the mean. Short runs are summed in double, the runs in long double.
   std::vector<long double> chunk_sum(workers, 0.0L);
   RunParallel(workers, [&](int w) {
@@ -513,8 +530,8 @@ double RatesToPhase(std::vector<double>* samples, int threads) {
   return mean;
 }
 
-std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s, const std::vector<int64_t>& factors,
-                               AllanEstimator estimator, int threads) {
+std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s,
+                               const std::vector<int64_t>& factors, AllanEstimator estimator, int threads) {
   const int64_t n = static_cast<int64_t>(phase.size()) - 1;
   std::vector<int64_t> terms;
   for (int64_t m : factors) {
@@ -552,11 +569,17 @@ std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s, 
     switch (estimator) {
       case AllanEstimator::kAdev:
       case AllanEstimator::kOadev:
-      case AllanEstimator::kTotdev: variance = sums[t] / (2.0L * m * m * count); break;
+      case AllanEstimator::kTotdev:
+        variance = sums[t] / (2.0L * m * m * count);
+        break;
       case AllanEstimator::kMdev:
-      case AllanEstimator::kTdev: variance = sums[t] / (2.0L * m * m * m * m * count); break;
+      case AllanEstimator::kTdev:
+        variance = sums[t] / (2.0L * m * m * m * m * count);
+        break;
       case AllanEstimator::kHdev:
-      case AllanEstimator::kOhdev: variance = sums[t] / (6.0L * m * m * count); break;
+      case AllanEstimator::kOhdev:
+        variance = sums[t] / (6.0L * m * m * count);
+        break;
     }
     double dev = std::sqrt(static_cast<double>(variance));
     if (estimator == AllanEstimator::kTdev) dev *= static_cast<double>(m) * tau0_s / std::sqrt(3.0);
@@ -624,8 +647,8 @@ AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const 
   return result;
 }
 
-AllanResult ComputeAllanFromRates(std::vector<double> rates, double tau0_s, const std::vector<int64_t>& factors,
-                                  const AllanOptions& options) {
+AllanResult ComputeAllanFromRates(std::vector<double> rates, double tau0_s,
+                                  const std::vector<int64_t>& factors, const AllanOptions& options) {
   const double mean = RatesToPhase(&rates, options.threads);
   AllanResult result = ComputeAllan(rates, tau0_s, factors, options);
   result.mean = mean;

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "imufit/model/enum_names.h"
 #include "imufit/model/constants.h"
+#include "imufit/model/enum_names.h"
 
 namespace imufit {
 namespace {
@@ -133,7 +133,6 @@ bool SolveSubset(const Whitened& problem, unsigned mask, Eigen::Matrix<double, 5
   *cost = (a * x - problem.data).squaredNorm();
   return true;
 }
-
 
 double SqrtSigma(double v, double s) {
   return 0.5 * (std::sqrt(std::max(v, 0.0) + s) - std::sqrt(std::max(v - s, 0.0)));

@@ -57,8 +57,8 @@ struct NoiseSection {
 NoiseSection GyroNoise(const Calibration& calibration, StaticStretch stretch);
 
 // Reads `samples_path` as the fit read it (labelled from `segmentation`, or segmented again, when
-// the file has no segment column) for its longest static stretch (ReadStaticStretch). A file that cannot be read or
-// does not match the plan gives a section that says why, not an exception.
+// the file has no segment column) for its longest static stretch (ReadStaticStretch). A file that cannot be
+// read or does not match the plan gives a section that says why, not an exception.
 NoiseSection MeasureGyroNoise(const Calibration& calibration, const Plan& plan,
                               const std::string& samples_path, const SamplesInput& input,
                               const std::optional<Segmentation>& segmentation);

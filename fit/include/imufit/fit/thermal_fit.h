@@ -39,7 +39,6 @@
 #include <vector>
 
 #include "imufit/model/option_table.h"
-#include "imufit/run/windows.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 #include "imufit/run/windows.h"

@@ -47,7 +47,8 @@ CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* 
 
 // `temp_c`: the temperature of every sample of a file without a temp_c column (written to the output).
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path, std::optional<double> temp_c = std::nullopt);
+                                     const std::string& output_path,
+                                     std::optional<double> temp_c = std::nullopt);
 
 }  // namespace imufit
 

@@ -93,7 +93,8 @@ struct NoiseRecord {
 // The text of the noise block (top-level key `noise:`).
 std::string NoiseYaml(const NoiseRecord& record);
 // Writes it atomically, in `transaction` when not null.
-void WriteNoiseYaml(const std::string& path, const NoiseRecord& record, OutputTransaction* transaction = nullptr);
+void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
+                    OutputTransaction* transaction = nullptr);
 
 // [value, 1-sigma] of noise.columns.<column>.<key> in a calibration's further keys (Calibration::
 // extra), when there and a pair of numbers.

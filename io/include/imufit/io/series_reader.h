@@ -32,14 +32,14 @@ struct UniformSeriesOptions {
 };
 
 struct UniformSeries {
-  std::vector<std::string> names;             // the columns read, in the order asked
-  std::vector<std::vector<double>> columns;   // one per name, all the same length
-  double sample_interval_s = 0.0;             // mean accepted interval, 12 digits
+  std::vector<std::string> names;            // the columns read, in the order asked
+  std::vector<std::vector<double>> columns;  // one per name, all the same length
+  double sample_interval_s = 0.0;            // mean accepted interval, 12 digits
   double start_time_s = 0.0;
   double end_time_s = 0.0;
   int64_t gaps_bridged = 0;
-  double bridged_time_s = 0.0;                // time removed by bridging
-  double max_jitter = 0.0;                    // largest |dt - dt_0| / dt_0 accepted
+  double bridged_time_s = 0.0;  // time removed by bridging
+  double max_jitter = 0.0;      // largest |dt - dt_0| / dt_0 accepted
 };
 
 // Reads `columns` (when empty: every column whose name starts with "gyro_" or "accel_") and

@@ -51,10 +51,10 @@ enum NoiseTerm {
 inline constexpr int kNoiseTerms = 5;
 
 inline constexpr EnumName<int> kNoiseTermNames[kNoiseTerms] = {{kQuantization, "quantization"},
-                                                              {kRandomWalk, "random_walk"},
-                                                              {kBiasInstability, "bias_instability"},
-                                                              {kRateRandomWalk, "rate_random_walk"},
-                                                              {kRateRamp, "rate_ramp"}};
+                                                               {kRandomWalk, "random_walk"},
+                                                               {kBiasInstability, "bias_instability"},
+                                                               {kRateRandomWalk, "rate_random_walk"},
+                                                               {kRateRamp, "rate_ramp"}};
 
 // "quantization", "random_walk", "bias_instability", "rate_random_walk", "rate_ramp"; "?" else.
 inline const char* NoiseTermName(int term) { return NameOf(kNoiseTermNames, term); }

@@ -67,13 +67,12 @@ struct CoefficientName {
   const char* axis;
 };
 inline constexpr CoefficientName kCoefficientNames[kGyroCoefficients] = {
-    {"bias", "x"},          {"bias", "y"},          {"bias", "z"},
-    {"scale", "x"},         {"scale", "y"},         {"scale", "z"},
-    {"misalignment", "xy"}, {"misalignment", "xz"}, {"misalignment", "yx"},
-    {"misalignment", "yz"}, {"misalignment", "zx"}, {"misalignment", "zy"},
-    {"g_sensitivity", "xx"}, {"g_sensitivity", "xy"}, {"g_sensitivity", "xz"},
-    {"g_sensitivity", "yx"}, {"g_sensitivity", "yy"}, {"g_sensitivity", "yz"},
-    {"g_sensitivity", "zx"}, {"g_sensitivity", "zy"}, {"g_sensitivity", "zz"}};
+    {"bias", "x"},           {"bias", "y"},           {"bias", "z"},           {"scale", "x"},
+    {"scale", "y"},          {"scale", "z"},          {"misalignment", "xy"},  {"misalignment", "xz"},
+    {"misalignment", "yx"},  {"misalignment", "yz"},  {"misalignment", "zx"},  {"misalignment", "zy"},
+    {"g_sensitivity", "xx"}, {"g_sensitivity", "xy"}, {"g_sensitivity", "xz"}, {"g_sensitivity", "yx"},
+    {"g_sensitivity", "yy"}, {"g_sensitivity", "yz"}, {"g_sensitivity", "zx"}, {"g_sensitivity", "zy"},
+    {"g_sensitivity", "zz"}};
 
 // The coefficients of one sensor evaluated at one temperature.
 template <typename T>
@@ -99,8 +98,7 @@ SensorCoefficients<T> CoefficientsAt(const T* params, int coefficients, const T&
   }
   c.misalignment.setIdentity();
   for (int m = 0; m < 6; ++m) {
-    c.misalignment(kMisalignmentRow[m], kMisalignmentCol[m]) =
-        coefficient(kMisalignmentCoefficient + m);
+    c.misalignment(kMisalignmentRow[m], kMisalignmentCol[m]) = coefficient(kMisalignmentCoefficient + m);
   }
   c.g_sensitivity.setZero();
   if (coefficients == kGyroCoefficients) {
@@ -147,8 +145,8 @@ void CorrectSample(const T* gyro_params, const T* accel_params, const Temperatur
 // force (body frame, SI): the exact inverse of CorrectSample().
 template <typename T>
 void ForwardSample(const T* gyro_params, const T* accel_params, const TemperatureBasis& basis,
-                   const T& temp_c, const Vector3<T>& omega_true_radps,
-                   const Vector3<T>& a_true_mps2, Vector3<T>* gyro_m, Vector3<T>* accel_m) {
+                   const T& temp_c, const Vector3<T>& omega_true_radps, const Vector3<T>& a_true_mps2,
+                   Vector3<T>* gyro_m, Vector3<T>* accel_m) {
   const T x = basis.Argument(temp_c);
   const SensorCoefficients<T> accel = CoefficientsAt(accel_params, kAccelCoefficients, x);
   *accel_m = ForwardSensor(accel, a_true_mps2, Vector3<T>::Zero().eval());
@@ -176,15 +174,12 @@ struct SensorModel {
 
   void Correct(double temp_c, const Eigen::Vector3d& gyro_m, const Eigen::Vector3d& accel_m,
                Eigen::Vector3d* omega_hat_radps, Eigen::Vector3d* a_hat_mps2) const {
-    CorrectSample(gyro.data(), accel.data(), basis, temp_c, gyro_m, accel_m, omega_hat_radps,
-                  a_hat_mps2);
+    CorrectSample(gyro.data(), accel.data(), basis, temp_c, gyro_m, accel_m, omega_hat_radps, a_hat_mps2);
   }
 
-  void Forward(double temp_c, const Eigen::Vector3d& omega_true_radps,
-               const Eigen::Vector3d& a_true_mps2, Eigen::Vector3d* gyro_m,
-               Eigen::Vector3d* accel_m) const {
-    ForwardSample(gyro.data(), accel.data(), basis, temp_c, omega_true_radps, a_true_mps2,
-                  gyro_m, accel_m);
+  void Forward(double temp_c, const Eigen::Vector3d& omega_true_radps, const Eigen::Vector3d& a_true_mps2,
+               Eigen::Vector3d* gyro_m, Eigen::Vector3d* accel_m) const {
+    ForwardSample(gyro.data(), accel.data(), basis, temp_c, omega_true_radps, a_true_mps2, gyro_m, accel_m);
   }
 };
 

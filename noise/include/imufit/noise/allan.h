@@ -55,11 +55,11 @@ std::string AllanEstimatorNames();
 
 // The noise type assumed for the degrees of freedom of the confidence intervals.
 enum class EdfNoise {
-  kIdentify,  // "auto": lag-1 autocorrelation per averaging factor (statistics.h)
-  kWhitePm,   // "wpm",  alpha = +2 (quantisation)
-  kFlickerPm, // "fpm",  alpha = +1
-  kWhiteFm,   // "wfm",  alpha =  0 (angle / velocity random walk)
-  kFlickerFm, // "ffm",  alpha = -1 (bias instability)
+  kIdentify,      // "auto": lag-1 autocorrelation per averaging factor (statistics.h)
+  kWhitePm,       // "wpm",  alpha = +2 (quantisation)
+  kFlickerPm,     // "fpm",  alpha = +1
+  kWhiteFm,       // "wfm",  alpha =  0 (angle / velocity random walk)
+  kFlickerFm,     // "ffm",  alpha = -1 (bias instability)
   kRandomWalkFm,  // "rwfm", alpha = -2 (rate random walk)
 };
 const char* ToString(EdfNoise noise);
@@ -79,8 +79,8 @@ std::string EdfNoiseNames();
 struct TauSpec {
   enum class Kind { kOctave, kDecade, kAll, kPerDecade, kList };
   Kind kind = Kind::kOctave;
-  int per_decade = 0;           // kPerDecade
-  std::vector<double> taus_s;   // kList
+  int per_decade = 0;          // kPerDecade
+  std::vector<double> taus_s;  // kList
 };
 inline constexpr double kTauMultipleTolerance = 0.01;
 // Parses the --taus text; returns "" or a message naming the allowed forms.
@@ -94,8 +94,8 @@ int64_t EstimatorTerms(AllanEstimator estimator, int64_t m, int64_t n_samples);
 
 // The averaging factors of `spec` for n samples at tau0, ascending, unique. Returns "" or a
 // message (a tau that is not a multiple of tau0, or that does not fit, or an empty set).
-std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int64_t n_samples,
-                             double tau0_s, std::vector<int64_t>* factors);
+std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int64_t n_samples, double tau0_s,
+                             std::vector<int64_t>* factors);
 
 struct AllanOptions {
   AllanEstimator estimator = AllanEstimator::kOadev;
@@ -114,14 +114,14 @@ struct AllanOptions {
 };
 
 struct AllanPoint {
-  int64_t m = 0;            // averaging factor
-  double tau_s = 0.0;       // m * tau0
-  int64_t terms = 0;        // T
-  double dev = 0.0;         // the deviation (y units; tdev: y units * s)
-  double dev_lo = 0.0;      // confidence interval; nan when no edf could be computed
+  int64_t m = 0;        // averaging factor
+  double tau_s = 0.0;   // m * tau0
+  int64_t terms = 0;    // T
+  double dev = 0.0;     // the deviation (y units; tdev: y units * s)
+  double dev_lo = 0.0;  // confidence interval; nan when no edf could be computed
   double dev_hi = 0.0;
-  double edf = 0.0;         // equivalent degrees of freedom (nan when unknown)
-  int alpha = 0;            // noise exponent used for the edf
+  double edf = 0.0;               // equivalent degrees of freedom (nan when unknown)
+  int alpha = 0;                  // noise exponent used for the edf
   bool alpha_identified = false;  // identified at this m (else assumed or carried from below)
 };
 
@@ -129,7 +129,7 @@ struct AllanResult {
   AllanEstimator estimator = AllanEstimator::kOadev;
   double tau0_s = 0.0;
   int64_t n_samples = 0;
-  double mean = 0.0;        // the mean that was removed, y units
+  double mean = 0.0;  // the mean that was removed, y units
   std::vector<AllanPoint> points;
 };
 
@@ -146,8 +146,8 @@ std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s,
 
 // The full computation: deviations, terms, noise identification, edf and intervals.
 // `phase` from RatesToPhase. Factors must satisfy EstimatorTerms(...) >= 1 (checked: abort).
-AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s,
-                         const std::vector<int64_t>& factors, const AllanOptions& options);
+AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const std::vector<int64_t>& factors,
+                         const AllanOptions& options);
 
 // Convenience for tests and small data: copies the rates, integrates, computes.
 AllanResult ComputeAllanFromRates(std::vector<double> rates, double tau0_s,

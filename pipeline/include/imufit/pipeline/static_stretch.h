@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "imufit/run/segmentation.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/sample.h"
 #include "imufit/pipeline/segment_run.h"
+#include "imufit/run/segmentation.h"
 
 namespace imufit {
 
