@@ -29,7 +29,7 @@ check_format() {
     return 0
   fi
   local files=() unformatted=()
-  mapfile -t files < <(git -C "$IMUFIT_ROOT" ls-files -- '*.cc' '*.h' '*.cpp' '*.hpp')
+  mapfile -t files < <(git -C "$IMUFIT_ROOT" ls-files -- '*.cc' '*.h' '*.cpp' '*.hpp' ':!fixtures/')
   imufit_say "format: clang-format --dry-run --Werror on ${#files[@]} tracked C/C++ files ($(clang-format --version))"
   mapfile -t unformatted < <(cd "$IMUFIT_ROOT" && clang-format --dry-run --Werror "${files[@]}" 2>&1 |
                                sed -n 's/^\([^:]*\):[0-9]*:[0-9]*: error: .*/\1/p' | sort -u)
