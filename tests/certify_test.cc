@@ -172,11 +172,18 @@ TEST_P(CertifyTest, TheStretchHandedOnIsTheOneInTheFile) {
   sources.plan = fit.plan;
   sources.run = fit.run;
   sources.inputs = {{"samples", samples_, fit.run.samples_sha256}};
+  {
+    const FileReadCounter reads(samples_);
+    ReadCertificateFiles(&sources);
+    EXPECT_EQ(reads.count(), 0) << "the stretch handed on: the file is not read";
+  }
   const Certificate handed_on = MakeCertificate(sources);
   sources.run.static_stretch.reset();
+  sources.noise.reset();
   const FileReadCounter reads(samples_);
-  const Certificate read_again = MakeCertificate(sources);
+  ReadCertificateFiles(&sources);
   EXPECT_EQ(reads.count(), 1) << "without the stretch, it is read";
+  const Certificate read_again = MakeCertificate(sources);
   ASSERT_TRUE(handed_on.noise.computed) << handed_on.noise.why_not;
   EXPECT_EQ(handed_on.noise.segment, read_again.noise.segment);
   EXPECT_EQ(handed_on.noise.temp_c, read_again.noise.temp_c);

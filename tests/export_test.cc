@@ -23,7 +23,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/samples.h"
 #include "imufit_runtime.h"
-#include "run_program.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {

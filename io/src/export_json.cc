@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "export_internal.h"
+#include "fit_record_yaml.h"
 #include "imufit/io/output_file.h"
 #include "imufit/model/check.h"
 
@@ -105,7 +106,11 @@ ExportResult ExportJson(const Calibration& calibration, const ExportOptions& opt
   // that a quoted "12" stays a string (an emitted and re-read YAML would lose the quotes).
   Calibration coefficients = calibration;
   coefficients.extra.reset(YAML::Node(YAML::NodeType::Map));  // rebinds; `=` would empty the shared node
+  coefficients.fit.reset();  // the records as nodes (their further keys keep how they were read)
+  coefficients.check.reset();
   YAML::Node root = YAML::Load(CalibrationToYaml(coefficients));
+  if (calibration.fit) root.force_insert("fit", FitRecordNode(*calibration.fit));
+  if (calibration.check) root.force_insert("check", CheckRecordNode(*calibration.check));
   if (calibration.extra.IsMap()) {
     for (const auto& entry : calibration.extra) {
       // A calibration read back from a JSON export: its provenance is replaced.
