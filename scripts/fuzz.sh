@@ -27,7 +27,7 @@ imufit_fuzz_available || imufit_die "fuzzing needs clang++ with libFuzzer (Debia
 
 dir=$IMUFIT_ROOT/build-fuzz
 imufit_say "libFuzzer build (build-fuzz/)"
-CXX=clang++ imufit_build "$dir" imufit_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DIMUFIT_BUILD_FUZZ=ON \
+CC=clang CXX=clang++ imufit_build "$dir" imufit_fuzz -- -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DIMUFIT_BUILD_FUZZ=ON \
   -DIMUFIT_BUILD_TESTS=OFF -DIMUFIT_BUILD_BENCH=OFF -DIMUFIT_BUILD_PYTHON=OFF
 
 # Seeds: the fixtures (plans, calibrations; the first rows of each samples file, plain and gzip).
