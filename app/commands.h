@@ -28,6 +28,7 @@ CommandRunner AddBatchCommand(CLI::App* root);
 CommandRunner AddHistoryCommand(CLI::App* root);
 CommandRunner AddReportCommand(CLI::App* root);
 CommandRunner AddSegmentCommand(CLI::App* root);
+CommandRunner AddPlanCommand(CLI::App* root);
 CommandRunner AddExportCommand(CLI::App* root);
 
 // How a command reads samples files without a temp_c or segment column: the options of

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   add(imufit::AddReportCommand(&app));
   add(imufit::AddSegmentCommand(&app));
   add(imufit::AddExportCommand(&app));
+  add(imufit::AddPlanCommand(&app));
 
   // Outputs are written to temporary files and renamed when complete; a stopped run removes them.
   imufit::InstallOutputCleanupOnSignals();

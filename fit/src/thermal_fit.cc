@@ -104,20 +104,27 @@ bool RefuseNegativeScales(FitSummary* summary) {
 }
 
 }  // namespace
+
+bool SetUpFit(const std::vector<Window>& windows, const TableSite& site,
+              const std::vector<TableSegment>& segments, const FitOptions& options, ThermalFitState* fit,
+              FitSummary* summary) {
+  ChooseBasis(windows, options, fit, summary);
+  AttachTruth(windows, site, segments, fit, summary);
+  if (!CheckRunCoverage(site, options, *fit, summary)) return false;
+  StartSensors(options, fit);
+  BuildProblem(fit);
+  return true;
+}
+
 }  // namespace internal
 
-using internal::AttachTruth;
-using internal::BuildProblem;
 using internal::CheckConvergence;
 using internal::CheckRank;
-using internal::CheckRunCoverage;
-using internal::ChooseBasis;
 using internal::ComputeCovariance;
 using internal::ComputeResiduals;
 using internal::RefuseNegativeScales;
 using internal::RobustPass;
 using internal::SolveLeastSquares;
-using internal::StartSensors;
 using internal::ThermalFitState;
 
 std::vector<double> DistinctTemperatures(std::vector<double> temps_c, double span_c) {
@@ -147,11 +154,7 @@ FitSummary FitThermalModel(const std::vector<Window>& windows, const TableSite& 
   summary.accel_fit = options.accel_fit;
   ThermalFitState fit;  // what the stages share; fresh for every fit
 
-  ChooseBasis(windows, options, &fit, &summary);
-  AttachTruth(windows, site, segments, &fit, &summary);
-  if (!CheckRunCoverage(site, options, fit, &summary)) return summary;
-  StartSensors(options, &fit);
-  BuildProblem(&fit);
+  if (!internal::SetUpFit(windows, site, segments, options, &fit, &summary)) return summary;
   ceres::Solver::Summary last_pass = SolveLeastSquares(options, &fit, &summary);
   if (options.loss != RobustLoss::kNone && last_pass.termination_type == ceres::CONVERGENCE) {
     last_pass = RobustPass(options, &fit, &summary);

@@ -11,44 +11,6 @@
 #include "thermal_fit_state.h"
 
 namespace imufit::internal {
-namespace {
-
-// One sensor's residuals (SI, each window's; the weights used) in `summary->residuals`, its RMS
-// and its reduced chi-square. The normalised residual r is the raw error over sigma_raw, so
-// r .* sigma (the SI noise at the start's scale) is the error in SI to first order. The windows
-// the robust loss acts on (|r| above its threshold) are flagged and left out of chi-square and
-// of its degrees of freedom: the chi-square measures the windows that weigh fully.
-void SensorResiduals(const FitOptions& options, const ceres::Problem& problem, const SensorProblem& sensor,
-                     FitSummary* summary) {
-  const std::vector<double> norms = NormalisedResidualNorms(problem, sensor);
-  double chi2 = 0.0;
-  int rows = 0;
-  double sum_squares = 0.0;
-  for (size_t w = 0; w < sensor.windows.size(); ++w) {
-    double residual[3];
-    double cost = 0.0;
-    problem.EvaluateResidualBlock(sensor.blocks[w], false, &cost, residual, nullptr);
-    const Eigen::Vector3d si = Eigen::Map<const Eigen::Vector3d>(residual).cwiseProduct(sensor.sigma[w]);
-    WindowResidual& out = summary->residuals[sensor.window_index[w]];
-    out.window = sensor.window_index[w];
-    (sensor.is_gyro ? out.gyro_radps : out.accel_mps2) = si;
-    (sensor.is_gyro ? out.gyro_sigma_radps : out.accel_sigma_mps2) = sensor.sigma[w];
-    const bool downweighted =
-        options.loss != RobustLoss::kNone && !sensor.IsFullyHeld() && norms[w] > sensor.loss_threshold;
-    out.downweighted = out.downweighted || downweighted;
-    sum_squares += si.squaredNorm();
-    if (!downweighted) {
-      chi2 += norms[w] * norms[w];
-      rows += 3;
-    }
-  }
-  const int free_parameters = sensor.parameters - static_cast<int>(sensor.held.size());
-  const double rms = std::sqrt(sum_squares / (3.0 * std::max<size_t>(sensor.windows.size(), 1)));
-  const double reduced_chi2 = rows > free_parameters ? chi2 / (rows - free_parameters) : 1.0;
-  (sensor.is_gyro ? summary->gyro_rms_radps : summary->accel_rms_mps2) = rms;
-  (sensor.is_gyro ? summary->gyro_reduced_chi2 : summary->accel_reduced_chi2) = reduced_chi2;
-}
-
 // Blocks of windows within which a slowly wandering bias is taken as constant: a new block starts
 // when a window starts more than `correlation_s` after the block's first window (or after a
 // gap of that length). Returns the block of each window.
@@ -104,6 +66,44 @@ Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor,
     for (int j = 0; j < n; ++j) ambient(sensor.free[i], sensor.free[j]) = added(i, j);
   }
   return ambient;
+}
+
+namespace {
+
+// One sensor's residuals (SI, each window's; the weights used) in `summary->residuals`, its RMS
+// and its reduced chi-square. The normalised residual r is the raw error over sigma_raw, so
+// r .* sigma (the SI noise at the start's scale) is the error in SI to first order. The windows
+// the robust loss acts on (|r| above its threshold) are flagged and left out of chi-square and
+// of its degrees of freedom: the chi-square measures the windows that weigh fully.
+void SensorResiduals(const FitOptions& options, const ceres::Problem& problem, const SensorProblem& sensor,
+                     FitSummary* summary) {
+  const std::vector<double> norms = NormalisedResidualNorms(problem, sensor);
+  double chi2 = 0.0;
+  int rows = 0;
+  double sum_squares = 0.0;
+  for (size_t w = 0; w < sensor.windows.size(); ++w) {
+    double residual[3];
+    double cost = 0.0;
+    problem.EvaluateResidualBlock(sensor.blocks[w], false, &cost, residual, nullptr);
+    const Eigen::Vector3d si = Eigen::Map<const Eigen::Vector3d>(residual).cwiseProduct(sensor.sigma[w]);
+    WindowResidual& out = summary->residuals[sensor.window_index[w]];
+    out.window = sensor.window_index[w];
+    (sensor.is_gyro ? out.gyro_radps : out.accel_mps2) = si;
+    (sensor.is_gyro ? out.gyro_sigma_radps : out.accel_sigma_mps2) = sensor.sigma[w];
+    const bool downweighted =
+        options.loss != RobustLoss::kNone && !sensor.IsFullyHeld() && norms[w] > sensor.loss_threshold;
+    out.downweighted = out.downweighted || downweighted;
+    sum_squares += si.squaredNorm();
+    if (!downweighted) {
+      chi2 += norms[w] * norms[w];
+      rows += 3;
+    }
+  }
+  const int free_parameters = sensor.parameters - static_cast<int>(sensor.held.size());
+  const double rms = std::sqrt(sum_squares / (3.0 * std::max<size_t>(sensor.windows.size(), 1)));
+  const double reduced_chi2 = rows > free_parameters ? chi2 / (rows - free_parameters) : 1.0;
+  (sensor.is_gyro ? summary->gyro_rms_radps : summary->accel_rms_mps2) = rms;
+  (sensor.is_gyro ? summary->gyro_reduced_chi2 : summary->accel_reduced_chi2) = reduced_chi2;
 }
 
 // One sensor's covariance of q: Ceres's (null when it could not be computed, or for a sensor held

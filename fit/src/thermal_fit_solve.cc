@@ -68,6 +68,8 @@ void EvaluateJacobian(const FitOptions& options, ceres::Problem* problem, Sensor
   sensor->jacobian = jacobian;
 }
 
+}  // namespace
+
 // The directions of q the residuals do not see: right singular vectors of the column-normalised
 // Jacobian (each column scaled to unit norm, so that units and steps do not decide the rank)
 // whose singular value is below rank_tolerance times the largest, each named by the parameters
@@ -94,8 +96,6 @@ std::vector<std::string> UndeterminedDirections(const FitOptions& options, const
   }
   return findings;
 }
-
-}  // namespace
 
 std::vector<double> NormalisedResidualNorms(const ceres::Problem& problem, const SensorProblem& sensor) {
   std::vector<double> norms;

@@ -112,6 +112,13 @@ void MarkUndetermined(FitSummary* summary);
 // The norm of each window's normalised residual (no loss) at the problem's current parameters.
 std::vector<double> NormalisedResidualNorms(const ceres::Problem& problem, const SensorProblem& sensor);
 
+// The stages up to the problem, in order (options and basis, truth, coverage, start, problem):
+// false, with the summary's findings, when the run does not determine the model. The fit then
+// solves; a planned run's information (plan_information.h) is the problem's Jacobian at the start.
+bool SetUpFit(const std::vector<Window>& windows, const TableSite& site,
+              const std::vector<TableSegment>& segments, const FitOptions& options, ThermalFitState* fit,
+              FitSummary* summary);
+
 // ---------------------------------------------------------------- stages (see the table above)
 
 // thermal_fit_start.cc
@@ -125,7 +132,19 @@ ceres::Solver::Summary RobustPass(const FitOptions& options, ThermalFitState* fi
 bool CheckConvergence(const ceres::Solver::Summary& last_pass, FitSummary* summary);
 bool CheckRank(const FitOptions& options, ThermalFitState* fit, FitSummary* summary);
 
+// The directions of the sensor's free q whose singular value of the column-normalised Jacobian
+// (sensor.jacobian) is below options.rank_tolerance times the largest, each named by its parameters
+// ("the run cannot separate gyro bias x, gyro g_sensitivity xz (...)") (thermal_fit_solve.cc).
+std::vector<std::string> UndeterminedDirections(const FitOptions& options, const SensorProblem& sensor);
+
 // thermal_fit_covariance.cc
+// The time block of each window: windows within `correlation_s` share one wandering bias.
+std::vector<int> TimeBlocks(const std::vector<FitWindow>& windows, double correlation_s);
+// The covariance in q (all parameters) a bias wandering by `stability` (SI, 1-sigma, one value per
+// time block and axis) adds, from the unscaled covariance in q (all parameters) and sensor.jacobian.
+Eigen::MatrixXd BiasStabilityCovariance(const SensorProblem& sensor,
+                                        const Eigen::MatrixXd& unscaled_covariance,
+                                        const std::vector<int>& time_blocks, double stability);
 void ComputeResiduals(const FitOptions& options, const ThermalFitState& fit, FitSummary* summary);
 bool ComputeCovariance(const FitOptions& options, ThermalFitState* fit, FitSummary* summary);
 
