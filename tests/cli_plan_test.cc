@@ -17,8 +17,7 @@ const std::vector<std::string> kNoise = {"--gyro-noise-density",
                                          "1e-4",
                                          "--accel-noise-density",
                                          "1e-3",
-                                         "--soak-temps",
-                                         "-20,25,85",
+                                         "--temps=-20,10,50,85",
                                          "--dwell",
                                          "20",
                                          "--rate",
@@ -74,7 +73,7 @@ TEST_F(CliPlanTest, WhiteNoiseSigmaFallsAsOneOverRootDwell) {
 
 TEST_F(CliPlanTest, UndeterminedPlanExitsOneNamingWhatIsMissing) {
   const RunResult r = Run({"plan", "check", Fixture("plan_24pos.yaml"), "--gyro-noise-density", "1e-4",
-                           "--accel-noise-density", "1e-3", "--soak-temps", "25", "--dwell", "20"});
+                           "--accel-noise-density", "1e-3", "--temps", "25", "--dwell", "20"});
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("undetermined: "), std::string::npos) << r.out;
 }
