@@ -21,6 +21,7 @@
 #include "imufit/io/file_reads.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
+#include "imufit/io/parallel_samples.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
@@ -511,6 +512,115 @@ TEST_F(IoTest, SamplesWriteReadRoundTripsPlainAndGzip) {
   }
 }
 
+// A samples file of `rows` rows in fixed-width columns (so a value can be replaced in place).
+std::string FixedWidthSamples(int rows) {
+  std::string text = "# serial: SN1\ntime_s,temp_c,segment,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
+  char row[128];
+  for (int i = 0; i < rows; ++i) {
+    std::snprintf(row, sizeof row, "%012.4f,%6.2f,%2d,%7d,%7d,%7d,%7d,%7d,%7d\n", 1.0 + i * 0.0125,
+                  20.0 + (i % 97) * 0.01, i % 7 - 1, i % 1009, -(i % 313), 7, i % 77, 3, -16384);
+    text += row;
+  }
+  return text;
+}
+
+// Every sample of `path` with its line, or the error that stops the reading (its what()).
+template <typename Reader>
+std::pair<std::vector<std::pair<Sample, long>>, std::string> ReadAll(Reader* reader) {
+  std::vector<std::pair<Sample, long>> samples;
+  try {
+    Sample s;
+    while (reader->Next(&s)) samples.emplace_back(s, reader->line_number());
+  } catch (const InputError& e) {
+    return {samples, e.what()};
+  }
+  return {samples, ""};
+}
+
+// Parsing on two threads gives what one reader gives: the same samples at the same lines, the same
+// error after the same samples, wherever in the file it is, also at the first row of a block.
+TEST_F(IoTest, ParallelParsingGivesWhatOneReaderGives) {
+  const std::string text = FixedWidthSamples(300000);  // ~20 MB: several read blocks
+  const auto compare = [&](const std::string& name, const std::string& bytes) {
+    const std::string path = Write(name, bytes);
+    SamplesReader one(path, true);
+    const auto expected = ReadAll(&one);
+    for (const int threads : {1, 2}) {
+      SamplesReader header(path, true);
+      ParallelSamplesReader parallel(&header, threads);
+      const auto got = ReadAll(&parallel);
+      EXPECT_EQ(got.second, expected.second) << name << ", " << threads << " threads";
+      EXPECT_EQ(got.first.size(), expected.first.size()) << name;
+      EXPECT_TRUE(std::equal(got.first.begin(), got.first.end(), expected.first.begin(), expected.first.end(),
+                             [](const auto& a, const auto& b) {
+                               return a.second == b.second && a.first.time_s == b.first.time_s &&
+                                      a.first.temp_c == b.first.temp_c &&
+                                      a.first.segment == b.first.segment && a.first.gyro == b.first.gyro &&
+                                      a.first.accel == b.first.accel;
+                             }))
+          << name << ", " << threads << " threads";
+    }
+    return expected;
+  };
+  const auto whole = compare("whole.csv", text);
+  EXPECT_EQ(whole.first.size(), 300000u);
+  EXPECT_EQ(whole.first.back().second, 300002);
+  EXPECT_EQ(whole.second, "");
+
+  // Where the blocks start (the second block's first line), as the reader splits the file.
+  const std::string path = Write("blocks.csv", text);
+  std::vector<long> starts;
+  std::string_view rows;
+  long line_before = 0;
+  CsvReader csv(path);
+  while (csv.NextBlock(&rows, &line_before)) starts.push_back(line_before + 1);
+  ASSERT_GE(starts.size(), 4u);
+  const size_t data_start = text.find('\n', text.find('\n') + 1) + 1;  // line 3
+  const size_t row_bytes = text.find('\n', data_start) + 1 - data_start;
+  const auto offset_of = [&](long line) { return data_start + (line - 3) * row_bytes; };
+  ASSERT_EQ(text.substr(offset_of(4), 13), "0000001.0125,");
+  constexpr size_t kGyroX = 23;          // where gyro_x starts in a row, 7 wide
+  const long late = starts.back() + 10;  // a line in the second half of the file
+  ASSERT_GT(late, 150000);
+
+  std::string bad = text;
+  bad.replace(offset_of(late) + kGyroX, 7, "  1.2.3");
+  auto result = compare("bad_number.csv", bad);
+  EXPECT_NE(
+      result.second.find("bad_number.csv:" + std::to_string(late) + ":4: gyro_x: \"1.2.3\" is not a number"),
+      std::string::npos)
+      << result.second;
+  // A time that does not increase at a block's first row, the row before being in another block;
+  // and the same row with a bad value after its time (the time is reported, as one reader does).
+  const long first = starts[2];
+  std::string back = text;
+  back.replace(offset_of(first), 12, text.substr(offset_of(first - 1), 12));
+  result = compare("back.csv", back);
+  EXPECT_NE(result.second.find(":" + std::to_string(first) + ":1: time_s:"), std::string::npos)
+      << result.second;
+  EXPECT_NE(result.second.find("does not increase"), std::string::npos) << result.second;
+  back.replace(offset_of(first) + kGyroX, 7, "  1.2.3");
+  const std::string time_error = result.second.substr(result.second.find(':'));
+  EXPECT_EQ(compare("back_and_bad.csv", back).second, Path("back_and_bad.csv") + time_error);
+  // A row error before a read error: the row's error, as one reader reads them.
+  std::string cut = text;
+  cut.replace(offset_of(starts[1] + 5) + kGyroX, 7, "  1.2.3");
+  const std::string gz = Path("cut.csv.gz");
+  WriteFileAtomically(gz, cut);
+  const std::string compressed = Read(gz);
+  result = compare("cut.csv.gz", compressed.substr(0, compressed.size() - 100));
+  EXPECT_NE(result.second.find(":" + std::to_string(starts[1] + 5) + ":4: gyro_x"), std::string::npos)
+      << result.second;
+  // A segment the caller refuses is located at its row (the reader's Fail).
+  SamplesReader again(Write("fail.csv", text), true);
+  ParallelSamplesReader parallel(&again);
+  Sample s;
+  for (long i = 0; i < late - 2; ++i) ASSERT_TRUE(parallel.Next(&s));
+  const InputError e = Catch([&] { parallel.Fail("segment", "not in the plan"); });
+  EXPECT_EQ(e.line(), late);
+  EXPECT_EQ(e.column(), 3);
+}
+
 // ---------------------------------------------------------------- output files
 
 TEST_F(IoTest, AnUncommittedOutputLeavesTheOldFileIntact) {
@@ -594,6 +704,66 @@ TEST_F(IoTest, TruncatedCorruptOrFakeGzipIsRefused) {
   const std::string second_path = (dir_ / "second.csv.gz").string();
   WriteFileAtomically(second_path, "5,6\n7,8\n");
   EXPECT_EQ(CountRows(Write("two.csv.gz", gz + Read(second_path))), 20002);
+}
+
+// Compressed outputs are standard gzip: gzip(1) tests them and Python reads them back; a file that
+// gzip(1) made (its header names the original file) is read, also when it is named .csv, and
+// members written by either, concatenated, are one stream.
+TEST_F(IoTest, GzipOutputIsStandardAndGzipInputIsFoundByItsBytes) {
+  const std::string text = CsvRows(50000);
+  const std::string ours = Path("ours.csv.gz");
+  WriteFileAtomically(ours, text);
+  testing::RunResult r = RunProgram("/bin/gzip", {"-t", ours});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = RunProgram("/usr/bin/python3",
+                 {"-c", "import gzip,sys; sys.stdout.write(gzip.open(sys.argv[1], 'rt').read())", ours});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.out == text) << "Python reads back " << r.out.size() << " bytes of " << text.size();
+
+  const std::string plain = Write("plain.csv", text);
+  r = RunProgram("/bin/gzip", {"-k", "-9", plain});  // plain.csv.gz, with the name in its header
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string theirs = Read(plain + ".gz");
+  ASSERT_NE(theirs[3] & 0x08, 0) << "gzip(1) stored no name";
+  EXPECT_EQ(CountRows(plain + ".gz"), 50000);
+  const std::string named_csv = Write("compressed.csv", theirs);  // gzip, but named .csv
+  EXPECT_EQ(CountRows(named_csv), 50000);
+  Sha256 digest;
+  {
+    CsvReader csv(named_csv, &digest);
+    EXPECT_EQ(csv.header(), (std::vector<std::string>{"a", "b"}));
+    while (csv.NextRow()) {
+    }
+  }
+  EXPECT_EQ(digest.HexDigest(), Sha256Hex(theirs)) << "the hash is of the bytes on disk";
+  EXPECT_EQ(CountRows(Write("mixed.csv.gz", Read(ours) + theirs)), 100001);  // the second header is a row
+  // Cut short and named .csv: the error says so, rather than showing the binary as a header.
+  const InputError e = Catch([&] { CountRows(Write("cut.csv", theirs.substr(0, theirs.size() / 2))); });
+  EXPECT_NE(e.message().find("truncated gzip stream"), std::string::npos) << e.what();
+}
+
+// A compressed output on a full disk names the reason, as a plain one does. The disk is a tmpfs of
+// 64 KiB (mounting needs root: elsewhere the test says so and is skipped).
+TEST_F(IoTest, AGzipOutputOnAFullDiskSaysWhy) {
+  const std::string mount_point = Path("full");
+  fs::create_directories(mount_point);
+  if (::geteuid() != 0 ||
+      RunProgram("/bin/mount", {"-t", "tmpfs", "-o", "size=64k", "tmpfs", mount_point}).status != 0) {
+    GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root): the full-disk case is not run";
+  }
+  std::string incompressible;
+  uint32_t state = 12345;
+  for (int i = 0; i < 200000; ++i) {
+    state = state * 1664525u + 1013904223u;
+    incompressible += std::to_string(state) + "\n";
+  }
+  for (const std::string name : {"out.csv.gz", "out.csv"}) {
+    const InputError e = Catch([&] { WriteFileAtomically(mount_point + "/" + name, incompressible); });
+    EXPECT_NE(e.message().find("write failed: No space left on device"), std::string::npos) << e.what();
+    EXPECT_EQ(e.file(), mount_point + "/" + name);
+  }
+  EXPECT_TRUE(fs::is_empty(mount_point)) << "a temporary file was left behind";
+  EXPECT_EQ(RunProgram("/bin/umount", {mount_point}).status, 0);
 }
 
 // The error of reading every row of `text` (as a CSV file) and parsing field 0 as a number.

@@ -1,9 +1,5 @@
 #include "imufit/io/csv_reader.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-#include <zlib.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -11,10 +7,8 @@
 #include <cstring>
 #include <unordered_set>
 
+#include "byte_source.h"
 #include "imufit/io/error.h"
-#include "imufit/io/file_reads.h"
-#include "imufit/io/path.h"
-#include "imufit/io/sha256.h"
 
 namespace imufit {
 namespace {
@@ -53,117 +47,10 @@ bool ParseSmallInteger(std::string_view text, double* value) {
 
 }  // namespace
 
-// Reads bytes from a plain file (read(2)) or a gzip stream (zlib's inflate over read(2)). The gzip
-// stream is checked to its end: a stream cut short, one whose CRC-32 or length trailer does not
-// match, bytes after the last member, or a file named .gz that is not gzip are InputErrors.
-// Concatenated members (`cat a.gz b.gz`) are one stream, as gzip(1) reads them. Every byte read
-// from the file goes through ReadRaw(), and so through the digest when there is one.
-class CsvReader::Source {
+// The file's bytes, decompressed when it is gzip (by its name or its magic bytes), hashed as read.
+class CsvReader::Source : public ByteSource {
  public:
-  Source(const std::string& path, Sha256* digest) : path_(path), digest_(digest) {
-    fd_ = ::open(path.c_str(), O_RDONLY);
-    if (fd_ < 0) throw InputError(path_, std::string("cannot open: ") + std::strerror(errno));
-    CountOpenedForReading(path_);
-    if (IsGzipPath(path)) {
-      gzip_ = true;
-      raw_.resize(kRawBytes);
-      if (inflateInit2(&stream_, 16 + MAX_WBITS) != Z_OK)
-        throw InputError(path_, "cannot start gzip decompression");
-      inflating_ = true;
-    }
-  }
-  ~Source() {
-    if (inflating_) inflateEnd(&stream_);
-    if (fd_ >= 0) ::close(fd_);
-  }
-  // Reads up to `size` bytes; 0 at the end.
-  size_t Read(char* data, size_t size) {
-    if (!gzip_) return ReadRaw(data, size);
-    const uInt want = static_cast<uInt>(std::min<size_t>(size, 1u << 30));
-    stream_.next_out = reinterpret_cast<Bytef*>(data);
-    stream_.avail_out = want;
-    while (stream_.avail_out == want) {  // until some output, or the end
-      if (stream_.avail_in == 0 && !raw_eof_) Refill();
-      if (stream_.avail_in == 0 && raw_eof_) {
-        if (member_started_) {
-          throw InputError(path_, "truncated gzip stream: the file ends before the stream does (after " +
-                                      std::to_string(compressed_bytes_) + " compressed bytes)");
-        }
-        if (members_ == 0) throw InputError(path_, "empty file, not a gzip stream (the name ends in .gz)");
-        return 0;
-      }
-      if (!member_started_) StartMember();
-      const int status = inflate(&stream_, Z_NO_FLUSH);
-      if (status == Z_STREAM_END) {
-        member_started_ = false;
-        ++members_;
-        inflateReset(&stream_);
-      } else if (status == Z_BUF_ERROR && stream_.avail_in == 0) {
-        continue;  // more input needed: refilled above, or reported as truncated
-      } else if (status != Z_OK) {
-        const std::string reason = stream_.msg != nullptr ? stream_.msg : "error " + std::to_string(status);
-        const bool trailer = reason == "incorrect data check" || reason == "incorrect length check";
-        throw InputError(
-            path_, "corrupt gzip stream: " + reason +
-                       (trailer ? " (the CRC-32 or length in its trailer does not match the data)" : ""));
-      }
-    }
-    return want - stream_.avail_out;
-  }
-
- private:
-  static constexpr size_t kRawBytes = 1 << 16;
-
-  size_t ReadRaw(char* data, size_t size) {
-    for (;;) {
-      const ssize_t n = ::read(fd_, data, size);
-      if (n >= 0) {
-        if (digest_ != nullptr) digest_->Update(std::string_view(data, static_cast<size_t>(n)));
-        return static_cast<size_t>(n);
-      }
-      if (errno != EINTR) throw InputError(path_, std::string("cannot read: ") + std::strerror(errno));
-    }
-  }
-  void Refill() {
-    const size_t n = ReadRaw(raw_.data(), raw_.size());
-    if (n == 0) raw_eof_ = true;
-    compressed_bytes_ += static_cast<long long>(n);
-    stream_.next_in = reinterpret_cast<Bytef*>(raw_.data());
-    stream_.avail_in = static_cast<uInt>(n);
-  }
-  // A member starts with the gzip magic bytes 1f 8b; anything else is not gzip (at the start)
-  // or garbage after the stream (after a complete member).
-  void StartMember() {
-    if (stream_.avail_in < 2 && !raw_eof_) {
-      // Keep the one byte and read on so both magic bytes are seen together.
-      const unsigned char first = stream_.next_in[0];
-      raw_[0] = static_cast<char>(first);
-      const size_t n = ReadRaw(raw_.data() + 1, raw_.size() - 1);
-      if (n == 0) raw_eof_ = true;
-      compressed_bytes_ += static_cast<long long>(n);
-      stream_.next_in = reinterpret_cast<Bytef*>(raw_.data());
-      stream_.avail_in = static_cast<uInt>(n + 1);
-    }
-    if (stream_.avail_in < 2 || stream_.next_in[0] != 0x1f || stream_.next_in[1] != 0x8b) {
-      if (members_ == 0)
-        throw InputError(path_, "not a gzip stream (the name ends in .gz, the bytes are not gzip)");
-      throw InputError(path_, "trailing garbage after the gzip stream (at compressed byte " +
-                                  std::to_string(compressed_bytes_ - stream_.avail_in) + ")");
-    }
-    member_started_ = true;
-  }
-
-  std::string path_;
-  Sha256* digest_;
-  int fd_ = -1;
-  bool gzip_ = false;
-  bool inflating_ = false;
-  z_stream stream_{};
-  std::vector<char> raw_;
-  bool raw_eof_ = false;
-  bool member_started_ = false;
-  long members_ = 0;
-  long long compressed_bytes_ = 0;
+  using ByteSource::ByteSource;
 };
 
 CsvReader::CsvReader(std::string path, Sha256* raw_digest) : path_(std::move(path)) {
@@ -202,6 +89,15 @@ CsvReader::CsvReader(std::string path, Sha256* raw_digest) : path_(std::move(pat
   }
   throw InputError(path_, "no header line: the file is empty");
 }
+
+CsvReader::CsvReader(const CsvReader& header_of, std::string_view rows, long line_before)
+    : path_(header_of.path_),
+      buffer_(rows.begin(), rows.end()),
+      end_(rows.size()),
+      eof_(true),
+      line_number_(line_before),
+      header_line_(header_of.header_line_),
+      header_(header_of.header_) {}
 
 CsvReader::~CsvReader() = default;
 
@@ -271,16 +167,42 @@ bool CsvReader::NextLine(std::string_view* line) {
       ++line_number_;
       return true;
     }
-    // Move the partial line to the front and refill; grow for very long lines.
-    const size_t partial = end_ - begin_;
-    if (partial > kMaxLineBytes) LineTooLong();
-    std::memmove(buffer_.data(), buffer_.data() + begin_, partial);
-    begin_ = 0;
-    end_ = partial;
-    if (end_ == buffer_.size()) buffer_.resize(std::min(buffer_.size() * 2, kMaxLineBytes + 2));
-    const size_t got = source_->Read(buffer_.data() + end_, buffer_.size() - end_);
-    if (got == 0) eof_ = true;
-    end_ += got;
+    Refill();
+  }
+}
+
+void CsvReader::Refill() {
+  // Move the partial line to the front and refill; grow for very long lines.
+  const size_t partial = end_ - begin_;
+  if (partial > kMaxLineBytes) LineTooLong();
+  std::memmove(buffer_.data(), buffer_.data() + begin_, partial);
+  begin_ = 0;
+  end_ = partial;
+  if (end_ == buffer_.size()) buffer_.resize(std::min(buffer_.size() * 2, kMaxLineBytes + 2));
+  const size_t got = source_->Read(buffer_.data() + end_, buffer_.size() - end_);
+  if (got == 0) eof_ = true;
+  end_ += got;
+}
+
+bool CsvReader::NextBlock(std::string_view* rows, long* line_before) {
+  *line_before = line_number_;
+  for (;;) {
+    const char* start = buffer_.data() + begin_;
+    const size_t size = end_ - begin_;
+    const void* last_newline = size > 0 ? ::memrchr(start, '\n', size) : nullptr;
+    const size_t take = last_newline != nullptr ? static_cast<const char*>(last_newline) - start + 1
+                        : eof_                  ? size
+                                                : 0;
+    if (take > 0) {
+      *rows = std::string_view(start, take);
+      begin_ += take;
+      bytes_read_ += static_cast<long long>(take);
+      line_number_ +=
+          static_cast<long>(std::count(rows->begin(), rows->end(), '\n')) + (rows->back() != '\n');
+      return true;
+    }
+    if (eof_) return false;
+    Refill();
   }
 }
 
@@ -412,8 +334,8 @@ long CsvReader::Integer(int column, long if_empty) const {
   return value;
 }
 
-void CsvReader::Fail(int column, const std::string& message) const {
-  throw InputError(path_, line_number_, column + 1, EscapeForMessage(header_[column], 40) + ": " + message);
+void CsvReader::FailAt(long line, int column, const std::string& message) const {
+  throw InputError(path_, line, column + 1, EscapeForMessage(header_[column], 40) + ": " + message);
 }
 
 void CsvReader::FailRow(const std::string& message) const {

@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <limits.h>
 #include <signal.h>
@@ -18,6 +17,7 @@
 #include <filesystem>
 #include <mutex>
 
+#include "gzip_writer.h"
 #include "imufit/io/error.h"
 #include "imufit/io/path.h"
 
@@ -148,26 +148,13 @@ OutputFile::OutputFile(std::string path, OutputTransaction* transaction)
   const mode_t mask = ::umask(0);
   ::umask(mask);
   ::fchmod(fd_, 0666 & ~mask);
-  if (IsGzipPath(path_)) {
-    gz_ = gzdopen(fd_, "wb6");
-    if (gz_ == nullptr) {
-      ::close(fd_);
-      ::unlink(temp_path_.c_str());
-      UnregisterTempFile(temp_slot_);
-      fd_ = -1;
-      throw InputError(path_, "cannot start gzip compression");
-    }
-  }
+  if (IsGzipPath(path_)) gz_ = std::make_unique<GzipWriter>(fd_, path_);
   buffer_.reserve(kFlushBytes + 4096);
 }
 
 OutputFile::~OutputFile() {
   if (committed_) return;
-  if (gz_ != nullptr) {
-    gzclose(static_cast<gzFile>(gz_));  // also closes fd_
-  } else if (fd_ >= 0) {
-    ::close(fd_);
-  }
+  if (fd_ >= 0) ::close(fd_);
   if (!temp_path_.empty()) ::unlink(temp_path_.c_str());
   UnregisterTempFile(temp_slot_);
 }
@@ -190,47 +177,21 @@ void OutputFile::WriteNumber(double value) {
 void OutputFile::Flush() {
   if (buffer_.empty()) return;
   if (gz_ != nullptr) {
-    const int written =
-        gzwrite(static_cast<gzFile>(gz_), buffer_.data(), static_cast<unsigned>(buffer_.size()));
-    if (written != static_cast<int>(buffer_.size())) {
-      throw InputError(path_, "write failed (gzip)");
-    }
+    gz_->Write(buffer_);
   } else {
-    const char* data = buffer_.data();
-    size_t left = buffer_.size();
-    while (left > 0) {
-      const ssize_t written = ::write(fd_, data, left);
-      if (written < 0) {
-        if (errno == EINTR) continue;
-        throw InputError(path_, std::string("write failed: ") + std::strerror(errno));
-      }
-      data += written;
-      left -= static_cast<size_t>(written);
-    }
+    WriteAll(fd_, buffer_, path_);
   }
   buffer_.clear();
 }
 
 void OutputFile::Commit() {
   Flush();
-  if (gz_ != nullptr) {
-    // gzclose closes the descriptor too, so sync through a second descriptor afterwards.
-    const int status = gzclose(static_cast<gzFile>(gz_));
-    gz_ = nullptr;
-    fd_ = -1;
-    if (status != Z_OK) throw InputError(path_, "write failed (gzip close)");
-    const int sync_fd = ::open(temp_path_.c_str(), O_RDONLY);
-    if (sync_fd >= 0) {
-      ::fsync(sync_fd);
-      ::close(sync_fd);
-    }
-  } else {
-    if (::fsync(fd_) != 0 && errno != EINVAL) {
-      throw InputError(path_, std::string("sync failed: ") + std::strerror(errno));
-    }
-    ::close(fd_);
-    fd_ = -1;
+  if (gz_ != nullptr) gz_->Finish();
+  if (::fsync(fd_) != 0 && errno != EINVAL) {
+    throw InputError(path_, std::string("sync failed: ") + std::strerror(errno));
   }
+  ::close(fd_);
+  fd_ = -1;
   if (transaction_ != nullptr) {
     transaction_->Add(temp_path_, path_, temp_slot_);  // renamed with the others, or removed
     committed_ = true;

@@ -3,14 +3,17 @@
 #include <set>
 #include <utility>
 
+#include "imufit/io/parallel_samples.h"
 #include "imufit/model/check.h"
 
 namespace imufit {
 namespace {
 
-// The samples of `reader`, labelled by `labeller` when not null, into windows, each checked
-// against the plan, and into the static stretch when not null.
-void ReadSamples(const Plan& plan, SamplesReader* reader, Labeller* labeller, WindowBuilder* builder,
+// The samples of `reader` (a SamplesReader or a ParallelSamplesReader), labelled by `labeller`
+// when not null, into windows, each checked against the plan, and into the static stretch when
+// not null.
+template <typename Reader>
+void ReadSamples(const Plan& plan, Reader* reader, Labeller* labeller, WindowBuilder* builder,
                  LongestStaticStretch* stretch) {
   std::set<int> ids;
   for (const TableSegment& segment : plan.segments) ids.insert(segment.id);
@@ -52,8 +55,12 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
   WindowBuilder builder(options, plan_.segments);
   std::optional<LongestStaticStretch> stretch;
   if (keep_static_stretch) stretch.emplace(plan_);
-  ReadSamples(plan_, second_pass ? &*second_pass : &first_pass_, labeller ? &*labeller : nullptr, &builder,
-              stretch ? &*stretch : nullptr);
+  if (second_pass) {
+    ReadSamples(plan_, &*second_pass, &*labeller, &builder, stretch ? &*stretch : nullptr);
+  } else {
+    ParallelSamplesReader samples(&first_pass_);  // a labelled file: parsed on every core
+    ReadSamples(plan_, &samples, nullptr, &builder, stretch ? &*stretch : nullptr);
+  }
   run.windows = builder.Finish();
   run.stats = builder.stats();
   run.samples_sha256 = digest_.HexDigest();  // the first pass has read the whole file

@@ -41,6 +41,9 @@ class CsvReader {
   // to it as it is read: once NextRow() has returned false, it has seen the whole file. It must
   // outlive the reader.
   explicit CsvReader(std::string path, Sha256* raw_digest = nullptr);
+  // Reads `rows`, lines of the file of `header_of` after its line `line_before`, with its header
+  // (parallel_samples.h parses the blocks of one file in several of these at once).
+  CsvReader(const CsvReader& header_of, std::string_view rows, long line_before);
   ~CsvReader();
   CsvReader(const CsvReader&) = delete;
   CsvReader& operator=(const CsvReader&) = delete;
@@ -71,8 +74,17 @@ class CsvReader {
   // Field `column` as an integer; an empty field gives `if_empty`.
   long Integer(int column, long if_empty) const;
 
+  // The next block of whole lines, at least one and at most a read block's worth, in `rows` (the
+  // file's text, newlines and all; valid until the next call); `line_before` gets the number of
+  // the line before its first. False at the end. Read either blocks or rows after the header.
+  bool NextBlock(std::string_view* rows, long* line_before);
+
   // Throws an InputError located at the current row and `column` (1-based field = column + 1).
-  [[noreturn]] void Fail(int column, const std::string& message) const;
+  [[noreturn]] void Fail(int column, const std::string& message) const {
+    FailAt(line_number_, column, message);
+  }
+  // The same at line `line`.
+  [[noreturn]] void FailAt(long line, int column, const std::string& message) const;
   [[noreturn]] void FailRow(const std::string& message) const;
 
   const std::string& path() const { return path_; }
@@ -83,6 +95,8 @@ class CsvReader {
  private:
   class Source;
   bool NextLine(std::string_view* line);
+  // Moves the partial line to the front of buffer_ and reads more after it; sets eof_ at the end.
+  void Refill();
   void SplitLine(std::string_view line);
   void SkipByteOrderMark(std::string_view* line) const;
   [[noreturn]] void LineTooLong() const;

@@ -4,7 +4,7 @@
 // destination only in Commit(), after a flush and an fsync. If Commit() is never reached (an
 // error, an exception, a crash) the temporary file is removed and an existing destination is
 // left exactly as it was; on SIGINT, SIGTERM or SIGHUP too (InstallOutputCleanupOnSignals).
-// Paths ending in ".gz" are written gzip-compressed.
+// Paths ending in ".gz" are written gzip-compressed (ISA-L's igzip; standard gzip).
 //
 // An existing destination must be a regular file that may be written: a symbolic link, FIFO,
 // device node, directory or read-only file is refused (InputError) rather than replaced.
@@ -14,12 +14,14 @@
 #ifndef IMUFIT_IO_OUTPUT_FILE_H_
 #define IMUFIT_IO_OUTPUT_FILE_H_
 
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace imufit {
 
+class GzipWriter;
 class OutputTransaction;
 
 class OutputFile {
@@ -51,7 +53,7 @@ class OutputFile {
   std::string temp_path_;
   std::string buffer_;
   int fd_ = -1;
-  void* gz_ = nullptr;  // gzFile when compressing
+  std::unique_ptr<GzipWriter> gz_;  // when compressing (ISA-L)
   bool committed_ = false;
   int temp_slot_ = -1;  // in the table of temporaries removed on a signal
 };

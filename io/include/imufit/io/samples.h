@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/output_file.h"
@@ -36,6 +37,11 @@ class SamplesReader {
   SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c = std::nullopt,
                 Sha256* raw_digest = nullptr);
 
+  // Reads `rows`, lines of the file of `header_of` after its line `line_before`, with its header
+  // and columns; `last_time_s`, when given, is the time of the row before (ParallelSamplesReader).
+  SamplesReader(const SamplesReader& header_of, std::string_view rows, long line_before,
+                std::optional<double> last_time_s = std::nullopt);
+
   // Reads the next sample; false at the end. Throws InputError on a bad value, a time that does
   // not increase, or a segment id below -1.
   bool Next(Sample* sample);
@@ -53,6 +59,7 @@ class SamplesReader {
   long long bytes_read() const { return csv_.bytes_read(); }
 
  private:
+  friend class ParallelSamplesReader;  // reads the file's blocks (parallel_samples.h)
   CsvReader csv_;
   int time_column_;
   int temp_column_ = -1;

@@ -1,6 +1,6 @@
 // imufit — SHA-256 (FIPS 180-4), for the input hashes of certificates, batch manifests and the
-// results store. Implemented here rather than taken from a crypto library so that io/ needs
-// nothing beyond yaml-cpp and zlib; tests/io_test.cc checks it against the FIPS 180-2 vectors.
+// results store. Computed by libcrypto (OpenSSL's EVP interface, with the CPU's SHA instructions
+// where it has them); tests/factory_test.cc checks it against the FIPS 180-2 vectors.
 #ifndef IMUFIT_IO_SHA256_H_
 #define IMUFIT_IO_SHA256_H_
 
@@ -11,8 +11,8 @@
 namespace imufit {
 
 // Incremental SHA-256: Update() any number of times, then HexDigest() once. The state is kept
-// out of this header, so that the implementation (this file's own, or a crypto library's) can
-// change without its users noticing. Readers hash a file while they stream it (csv_reader.h).
+// out of this header, so that no user of it sees libcrypto. Readers hash a file while they
+// stream it (csv_reader.h), so a file is read once for its samples and its hash.
 class Sha256 {
  public:
   Sha256();
