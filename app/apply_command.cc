@@ -24,9 +24,9 @@ struct ApplyArguments {
 int RunApply(const ApplyArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
   const Calibration calibration = ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch);
-  const CorrectFileReport report = CorrectSamplesFile(
-      calibration, args.samples, args.output, args.input.Get().Format(),
-      CorrectedByComment(calibration, Sha256OfFile(args.calibration), SoftwareVersion()));
+  const CorrectFileReport report =
+      CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().Format(),
+                         CorrectedByComment(calibration, Sha256OfFile(args.calibration), SoftwareVersion()));
   WarnOutsideFitTempRange(calibration, report);
   if (!args.quiet) {
     std::printf("corrected %lld samples -> %s\n", report.samples, args.output.c_str());

@@ -52,8 +52,8 @@ std::string CorrectedByComment(const Calibration& calibration, const std::string
 void RefuseCorrectedSamples(const SamplesReader& reader) {
   for (const CsvReader::Comment& comment : reader.header_comments()) {
     if (comment.text.compare(0, kCorrectedByKey.size(), kCorrectedByKey) != 0) continue;
-    throw std::runtime_error(reader.path() + ":" + std::to_string(comment.line) +
-                             ": is corrected already (" + comment.text +
+    throw std::runtime_error(reader.path() + ":" + std::to_string(comment.line) + ": is corrected already (" +
+                             comment.text +
                              "): a calibration corrects the unit's raw log, not its corrected samples");
   }
 }

@@ -5,10 +5,10 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cctype>
 #include <cstring>
 #include <unordered_set>
 
@@ -83,7 +83,8 @@ std::string NearestName(const std::vector<std::string>& header, std::string_view
   size_t best_distance = std::max<size_t>(1, name.size() / 3) + 1;
   for (const std::string& candidate : header) {
     if (candidate.size() > kMaxNameBytes) continue;
-    const bool prefix = candidate.size() >= 3 && EqualIgnoringCase(name.substr(0, candidate.size()), candidate);
+    const bool prefix =
+        candidate.size() >= 3 && EqualIgnoringCase(name.substr(0, candidate.size()), candidate);
     const size_t distance = prefix ? 1 : NameDistance(candidate, name);
     if (distance < best_distance) {
       best = candidate;
@@ -260,17 +261,21 @@ std::optional<int> CsvReader::FindColumn(std::string_view name) const {
   return found;
 }
 
-int CsvReader::RequireColumn(std::string_view name) const { return RequireColumns({std::string(name)}).front(); }
+int CsvReader::RequireColumn(std::string_view name) const {
+  return RequireColumns({std::string(name)}).front();
+}
 
-std::vector<int> CsvReader::RequireColumns(const std::vector<std::string>& names, const std::string& hint) const {
+std::vector<int> CsvReader::RequireColumns(const std::vector<std::string>& names,
+                                           const std::string& hint) const {
   std::vector<int> columns;
   std::vector<std::string> missing;
   std::string guesses;
   // A near name is guessed among the columns no needed name takes ("accel_x" is no "accel_z").
   std::vector<std::string> unclaimed;
   for (const std::string& column : header_) {
-    const bool claimed = std::any_of(names.begin(), names.end(),
-                                     [&column](const std::string& name) { return EqualIgnoringCase(column, name); });
+    const bool claimed = std::any_of(names.begin(), names.end(), [&column](const std::string& name) {
+      return EqualIgnoringCase(column, name);
+    });
     if (!claimed) unclaimed.push_back(column);
   }
   for (const std::string& name : names) {
@@ -493,7 +498,8 @@ double CsvReader::Number(int column) const {
 long CsvReader::Integer(int column, long if_empty) const {
   std::string_view text = Trim(Field(column));
   if (text.empty()) return if_empty;
-  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);  // "+1"
+  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+')
+    text.remove_prefix(1);  // "+1"
   long value = 0;
   const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
   if (result.ec != std::errc() || result.ptr != text.data() + text.size()) {

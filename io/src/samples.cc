@@ -134,8 +134,8 @@ void SamplesReader::CheckTemperature(double temp_c) const {
                         FormatDouble(kMaxPlausibleTempC) + " degC, what an IMU can report: ";
   const double as_kelvin_c = temp_c - kZeroCelsiusK;
   if (as_kelvin_c >= kMinPlausibleTempC && as_kelvin_c <= kMaxPlausibleTempC) {
-    message += std::string(rows_ == 1 ? "the column is in kelvin?" : "kelvin?") + " (" + FormatDouble(temp_c) +
-               " K is " + FormatDouble(as_kelvin_c) + " degC; temp_c must be degC)";
+    message += std::string(rows_ == 1 ? "the column is in kelvin?" : "kelvin?") + " (" +
+               FormatDouble(temp_c) + " K is " + FormatDouble(as_kelvin_c) + " degC; temp_c must be degC)";
   } else if (temp_c == -kZeroCelsiusK) {
     message += "absolute zero, a logger's fill value for a missing reading? (kelvin? temp_c must be degC)";
   } else {

@@ -4,9 +4,9 @@
 
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
-#include "imufit/model/enum_names.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/model/enum_names.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
@@ -31,7 +31,9 @@ OptionTable<SamplesInput> MakeSamplesInputOptionTable() {
   // it had before the option existed.
   time_unit.fingerprint = Fingerprint::kCustom;
   time_unit.describe = [](const SamplesInput& in) {
-    return in.seconds_per_time_unit == 1.0 ? "" : "time_unit=" + std::string(NameOf(kTimeUnitNames, in.seconds_per_time_unit));
+    return in.seconds_per_time_unit == 1.0
+               ? ""
+               : "time_unit=" + std::string(NameOf(kTimeUnitNames, in.seconds_per_time_unit));
   };
   t.Include(SegmentationOptionTable(), &SamplesInput::segmentation);
   return t;

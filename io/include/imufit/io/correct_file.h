@@ -52,9 +52,9 @@ std::string CorrectedByComment(const Calibration& calibration, const std::string
 // the header of `reader` has a `corrected by:` line.
 void RefuseCorrectedSamples(const SamplesReader& reader);
 
-// Reads every sample of `reader` (refused by RefuseCorrectedSamples first), corrects it and calls `sink` with the corrected sample (time_s,
-// temp_c and segment as read). Throws InputError, located at the row, when a correction is not a
-// finite number (a temperature far outside the fit range overflows the polynomials).
+// Reads every sample of `reader` (refused by RefuseCorrectedSamples first), corrects it and calls `sink` with
+// the corrected sample (time_s, temp_c and segment as read). Throws InputError, located at the row, when a
+// correction is not a finite number (a temperature far outside the fit range overflows the polynomials).
 CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
                                  const std::function<void(const Sample& corrected)>& sink);
 
