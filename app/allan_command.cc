@@ -38,15 +38,15 @@ struct AllanArguments {
   std::string noise_yaml;
   std::string plot;
   std::string plot_units = "native";
-  std::string time_unit = "s";
   double scale = 1.0;
   std::string calibration;      // correct the raw samples through it first (as imufit apply does)
-  SamplesInputArguments input;  // --temp-c, for a raw log without temp_c
+  SamplesInputArguments input;  // --temp-c, for a raw log without temp_c; --time-unit
   double confidence = 0.683;
   double time_tolerance = 0.1;
   double min_clusters = 8.0;
   int threads = 0;
   bool quiet = false;
+  bool allow_mismatch = false;  // with --calibration
 };
 
 [[noreturn]] void BadInvocation(const std::string& message) { throw InputError("imufit allan", message); }
@@ -58,33 +58,17 @@ std::string Number(double value, int digits = 4) {
   return text;
 }
 
-// The units of the time column (model/enum_names.h), as seconds per unit.
-struct TimeUnitName {
-  double value;
-  const char* name;
-};
-constexpr TimeUnitName kTimeUnitNames[] = {{1.0, "s"}, {1e-3, "ms"}, {1e-6, "us"}, {1e-9, "ns"}};
-
-// Seconds per unit of the time column.
-double SecondsPer(const std::string& unit) {
-  double seconds = 0.0;
-  if (!ValueOf(kTimeUnitNames, unit, &seconds)) {
-    BadInvocation("--time-unit " + QuoteForMessage(unit) + " is not one of: " + AllNames(kTimeUnitNames));
-  }
-  return seconds;
-}
-
 // A static gyro reads Earth rate and its bias: far below 1 rad/s (57 deg/s) in rad/s. A larger
 // mean means the column is not in rad/s (raw counts, or deg/s).
 constexpr double kImplausibleGyroMeanRadps = 1.0;
 // An accelerometer at rest reads about 1 g; a mean beyond 4 g is not m/s^2.
 constexpr double kImplausibleAccelMeanMps2 = 4.0 * kStandardGravityMps2;
-// IMU logs are sampled at 1 Hz or faster: a longer interval suggests milliseconds or microseconds.
-constexpr double kImplausibleIntervalS = 1.0;
 
 void PlausibilityWarnings(const AllanArguments& args, const UniformSeries& series,
                           const std::vector<ColumnAnalysis>& results) {
-  if (args.time_unit == "s" && series.sample_interval_s >= kImplausibleIntervalS) {
+  // A static log may be long and slow: a warning here, where a run against a plan is refused
+  // (SamplesReader).
+  if (!args.input.options.Given("time_unit") && series.sample_interval_s >= kMaxSampleIntervalS) {
     std::fprintf(stderr,
                  "imufit: warning: %s: time_s steps by %s s (%s Hz), slow for an IMU: if the timestamps are "
                  "milliseconds or microseconds, say so with --time-unit ms or --time-unit us\n",
@@ -224,7 +208,7 @@ bool CheckOutputs(const AllanArguments& args, AllanSettings* settings) {
       if (outputs[i] == outputs[j]) throw InputError(outputs[i], "named for two outputs");
     }
   }
-  settings->seconds_per_unit = SecondsPer(args.time_unit);
+  settings->seconds_per_unit = args.input.Get().seconds_per_time_unit;
   if (!(args.scale > 0.0) || !std::isfinite(args.scale)) BadInvocation("--scale must be a positive number");
   if (!ParseAllanPlotUnits(args.plot_units, &settings->plot_units)) {
     BadInvocation("--plot-units " + QuoteForMessage(args.plot_units) +
@@ -253,11 +237,12 @@ UniformSeries ReadSeries(const AllanArguments& args, double seconds_per_unit) {
   if (args.calibration.empty()) {
     series = ReadUniformSeries(args.samples, args.columns, series_options);
   } else {
-    const Calibration calibration = ReadCalibration(args.calibration);
+    const Calibration calibration = ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch);
     CorrectFileReport correction;
-    series = ReadCorrectedSeries(args.samples, calibration, args.input.Get().temp_c, args.columns,
+    series = ReadCorrectedSeries(args.samples, calibration, args.input.Get().Format(), args.columns,
                                  series_options, &correction);
     WarnOutsideFitTempRange(calibration, correction);
+    return series;  // SamplesReader has read the times in seconds
   }
   series.sample_interval_s *= seconds_per_unit;
   series.start_time_s *= seconds_per_unit;
@@ -413,7 +398,6 @@ CommandRunner AddAllanCommand(CLI::App* root) {
   command->add_option("--plot-units", args->plot_units,
                       "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
                       "corrected file), rad/s, deg/s or deg/h");
-  command->add_option("--time-unit", args->time_unit, "unit of the time_s column: s (default), ms, us or ns");
   CLI::Option* scale = command->add_option(
       "--scale", args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "
@@ -426,6 +410,7 @@ CommandRunner AddAllanCommand(CLI::App* root) {
               "does (then the columns are among gyro_*, accel_* and temp_c)")
           ->excludes(scale);
   AddTempOption(command, &args->input);
+  AddAllowMismatchFlag(command, &args->allow_mismatch);
   args->input.TempOption()->needs(calibration);  // a temperature only matters to the correction
   command->add_option("--threads", args->threads, "worker threads (default 0: all cores)");
   command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");

@@ -6,6 +6,8 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/correct_file.h"
 #include "imufit/io/output_file.h"
+#include "imufit/io/sha256.h"
+#include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
 namespace {
@@ -15,14 +17,16 @@ struct ApplyArguments {
   std::string samples;
   std::string output;
   bool quiet = false;
+  bool allow_mismatch = false;
   SamplesInputArguments input;
 };
 
 int RunApply(const ApplyArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
-  const Calibration calibration = ReadCalibration(args.calibration);
+  const Calibration calibration = ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch);
   const CorrectFileReport report =
-      CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().temp_c);
+      CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().Format(),
+                         CorrectedByComment(calibration, Sha256OfFile(args.calibration), SoftwareVersion()));
   WarnOutsideFitTempRange(calibration, report);
   if (!args.quiet) {
     std::printf("corrected %lld samples -> %s\n", report.samples, args.output.c_str());
@@ -31,6 +35,20 @@ int RunApply(const ApplyArguments& args) {
 }
 
 }  // namespace
+
+Calibration ReadUnitCalibration(const std::string& calibration_path, const std::string& samples_path,
+                                bool allow_mismatch) {
+  Calibration calibration = ReadCalibration(calibration_path);
+  SerialSource source;
+  source.kind = SerialSource::Kind::kStated;
+  source.name = "the calibration " + calibration_path;
+  source.serial = calibration.serial;
+  for (const std::string& warning :
+       ResolveSerial({source, SamplesHeaderSerial(samples_path)}, allow_mismatch).warnings) {
+    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  }
+  return calibration;
+}
 
 void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report) {
   if (report.outside_temp_range == 0) return;
@@ -42,6 +60,12 @@ void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileRe
       report.outside_temp_range, report.samples, 100.0 * report.outside_temp_range / report.samples,
       kFitRangeToleranceC, calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1],
       report.min_temp_c, report.max_temp_c);
+}
+
+void AddAllowMismatchFlag(CLI::App* command, bool* allow_mismatch) {
+  command->add_flag("--allow-mismatch", *allow_mismatch,
+                    "correct even when the calibration names another unit than the samples header (a "
+                    "warning); without it such a log is refused");
 }
 
 CommandRunner AddApplyCommand(CLI::App* root) {
@@ -56,6 +80,7 @@ CommandRunner AddApplyCommand(CLI::App* root) {
   command->add_option("--output,-o", args->output, "corrected samples CSV to write (.gz compresses)")
       ->required();
   AddTempOption(command, &args->input);
+  AddAllowMismatchFlag(command, &args->allow_mismatch);
   command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
   return [args] { return RunApply(*args); };
 }

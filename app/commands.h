@@ -43,7 +43,7 @@ struct SamplesInputArguments {
     return input;
   }
 };
-// --temp-c.
+// --temp-c and --time-unit.
 void AddTempOption(CLI::App* command, SamplesInputArguments* args);
 // The segmentation options: --segment-window, --min-steady, --direction-tolerance, ...
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
@@ -76,6 +76,14 @@ void AddFitRunOptions(CLI::App* command, FitRunArguments* args, const std::set<s
 
 struct Calibration;
 struct CorrectFileReport;
+// The calibration at `calibration_path` for correcting the samples at `samples_path`: refused
+// (InputError at the samples header's serial) when its serial names another unit than that header,
+// unless `allow_mismatch` (then a warning); as fit, report and batch refuse (unit_serial.h).
+// apply_command.cc; apply and allan --calibration share it, and --allow-mismatch
+// (AddAllowMismatchFlag).
+Calibration ReadUnitCalibration(const std::string& calibration_path, const std::string& samples_path,
+                                bool allow_mismatch);
+void AddAllowMismatchFlag(CLI::App* command, bool* allow_mismatch);
 // Warns once, with a count, when corrected samples lay outside the calibration's fit temperature
 // range (an extrapolation): apply_command.cc; apply and allan --calibration share it.
 void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report);

@@ -48,10 +48,11 @@ int RunSegment(const SegmentArguments& args) {
 
 void AddTempOption(CLI::App* command, SamplesInputArguments* args) {
   args->options.AddOne(command, SamplesInputOptionTable(), "temp_c");
+  args->options.AddOne(command, SamplesInputOptionTable(), "time_unit");
 }
 
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args) {
-  args->options.Add(command, SamplesInputOptionTable(), {"temp_c"});
+  args->options.Add(command, SamplesInputOptionTable(), {"temp_c", "time_unit"});
 }
 
 CommandRunner AddSegmentCommand(CLI::App* root) {

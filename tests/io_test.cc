@@ -1081,7 +1081,7 @@ TEST_F(IoTest, ACsvReaderHashesTheFileAsItReadsIt) {
     }
     const FileReadCounter reads(path);
     Sha256 digest;
-    SamplesReader reader(path, true, std::nullopt, &digest);
+    SamplesReader reader(path, true, SamplesFormat{}, &digest);
     Sample sample;
     long long samples = 0;
     while (reader.Next(&sample)) ++samples;

@@ -1,6 +1,7 @@
 #include "imufit/io/correct_file.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "imufit/io/output_file.h"
 
@@ -8,6 +9,7 @@ namespace imufit {
 
 CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
                                  const std::function<void(const Sample& corrected)>& sink) {
+  RefuseCorrectedSamples(*reader);
   CorrectFileReport report;
   Sample raw;
   Sample corrected;
@@ -36,10 +38,33 @@ CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* 
   return report;
 }
 
+std::string CorrectedByComment(const Calibration& calibration, const std::string& calibration_sha256,
+                               const std::string& software) {
+  const std::string serial = calibration.serial.empty() ? "(none)" : calibration.serial;
+  std::string line = std::string(kCorrectedByKey) + " serial " + serial + ", calibration sha256 " +
+                     calibration_sha256 + ", software " + software;
+  for (char& c : line) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';  // one header line
+  }
+  return line;
+}
+
+void RefuseCorrectedSamples(const SamplesReader& reader) {
+  for (const CsvReader::Comment& comment : reader.header_comments()) {
+    if (comment.text.compare(0, kCorrectedByKey.size(), kCorrectedByKey) != 0) continue;
+    throw std::runtime_error(reader.path() + ":" + std::to_string(comment.line) + ": is corrected already (" +
+                             comment.text +
+                             "): a calibration corrects the unit's raw log, not its corrected samples");
+  }
+}
+
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path, std::optional<double> temp_c) {
-  SamplesReader reader(samples_path, /*require_segment=*/false, temp_c);
-  SamplesWriter writer(output_path, reader.has_segment(), SerialComment(reader.serial(), samples_path));
+                                     const std::string& output_path, const SamplesFormat& format,
+                                     const std::string& corrected_by) {
+  SamplesReader reader(samples_path, /*require_segment=*/false, format);
+  std::string comment = SerialComment(reader.serial(), samples_path);
+  if (!corrected_by.empty()) comment += (comment.empty() ? "" : "\n") + corrected_by;
+  SamplesWriter writer(output_path, reader.has_segment(), comment);
   const CorrectFileReport report =
       CorrectSamples(calibration, &reader, [&writer](const Sample& corrected) { writer.Write(corrected); });
   writer.Commit();

@@ -1,6 +1,7 @@
 #include "imufit/io/csv_reader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -43,6 +44,48 @@ bool ParseSmallInteger(std::string_view text, double* value) {
   }
   *value = negative ? -static_cast<double>(magnitude) : static_cast<double>(magnitude);
   return true;
+}
+
+bool EqualIgnoringCase(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+// Edit distance, ignoring case, of two short names (a header name and one a reader needs).
+size_t NameDistance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      const bool same = EqualIgnoringCase(a.substr(i - 1, 1), b.substr(j - 1, 1));
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// The header name nearest to `name` ("gyro x", "gyrox", "temp" for "temp_c"), or "" when none is
+// near: within a third of the name's length, or a prefix of it.
+std::string NearestName(const std::vector<std::string>& header, std::string_view name) {
+  constexpr size_t kMaxNameBytes = 64;
+  std::string best;
+  size_t best_distance = std::max<size_t>(1, name.size() / 3) + 1;
+  for (const std::string& candidate : header) {
+    if (candidate.size() > kMaxNameBytes) continue;
+    const bool prefix =
+        candidate.size() >= 3 && EqualIgnoringCase(name.substr(0, candidate.size()), candidate);
+    const size_t distance = prefix ? 1 : NameDistance(candidate, name);
+    if (distance < best_distance) {
+      best = candidate;
+      best_distance = distance;
+    }
+  }
+  return best;
 }
 
 }  // namespace
@@ -105,18 +148,69 @@ std::optional<int> CsvReader::FindColumn(std::string_view name) const {
   for (size_t i = 0; i < header_.size(); ++i) {
     if (header_[i] == name) return static_cast<int>(i);
   }
-  return std::nullopt;
+  std::optional<int> found;
+  for (size_t i = 0; i < header_.size(); ++i) {
+    if (!EqualIgnoringCase(header_[i], name)) continue;
+    if (found) return std::nullopt;  // "Gyro_X" and "GYRO_X": neither is chosen
+    found = static_cast<int>(i);
+  }
+  return found;
 }
 
 int CsvReader::RequireColumn(std::string_view name) const {
-  if (const std::optional<int> column = FindColumn(name)) return *column;
+  return RequireColumns({std::string(name)}).front();
+}
+
+std::vector<int> CsvReader::RequireColumns(const std::vector<std::string>& names,
+                                           const std::string& hint) const {
+  std::vector<int> columns;
+  std::vector<std::string> missing;
+  std::string guesses;
+  // A near name is guessed among the columns no needed name takes ("accel_x" is no "accel_z").
+  std::vector<std::string> unclaimed;
+  for (const std::string& column : header_) {
+    const bool claimed = std::any_of(names.begin(), names.end(), [&column](const std::string& name) {
+      return EqualIgnoringCase(column, name);
+    });
+    if (!claimed) unclaimed.push_back(column);
+  }
+  for (const std::string& name : names) {
+    if (const std::optional<int> column = FindColumn(name)) {
+      columns.push_back(*column);
+      continue;
+    }
+    missing.push_back(QuoteForMessage(name));
+    if (const std::string near = NearestName(unclaimed, name); !near.empty()) {
+      guesses += (guesses.empty() ? "; did you mean " : ", ") + QuoteForMessage(near) + " for " +
+                 QuoteForMessage(name);
+    }
+  }
+  if (missing.empty()) return columns;
+  // One field holding the other delimiter: the columns were never split.
+  std::string delimiter;
+  if (header_.size() == 1) {
+    if (header_[0].find(';') != std::string::npos) delimiter = "';'";
+    if (header_[0].find('\t') != std::string::npos) delimiter = "tabs";
+  }
+  if (!delimiter.empty()) {
+    throw InputError(path_, header_line_, 0,
+                     "the header is separated by " + delimiter +
+                         ", not commas (a spreadsheet's export in a locale with a decimal comma?): "
+                         "save it as CSV with ',' between fields and '.' in numbers (header: " +
+                         EscapeForMessage(header_[0], 80) + ")");
+  }
   constexpr size_t kShown = 12;
   std::string have;
   for (size_t i = 0; i < header_.size() && i < kShown; ++i)
     have += (i ? "," : "") + EscapeForMessage(header_[i], 24);
   if (header_.size() > kShown) have += ",... " + std::to_string(header_.size()) + " columns in all";
+  std::string list;
+  for (size_t i = 0; i < missing.size(); ++i) {
+    list += (i == 0 ? "" : i + 1 == missing.size() ? " and " : ", ") + missing[i];
+  }
   throw InputError(path_, header_line_, 0,
-                   "no column " + QuoteForMessage(name) + " in the header (it has: " + have + ")");
+                   std::string(missing.size() == 1 ? "no column " : "no columns ") + list +
+                       " in the header (it has: " + have + ")" + guesses + hint);
 }
 
 void CsvReader::SkipByteOrderMark(std::string_view* line) const {
@@ -324,8 +418,10 @@ double CsvReader::Number(int column) const {
 }
 
 long CsvReader::Integer(int column, long if_empty) const {
-  const std::string_view text = Trim(Field(column));
+  std::string_view text = Trim(Field(column));
   if (text.empty()) return if_empty;
+  if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+')
+    text.remove_prefix(1);  // "+1"
   long value = 0;
   const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
   if (result.ec != std::errc() || result.ptr != text.data() + text.size()) {

@@ -28,14 +28,16 @@ constexpr size_t kMinRowBytes = 24;
 }  // namespace
 
 SamplesReader::SamplesReader(const SamplesReader& header_of, std::string_view rows, long line_before,
-                             std::optional<double> last_time_s)
+                             std::optional<double> last_time_s, bool probe_interval)
     : csv_(header_of.csv_, rows, line_before),
+      seconds_per_time_unit_(header_of.seconds_per_time_unit_),
       time_column_(header_of.time_column_),
       temp_column_(header_of.temp_column_),
       fixed_temp_c_(header_of.fixed_temp_c_),
       segment_column_(header_of.segment_column_),
       serial_(header_of.serial_),
-      first_(!last_time_s),
+      // Past the probe unless asked (the file's first block): a later block continues the file.
+      rows_(probe_interval ? 0 : kIntervalProbeRows + 1),
       last_time_s_(last_time_s.value_or(0.0)) {
   std::copy(std::begin(header_of.gyro_columns_), std::end(header_of.gyro_columns_), gyro_columns_);
   std::copy(std::begin(header_of.accel_columns_), std::end(header_of.accel_columns_), accel_columns_);
@@ -62,10 +64,12 @@ bool ParallelSamplesReader::Launch() {
     end_of_file_ = true;
   }
   const SamplesReader* header = header_;
-  auto parse = [header, block = std::move(block)]() mutable {
+  const bool first_block = !launched_;
+  launched_ = true;
+  auto parse = [header, first_block, block = std::move(block)]() mutable {
     if (block->error) return std::move(block);
     try {
-      SamplesReader reader(*header, block->rows, block->line_before);
+      SamplesReader reader(*header, block->rows, block->line_before, std::nullopt, first_block);
       block->samples.reserve(block->rows.size() / kMinRowBytes);
       block->lines.reserve(block->rows.size() / kMinRowBytes);
       Sample sample;

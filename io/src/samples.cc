@@ -1,6 +1,8 @@
 #include "imufit/io/samples.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <iterator>
 #include <sstream>
 #include <string_view>
 
@@ -45,47 +47,71 @@ SamplesSerial SerialInHeader(const CsvReader& csv) {
   return serial;
 }
 
+// A figure of a message, to 4 significant digits.
+std::string ShortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", value);
+  return text;
+}
+
 }  // namespace
 
-SamplesReader::SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c,
+SamplesReader::SamplesReader(std::string path, bool require_segment, const SamplesFormat& format,
                              Sha256* raw_digest)
-    : csv_(std::move(path), raw_digest), serial_(SerialInHeader(csv_)) {
-  time_column_ = csv_.RequireColumn("time_s");
+    : csv_(std::move(path), raw_digest),
+      seconds_per_time_unit_(format.seconds_per_time_unit),
+      serial_(SerialInHeader(csv_)) {
+  const std::optional<double>& temp_c = format.temp_c;
+  // Every column needed, so that all that are absent are named at once.
+  std::vector<std::string> names = {"time_s"};
+  names.insert(names.end(), std::begin(kGyroNames), std::end(kGyroNames));
+  names.insert(names.end(), std::begin(kAccelNames), std::end(kAccelNames));
+  if (!temp_c) names.push_back("temp_c");
+  if (require_segment) names.push_back("segment");
+  const bool has_temp = csv_.FindColumn("temp_c").has_value();
+  const std::vector<int> columns = csv_.RequireColumns(
+      names, temp_c || has_temp ? "" : "; for a run without a thermometer give its temperature (--temp-c)");
+  time_column_ = columns[0];
+  for (int axis = 0; axis < 3; ++axis) {
+    gyro_columns_[axis] = columns[1 + axis];
+    accel_columns_[axis] = columns[4 + axis];
+  }
   if (!temp_c) {
-    try {
-      temp_column_ = csv_.RequireColumn("temp_c");
-    } catch (const InputError& e) {
-      throw InputError(e.file(), e.line(), e.column(),
-                       e.message() + "; for a run without a thermometer give its temperature (--temp-c)");
-    }
-  } else if (csv_.FindColumn("temp_c")) {
+    temp_column_ = columns[7];
+  } else if (has_temp) {
     throw InputError(csv_.path(),
                      "has a temp_c column: a fixed temperature (--temp-c) is only for samples "
                      "without one (leave it out to use the readings)");
   } else {
     fixed_temp_c_ = *temp_c;
   }
-  for (int axis = 0; axis < 3; ++axis) {
-    gyro_columns_[axis] = csv_.RequireColumn(kGyroNames[axis]);
-    accel_columns_[axis] = csv_.RequireColumn(kAccelNames[axis]);
-  }
   if (require_segment) {
-    segment_column_ = csv_.RequireColumn("segment");
+    segment_column_ = columns.back();
   } else if (const auto column = csv_.FindColumn("segment")) {
     segment_column_ = *column;
   }
 }
 
 bool SamplesReader::Next(Sample* sample) {
-  if (!csv_.NextRow()) return false;
-  sample->time_s = csv_.Number(time_column_);
-  if (!first_ && !(sample->time_s > last_time_s_)) {
+  if (!csv_.NextRow()) {
+    if (rows_ > 1 && rows_ <= kIntervalProbeRows) CheckInterval();
+    return false;
+  }
+  sample->time_s = csv_.Number(time_column_) * seconds_per_time_unit_;
+  if (rows_ > 0 && !(sample->time_s > last_time_s_)) {
     csv_.Fail(time_column_, FormatDouble(sample->time_s) + " s does not increase (the row before has " +
                                 FormatDouble(last_time_s_) + " s)");
   }
-  first_ = false;
+  if (rows_ == 0) first_time_s_ = sample->time_s;
+  ++rows_;
   last_time_s_ = sample->time_s;
-  sample->temp_c = temp_column_ >= 0 ? csv_.Number(temp_column_) : fixed_temp_c_;
+  if (rows_ == kIntervalProbeRows + 1) CheckInterval();
+  if (temp_column_ >= 0) {
+    sample->temp_c = csv_.Number(temp_column_);
+    CheckTemperature(sample->temp_c);
+  } else {
+    sample->temp_c = fixed_temp_c_;
+  }
   for (int axis = 0; axis < 3; ++axis) {
     sample->gyro(axis) = csv_.Number(gyro_columns_[axis]);
     sample->accel(axis) = csv_.Number(accel_columns_[axis]);
@@ -100,6 +126,45 @@ bool SamplesReader::Next(Sample* sample) {
     sample->segment = static_cast<int>(segment);
   }
   return true;
+}
+
+void SamplesReader::CheckTemperature(double temp_c) const {
+  if (temp_c >= kMinPlausibleTempC && temp_c <= kMaxPlausibleTempC) return;
+  std::string message = FormatDouble(temp_c) + " degC is outside " + FormatDouble(kMinPlausibleTempC) + ".." +
+                        FormatDouble(kMaxPlausibleTempC) + " degC, what an IMU can report: ";
+  const double as_kelvin_c = temp_c - kZeroCelsiusK;
+  if (as_kelvin_c >= kMinPlausibleTempC && as_kelvin_c <= kMaxPlausibleTempC) {
+    message += std::string(rows_ == 1 ? "the column is in kelvin?" : "kelvin?") + " (" +
+               FormatDouble(temp_c) + " K is " + FormatDouble(as_kelvin_c) + " degC; temp_c must be degC)";
+  } else if (temp_c == -kZeroCelsiusK) {
+    message += "absolute zero, a logger's fill value for a missing reading? (kelvin? temp_c must be degC)";
+  } else {
+    message += "a fill value or a broken reading? (kelvin? temp_c must be degC)";
+  }
+  csv_.Fail(temp_column_, message);
+}
+
+void SamplesReader::CheckInterval() const {
+  const long long intervals = rows_ - 1;
+  const double interval_s = (last_time_s_ - first_time_s_) / static_cast<double>(intervals);
+  if (interval_s < kMaxSampleIntervalS && interval_s >= kMinSampleIntervalS) return;
+  // The first other unit that makes the interval plausible.
+  constexpr const char* kLongNames[] = {"seconds", "milliseconds", "microseconds", "nanoseconds"};
+  std::string hint = " (is --time-unit right?)";
+  const double as_written = interval_s / seconds_per_time_unit_;
+  for (size_t i = 0; i < std::size(kTimeUnitNames); ++i) {
+    const double candidate = as_written * kTimeUnitNames[i].value;
+    if (kTimeUnitNames[i].value == seconds_per_time_unit_ || candidate >= kMaxSampleIntervalS ||
+        candidate < kMinSampleIntervalS) {
+      continue;
+    }
+    hint = std::string(": time in ") + kLongNames[i] + "? use --time-unit " + kTimeUnitNames[i].name;
+    break;
+  }
+  csv_.Fail(time_column_, "the time steps by " + ShortNumber(interval_s) + " s per sample over the first " +
+                              std::to_string(intervals) + " intervals (" + ShortNumber(1.0 / interval_s) +
+                              " Hz), too " + (interval_s >= kMaxSampleIntervalS ? "slow" : "fast") +
+                              " for an IMU run whose dwells and turns last seconds" + hint);
 }
 
 void SamplesReader::Fail(const std::string& column, const std::string& message) const {

@@ -165,10 +165,10 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
 }
 
 UniformSeries ReadCorrectedSeries(const std::string& path, const Calibration& calibration,
-                                  std::optional<double> temp_c, const std::vector<std::string>& columns,
+                                  const SamplesFormat& format, const std::vector<std::string>& columns,
                                   const UniformSeriesOptions& options, CorrectFileReport* report) {
   CheckTolerance(path, options);
-  SamplesReader reader(path, /*require_segment=*/false, temp_c);
+  SamplesReader reader(path, /*require_segment=*/false, format);
   std::vector<std::string> names = columns;
   if (names.empty()) names.assign(std::begin(kCorrectedNames), std::begin(kCorrectedNames) + kCorrectedRates);
   std::vector<int> indices;

@@ -3,8 +3,10 @@
 #include <type_traits>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/model/enum_names.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
@@ -15,7 +17,24 @@ OptionTable<SamplesInput> MakeSamplesInputOptionTable() {
   t.OptionalNumber("temp_c", "--temp-c",
                    "the temperature of every sample, for samples without a temp_c column (a run without a "
                    "thermometer); a file with the column is refused",
-                   "degC", &SamplesInput::temp_c, OptionRange{}, "column");
+                   "degC", &SamplesInput::temp_c, Between(kMinPlausibleTempC, kMaxPlausibleTempC), "column");
+  OptionEntry<SamplesInput>& time_unit = t.Text(
+      "time_unit", "--time-unit",
+      "the unit of the time_s column: s (default), ms, us or ns (a logger's clock in milliseconds, say); "
+      "read as seconds, a finer unit gives an implausible sample rate and is refused",
+      [](const SamplesInput& in) { return std::string(NameOf(kTimeUnitNames, in.seconds_per_time_unit)); },
+      [](const std::string& text, SamplesInput* in) {
+        if (ValueOf(kTimeUnitNames, text, &in->seconds_per_time_unit)) return std::string();
+        return "time_unit " + QuoteForMessage(text) + " is not one of: " + AllNames(kTimeUnitNames);
+      });
+  // In the fingerprint (another unit reads another run), but a run in seconds keeps the fingerprint
+  // it had before the option existed.
+  time_unit.fingerprint = Fingerprint::kCustom;
+  time_unit.describe = [](const SamplesInput& in) {
+    return in.seconds_per_time_unit == 1.0
+               ? ""
+               : "time_unit=" + std::string(NameOf(kTimeUnitNames, in.seconds_per_time_unit));
+  };
   t.Include(SegmentationOptionTable(), &SamplesInput::segmentation);
   return t;
 }

@@ -38,7 +38,7 @@ void ReadSamples(const Plan& plan, Reader* reader, Labeller* labeller, WindowBui
 RunReader::RunReader(const Plan& plan, std::string samples_path, const SamplesInput& input)
     : plan_(plan),
       input_(input),
-      first_pass_(std::move(samples_path), /*require_segment=*/false, input.temp_c, &digest_) {}
+      first_pass_(std::move(samples_path), /*require_segment=*/false, input.Format(), &digest_) {}
 
 RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretch) {
   IMUFIT_CHECK(!read_, "RunReader::Read() reads the file once");
@@ -50,7 +50,7 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
   if (!first_pass_.has_segment()) {
     run.segmentation = SegmentSamples(plan_, &first_pass_, input_);
     labeller.emplace(*run.segmentation);
-    second_pass.emplace(first_pass_.path(), /*require_segment=*/false, input_.temp_c);
+    second_pass.emplace(first_pass_.path(), /*require_segment=*/false, input_.Format());
   }
   WindowBuilder builder(options, plan_.segments);
   std::optional<LongestStaticStretch> stretch;

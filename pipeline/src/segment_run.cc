@@ -20,7 +20,8 @@ std::optional<double> TempToRead(const std::string& samples_path, const SamplesI
 
 Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path,
                                 const SamplesInput& input) {
-  SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
+  SamplesReader reader(samples_path, /*require_segment=*/false,
+                       SamplesFormat{TempToRead(samples_path, input), input.seconds_per_time_unit});
   return SegmentSamples(plan, &reader, input);
 }
 
@@ -38,7 +39,8 @@ Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const Sampl
 
 LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
                                         const std::string& output_path, const SamplesInput& input) {
-  SamplesReader reader(samples_path, /*require_segment=*/false, TempToRead(samples_path, input));
+  SamplesReader reader(samples_path, /*require_segment=*/false,
+                       SamplesFormat{TempToRead(samples_path, input), input.seconds_per_time_unit});
   SamplesWriter writer(output_path, SampleColumns{true, reader.has_temp() || input.temp_c.has_value()},
                        SerialComment(reader.serial(), samples_path));
   LabelledFileReport report;

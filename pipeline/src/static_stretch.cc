@@ -42,7 +42,7 @@ StaticStretch LongestStaticStretch::Finish() {
 
 StaticStretch ReadStaticStretch(const Plan& plan, const std::string& samples_path, const SamplesInput& input,
                                 const std::optional<Segmentation>& segmentation) {
-  SamplesReader reader(samples_path, /*require_segment=*/false, input.temp_c);
+  SamplesReader reader(samples_path, /*require_segment=*/false, input.Format());
   std::optional<Labeller> labeller;
   if (!reader.has_segment()) {
     labeller.emplace(segmentation ? *segmentation : SegmentSamplesFile(plan, samples_path, input));

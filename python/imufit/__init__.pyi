@@ -187,6 +187,7 @@ class _FitOptions(TypedDict, total=False):
     gyro_full_scale_raw: float  # raw
     accel_full_scale_raw: float  # raw
     temp_c: float | None  # degC, for a run without a temp_c column
+    time_unit: str  # the unit of the time_s column: "s" (default), "ms", "us" or "ns"
     segment_window_s: float  # s; this and the next six: finding the segments of a run without a segment column
     segment_noise_quantile: float
     segment_threshold_factor: float

@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "imufit/io/calibration.h"
 #include "imufit/io/samples.h"
@@ -39,16 +40,30 @@ struct CorrectFileReport {
   double max_temp_c = 0.0;
 };
 
-// Reads every sample of `reader`, corrects it and calls `sink` with the corrected sample (time_s,
-// temp_c and segment as read). Throws InputError, located at the row, when a correction is not a
-// finite number (a temperature far outside the fit range overflows the polynomials).
+// A corrected file says what corrected it, in a header line (without the '#'):
+//   corrected by: serial SN0001, calibration sha256 3f2a...e1, software imufit 0.1.0 (git abc123)
+// and such a file is never corrected again (its numbers are rad/s and m/s^2, not raw).
+inline constexpr std::string_view kCorrectedByKey = "corrected by:";
+// That line for `calibration` (whose file has the SHA-256 `calibration_sha256`), corrected by
+// `software`.
+std::string CorrectedByComment(const Calibration& calibration, const std::string& calibration_sha256,
+                               const std::string& software);
+// Throws std::runtime_error (exit status 1) naming the file, its line and what corrected it when
+// the header of `reader` has a `corrected by:` line.
+void RefuseCorrectedSamples(const SamplesReader& reader);
+
+// Reads every sample of `reader` (refused by RefuseCorrectedSamples first), corrects it and calls `sink` with
+// the corrected sample (time_s, temp_c and segment as read). Throws InputError, located at the row, when a
+// correction is not a finite number (a temperature far outside the fit range overflows the polynomials).
 CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
                                  const std::function<void(const Sample& corrected)>& sink);
 
-// `temp_c`: the temperature of every sample of a file without a temp_c column (written to the output).
+// `format`: how the samples are read (a fixed temperature is written to the output; times are
+// written in seconds). `corrected_by` (CorrectedByComment), when not empty, is written into the
+// output's header.
 CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::string& samples_path,
-                                     const std::string& output_path,
-                                     std::optional<double> temp_c = std::nullopt);
+                                     const std::string& output_path, const SamplesFormat& format = {},
+                                     const std::string& corrected_by = "");
 
 }  // namespace imufit
 

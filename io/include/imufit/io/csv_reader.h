@@ -59,10 +59,16 @@ class CsvReader {
     std::string text;
   };
   const std::vector<Comment>& header_comments() const { return header_comments_; }
-  // The index of the column called `name`, if there is one.
+  // The index of the column called `name`, if there is one: the column of that exact name, else the
+  // one column whose name differs from it in case only (a logger's "Time_S").
   std::optional<int> FindColumn(std::string_view name) const;
   // The index of the column called `name`; throws InputError naming the header line if absent.
   int RequireColumn(std::string_view name) const;
+  // The indices of the columns called `names`, in order; when any is absent, throws one InputError
+  // at the header line naming every absent one, with a "did you mean" for a near name, and the
+  // delimiter when the header is not separated by commas (a spreadsheet's ';' export). `hint`, when
+  // not empty, is added to the message.
+  std::vector<int> RequireColumns(const std::vector<std::string>& names, const std::string& hint = "") const;
 
   // Advances to the next data row (skipping comments and blank lines); false at the end.
   bool NextRow();

@@ -51,6 +51,7 @@ class ParallelSamplesReader {
   std::unique_ptr<Block> current_;
   size_t next_ = 0;  // the next sample of current_
   bool end_of_file_ = false;
+  bool launched_ = false;  // a block was launched: the next is not the file's first
   std::optional<double> last_time_s_;
   long line_ = 0;
 };

@@ -19,6 +19,35 @@
 
 namespace imufit {
 
+// The units a time_s column may be written in (--time-unit, model/enum_names.h), as seconds per
+// unit: loggers write seconds, milliseconds, microseconds or nanoseconds.
+struct TimeUnitName {
+  double value;
+  const char* name;
+};
+inline constexpr TimeUnitName kTimeUnitNames[] = {{1.0, "s"}, {1e-3, "ms"}, {1e-6, "us"}, {1e-9, "ns"}};
+
+// What an IMU log can plausibly hold (docs/conventions.md). A calibration plan dwells and turns
+// for seconds, so its samples come faster than one a second: a slower time column is one in
+// milliseconds or finer read as seconds. Faster than a megahertz is the opposite mistake.
+inline constexpr double kMaxSampleIntervalS = 1.0;  // refused from here on (1 Hz or slower)
+inline constexpr double kMinSampleIntervalS = 1e-6;
+// The rows whose mean interval is judged (fewer in a shorter file).
+inline constexpr int kIntervalProbeRows = 16;
+// A temperature an IMU can report, degC (a kelvin column, 233..358, or a fill value lies outside).
+inline constexpr double kMinPlausibleTempC = -100.0;
+inline constexpr double kMaxPlausibleTempC = 200.0;
+inline constexpr double kZeroCelsiusK = 273.15;
+
+// How a samples file is read beyond its column names: what a command's options say about it.
+struct SamplesFormat {
+  // The temperature of every sample of a file without a temp_c column (a file with one is then
+  // refused, so that no reading is silently replaced).
+  std::optional<double> temp_c;
+  // Seconds per unit of the time_s column (kTimeUnitNames): times are read as seconds times this.
+  double seconds_per_time_unit = 1.0;
+};
+
 // The serial of a samples header and where it is stated (its first `# serial:` line, at the text
 // after "serial:"), so that a contradiction can be reported at its place (pipeline/unit_serial.h).
 struct SamplesSerial {
@@ -30,20 +59,21 @@ struct SamplesSerial {
 class SamplesReader {
  public:
   // Opens a samples file; `require_segment` makes the segment column mandatory (imufit fit).
-  // `temp_c`, when given, is the temperature of every sample of a file without a temp_c column
-  // (a run without a thermometer); a file that has the column is then refused, so that no reading
-  // is silently replaced. Throws InputError naming the missing column. `raw_digest`, when not
-  // null, hashes the file as it is read (CsvReader).
-  SamplesReader(std::string path, bool require_segment, std::optional<double> temp_c = std::nullopt,
+  // `format` says how it is read (SamplesFormat). Throws InputError naming the missing column.
+  // `raw_digest`, when not null, hashes the file as it is read (CsvReader).
+  SamplesReader(std::string path, bool require_segment, const SamplesFormat& format = {},
                 Sha256* raw_digest = nullptr);
 
   // Reads `rows`, lines of the file of `header_of` after its line `line_before`, with its header
-  // and columns; `last_time_s`, when given, is the time of the row before (ParallelSamplesReader).
+  // and columns; `last_time_s`, when given, is the time of the row before; `probe_interval` judges
+  // the sample interval over its first rows, as Next() does at a file's start (ParallelSamplesReader).
   SamplesReader(const SamplesReader& header_of, std::string_view rows, long line_before,
-                std::optional<double> last_time_s = std::nullopt);
+                std::optional<double> last_time_s = std::nullopt, bool probe_interval = false);
 
   // Reads the next sample; false at the end. Throws InputError on a bad value, a time that does
-  // not increase, or a segment id below -1.
+  // not increase, a segment id below -1, a temperature outside kMin..kMaxPlausibleTempC (with a
+  // "kelvin?" hint), or a sample interval outside kMin..kMaxSampleIntervalS over the first
+  // kIntervalProbeRows rows (with a --time-unit hint).
   bool Next(Sample* sample);
 
   bool has_segment() const { return segment_column_ >= 0; }
@@ -52,6 +82,8 @@ class SamplesReader {
   // The same with its place in the header (LocateSamplesSerial).
   const SamplesSerial& located_serial() const { return serial_; }
   bool has_temp() const { return temp_column_ >= 0; }
+  // The comment lines before the column names (CsvReader::header_comments()).
+  const std::vector<CsvReader::Comment>& header_comments() const { return csv_.header_comments(); }
   // Throws an InputError located at the current row and the column called `column`.
   [[noreturn]] void Fail(const std::string& column, const std::string& message) const;
   const std::string& path() const { return csv_.path(); }
@@ -60,7 +92,11 @@ class SamplesReader {
 
  private:
   friend class ParallelSamplesReader;  // reads the file's blocks (parallel_samples.h)
+  void CheckTemperature(double temp_c) const;
+  void CheckInterval() const;
+
   CsvReader csv_;
+  double seconds_per_time_unit_ = 1.0;
   int time_column_;
   int temp_column_ = -1;
   double fixed_temp_c_ = 0.0;  // without a temp_c column
@@ -68,7 +104,8 @@ class SamplesReader {
   SamplesSerial serial_;
   int gyro_columns_[3];
   int accel_columns_[3];
-  bool first_ = true;
+  long long rows_ = 0;
+  double first_time_s_ = 0.0;
   double last_time_s_ = 0.0;
 };
 

@@ -51,11 +51,11 @@ UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::
 // The same series of a raw samples file corrected through `calibration` first, sample by sample
 // with CorrectSamples (correct_file.h): the values are those `imufit apply` writes, bit for bit.
 // `columns` are among gyro_x..z (rad/s), accel_x..z (m/s^2) and temp_c (when empty: the six
-// rates); `temp_c` is the temperature of a file without a temp_c column, as for SamplesReader.
+// rates); `format` says how the samples are read, as for SamplesReader (times in seconds).
 // `report` receives the correction's counts (samples outside the fit temperature range).
 // Throws InputError as ReadUniformSeries does, and for a column the calibration does not correct.
 UniformSeries ReadCorrectedSeries(const std::string& path, const Calibration& calibration,
-                                  std::optional<double> temp_c, const std::vector<std::string>& columns,
+                                  const SamplesFormat& format, const std::vector<std::string>& columns,
                                   const UniformSeriesOptions& options, CorrectFileReport* report);
 
 }  // namespace imufit

@@ -18,11 +18,15 @@ struct SamplesInput {
   // The temperature of every sample, degC, for a file without a temp_c column (a file with one is
   // then refused).
   std::optional<double> temp_c;
+  // Seconds per unit of the time_s column (--time-unit: kTimeUnitNames).
+  double seconds_per_time_unit = 1.0;
   // How the segments are found in a file without a segment column.
   SegmentationOptions segmentation;
 
   // An empty string when usable, else what is wrong (naming the option and its value).
   std::string Validate() const;
+  // How SamplesReader reads the file.
+  SamplesFormat Format() const { return {temp_c, seconds_per_time_unit}; }
 };
 
 // Every option of SamplesInput, described once (model/option_table.h; run_options.cc).

@@ -1,0 +1,273 @@
+// End-to-end tests of how samples files are read as a station writes them: the unit of the time
+// column (--time-unit, and the sample interval judged against what a plan needs), temperatures an
+// IMU cannot report (kelvin, fill values), and the calibration of the right unit.
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli_util.h"
+
+namespace imufit::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+// `text` (a CSV with '#' comments) with the field `column` of every data row replaced by
+// `change(field, data row index)`.
+std::string MapColumn(const std::string& text, const std::string& column,
+                      const std::function<std::string(const std::string&, int)>& change) {
+  std::istringstream lines(text);
+  std::string line;
+  std::string out;
+  int index = -1;
+  int row = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] == '#') {
+      out += line + "\n";
+      continue;
+    }
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    std::string field;
+    while (std::getline(split, field, ',')) fields.push_back(field);
+    if (index < 0) {
+      index = static_cast<int>(std::find(fields.begin(), fields.end(), column) - fields.begin());
+    } else {
+      fields[index] = change(fields[index], row++);
+    }
+    for (size_t i = 0; i < fields.size(); ++i) out += (i ? "," : "") + fields[i];
+    out += "\n";
+  }
+  return out;
+}
+
+std::string Scaled(const std::string& field, double factor) {
+  std::ostringstream text;
+  text.precision(17);
+  text << std::stod(field) * factor;
+  return text.str();
+}
+
+// One line on stderr, and it holds `expected`.
+void ExpectOneLine(const RunResult& r, const std::string& expected) {
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+class CliInputTest : public CliTest {
+ protected:
+  // A small labelled run in seconds (raw.csv), as SmallRunArgs makes it.
+  std::string RawRun() {
+    const std::string raw = Path("raw.csv");
+    const RunResult r = Run(SmallRunArgs(raw, {}));
+    EXPECT_EQ(r.status, 0) << r.err;
+    return raw;
+  }
+  // The SHA-256 of a file as coreutils' sha256sum gives it (not imufit's own code).
+  std::string Sha256OfFileForTest(const std::string& path) const {
+    const RunResult r = RunProgram("/usr/bin/sha256sum", {path});
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r.out.substr(0, 64);
+  }
+  RunResult Fit(const std::string& samples, const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args = {"fit",   "-p", Fixture("plan_6pos.yaml"), "-s",
+                                     samples, "-o", Path("cal.yaml"),          "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Run(args);
+  }
+};
+
+// Time stamps in milliseconds or nanoseconds read as seconds give a sample rate no calibration
+// run has: refused with the unit to give; given, the run reads as the one in seconds.
+TEST_F(CliInputTest, TimeInMillisecondsOrNanosecondsIsRefusedWithTheUnitToGive) {
+  const std::string text = ReadBytes(RawRun());
+  struct Case {
+    const char* unit;
+    double factor;
+    const char* hint;
+  };
+  for (const Case& c : {Case{"ms", 1e3, "time in milliseconds? use --time-unit ms"},
+                        Case{"ns", 1e9, "time in nanoseconds? use --time-unit ns"}}) {
+    SCOPED_TRACE(c.unit);
+    const std::string file =
+        Write(std::string("raw_") + c.unit + ".csv",
+              MapColumn(text, "time_s", [&](const std::string& f, int) { return Scaled(f, c.factor); }));
+    for (const std::string command : {"fit", "apply", "segment"}) {
+      RunResult r;
+      if (command == "fit") r = Fit(file);
+      if (command == "apply") {
+        r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", file, "-o", Path("cal.yaml")});
+      }
+      if (command == "segment") {
+        r = Run({"segment", "-p", Fixture("plan_6pos.yaml"), "-s", file, "-o", Path("cal.yaml")});
+      }
+      EXPECT_EQ(r.status, 2) << command;
+      ExpectOneLine(r, c.hint);
+      EXPECT_NE(r.err.find("too slow for an IMU run"), std::string::npos) << r.err;
+      EXPECT_FALSE(fs::exists(Path("cal.yaml"))) << command;
+    }
+    const RunResult fitted = Fit(file, {"--time-unit", c.unit});
+    EXPECT_EQ(fitted.status, 0) << fitted.err;
+    fs::remove(Path("cal.yaml"));
+    // Applied with the unit, the times come out in seconds, as the run in seconds gives them.
+    ASSERT_EQ(Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", file, "-o", Path("a.csv"), "--time-unit",
+                   c.unit})
+                  .status,
+              0);
+    ASSERT_EQ(
+        Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Path("raw.csv"), "-o", Path("b.csv")}).status,
+        0);
+    const Table a = ReadTable(Path("a.csv"));
+    const Table b = ReadTable(Path("b.csv"));
+    ASSERT_EQ(a.rows.size(), b.rows.size());
+    for (size_t i = 0; i < a.rows.size(); i += 97) {
+      EXPECT_NEAR(a.Number(i, "time_s"), b.Number(i, "time_s"), 1e-9);
+      EXPECT_EQ(a.Vector(i, "gyro"), b.Vector(i, "gyro"));
+    }
+    fs::remove(Path("a.csv"));
+  }
+  const RunResult bad = Fit(Path("raw.csv"), {"--time-unit", "min"});
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_NE(bad.err.find("is not one of: s, ms, us, ns"), std::string::npos) << bad.err;
+  // The correct run is unchanged.
+  EXPECT_EQ(Fit(Path("raw.csv")).status, 0);
+}
+
+// Temperatures no IMU reports are refused where they stand: a kelvin column at its first row, a
+// fill value at its own row.
+TEST_F(CliInputTest, TemperaturesOutsideWhatAnImuReportsAreRefusedAtTheirRow) {
+  const std::string text = ReadBytes(RawRun());
+  const auto header_line = [&text]() {
+    std::istringstream lines(text);
+    std::string line;
+    int n = 0;
+    while (std::getline(lines, line)) {
+      ++n;
+      if (!line.empty() && line[0] != '#') return n;
+    }
+    return 0;
+  };
+  const int first_row_line = header_line() + 1;
+  struct Case {
+    const char* name;
+    std::function<std::string(const std::string&, int)> change;
+    int row;
+    const char* expected;
+  };
+  const std::vector<Case> cases = {
+      {"kelvin",
+       [](const std::string& f, int) {
+         std::ostringstream out;
+         out.precision(17);
+         out << std::stod(f) + 273.15;
+         return out.str();
+       },
+       0, "the column is in kelvin? ("},
+      {"absolute zero", [](const std::string& f, int row) { return row == 500 ? "-273.15" : f; }, 500,
+       "-273.15 degC is outside -100..200 degC, what an IMU can report: absolute zero, a logger's fill "
+       "value"},
+      {"1e6", [](const std::string& f, int row) { return row == 700 ? "1e6" : f; }, 700,
+       "1e+06 degC is outside -100..200 degC, what an IMU can report: a fill value or a broken reading?"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string file = Write("t.csv", MapColumn(text, "temp_c", c.change));
+    for (const bool apply : {false, true}) {
+      const RunResult r =
+          apply ? Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", file, "-o", Path("cal.yaml")})
+                : Fit(file);
+      EXPECT_EQ(r.status, 2);
+      const std::string place = "t.csv:" + std::to_string(first_row_line + c.row) + ":2: temp_c: ";
+      ExpectOneLine(r, place);
+      EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+      EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+    }
+  }
+  // A fixed temperature is judged the same way.
+  const RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Path("raw.csv"), "-o",
+                           Path("x.csv"), "--temp-c", "298"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(fs::exists(Path("x.csv")));
+}
+
+// apply and allan --calibration correct a unit's log only with that unit's calibration; the
+// corrected file says what corrected it and is never corrected again.
+TEST_F(CliInputTest, ApplyAndAllanCorrectOnlyWithTheUnitsOwnCalibration) {
+  const std::string cal = Fixture("mems_truth.yaml");  // serial MEMS-TRUTH-0001
+  ASSERT_EQ(Run(SmallRunArgs(Path("other.csv"), {"--serial", "SN-2"})).status, 0);
+  ASSERT_EQ(Run(SmallRunArgs(Path("own.csv"), {"--serial", "MEMS-TRUTH-0001"})).status, 0);
+  const std::string refused = "names the unit \"SN-2\", the calibration " + cal +
+                              " names it \"MEMS-TRUTH-0001\": are these that unit's samples?";
+  RunResult r = Run({"apply", "-c", cal, "-s", Path("other.csv"), "-o", Path("out.csv")});
+  EXPECT_EQ(r.status, 2);
+  ExpectOneLine(r, "other.csv:2:11: the samples header of " + Path("other.csv") + " " + refused);
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  r = Run(
+      {"allan", "-s", Path("other.csv"), "--calibration", cal, "-c", "gyro_x", "-o", Path("out.csv"), "-q"});
+  EXPECT_EQ(r.status, 2);
+  ExpectOneLine(r, refused);
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // --allow-mismatch corrects it, with a warning.
+  r = Run({"apply", "-c", cal, "-s", Path("other.csv"), "-o", Path("out.csv"), "--allow-mismatch", "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: the samples header of"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(allowed with --allow-mismatch)"), std::string::npos) << r.err;
+  // The unit's own calibration: the output names the log's serial and what corrected it.
+  r = Run({"apply", "-c", cal, "-s", Path("own.csv"), "-o", Path("own_corrected.csv"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const std::string corrected = ReadBytes(Path("own_corrected.csv"));
+  EXPECT_NE(corrected.find("# serial: MEMS-TRUTH-0001\n# corrected by: serial MEMS-TRUTH-0001, calibration "
+                           "sha256 " +
+                           Sha256OfFileForTest(cal) + ", software imufit "),
+            std::string::npos)
+      << corrected.substr(0, 300);
+  // A corrected file is not corrected again: exit 1, naming the line.
+  for (const bool allan : {false, true}) {
+    r = allan ? Run({"allan", "-s", Path("own_corrected.csv"), "--calibration", cal, "-c", "gyro_x", "-o",
+                     Path("again.csv"), "-q"})
+              : Run({"apply", "-c", cal, "-s", Path("own_corrected.csv"), "-o", Path("again.csv")});
+    EXPECT_EQ(r.status, 1);
+    ExpectOneLine(r, "own_corrected.csv:2: is corrected already (corrected by: serial MEMS-TRUTH-0001");
+    EXPECT_FALSE(fs::exists(Path("again.csv")));
+  }
+}
+
+// A header as a spreadsheet or another logger writes it: named columns matched without regard to
+// case, every absent one named at once with a near name, a ';' export said to be one, "+1" read as 1.
+TEST_F(CliInputTest, HeadersAsSpreadsheetsAndLoggersWriteThem) {
+  const std::string cal = Fixture("mems_truth.yaml");
+  const std::string rows = "0,25,+1,23,-41,12,35,-18,2100\n0.01,25,+1,24,-42,13,36,-19,2101\n";
+  // Case: read as the lower-case names; "+1" is segment 1.
+  Write("upper.csv", "Time_S,TEMP_C,Segment,Gyro_X,Gyro_Y,Gyro_Z,Accel_X,Accel_Y,Accel_Z\n" + rows);
+  RunResult r = Run({"apply", "-c", cal, "-s", Path("upper.csv"), "-o", Path("out.csv"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(ReadTable(Path("out.csv")).rows.at(1).at(2), "1");
+  // Every absent column at once, with the near names.
+  Write("near.csv", "time,temp_c,segment,gyro x,gyro_y,gyro_z,accel_x,accel_y,acc_z\n" + rows);
+  r = Run({"apply", "-c", cal, "-s", Path("near.csv"), "-o", Path("out2.csv")});
+  EXPECT_EQ(r.status, 2);
+  ExpectOneLine(r,
+                "near.csv:1: no columns \"time_s\", \"gyro_x\" and \"accel_z\" in the header (it has: "
+                "time,temp_c,segment,gyro x,gyro_y,gyro_z,accel_x,accel_y,acc_z); did you mean \"time\" for "
+                "\"time_s\", \"gyro x\" for \"gyro_x\", \"acc_z\" for \"accel_z\"");
+  EXPECT_FALSE(fs::exists(Path("out2.csv")));
+  // A German-locale export: ';' between fields, decimal commas, CRLF.
+  Write("de.csv",
+        "time_s;temp_c;segment;gyro_x;gyro_y;gyro_z;accel_x;accel_y;accel_z\r\n0;25,5;1;23;-41;12;35;-18;"
+        "2100\r\n");
+  r = Run({"apply", "-c", cal, "-s", Path("de.csv"), "-o", Path("out2.csv")});
+  EXPECT_EQ(r.status, 2);
+  ExpectOneLine(r,
+                "de.csv:1: the header is separated by ';', not commas (a spreadsheet's export in a locale "
+                "with a decimal comma?)");
+  EXPECT_FALSE(fs::exists(Path("out2.csv")));
+}
+
+}  // namespace
+}  // namespace imufit::testing
