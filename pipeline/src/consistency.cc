@@ -17,8 +17,9 @@ std::string Format(const char* format, double value) {
   return text;
 }
 
-std::string Chi2Finding(const char* sensor, double reduced_chi2, int dof) {
-  if (dof <= 0 || !(reduced_chi2 > ReducedChi2Limit(dof))) return "";
+// A sensor held whole (SensorFit::kNone) was not fitted: its chi-square measures the held values.
+std::string Chi2Finding(const char* sensor, SensorFit fitted, double reduced_chi2, int dof) {
+  if (fitted == SensorFit::kNone || dof <= 0 || !(reduced_chi2 > ReducedChi2Limit(dof))) return "";
   return std::string(sensor) + " reduced chi-square " + Format("%.3g", reduced_chi2) + " (at most " +
          Format("%.3g", ReducedChi2Limit(dof)) + " for the noise and model error of " + std::to_string(dof) +
          " degrees of freedom)";
@@ -82,8 +83,9 @@ double ReducedChi2Limit(int dof) {
 std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows) {
   std::string text;
   for (const std::string& finding :
-       {Chi2Finding("gyro", fit.gyro_reduced_chi2, fit.gyro_dof),
-        Chi2Finding("accel", fit.accel_reduced_chi2, fit.accel_dof), DownweightedSegments(fit, windows)}) {
+       {Chi2Finding("gyro", fit.gyro_fit, fit.gyro_reduced_chi2, fit.gyro_dof),
+        Chi2Finding("accel", fit.accel_fit, fit.accel_reduced_chi2, fit.accel_dof),
+        DownweightedSegments(fit, windows)}) {
     if (!finding.empty()) text += (text.empty() ? "" : "; ") + finding;
   }
   if (text.empty()) return text;

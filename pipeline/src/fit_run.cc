@@ -83,20 +83,23 @@ Calibration MakeCalibration(const FitRunResult& result, const FitRunOptions& opt
   return calibration;
 }
 
-// Before any work: every raw channel live, then the controller's labels against the plan (an
-// unlabelled log was matched to it while it was labelled). Throws PlanMismatchError.
+// Before any work: the controller's labels against the plan (an unlabelled log was matched to it
+// while it was labelled), then every raw channel live (a dead or railed channel does not upset the
+// label check: a zero or constant row of K fits it; mislabelled windows would upset this one).
+// Throws PlanMismatchError.
 void CheckBeforeFit(const std::string& plan_path, const std::string& samples_path,
                     const FitRunOptions& options, const FitRunResult& result) {
+  if (!result.run.segmentation) {
+    const std::string disagreement = CheckLabels(result.run.windows, result.plan.site, result.plan.segments,
+                                                 options.fit.gyro_temp_order, options.fit.accel_temp_order);
+    if (!disagreement.empty()) {
+      throw PlanMismatchError(samples_path + ": the labelled log does not match the plan " + plan_path +
+                              ": " + disagreement);
+    }
+  }
   const std::string dead = CheckChannels(result.run.windows, result.run.stats, result.plan.site,
                                          result.plan.segments, options.windows);
   if (!dead.empty()) throw PlanMismatchError(samples_path + ": " + dead);
-  if (result.run.segmentation) return;
-  const std::string disagreement = CheckLabels(result.run.windows, result.plan.site, result.plan.segments,
-                                               options.fit.gyro_temp_order, options.fit.accel_temp_order);
-  if (!disagreement.empty()) {
-    throw PlanMismatchError(samples_path + ": the labelled log does not match the plan " + plan_path + ": " +
-                            disagreement);
-  }
 }
 
 }  // namespace

@@ -17,6 +17,9 @@ std::string Format(const char* format, double value) {
   return text;
 }
 
+// A gyro axis is judged only when the plan turns the table about it at least this fast, rad/s.
+constexpr double kMinDrivingRateRadps = 0.1;
+
 const char* ChannelName(int channel) {
   static const char* const kNames[6] = {"gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"};
   return kNames[channel];
@@ -95,7 +98,8 @@ std::string Unresponsive(int channel, const std::vector<Window>& windows, const 
     ++group.count;
     group.segments.insert(w->segment);
   }
-  if (plus.count == 0 || minus.count == 0) return "";
+  // The Earth rate alone (a static-only plan) drives no gyro measurably.
+  if (plus.count == 0 || minus.count == 0 || (gyro && largest < kMinDrivingRateRadps)) return "";
   const double response = std::abs(plus.Mean() - minus.Mean());
   if (response > kResponseSigmas * (plus.Scatter() + minus.Scatter())) return "";
   std::set<int> ids = plus.segments;

@@ -20,6 +20,9 @@ constexpr double kMinSpread = 0.05;
 // A measurement is "along" a planned vector within this angle, deg, and "of its size" within this fraction.
 constexpr double kSameDirectionDeg = 15.0;
 constexpr double kSameSize = 0.1;
+// A gyro whose planned truths are all below this (a static-only plan: the Earth rate at most) is
+// not checked, rad/s: the fit does not determine its scale either (the coverage check's 0.1 rad/s).
+constexpr double kMinGyroTruthRadps = 0.1;
 // More distinct temperatures than this are given as a range.
 constexpr size_t kTemperaturesListed = 6;
 
@@ -179,6 +182,7 @@ struct Finding {
 std::vector<Finding> CheckSensor(const Sensor& sensor) {
   std::vector<Finding> findings;
   if (sensor.rows.empty() || !Determined(sensor, {})) return findings;
+  if (sensor.gyro && sensor.max_truth < kMinGyroTruthRadps) return findings;
   std::set<int> excluded;
   Model model = FitModel(sensor, excluded);
   std::set<int> ids;
