@@ -159,7 +159,8 @@ int ReportUndetermined(const FitArguments& args, const FitRunOptions& options, c
 void PrintFit(const FitRunOptions& options, const FitRunResult& result) {
   const FitSummary& fit = result.fit;
   const WindowStats& stats = result.run.stats;
-  std::printf("imufit fit: %s\n", fit.BriefReport().c_str());
+  std::printf("imufit fit: %s%s\n", fit.BriefReport().c_str(),
+              result.inconsistency.empty() ? "" : " INCONSISTENT (written with --write-inconsistent)");
   std::printf(
       "  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
       stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
@@ -258,6 +259,11 @@ int RunFit(const FitArguments& args) {
   const FitRunResult& result = *unit.fit;
   for (const std::string& warning : result.serial_warnings) {
     std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  }
+  if (!result.inconsistency.empty()) {
+    std::fprintf(stderr,
+                 "imufit: warning: the fit is inconsistent with the run's noise: %s; written anyway\n",
+                 result.inconsistency.c_str());
   }
   if (!args.quiet) PrintRunNotes(options, result);
   if (result.fit.status == FitStatus::kUndetermined) return ReportUndetermined(args, options, result);

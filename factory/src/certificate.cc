@@ -120,6 +120,11 @@ void Identify(const CertificateSources& sources, Certificate* c) {
         "no serial: neither --serial, the calibration, the samples file's '# serial:' header line nor the "
         "plan names the unit");
   }
+  if (cal.fit && cal.fit->inconsistent) {
+    c->warnings.push_back(
+        "written with --write-inconsistent: the fit is inconsistent with the run's noise: " +
+        *cal.fit->inconsistent);
+  }
   for (const std::string& w : sources.warnings) c->warnings.push_back(w);
   c->station = sources.station;
   if (c->station) StationWarnings(*c->station, c->calibrated_utc, c->written_utc, &c->warnings);

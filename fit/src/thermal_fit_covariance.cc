@@ -104,6 +104,7 @@ void SensorResiduals(const FitOptions& options, const ceres::Problem& problem, c
   const double reduced_chi2 = rows > free_parameters ? chi2 / (rows - free_parameters) : 1.0;
   (sensor.is_gyro ? summary->gyro_rms_radps : summary->accel_rms_mps2) = rms;
   (sensor.is_gyro ? summary->gyro_reduced_chi2 : summary->accel_reduced_chi2) = reduced_chi2;
+  (sensor.is_gyro ? summary->gyro_dof : summary->accel_dof) = std::max(rows - free_parameters, 0);
 }
 
 // One sensor's covariance of q: Ceres's (null when it could not be computed, or for a sensor held

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/SVD>
+#include <glog/logging.h>
 
 #include "imufit/fit/window_cost.h"
 #include "imufit/model/check.h"
@@ -22,10 +23,25 @@ constexpr double kMinRobustSpread = 1.0;
 // A direction of the Jacobian names the parameters whose share of it is at least this.
 constexpr double kDirectionShare = 0.3;
 
+// The solver's own log (glog: a warning per residual block that does not evaluate, an error on
+// termination) never reaches a terminal or a notebook: what it says comes back through the
+// summary, in the fit's words (CheckConvergence).
+void SilenceSolverLog() {
+  static const bool silenced = [] {
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    FLAGS_logtostderr = false;
+    FLAGS_stderrthreshold = google::GLOG_FATAL;
+    return true;
+  }();
+  static_cast<void>(silenced);
+}
+
 // Both passes solve with the same options: Levenberg-Marquardt on a dense QR (132 parameters at
-// most), tight tolerances (the start is close; the covariance wants the minimum).
+// most), tight tolerances (the start is close; the covariance wants the minimum), silently.
 ceres::Solver::Options SolverOptions(const FitOptions& options) {
+  SilenceSolverLog();
   ceres::Solver::Options solver_options;
+  solver_options.logging_type = ceres::SILENT;
   solver_options.linear_solver_type = ceres::DENSE_QR;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.num_threads = options.num_threads;
@@ -174,6 +190,12 @@ bool CheckConvergence(const ceres::Solver::Summary& last_pass, FitSummary* summa
   summary->termination = last_pass.message;
   if (last_pass.termination_type == ceres::CONVERGENCE) return true;
   summary->status = FitStatus::kNotConverged;
+  if (!std::isfinite(last_pass.final_cost) || last_pass.message.find("evaluation failed") != std::string::npos) {
+    summary->termination =
+        "the model's residuals are not finite numbers: a raw channel that never changes (dead, stuck or at "
+        "its rail) or a non-finite reading leaves a scale factor at zero";
+    return false;
+  }
   summary->termination =
       std::string(ceres::TerminationTypeToString(last_pass.termination_type)) + ": " + last_pass.message;
   return false;

@@ -4,7 +4,10 @@
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/pipeline/consistency.h"
 #include "imufit/pipeline/unit_serial.h"
+#include "imufit/run/channel_check.h"
+#include "imufit/run/label_check.h"
 
 namespace imufit {
 namespace {
@@ -80,6 +83,25 @@ Calibration MakeCalibration(const FitRunResult& result, const FitRunOptions& opt
   return calibration;
 }
 
+// Before any work: the controller's labels against the plan (an unlabelled log was matched to it
+// while it was labelled), then every raw channel live (a dead or railed channel does not upset the
+// label check: a zero or constant row of K fits it; mislabelled windows would upset this one).
+// Throws PlanMismatchError.
+void CheckBeforeFit(const std::string& plan_path, const std::string& samples_path,
+                    const FitRunOptions& options, const FitRunResult& result) {
+  if (!result.run.segmentation) {
+    const std::string disagreement = CheckLabels(result.run.windows, result.plan.site, result.plan.segments,
+                                                 options.fit.gyro_temp_order, options.fit.accel_temp_order);
+    if (!disagreement.empty()) {
+      throw PlanMismatchError(samples_path + ": the labelled log does not match the plan " + plan_path +
+                              ": " + disagreement);
+    }
+  }
+  const std::string dead = CheckChannels(result.run.windows, result.run.stats, result.plan.site,
+                                         result.plan.segments, options.windows);
+  if (!dead.empty()) throw PlanMismatchError(samples_path + ": " + dead);
+}
+
 }  // namespace
 
 FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
@@ -92,6 +114,7 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   result.serial = std::move(serial.serial);
   result.serial_warnings = std::move(serial.warnings);
   result.run = samples.Read(options.windows, options.keep_static_stretch);
+  CheckBeforeFit(plan_path, samples_path, options, result);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   Plan check_plan;
   std::vector<Window> check_windows;
@@ -103,6 +126,14 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
   if (!result.fit.IsSolutionUsable()) return result;
+  result.inconsistency = Inconsistency(result.fit, result.run.windows);
+  if (!result.inconsistency.empty()) {
+    if (!options.write_inconsistent) {
+      throw PlanMismatchError(samples_path + ": the fit is inconsistent with the run's noise: " +
+                              result.inconsistency + " (--write-inconsistent writes it anyway, marked)");
+    }
+    result.record.inconsistent = result.inconsistency;
+  }
   result.record.plan_sha256 = result.plan_sha256;
   result.record.samples_sha256 = result.run.samples_sha256;
   Calibration calibration = MakeCalibration(result, options);

@@ -92,6 +92,17 @@ OptionTable<FitRunOptions> MakeFitRunOptionTable() {
              PathGetter(&O::check_plan), PathSetter(&O::check_plan), /*path=*/true);
   check_plan.fingerprint = Fingerprint::kCustom;  // in `check`
   check_plan.describe = [](const O&) { return std::string(); };
+  // In the fingerprint only when set: a lot fitted before the option existed is not redone.
+  OptionEntry<O>& write_inconsistent =
+      t.Flag("write_inconsistent", "--write-inconsistent",
+             "write the calibration even when the fit is inconsistent with the run's noise (reduced "
+             "chi-square beyond "
+             "noise and model error, or a segment down-weighted at every temperature); it is marked so",
+             &O::write_inconsistent);
+  write_inconsistent.fingerprint = Fingerprint::kCustom;
+  write_inconsistent.describe = [](const O& o) {
+    return o.write_inconsistent ? "write_inconsistent=true" : "";
+  };
   t.Flag("allow_serial_mismatch", "--allow-mismatch",
          "fit even when the stated serial (--serial, a batch unit's serial.txt) names another unit than the "
          "samples header (a warning, also on the certificate); without it such a unit is refused",

@@ -198,6 +198,7 @@ class _FitOptions(TypedDict, total=False):
     validate: bool
     check_samples: PathLike
     check_plan: PathLike
+    write_inconsistent: bool
     allow_serial_mismatch: bool
 
 def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Unpack[_FitOptions]) -> FitResult:

@@ -165,6 +165,9 @@ struct FitSummary {
   // Reduced chi-square of the normalised residuals, per sensor (the covariance scale when above 1).
   double gyro_reduced_chi2 = -1.0;
   double accel_reduced_chi2 = -1.0;
+  // Their degrees of freedom: the rows that weigh fully less the free parameters.
+  int gyro_dof = -1;
+  int accel_dof = -1;
   // The fitted model in powers of dT = T - 25 degC, and the 1-sigma of every parameter.
   SensorModel model;
   SensorModel sigma;

@@ -49,7 +49,8 @@
   X(double, accel_bias_stability_mps2, "the accelerometer bias stability in the sigmas, m/s^2")         \
   X(double, bias_correlation_s, "correlation time of that bias wander, s")                              \
   X(std::vector<int>, segments_without_windows, "plan segments without a single usable window")         \
-  X(int, missing_segments, "how many segments that is")
+  X(int, missing_segments, "how many segments that is")                                                 \
+  X(std::string, inconsistent, "written with --write-inconsistent: why the fit is inconsistent")
 
 // X(type, key, description): the `check:` block, with `imufit fit --check-samples`.
 #define IMUFIT_CHECK_RECORD_FIELDS(X)                                      \

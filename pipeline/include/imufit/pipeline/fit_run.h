@@ -9,7 +9,9 @@
 // InputError; a run that does not determine the model, or a fit that does not converge, is reported
 // through `fit.status` (then `calibration` is not set). A samples file without a segment column is
 // labelled from the plan first (segment_run.h); when it does not match the plan, PlanMismatchError
-// is thrown.
+// is thrown. So it is when a labelled file's labels contradict the plan (run/label_check.h), and
+// when a converged fit is inconsistent with the run's noise (consistency.h) unless
+// FitRunOptions::write_inconsistent.
 #ifndef IMUFIT_PIPELINE_FIT_RUN_H_
 #define IMUFIT_PIPELINE_FIT_RUN_H_
 
@@ -42,6 +44,9 @@ struct FitRunOptions {
   std::string serial;
   // How messages name `serial`: "--serial", or a batch unit's serial.txt.
   std::string serial_source = "--serial";
+  // Write the calibration of a fit the consistency gate refuses (consistency.h), marked as such in
+  // its `fit:` block (`inconsistent`), on the summary and on the certificate (--write-inconsistent).
+  bool write_inconsistent = false;
   // Fit even when `serial` contradicts the samples header's serial (then a warning; --allow-mismatch).
   bool allow_serial_mismatch = false;
   // SHA-256 of the plan file, recorded in the calibration's `fit:` block (with the samples', which
@@ -79,6 +84,9 @@ struct FitRunResult {
   std::string plan_sha256;  // the samples' is run.samples_sha256
   RunWindows run;
   FitSummary fit;
+  // Why the fit is inconsistent (consistency.h): "" when it is not; set only with
+  // FitRunOptions::write_inconsistent (without it FitRun throws PlanMismatchError).
+  std::string inconsistency;
   // The calibration's `fit:` block, also when the fit is not usable (then without the hashes).
   FitRecord record;
   std::vector<HeldOutGroup> folds;         // with options.validate
