@@ -651,7 +651,7 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
        "file is not a database"},
       {read_only, "the results store is read-only"},
       {newer, "results store schema version 7 is not supported"},
-      {refusing, "disk quota; nothing written"}};
+      {refusing, "disk quota: the fit is not recorded in the results store; nothing written"}};
   for (const auto& [store, message] : cases) {
     const RunResult r = run_with(store);
     EXPECT_EQ(r.status, kExitBadInput) << store;
