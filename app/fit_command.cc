@@ -220,18 +220,18 @@ void PrintValidation(const std::vector<HeldOutGroup>& folds) {
 }
 
 // After CertifyUnit: the verdict, the files written, the store. Returns the exit status: 0,
-// kExitFailedLimits, or 2 when the store refused the fit.
+// kExitFailedLimits, or 2 when the store refused the fit (then nothing was written).
 int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool recorded) {
+  if (!recorded) {
+    std::fprintf(stderr, "imufit: %s; nothing written\n", unit.message.c_str());
+    return 2;
+  }
   if (!args.report.empty()) WarnIfNoSerial(unit.fit->calibration->serial, args.samples);
   const bool judged = !unit.verdict.empty();
   if (judged && (!args.quiet || !unit.verdict_detail.pass))
     std::printf("%s", unit.verdict_detail.Table().c_str());
   if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
   if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
-  if (!recorded) {
-    std::fprintf(stderr, "imufit: %s\n", unit.message.c_str());
-    return 2;
-  }
   if (!args.store.empty() && !args.quiet) std::printf("  recorded in %s\n", args.store.c_str());
   return judged && !unit.verdict_detail.pass ? kExitFailedLimits : 0;
 }

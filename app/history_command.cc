@@ -47,7 +47,7 @@ int RunHistory(const HistoryArguments& args) {
                       (!args.serial.empty() && args.trend.empty() ? 1 : 0);
   if (queries != 1)
     throw InputError("imufit history", "give one of --serial S, --lot [NAME], --trend FIGURE [--serial S]");
-  ResultsStore store(args.store);
+  ResultsStore store(args.store, StoreAccess::kRead);
   if (args.lot_given && !args.html.empty()) return WriteLotHistoryPage(args, &store);
   if (args.lot_given) {
     const std::vector<LotYield> yields = store.Yield(args.lot);
@@ -57,9 +57,17 @@ int RunHistory(const HistoryArguments& args) {
       std::printf("%-24s %6s %6s %6s %10s %8s\n", "lot", "units", "passed", "failed", "not fitted", "yield");
     }
     for (const LotYield& y : yields) {
-      const double yield = y.units > 0 ? 100.0 * y.passed / y.units : 0.0;
-      std::printf(args.csv ? "%s,%d,%d,%d,%d,%.2f\n" : "%-24s %6d %6d %6d %10d %7.1f%%\n", y.lot.c_str(),
-                  y.units, y.passed, y.failed, y.not_fitted, yield);
+      // A lot without limits has no verdicts: its yield is not judged (empty in CSV), not 0 %.
+      char yield[32] = "not judged";
+      if (y.passed + y.failed > 0)
+        std::snprintf(yield, sizeof yield, args.csv ? "%.2f" : "%.1f", 100.0 * y.passed / y.units);
+      if (args.csv) {
+        std::printf("%s,%d,%d,%d,%d,%s\n", y.lot.c_str(), y.units, y.passed, y.failed, y.not_fitted,
+                    y.passed + y.failed > 0 ? yield : "");
+      } else {
+        std::printf("%-24s %6d %6d %6d %10d %8s%s\n", y.lot.c_str(), y.units, y.passed, y.failed,
+                    y.not_fitted, yield, y.passed + y.failed > 0 ? "%" : "");
+      }
     }
     if (yields.empty() && !args.csv)
       std::printf("(no lots%s)\n", args.lot.empty() ? "" : (" named " + args.lot).c_str());
@@ -131,8 +139,7 @@ CommandRunner AddHistoryCommand(CLI::App* root) {
                                            "key figure over time (--trend gyro.bias.x, or a figure name such "
                                            "as gyro_bias_dps.x; with --serial, one unit's).");
   command->add_option("store", args->store, "results store (SQLite) written by imufit batch/fit --store")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   command->add_option("--serial", args->serial, "a unit's serial");
   CLI::Option* lot =
       command->add_option("--lot", args->lot, "yield of this lot (no name: of every lot)")->expected(0, 1);

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/io/sha256.h"
@@ -258,6 +259,25 @@ class FactoryCliTest : public testing::TempDirTest {
   }
 };
 
+// Runs `sql` on the SQLite database at `path` (the test's own change to a store).
+void ExecuteSql(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
+// The files in `folder` whose names contain ".tmp-" (an output never committed).
+std::vector<std::string> Temporaries(const fs::path& folder) {
+  std::vector<std::string> found;
+  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos) found.push_back(entry.path());
+  }
+  return found;
+}
+
 TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   std::vector<std::string> args = BatchArgs("out");
   args.insert(args.end(), {"--jobs", "2"});
@@ -464,6 +484,91 @@ TEST_F(FactoryCliTest, KilledBatchResumesWithoutLoss) {
   }
 }
 
+// Ctrl-C during a batch: the batch says how far it got, every unit folder is complete (calibration,
+// certificate and manifest together) or holds no calibration, and the same command finishes the lot.
+TEST_F(FactoryCliTest, InterruptedBatchSaysSoAndLeavesNoHalfUnit) {
+  std::vector<std::string> storage = {IMUFIT_EXE};
+  for (const std::string& a : BatchArgs("out")) storage.push_back(a);
+  storage.insert(storage.end(), {"--jobs", "2", "-q"});
+  std::vector<char*> argv;
+  for (std::string& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, 2, Path("batch.err").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, IMUFIT_EXE, &files, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&files);
+  const fs::path first = dir_ / "out" / "unit-01" / "manifest.yaml";
+  constexpr int kPollLimit = 60000;  // x 1 ms
+  for (int i = 0; i < kPollLimit && !fs::exists(first); ++i) ::usleep(1000);
+  ::kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
+  const std::string err = ReadBytes(Path("batch.err"));
+  EXPECT_TRUE(std::regex_search(err, std::regex("imufit: interrupted: [1-5] of 5 units done; run the same "
+                                                "command again to finish\n")))
+      << err;
+  for (const auto& unit : fs::directory_iterator(dir_ / "out")) {
+    if (!unit.is_directory()) continue;
+    if (fs::exists(unit.path() / "calibration.yaml")) {
+      EXPECT_TRUE(fs::exists(unit.path() / "report.html")) << unit.path();
+      EXPECT_TRUE(fs::exists(unit.path() / "manifest.yaml")) << unit.path();
+    }
+  }
+  EXPECT_EQ(Temporaries(dir_ / "out"), std::vector<std::string>{});
+  const RunResult r = Run(BatchArgs("out"));
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_EQ(Summary("out").size(), kUnits);
+}
+
+// Two batches create the same new store at once: both wait for each other, neither fails; a batch
+// with another new store records the units it skips as unchanged; without limits the yield is not
+// judged.
+TEST_F(FactoryCliTest, BatchesShareANewStoreAndRecordSkippedUnits) {
+  const auto spawn = [&](const std::string& out) {
+    std::vector<std::string> storage = {IMUFIT_EXE};
+    for (const std::string& a : BatchArgs(out)) storage.push_back(a);
+    storage.insert(storage.end(), {"--jobs", "1", "-q"});
+    std::vector<char*> argv;
+    for (std::string& a : storage) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    posix_spawn_file_actions_addopen(&files, 2, Path(out + ".err").c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    pid_t pid = 0;
+    EXPECT_EQ(posix_spawn(&pid, IMUFIT_EXE, &files, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&files);
+    return pid;
+  };
+  const pid_t a = spawn("out_a"), b = spawn("out_b");
+  for (const auto& [pid, out] : {std::pair{a, "out_a"}, std::pair{b, "out_b"}}) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == kExitFailedLimits)
+        << out << ": " << ReadBytes(Path(std::string(out) + ".err"));
+  }
+  // The same lot again into a new store: every unit is unchanged, and every one is recorded.
+  std::vector<std::string> args = BatchArgs("out_a");
+  args[std::find(args.begin(), args.end(), "--store") - args.begin() + 1] = Path("new.db");
+  RunResult r = Run(args);
+  EXPECT_NE(r.out.find("5 unchanged and skipped"), std::string::npos) << r.out;
+  r = Run({"history", Path("new.db"), "--lot", "LOT-A", "--csv"});
+  auto yields = ReadCsv(r.out);
+  ASSERT_EQ(yields.size(), 1u) << r.out << r.err;
+  EXPECT_EQ(yields[0]["units"], "5");
+  EXPECT_EQ(yields[0]["passed"], "3");
+  // No limits: no verdicts, and the yield is "not judged", not 0 %.
+  r = Run({"batch", Path("units"), "-o", Path("out_c"), "--plan", kFixtures + "/plan_6pos.yaml", "--store",
+           Path("c.db"), "--lot", "LOT-C", "-q"});
+  ASSERT_TRUE(fs::exists(Path("out_c/lot.html"))) << r.err;
+  EXPECT_NE(ReadBytes(Path("out_c/lot.html")).find("data-key=\"yield\">not judged"), std::string::npos);
+  r = Run({"history", Path("c.db"), "--lot"});
+  EXPECT_NE(r.out.find("not judged"), std::string::npos) << r.out;
+}
+
 TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
   const std::string plan = Path("units/unit-01/plan.yaml");
   RunResult r =
@@ -505,6 +610,83 @@ TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
   r = Run({"history", Path("fit.db"), "--serial", "NO-SUCH-SERIAL"});
   EXPECT_EQ(r.status, kExitBadInput);
   EXPECT_NE(r.err.find("no calibrations of serial"), std::string::npos) << r.err;
+}
+
+// A store that cannot take the fit (not SQLite, read-only, of a newer imufit, refusing the row):
+// exit 2 in one line naming it, and neither the calibration nor the certificate is written (an
+// existing calibration stays as it was).
+TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
+  const std::vector<std::string> fit = {"fit",
+                                        "-p",
+                                        Path("units/unit-01/plan.yaml"),
+                                        "-s",
+                                        Path("units/unit-01/samples.csv.gz"),
+                                        "-o",
+                                        Path("cal.yaml"),
+                                        "--report",
+                                        Path("cal.html"),
+                                        "-q",
+                                        "--store"};
+  const auto run_with = [&](const std::string& store) {
+    std::vector<std::string> args = fit;
+    args.push_back(store);
+    return Run(args);
+  };
+  ASSERT_EQ(run_with(Path("good.db")).status, 0);
+  fs::remove(Path("cal.html"));
+  const std::string previous = Write("cal.yaml", "# the calibration flashed last week\n");
+  const auto copy_of_good = [&](const std::string& name) {
+    fs::copy_file(Path("good.db"), Path(name));
+    return Path(name);
+  };
+  const std::string read_only = copy_of_good("read_only.db");
+  fs::permissions(read_only, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  const std::string newer = copy_of_good("newer.db");
+  ExecuteSql(newer, "PRAGMA user_version = 7");
+  const std::string refusing = copy_of_good("refusing.db");
+  ExecuteSql(refusing,
+             "CREATE TRIGGER refuse BEFORE INSERT ON fits BEGIN SELECT RAISE(ABORT, 'disk quota'); END");
+  const std::pair<std::string, std::string> cases[] = {
+      {Write("text.db", "this is not a database, just some text long enough to matter\n"),
+       "file is not a database"},
+      {read_only, "the results store is read-only"},
+      {newer, "results store schema version 7 is not supported"},
+      {refusing, "disk quota: the fit is not recorded in the results store; nothing written"}};
+  for (const auto& [store, message] : cases) {
+    const RunResult r = run_with(store);
+    EXPECT_EQ(r.status, kExitBadInput) << store;
+    EXPECT_EQ(r.err.rfind("imufit: " + store + ": ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(ReadBytes(previous), "# the calibration flashed last week\n") << store;
+    EXPECT_FALSE(fs::exists(Path("cal.html"))) << store;
+  }
+  EXPECT_EQ(Temporaries(dir_), std::vector<std::string>{});
+  // Nothing was recorded in the refusing store either; the good one still reads.
+  RunResult r = Run({"history", refusing, "--serial", "SN-01", "--csv"});
+  EXPECT_EQ(ReadCsv(r.out).size(), 1u) << r.err;  // the copy's row only
+  // `history` reads a read-only store, and says in one line when there is none.
+  r = Run({"history", read_only, "--serial", "SN-01", "--csv"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = Run({"history", Path("missing.db"), "--lot"});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_EQ(r.err, "imufit: " + Path("missing.db") +
+                       ": no such results store (imufit fit --store and imufit batch --store create one)\n");
+  EXPECT_FALSE(fs::exists(Path("missing.db")));
+}
+
+// `imufit fit ... | head -3`: the program stops of SIGPIPE, silently, and leaves no temporary.
+TEST_F(FactoryCliTest, FitIntoAClosedPipeLeavesNoTemporaries) {
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const RunResult r = testing::RunProgram(
+        "/bin/sh", {"-c", std::string("'") + IMUFIT_EXE + "' fit -p '" + Path("units/unit-01/plan.yaml") +
+                              "' -s '" + Path("units/unit-01/samples.csv.gz") + "' -o '" + Path("cal.yaml") +
+                              "' --report '" + Path("cal.html") + "' --validate | head -3"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 3) << r.out;
+    EXPECT_EQ(r.err, "");
+  }
+  EXPECT_EQ(Temporaries(dir_), std::vector<std::string>{});
 }
 
 // A run with a long static stretch gets the Allan deviation and the ARW in its certificate.

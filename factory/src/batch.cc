@@ -80,7 +80,7 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
   }
 }
 
-void WriteManifest(const std::string& path, const Manifest& m) {
+void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction* transaction) {
   YAML::Emitter out;
   out << YAML::BeginMap << YAML::Key << "format" << YAML::Value << kManifestFormat << YAML::Key << "version"
       << YAML::Value << 1;
@@ -99,8 +99,9 @@ void WriteManifest(const std::string& path, const Manifest& m) {
     out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
   out << YAML::EndMap;
   WriteFileAtomically(
-      path, std::string("# imufit batch: this unit's inputs and outcome; delete to redo it\n") + out.c_str() +
-                "\n");
+      path,
+      std::string("# imufit batch: this unit's inputs and outcome; delete to redo it\n") + out.c_str() + "\n",
+      transaction);
 }
 
 // Temporary files of outputs a killed run never committed (OutputFile's ".NAME.tmp-XXXXXX").
@@ -226,6 +227,18 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
   return true;
 }
 
+// A unit skipped as unchanged that the store does not know (a new store, or another one): recorded
+// from its manifest and calibration, so that the store holds every unit of the lot.
+void RecordSkippedUnit(const Shared& shared, const UnitPaths& paths, UnitOutcome* unit) {
+  if (shared.store == nullptr || shared.store->HasUnit(shared.certify.lot, unit->unit)) return;
+  if (unit->status == "fitted") {
+    std::ifstream stream(paths.calibration, std::ios::binary);
+    unit->calibration_yaml.assign(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
+  }
+  RecordUnit(shared.certify, unit);
+  unit->calibration_yaml.clear();
+}
+
 // Fits the unit, whose serial.txt states its serial. A unit not fitted says why; a fitted one's
 // calibration carries the unit's serial (the folder name when nothing else names the unit).
 void FitUnit(const Shared& shared, const fs::path& unit_dir, const UnitPaths& paths, UnitOutcome* unit) {
@@ -251,15 +264,54 @@ void FitUnit(const Shared& shared, const fs::path& unit_dir, const UnitPaths& pa
   }
 }
 
-// Marks the unit done: its manifest, written last.
-void WriteUnitManifest(const UnitPaths& paths, const UnitOutcome& unit, Manifest manifest) {
+// Marks the unit done: its manifest, in the transaction of the unit's other outputs.
+void WriteUnitManifest(const UnitPaths& paths, const UnitOutcome& unit, Manifest manifest,
+                       OutputTransaction* transaction) {
   manifest.serial = unit.serial;
   manifest.status = unit.status;
   manifest.verdict = unit.verdict;
   manifest.message = unit.message;
   if (!unit.calibration_yaml.empty()) manifest.calibration_sha256 = Sha256Hex(unit.calibration_yaml);
   fs::create_directories(paths.folder);
-  WriteManifest(paths.manifest, manifest);
+  WriteManifest(paths.manifest, manifest, transaction);
+}
+
+// A failure that is not the unit's (the output folder or the disk, a read error, memory): the unit
+// is neither recorded nor marked done, so the next run does it again.
+bool OutsideTheUnit(const InputError& e) {
+  const std::string& m = e.message();
+  return m.rfind("cannot read", 0) == 0 || m.rfind("cannot open", 0) == 0 || m.rfind("cannot stat", 0) == 0;
+}
+
+// The batch's progress for the interrupt note (a signal handler reads them).
+std::atomic<int> g_units_done{0};
+std::atomic<int> g_units_total{0};
+
+// Appends the decimal digits of `value` (async-signal-safe).
+char* AppendNumber(char* out, int value) {
+  char digits[16];
+  int n = 0;
+  do {
+    digits[n++] = static_cast<char>('0' + value % 10);
+    value /= 10;
+  } while (value > 0 && n < 16);
+  while (n > 0) *out++ = digits[--n];
+  return out;
+}
+
+// "imufit: interrupted: 3 of 8 units done; run the same command again to finish", from a signal handler.
+void InterruptNote() {
+  char line[160];
+  char* out = line;
+  const auto append = [&out](const char* text) {
+    while (*text) *out++ = *text++;
+  };
+  append("\nimufit: interrupted: ");
+  out = AppendNumber(out, g_units_done.load());
+  append(" of ");
+  out = AppendNumber(out, g_units_total.load());
+  append(" units done; run the same command again to finish\n");
+  [[maybe_unused]] const ssize_t written = ::write(2, line, static_cast<size_t>(out - line));
 }
 
 UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
@@ -270,38 +322,47 @@ UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
   unit.status = "error";
   const UnitPaths paths = PathsOf(*shared.options, unit.unit);
   Manifest manifest;
-  bool offered = false;  // to the store: CertifyUnit records a fitted unit
-  bool recorded = false;
+  bool done = false;     // certified: outputs, manifest and store row committed together
+  bool outside = false;  // failed for a reason outside the unit: not marked done
   try {
     FindInputs(*shared.options, unit_dir, &unit);
     manifest = InputsManifest(shared, unit);
-    if (TakeUnchanged(shared, manifest, paths, &unit)) return unit;
-    FitUnit(shared, unit_dir, paths, &unit);
-    if (unit.fit->calibration) {
-      const UnitFiles files{paths.calibration, shared.options->write_reports ? paths.report : ""};
-      recorded = CertifyUnit(shared.certify, files, &unit);
-      offered = true;
-      unit.fit->run.static_stretch.reset();  // measured: not kept for the rest of the lot
+    if (TakeUnchanged(shared, manifest, paths, &unit)) {
+      RecordSkippedUnit(shared, paths, &unit);
+      return unit;
     }
+    FitUnit(shared, unit_dir, paths, &unit);
   } catch (const InputError& e) {
     unit.status = "error";
     unit.message = e.what();
+    outside = OutsideTheUnit(e);
   } catch (const std::exception& e) {
     unit.status = "error";
     unit.message = std::string("error: ") + e.what();
+    outside = true;
+  }
+  try {
+    if (!outside && unit.fit && unit.fit->calibration) {
+      UnitFiles files{paths.calibration, shared.options->write_reports ? paths.report : ""};
+      files.more = [&](const UnitOutcome& judged, OutputTransaction* outputs) {
+        WriteUnitManifest(paths, judged, manifest, outputs);
+      };
+      CertifyUnit(shared.certify, files, &unit);
+      unit.fit->run.static_stretch.reset();  // measured: not kept for the rest of the lot
+      done = true;
+    }
+    // Not fitted, or the unit's own bad input: recorded and marked done together.
+    if (!outside && !done && !unit.plan_sha256.empty()) {
+      OutputTransaction outputs;
+      WriteUnitManifest(paths, unit, manifest, &outputs);
+      RecordUnit(shared.certify, &unit, &outputs);
+    }
+  } catch (const std::exception& e) {  // an output could not be written: nothing was
+    unit.status = "error";
+    unit.verdict.clear();
+    unit.message = std::string("not written (the unit is done again on the next run): ") + e.what();
   }
   unit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (unit.plan_sha256.empty()) return unit;  // no inputs: nothing to record or to mark done
-  // Recorded, then marked done: a crash between the two redoes the unit (a second row in the
-  // store), never loses it. A unit the store refused gets no manifest: the next run redoes it.
-  if (!offered) recorded = RecordUnit(shared.certify, &unit);
-  if (!recorded) return unit;
-  try {
-    WriteUnitManifest(paths, unit, manifest);
-  } catch (const std::exception& e) {
-    unit.status = "error";
-    unit.message = std::string("cannot write the manifest: ") + e.what();
-  }
   return unit;
 }
 
@@ -376,6 +437,8 @@ std::vector<std::optional<UnitOutcome>> ProcessUnits(const Shared& shared,
   std::mutex progress_mutex;
   BatchProgress progress;
   progress.total = static_cast<int>(units.size());
+  g_units_done.store(0);
+  g_units_total.store(progress.total);
   const auto start = std::chrono::steady_clock::now();
   const auto worker = [&] {
     for (;;) {
@@ -390,6 +453,7 @@ std::vector<std::optional<UnitOutcome>> ProcessUnits(const Shared& shared,
       progress.skipped += outcomes[i]->skipped ? 1 : 0;
       progress.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       progress.last = &*outcomes[i];
+      g_units_done.store(progress.done);
       if (options.progress) options.progress(progress);
     }
   };
@@ -454,7 +518,9 @@ BatchResult RunBatch(const BatchOptions& options) {
     shared.store = std::make_unique<ResultsStore>(options.store_path);
     shared.certify.store = shared.store.get();
   }
+  SetInterruptNote(InterruptNote);
   BatchResult result = Tally(ProcessUnits(shared, ListUnits(options.units_dir)));
+  SetInterruptNote(nullptr);
   if (result.complete) WriteLotOutputs(shared, result);
   return result;
 }

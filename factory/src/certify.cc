@@ -1,5 +1,6 @@
 #include "imufit/factory/certify.h"
 
+#include <exception>
 #include <utility>
 
 #include "imufit/factory/certificate.h"
@@ -38,14 +39,6 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
   return MakeCertificate(sources);
 }
 
-// The calibration and the certificate, both or neither.
-void Commit(const UnitFiles& files, const UnitOutcome& unit, const std::optional<Certificate>& certificate) {
-  OutputTransaction outputs;
-  WriteFileAtomically(files.calibration, unit.calibration_yaml, &outputs);
-  if (certificate) WriteCertificate(files.report, *certificate, &outputs);
-  outputs.Commit();
-}
-
 }  // namespace
 
 void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
@@ -77,12 +70,19 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
   std::optional<Certificate> certificate;
   if (!files.report.empty()) certificate = MakeUnitCertificate(settings, files, *unit);
   JudgeUnit(settings, calibration, certificate ? certificate->verdict : std::nullopt, unit);
-  Commit(files, *unit, certificate);
-  return RecordUnit(settings, unit);
+  // The calibration, the certificate, the caller's further outputs and the store's row: all or none.
+  OutputTransaction outputs;
+  WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
+  if (certificate) WriteCertificate(files.report, *certificate, &outputs);
+  if (files.more) files.more(*unit, &outputs);
+  return RecordUnit(settings, unit, &outputs);
 }
 
-bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit) {
-  if (settings.store == nullptr) return true;
+bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransaction* outputs) {
+  if (settings.store == nullptr) {
+    if (outputs != nullptr) outputs->Commit();
+    return true;
+  }
   StoredFit row;
   row.unit = unit->unit.empty() ? unit->samples_path : unit->unit;
   row.serial = unit->serial.empty() ? row.unit : unit->serial;
@@ -98,12 +98,23 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit) {
   row.message = unit->message;
   row.calibration_yaml = unit->calibration_yaml;
   row.figures = unit->figures;
+  std::exception_ptr output_error;  // the outputs' failure passes on; the store's is the unit's
+  const auto commit_outputs = [&] {
+    if (outputs == nullptr) return;
+    try {
+      outputs->Commit();
+    } catch (...) {
+      output_error = std::current_exception();
+      throw;
+    }
+  };
   try {
-    settings.store->Record(row);
+    settings.store->Record(row, commit_outputs);
   } catch (const std::exception& e) {
+    if (output_error) std::rethrow_exception(output_error);
     unit->status = "error";
     unit->verdict.clear();
-    unit->message = std::string("not recorded in the results store: ") + e.what();
+    unit->message = std::string(e.what()) + ": the fit is not recorded in the results store";
     return false;
   }
   return true;

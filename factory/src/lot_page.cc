@@ -2,6 +2,8 @@
 // the results store across lots when the batch had one (history_page.cc's section).
 #include "imufit/factory/lot_page.h"
 
+#include <cmath>
+
 #include "imufit/factory/history_page.h"
 #include "imufit/io/output_file.h"
 #include "page.h"
@@ -95,11 +97,13 @@ void Summary(Html* h, const LotSummary& lot) {
   h->Open("tr").Element("td", "failed limits").Open("td");
   h->Element("span", Count(lot.failed), {{"class", "FAIL"}, {"data-key", "failed"}}).Close("td").Close("tr");
   Row(h, {"not fitted / errors", Count(lot.not_fitted) + " / " + Count(lot.errors)});
-  h->Open("tr")
-      .Element("td", "yield")
-      .Open("td")
-      .Element("span", Fmt("%.1f", lot.yield_pct), {{"data-key", "yield"}});
-  h->Text(" %").Close("td").Close("tr");
+  h->Open("tr").Element("td", "yield").Open("td");
+  if (std::isfinite(lot.yield_pct)) {
+    h->Element("span", Fmt("%.1f", lot.yield_pct), {{"data-key", "yield"}}).Text(" %");
+  } else {
+    h->Element("span", "not judged (no acceptance limits)", {{"data-key", "yield"}});
+  }
+  h->Close("td").Close("tr");
   Row(h, {"acceptance limits", lot.limits_name.empty() ? "none given" : lot.limits_name});
   Row(h, {"written", lot.written_utc + " by " + lot.software + ", git " + lot.git_revision});
   h->Close("table");

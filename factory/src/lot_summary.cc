@@ -106,7 +106,8 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
   s.failed = batch.failed;
   s.not_fitted = batch.not_fitted;
   s.errors = batch.errors;
-  s.yield_pct = s.units > 0 ? 100.0 * batch.passed / s.units : 0.0;
+  // Without limits no unit is judged: the yield is not 0 %, it is not known (nan: "not judged").
+  s.yield_pct = !limits ? std::nan("") : s.units > 0 ? 100.0 * batch.passed / s.units : 0.0;
   std::vector<std::string> names;
   for (const UnitOutcome& u : batch.units) names.push_back(u.unit);
   s.unit_prefix = SharedPrefix(names);

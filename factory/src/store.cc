@@ -1,8 +1,15 @@
 #include "imufit/factory/store.h"
 
 #include <sqlite3.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <optional>
+#include <thread>
 
 #include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
 
 namespace imufit {
 namespace {
@@ -56,16 +63,34 @@ CREATE TABLE figures (
 
 }  // namespace
 
-ResultsStore::ResultsStore(const std::string& path) : path_(path) {
-  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
-                      nullptr) != SQLITE_OK) {
+ResultsStore::ResultsStore(const std::string& path, StoreAccess access) : path_(path) {
+  struct stat status;
+  const bool exists = ::stat(path.c_str(), &status) == 0;
+  if (!exists && access == StoreAccess::kRead) {
+    throw InputError(path, "no such results store (imufit fit --store and imufit batch --store create one)");
+  }
+  // As for outputs (output_file.h): a file without write permission is not written, even by root.
+  if (exists && access == StoreAccess::kRecord &&
+      ((status.st_mode & 0222) == 0 || ::access(path.c_str(), W_OK) != 0)) {
+    throw InputError(path,
+                     "the results store is read-only: imufit records every fit in it (make it "
+                     "writable, or give another --store)");
+  }
+  const int flags =
+      access == StoreAccess::kRead ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
+  if (sqlite3_open_v2(path.c_str(), &db_, flags | SQLITE_OPEN_FULLMUTEX, nullptr) != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
     throw InputError(path, "cannot open the results store: " + message);
   }
   try {
-    Open();
+    if (access == StoreAccess::kRecord && sqlite3_db_readonly(db_, "main") == 1) {
+      throw InputError(path,
+                       "the results store cannot be written (a read-only file system?): imufit "
+                       "records every fit in it (give another --store)");
+    }
+    Open(access);
   } catch (...) {
     sqlite3_close(db_);  // the destructor does not run for a constructor that throws
     db_ = nullptr;
@@ -73,32 +98,58 @@ ResultsStore::ResultsStore(const std::string& path) : path_(path) {
   }
 }
 
-void ResultsStore::Open() {
-  const std::string& path = path_;
-  sqlite3_busy_timeout(db_, 10000);
-  Execute("PRAGMA journal_mode = WAL");
+void ResultsStore::Open(StoreAccess access) {
+  sqlite3_busy_timeout(db_, kStoreBusyWaitSeconds * 1000);
+  if (access == StoreAccess::kRead) {
+    CheckVersion();
+    return;
+  }
+  // Changing the journal mode takes the database exclusively and does not wait on its own.
+  ExecuteWaiting("PRAGMA journal_mode = WAL");
   Execute("PRAGMA synchronous = NORMAL");  // durable across a process crash; WAL keeps it consistent
   Execute("PRAGMA foreign_keys = ON");
-  Execute("BEGIN IMMEDIATE");
+  ExecuteWaiting("BEGIN IMMEDIATE");  // another process creating the schema finishes first
   Statement tables(db_, "SELECT count(*) FROM sqlite_master WHERE type = 'table'");
   if (!tables.ok() || tables.Step() != SQLITE_ROW) Fail("not an SQLite database");
   if (tables.Integer(0) == 0) {
     Execute(kSchema);
     Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
+    Execute("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
   }
+  CheckVersion();
+  Execute("COMMIT");
+}
+
+void ResultsStore::CheckVersion() {
+  const auto refuse = [&](int64_t found) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // harmless outside a transaction
+    throw InputError(path_, "results store schema version " + std::to_string(found) +
+                                " is not supported (this imufit reads and writes version " +
+                                std::to_string(kStoreSchemaVersion) + "; use the imufit that wrote it)");
+  };
+  Statement user_version(db_, "PRAGMA user_version");
+  if (!user_version.ok() || user_version.Step() != SQLITE_ROW) Fail("not an SQLite database");
+  if (user_version.Integer(0) > kStoreSchemaVersion) refuse(user_version.Integer(0));
   Statement version(db_, "SELECT version FROM schema_version");
   if (!version.ok() || version.Step() != SQLITE_ROW) {
-    Execute("ROLLBACK");
-    throw InputError(path, "not an imufit results store (no schema_version table)");
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw InputError(path_, "not an imufit results store (no schema_version table)");
   }
   const int64_t found = version.Integer(0);
-  if (found > kStoreSchemaVersion || found < 1) {
-    Execute("ROLLBACK");
-    throw InputError(path, "results store schema version " + std::to_string(found) +
-                               " is not supported (this imufit writes version " +
-                               std::to_string(kStoreSchemaVersion) + ")");
+  if (found > kStoreSchemaVersion || found < 1) refuse(found);
+}
+
+void ResultsStore::ExecuteWaiting(const std::string& sql) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(kStoreBusyWaitSeconds);
+  for (;;) {
+    const int code = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr);
+    if (code == SQLITE_OK) return;
+    if (code != SQLITE_BUSY && code != SQLITE_LOCKED) Fail("results store");
+    if (std::chrono::steady_clock::now() > give_up) {
+      Fail("results store (held by another process for " + std::to_string(kStoreBusyWaitSeconds) + " s)");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  Execute("COMMIT");
 }
 
 ResultsStore::~ResultsStore() { sqlite3_close(db_); }
@@ -119,9 +170,9 @@ void ResultsStore::Execute(const std::string& sql) {
   }
 }
 
-int64_t ResultsStore::Record(const StoredFit& fit) {
+int64_t ResultsStore::Record(const StoredFit& fit, const std::function<void()>& before_commit) {
   const std::lock_guard<std::mutex> lock(record_mutex_);
-  Execute("BEGIN IMMEDIATE");
+  ExecuteWaiting("BEGIN IMMEDIATE");
   int64_t id = 0;
   {
     Statement insert(db_,
@@ -151,8 +202,26 @@ int64_t ResultsStore::Record(const StoredFit& fit) {
       figure.Reset();
     }
   }
+  std::optional<SignalsDeferred> deferred;  // the files and the row: both, even on Ctrl-C
+  if (before_commit) {
+    deferred.emplace();
+    try {
+      before_commit();
+    } catch (...) {
+      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      throw;
+    }
+  }
   Execute("COMMIT");
   return id;
+}
+
+bool ResultsStore::HasUnit(const std::string& lot, const std::string& unit) {
+  Statement query(db_, "SELECT 1 FROM fits WHERE lot = ?1 AND unit = ?2 LIMIT 1");
+  if (!query.ok()) Fail("querying fits");
+  query.Bind(1, lot);
+  query.Bind(2, unit);
+  return query.Step() == SQLITE_ROW;
 }
 
 std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {

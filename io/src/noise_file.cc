@@ -6,15 +6,28 @@
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/units.h"
+#include "imufit/model/check.h"
 
 namespace imufit {
 namespace {
 
-// YAML scalar: shortest round-trip text, .nan / .inf as YAML spells them.
+// The file holds no non-finite number: a figure that is not finite is left out (docs/allan.md).
 std::string YamlNumber(double value) {
-  if (std::isnan(value)) return ".nan";
-  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  IMUFIT_CHECK(std::isfinite(value), "a noise file number is finite");
   return FormatDouble(value);
+}
+
+// "<indent><key>: <value><comment>\n", or nothing when `value` is not finite.
+void Scalar(std::ostream& yaml, const char* indent, const std::string& key, double value,
+            const char* comment = "") {
+  if (std::isfinite(value)) yaml << indent << key << ": " << YamlNumber(value) << comment << "\n";
+}
+
+// "<indent><key>: [value, sigma]\n", or nothing when either is not finite.
+void Pair(std::ostream& yaml, const char* indent, const std::string& key, double value, double sigma) {
+  if (std::isfinite(value) && std::isfinite(sigma)) {
+    yaml << indent << key << ": [" << YamlNumber(value) << ", " << YamlNumber(sigma) << "]\n";
+  }
 }
 
 std::string YamlString(const std::string& text) {
@@ -111,10 +124,10 @@ std::string NoiseYaml(const NoiseRecord& record) {
     yaml << "  calibration: " << YamlString(record.calibration) << "\n"
          << "  calibration_sha256: " << YamlString(record.calibration_sha256) << "\n";
   }
-  yaml << "  sample_interval_s: " << YamlNumber(record.sample_interval_s) << "\n"
-       << "  sample_count: " << record.sample_count << "\n"
-       << "  duration_s: " << YamlNumber(record.duration_s) << "\n"
-       << "  model: \"sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2\"\n"
+  Scalar(yaml, "  ", "sample_interval_s", record.sample_interval_s);
+  yaml << "  sample_count: " << record.sample_count << "\n";
+  Scalar(yaml, "  ", "duration_s", record.duration_s);
+  yaml << "  model: \"sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2\"\n"
        << "  columns:\n";
   for (const NoiseColumnRecord& fit : record.columns) {
     yaml << "    " << fit.name << ":\n"
@@ -125,34 +138,37 @@ std::string NoiseYaml(const NoiseRecord& record) {
       yaml << "      reason: " << YamlString(fit.reason) << "\n";
       continue;
     }
-    yaml << "      points_used: " << fit.points_used << "\n"
-         << "      reduced_chi_square: " << YamlNumber(fit.reduced_chi_square) << "\n";
-    for (int k = 0; k < kNoiseTerms; ++k) {
-      const NoiseTermUnits& units = UnitsOf(fit.kind, k);
-      yaml << "      " << units.si_key << ": [" << YamlNumber(fit.value[k]) << ", "
-           << YamlNumber(fit.sigma[k]) << "]\n";
-    }
+    yaml << "      points_used: " << fit.points_used << "\n";
+    Scalar(yaml, "      ", "reduced_chi_square", fit.reduced_chi_square);
+    for (int k = 0; k < kNoiseTerms; ++k)
+      Pair(yaml, "      ", UnitsOf(fit.kind, k).si_key, fit.value[k], fit.sigma[k]);
     for (int k = 0; k < kNoiseTerms; ++k) {
       const NoiseTermUnits& units = UnitsOf(fit.kind, k);
       if (*units.engineer_key == '\0') continue;
-      yaml << "      " << units.engineer_key << ": [" << YamlNumber(fit.value[k] * units.engineer_per_si)
-           << ", " << YamlNumber(fit.sigma[k] * units.engineer_per_si) << "]\n";
+      Pair(yaml, "      ", units.engineer_key, fit.value[k] * units.engineer_per_si,
+           fit.sigma[k] * units.engineer_per_si);
     }
     for (int k = 0; k < kNoiseTerms; ++k) {
-      if (!fit.resolved[k]) yaml << "      " << UnitsOf(fit.kind, k).si_key << "_resolved: false\n";
+      // A term without a finite value and sigma is unresolved, whatever the fit said.
+      const bool finite = std::isfinite(fit.value[k]) && std::isfinite(fit.sigma[k]);
+      if (!fit.resolved[k] || !finite)
+        yaml << "      " << UnitsOf(fit.kind, k).si_key << "_resolved: false\n";
     }
     const NoiseTermUnits& n = UnitsOf(fit.kind, kRandomWalk);
     const NoiseTermUnits& b = UnitsOf(fit.kind, kBiasInstability);
     const NoiseTermUnits& k = UnitsOf(fit.kind, kRateRandomWalk);
     const bool engineer = *n.engineer_key != '\0';
-    yaml << "      readout:  # IEEE 952 graphical read-outs of the measured curve\n"
-         << "        " << (engineer ? n.engineer_key : n.si_key) << ": "
-         << YamlNumber(fit.readout_random_walk * n.engineer_per_si) << "\n"
-         << "        " << (engineer ? b.engineer_key : b.si_key) << ": "
-         << YamlNumber(fit.readout_bias_instability * b.engineer_per_si) << "\n"
-         << "        bias_instability_tau_s: " << YamlNumber(fit.readout_bias_tau_s) << "\n"
-         << "        " << (engineer ? k.engineer_key : k.si_key) << ": "
-         << YamlNumber(fit.readout_rate_random_walk * k.engineer_per_si) << "\n";
+    std::ostringstream readout;
+    Scalar(readout, "        ", engineer ? n.engineer_key : n.si_key,
+           fit.readout_random_walk * n.engineer_per_si);
+    Scalar(readout, "        ", engineer ? b.engineer_key : b.si_key,
+           fit.readout_bias_instability * b.engineer_per_si);
+    Scalar(readout, "        ", "bias_instability_tau_s", fit.readout_bias_tau_s);
+    Scalar(readout, "        ", engineer ? k.engineer_key : k.si_key,
+           fit.readout_rate_random_walk * k.engineer_per_si);
+    if (!readout.str().empty()) {
+      yaml << "      readout:  # IEEE 952 graphical read-outs of the measured curve\n" << readout.str();
+    }
   }
   const auto has = [&](ColumnKind kind) {
     return std::any_of(record.columns.begin(), record.columns.end(),
@@ -162,20 +178,18 @@ std::string NoiseYaml(const NoiseRecord& record) {
   if (has_gyro || has_accel) {
     yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor\n";
     if (has_gyro) {
-      yaml << "    gyroscope_noise_density: "
-           << YamlNumber(WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk)) << "  # rad/s/sqrt(Hz)\n"
-           << "    gyroscope_random_walk: "
-           << YamlNumber(WorstAxis(record.columns, ColumnKind::kGyro, kRateRandomWalk))
-           << "  # rad/s^2/sqrt(Hz)\n";
+      Scalar(yaml, "    ", "gyroscope_noise_density",
+             WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk), "  # rad/s/sqrt(Hz)");
+      Scalar(yaml, "    ", "gyroscope_random_walk",
+             WorstAxis(record.columns, ColumnKind::kGyro, kRateRandomWalk), "  # rad/s^2/sqrt(Hz)");
     }
     if (has_accel) {
-      yaml << "    accelerometer_noise_density: "
-           << YamlNumber(WorstAxis(record.columns, ColumnKind::kAccel, kRandomWalk)) << "  # m/s^2/sqrt(Hz)\n"
-           << "    accelerometer_random_walk: "
-           << YamlNumber(WorstAxis(record.columns, ColumnKind::kAccel, kRateRandomWalk))
-           << "  # m/s^3/sqrt(Hz)\n";
+      Scalar(yaml, "    ", "accelerometer_noise_density",
+             WorstAxis(record.columns, ColumnKind::kAccel, kRandomWalk), "  # m/s^2/sqrt(Hz)");
+      Scalar(yaml, "    ", "accelerometer_random_walk",
+             WorstAxis(record.columns, ColumnKind::kAccel, kRateRandomWalk), "  # m/s^3/sqrt(Hz)");
     }
-    yaml << "    update_rate: " << YamlNumber(1.0 / record.sample_interval_s) << "  # Hz\n";
+    Scalar(yaml, "    ", "update_rate", 1.0 / record.sample_interval_s, "  # Hz");
   }
   return yaml.str();
 }

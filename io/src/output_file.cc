@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <limits.h>
+#include <pthread.h>
 #include <signal.h>
 
 #include <atomic>
@@ -56,12 +57,31 @@ void UnregisterTempFile(int slot) {
   g_temp_slots[slot].used = 0;
 }
 
-extern "C" void RemoveTempFilesAndReraise(int signal_number) {
+// A signal that arrives while outputs are being committed (SignalsDeferred) waits until they are:
+// the handler notes it and returns, and the last section to end stops the program. Lock-free
+// atomics, so the handler (on any thread) may use them.
+std::atomic<int> g_commit_sections{0};
+std::atomic<int> g_pending_signal{0};
+std::atomic<void (*)()> g_interrupt_note{nullptr};
+
+[[noreturn]] void StopOnSignal(int signal_number) {
+  if (void (*note)() = g_interrupt_note.load(); note != nullptr && signal_number != SIGPIPE) note();
   for (TempSlot& slot : g_temp_slots) {
     if (slot.used) ::unlink(slot.path);
   }
   std::signal(signal_number, SIG_DFL);
+  sigset_t blocked;  // in the handler, the signal itself is blocked
+  sigemptyset(&blocked);
+  sigaddset(&blocked, signal_number);
+  ::pthread_sigmask(SIG_UNBLOCK, &blocked, nullptr);
   std::raise(signal_number);
+  ::_exit(128 + signal_number);  // not reached
+}
+
+extern "C" void RemoveTempFilesAndReraise(int signal_number) {
+  g_pending_signal.store(signal_number);  // first: a section starting now sees it
+  if (g_commit_sections.load() > 0) return;
+  StopOnSignal(signal_number);
 }
 
 // Refuses a destination that exists but is not an ordinary, writable file: rename() would
@@ -91,15 +111,31 @@ void CheckDestination(const std::string& path) {
 
 }  // namespace
 
+SignalsDeferred::SignalsDeferred() {
+  g_commit_sections.fetch_add(1);
+  if (g_pending_signal.load() != 0) {
+    // The program is being stopped: a commit that has not started does not start.
+    g_commit_sections.fetch_sub(1);
+    for (;;) ::pause();
+  }
+}
+
+SignalsDeferred::~SignalsDeferred() {
+  if (g_commit_sections.fetch_sub(1) == 1 && g_pending_signal.load() != 0) {
+    StopOnSignal(g_pending_signal.load());
+  }
+}
+
+void SetInterruptNote(void (*note)()) { g_interrupt_note.store(note); }
+
 void InstallOutputCleanupOnSignals() {
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
     struct sigaction previous;
     if (::sigaction(signal_number, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN)
       continue;  // nohup
     struct sigaction action {};
     action.sa_handler = RemoveTempFilesAndReraise;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;
+    sigfillset(&action.sa_mask);  // one signal handled at a time
     ::sigaction(signal_number, &action, nullptr);
   }
 }
@@ -116,6 +152,7 @@ void OutputTransaction::Add(std::string temp_path, std::string path, int slot) {
 }
 
 void OutputTransaction::Commit() {
+  const SignalsDeferred deferred;  // the renames all happen, or none
   // Every output is complete and synced on disk; only the renames are left, in one folder each,
   // so the last thing that can fail has been done for all of them before any is renamed.
   for (const Pending& pending : pending_) CheckDestination(pending.path);

@@ -7,15 +7,17 @@
 //     that the samples file is not read again;
 //   judges it: its key figures, and its verdict against the acceptance limits with the noise
 //     figures the certificate measured (acceptance.h);
-//   commits it: the calibration and the certificate written in one OutputTransaction, both or
-//     neither;
-//   records it: one row in the results store (store.h), when there is one (RecordUnit()).
+//   commits and records it: the calibration, the certificate, the caller's further outputs (a
+//     batch's manifest) and one row in the results store (store.h, when there is one) in one
+//     transaction: all of them or none (the files are renamed inside the store's transaction,
+//     before its commit; signals wait for both, output_file.h SignalsDeferred).
 // The certificate names the software that made the calibration (the calibration's `software`)
 // and the software that certifies it (CertifySettings::software: the program's version, which
 // the program passes in).
 #ifndef IMUFIT_FACTORY_CERTIFY_H_
 #define IMUFIT_FACTORY_CERTIFY_H_
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +25,7 @@
 #include "imufit/factory/acceptance.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/output_file.h"
 #include "imufit/io/station.h"
 #include "imufit/pipeline/fit_run.h"
 
@@ -79,12 +82,15 @@ void ReadLimitsAndStation(const std::string& limits_path, const std::string& sta
 struct UnitFiles {
   std::string calibration;
   std::string report;  // the certificate; "" for none
+  // Further outputs written into the unit's transaction once it is judged (a batch's manifest).
+  std::function<void(const UnitOutcome&, OutputTransaction*)> more;
 };
 
 // Certifies, judges, commits and records `unit`: unit->fit holds FitRun's result with a calibration
 // (the serial it is to carry set), and unit->plan_path, samples_path and their hashes are filled.
 // Sets the unit's status ("fitted"), figures, verdict and calibration text. Throws InputError when
-// an output cannot be written (then none is). Returns RecordUnit()'s answer.
+// an output cannot be written (then none is, and nothing is recorded). Returns RecordUnit()'s
+// answer (false: the store refused the row; then no output was written either).
 bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit);
 
 // The unit's key figures, and its verdict against settings.limits: `certified` (a certificate's,
@@ -93,9 +99,10 @@ void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
                const std::optional<Verdict>& certified, UnitOutcome* unit);
 
 // Records `unit`, whatever its status, in settings.store when there is one (safe from several
-// threads at once). Returns false when the store refuses it: then the unit is an "error" whose
-// message says why.
-bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit);
+// threads at once), committing `outputs` (may be null) with the row: both or neither. Returns
+// false when the store refuses it: then the unit is an "error" whose message says why, and no
+// output is written. An output that cannot be written throws (InputError); then nothing is recorded.
+bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransaction* outputs = nullptr);
 
 }  // namespace imufit
 

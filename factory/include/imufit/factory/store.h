@@ -7,11 +7,16 @@
 //   figures(fit_id -> fits.id, name, coefficient, unit, value, sigma)   the key figures at 25 degC
 // The database runs in WAL mode; Record() writes one fit and its figures in one transaction, so a
 // crash loses at most the fit being written and never leaves half a fit. Errors (the file cannot
-// be opened, is not an imufit store, has a newer schema) are InputErrors naming the file.
+// be opened, is not an imufit store, has a newer schema, may not be written) are InputErrors naming
+// the file, raised when the store is opened: before any work. The schema version is kept twice:
+// in schema_version and in SQLite's user_version (a store of a newer imufit is refused by either).
+// Several processes may open and create one store at once: a busy database is waited for (up to
+// kStoreBusyWaitSeconds), never an error.
 #ifndef IMUFIT_FACTORY_STORE_H_
 #define IMUFIT_FACTORY_STORE_H_
 
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -23,6 +28,12 @@ struct sqlite3;
 namespace imufit {
 
 inline constexpr int kStoreSchemaVersion = 1;
+// How long opening or writing the store waits for another process that holds it.
+inline constexpr int kStoreBusyWaitSeconds = 60;
+
+// How a store is opened: to record fits (created when missing; refused when it may not be
+// written), or only to read an existing one (`imufit history`).
+enum class StoreAccess { kRecord, kRead };
 
 struct StoredFit {
   int64_t id = 0;
@@ -69,8 +80,8 @@ struct LotValue {
 
 class ResultsStore {
  public:
-  // Opens the database at `path`, creating it (and its schema) when it does not exist.
-  explicit ResultsStore(const std::string& path);
+  // Opens the database at `path`; to record, creating it (and its schema) when it does not exist.
+  explicit ResultsStore(const std::string& path, StoreAccess access = StoreAccess::kRecord);
   ~ResultsStore();
   ResultsStore(const ResultsStore&) = delete;
   ResultsStore& operator=(const ResultsStore&) = delete;
@@ -78,9 +89,14 @@ class ResultsStore {
   const std::string& path() const { return path_; }
 
   // Records one fit in one transaction; returns its id. Safe from several threads at once (the
-  // units of a batch).
-  int64_t Record(const StoredFit& fit);
+  // units of a batch). `before_commit` (may be empty) runs inside the transaction, after the row is
+  // written and before it is committed: the outputs that belong to the row are committed there, so
+  // that the row and the files appear together. When it throws, the row is rolled back and the
+  // exception passes on.
+  int64_t Record(const StoredFit& fit, const std::function<void()>& before_commit = {});
 
+  // Whether any fit of `unit` in `lot` is recorded.
+  bool HasUnit(const std::string& lot, const std::string& unit);
   // Every fit of a serial, oldest first, with figures.
   std::vector<StoredFit> BySerial(const std::string& serial);
   // Yield per lot (one lot when `lot` is not empty), by each unit's latest fit in the lot.
@@ -93,8 +109,11 @@ class ResultsStore {
   std::vector<LotValue> LotValues(const std::string& figure);
 
  private:
-  void Open();  // pragmas, schema, version check
+  void Open(StoreAccess access);  // pragmas, schema, version checks
+  void CheckVersion();
   void Execute(const std::string& sql);
+  // Execute(), waiting while another process holds the database (SQLITE_BUSY, SQLITE_LOCKED).
+  void ExecuteWaiting(const std::string& sql);
   [[noreturn]] void Fail(const std::string& what);
 
   std::string path_;

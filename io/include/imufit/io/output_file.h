@@ -3,7 +3,7 @@
 // An OutputFile writes into a temporary file in the destination's folder and renames it over the
 // destination only in Commit(), after a flush and an fsync. If Commit() is never reached (an
 // error, an exception, a crash) the temporary file is removed and an existing destination is
-// left exactly as it was; on SIGINT, SIGTERM or SIGHUP too (InstallOutputCleanupOnSignals).
+// left exactly as it was; on SIGINT, SIGTERM, SIGHUP or SIGPIPE too (InstallOutputCleanupOnSignals).
 // Paths ending in ".gz" are written gzip-compressed (ISA-L's igzip; standard gzip).
 //
 // An existing destination must be a regular file that may be written: a symbolic link, FIFO,
@@ -86,9 +86,24 @@ class OutputTransaction {
 };
 
 // Removes the temporary files of uncommitted outputs when the program is stopped by SIGINT,
-// SIGTERM or SIGHUP (then dies of that signal as it would have). Signals that are ignored
-// (nohup) stay ignored. Called once by main().
+// SIGTERM, SIGHUP or SIGPIPE (`imufit fit ... | head`), then dies of that signal as it would have,
+// silently. Signals that are ignored (nohup) stay ignored. Called once by main().
 void InstallOutputCleanupOnSignals();
+
+// While one of these lives (on any thread), those signals wait: the outputs being committed (a
+// transaction's renames, and the results store's commit that goes with them) all appear before
+// the program stops. A section that would start after a signal arrived never starts.
+class SignalsDeferred {
+ public:
+  SignalsDeferred();
+  ~SignalsDeferred();
+  SignalsDeferred(const SignalsDeferred&) = delete;
+  SignalsDeferred& operator=(const SignalsDeferred&) = delete;
+};
+
+// `note` (async-signal-safe: write(2) only) runs when SIGINT, SIGTERM or SIGHUP stops the program,
+// before the temporary files are removed: a batch says how far it got. nullptr: none.
+void SetInterruptNote(void (*note)());
 
 // Writes `text` to `path` atomically (OutputFile in one call), in `transaction` when not null.
 void WriteFileAtomically(const std::string& path, std::string_view text,
