@@ -3,6 +3,7 @@
 
 #include <array>
 
+#include "certificate_budget_page.h"
 #include "imufit/factory/allan_plot.h"
 #include "imufit/factory/html.h"
 #include "imufit/io/output_file.h"
@@ -363,8 +364,8 @@ void KeyFigures(Html* h, const Certificate& c) {
   h->Open("div", {{"class", "keep"}});
   h->Element("h2", "Coefficients at 25 degC");
   h->Element("p",
-             "1-sigma from the fit's covariance; U is the expanded uncertainty at k = 2 (about 95 % for a "
-             "normal distribution).",
+             "1-sigma from the fit's covariance (Type A); U is the expanded uncertainty of the budget below "
+             "(Type A and the station's Type B sources) at k = 2 (about 95 % for a normal distribution).",
              {{"class", "note"}});
   h->Open("div", {{"class", "cols"}});
   h->Open("div");
@@ -613,6 +614,7 @@ std::string CertificateHtml(const Certificate& c) {
   RunAndSettings(&h, c);
   if (c.verdict) Acceptance(&h, *c.verdict);
   KeyFigures(&h, c);
+  internal::BudgetSection(&h, c);
   CoefficientPlots(&h, c, svgs);
   ErrorPlots(&h, c, svgs);
   NoisePlot(&h, c, svgs);
