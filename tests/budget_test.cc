@@ -12,6 +12,7 @@
 
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certificate_page.h"
+#include "imufit/factory/lot_summary.h"
 #include "imufit/factory/uncertainty_budget.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
@@ -196,6 +197,93 @@ TEST_F(BudgetTest, TheCertificateCarriesTheBudget) {
   EXPECT_NE(html.find("data-budget-class=\"gyro_scale_per_dps\""), std::string::npos);
   EXPECT_NE(html.find("Rate table rate accuracy"), std::string::npos);
   EXPECT_NE(html.find("U does not cover the unit"), std::string::npos);
+}
+
+// ILAC-G8: a value within U of its limit is conditional; simple acceptance passes it when inside,
+// guarded acceptance (w = U) does not; a lot counts such units apart.
+TEST_F(BudgetTest, DecisionRuleJudgesWithU) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const UncertaintyBudget budget = Budget({Source(StationInfluence::kRateAccuracy, 10e-6)});
+  const FigureBudget* bias = budget.Find("gyro_bias_dps.x");
+  ASSERT_NE(bias, nullptr);
+  const double value = std::abs(bias->value), u = bias->expanded;
+  ASSERT_GT(u, 0.0);
+  const auto judge = [&](double limit, DecisionRule rule) {
+    Limits limits;
+    limits.decision_rule = rule;
+    LimitCriterion criterion;
+    criterion.quantity = "gyro_bias_dps";
+    criterion.unit = "deg/s";
+    criterion.axes = {"x"};
+    criterion.max_abs = limit;
+    limits.criteria = {criterion};
+    return EvaluateLimits(limits, *fit_->calibration, {}, &budget);
+  };
+  struct Case {
+    double limit;
+    DecisionRule rule;
+    Outcome outcome;
+    bool pass;
+  };
+  const Case cases[] = {{value + 2.0 * u, DecisionRule::kSimple, Outcome::kPass, true},
+                        {value + 0.5 * u, DecisionRule::kSimple, Outcome::kConditionalPass, true},
+                        {value + 0.5 * u, DecisionRule::kGuarded, Outcome::kConditionalPass, false},
+                        {value - 0.5 * u, DecisionRule::kSimple, Outcome::kConditionalFail, false},
+                        {value - 2.0 * u, DecisionRule::kGuarded, Outcome::kFail, false}};
+  for (const Case& c : cases) {
+    const Verdict verdict = judge(c.limit, c.rule);
+    ASSERT_EQ(verdict.criteria.size(), 1u);
+    const CriterionResult& r = verdict.criteria[0];
+    EXPECT_EQ(r.outcome, c.outcome) << c.limit << " " << OutcomeName(r.outcome);
+    EXPECT_EQ(r.pass, c.pass) << c.limit;
+    EXPECT_EQ(verdict.pass, c.pass);
+    EXPECT_DOUBLE_EQ(r.expanded, u);
+    const bool conditional = c.outcome == Outcome::kConditionalPass || c.outcome == Outcome::kConditionalFail;
+    EXPECT_EQ(verdict.Conditional(), conditional ? 1 : 0);
+    EXPECT_EQ(r.reason.find("within U = ") == 0, conditional) << r.reason;
+    EXPECT_NE(verdict.RuleText().find(c.rule == DecisionRule::kGuarded ? "guarded" : "simple"),
+              std::string::npos);
+  }
+
+  // The lot: one clear pass, one conditional pass, one conditional fail.
+  BatchResult batch;
+  for (double limit : {value + 2.0 * u, value + 0.5 * u, value - 0.5 * u}) {
+    UnitOutcome unit;
+    unit.unit = "unit-" + std::to_string(batch.units.size());
+    unit.status = "fitted";
+    unit.verdict_detail = judge(limit, DecisionRule::kSimple);
+    unit.verdict = unit.verdict_detail.pass ? "PASS" : "FAIL";
+    (unit.verdict_detail.pass ? batch.passed : batch.failed) += 1;
+    batch.units.push_back(unit);
+  }
+  const LotSummary lot = MakeLotSummary("lot", batch, "imufit test", std::nullopt);
+  EXPECT_EQ(lot.passed, 2);
+  EXPECT_EQ(lot.conditional, 2);
+}
+
+// The limits file chooses the rule; a guard band needs the guarded rule.
+TEST_F(BudgetTest, LimitsFileChoosesTheRule) {
+  const std::string path = (dir_ / "limits.yaml").string();
+  const std::string head =
+      "format: imufit-limits\nversion: 1\ncriteria:\n  - {quantity: gyro_bias_dps, max_abs: 1}\n";
+  std::ofstream(path) << head;
+  EXPECT_EQ(ReadLimits(path).decision_rule, DecisionRule::kSimple);
+  std::ofstream(path) << head << "decision_rule: guarded\nguard_band: 0.5\n";
+  const Limits guarded = ReadLimits(path);
+  EXPECT_EQ(guarded.decision_rule, DecisionRule::kGuarded);
+  EXPECT_DOUBLE_EQ(guarded.guard_band_u, 0.5);
+  std::ofstream(path) << head << "guard_band: 0.5\n";
+  EXPECT_THROW(ReadLimits(path), InputError);
+  std::ofstream(path) << head << "decision_rule: strict\n";
+  try {
+    ReadLimits(path);
+    ADD_FAILURE() << "an unknown rule";
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("limits.yaml:5:16: decision_rule: \"strict\" is not a decision rule"),
+        std::string::npos)
+        << e.what();
+  }
 }
 
 // The station file declares each source with u or a rectangular half width, in its units.

@@ -5,6 +5,7 @@
 #include <optional>
 #include <utility>
 
+#include "imufit/factory/uncertainty_budget.h"
 #include "imufit/io/noise_file.h"
 
 namespace imufit {
@@ -25,7 +26,43 @@ std::optional<double> FitFigure(const Calibration& calibration, std::optional<do
   return value;
 }
 
+// The outcome of |value| `measured` against `limit` with U `expanded` under the verdict's rule.
+void Decide(const Verdict& verdict, CriterionResult* r) {
+  const double m = r->measured, limit = r->limit, u = r->expanded;
+  if (!(u > 0.0)) {
+    r->outcome = r->margin > 0.0 ? Outcome::kPass : Outcome::kFail;
+    r->pass = r->outcome == Outcome::kPass;
+    return;
+  }
+  r->outcome = m + u < limit   ? Outcome::kPass
+               : m < limit     ? Outcome::kConditionalPass
+               : m - u < limit ? Outcome::kConditionalFail
+                               : Outcome::kFail;
+  const double guard = verdict.rule == DecisionRule::kGuarded ? verdict.guard_band_u * u : 0.0;
+  r->pass = m + guard < limit;
+  if (r->outcome == Outcome::kConditionalPass || r->outcome == Outcome::kConditionalFail) {
+    r->reason = "within U = " + Number(u) + " " + r->unit + " of the limit";
+    if (verdict.rule == DecisionRule::kGuarded && r->outcome == Outcome::kConditionalPass) {
+      r->reason += ": inside the guard band, not accepted";
+    }
+  }
+}
+
 }  // namespace
+
+const char* OutcomeName(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kPass:
+      return "PASS";
+    case Outcome::kConditionalPass:
+      return "conditional pass";
+    case Outcome::kConditionalFail:
+      return "conditional fail";
+    case Outcome::kFail:
+      return "FAIL";
+  }
+  return "FAIL";
+}
 
 std::vector<Figure> KeyFigures(const Calibration& calibration) {
   const SensorModel* sigma = calibration.sigma ? &*calibration.sigma : nullptr;
@@ -90,6 +127,27 @@ int Verdict::Failed() const {
   return failed;
 }
 
+int Verdict::Conditional() const {
+  int conditional = 0;
+  for (const CriterionResult& c : criteria) {
+    conditional += c.outcome == Outcome::kConditionalPass || c.outcome == Outcome::kConditionalFail ? 1 : 0;
+  }
+  return conditional;
+}
+
+std::string Verdict::RuleText() const {
+  if (rule == DecisionRule::kGuarded) {
+    return "guarded acceptance (ILAC-G8): a value passes when it lies inside its limit by more than the "
+           "guard "
+           "band w = " +
+           Number(guard_band_u) +
+           " x U; a value within U of a limit is reported as a conditional pass (inside, not accepted) or a "
+           "conditional fail (outside).";
+  }
+  return "simple acceptance (ILAC-G8): a value passes when it lies inside its limit, whatever its U; a value "
+         "within U of a limit is reported as a conditional pass (inside) or a conditional fail (outside).";
+}
+
 std::string Verdict::FailedSummary() const {
   std::string text;
   for (const CriterionResult& c : criteria) {
@@ -110,18 +168,25 @@ std::string Verdict::Table() const {
                 "margin", "verdict");
   text += line;
   for (const CriterionResult& c : criteria) {
-    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", c.name.c_str(),
+    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s%s%s\n", c.name.c_str(),
                   c.measured_text.c_str(), c.limit_text.c_str(), c.margin_text.c_str(),
-                  c.pass ? "PASS" : "FAIL");
+                  OutcomeName(c.outcome), c.reason.empty() ? "" : ": ", c.reason.c_str());
     text += line;
   }
   return text;
 }
 
 Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
-                       const std::vector<Figure>& measured) {
+                       const std::vector<Figure>& measured, const UncertaintyBudget* budget) {
   Verdict verdict;
   verdict.limits_name = limits.name;
+  verdict.rule = limits.decision_rule;
+  verdict.guard_band_u = limits.guard_band_u;
+  // U of a figure: the budget's, else k = 2 times its 1-sigma; < 0: none.
+  const auto expanded = [&](const Figure& f) {
+    const FigureBudget* b = budget != nullptr ? budget->Find(f.name) : nullptr;
+    return b != nullptr ? b->expanded : f.sigma >= 0.0 ? 2.0 * f.sigma : -1.0;
+  };
   std::vector<Figure> figures = measured;  // found first: they take the place of the calibration's
   for (const Figure& f : KeyFigures(calibration)) figures.push_back(f);
   for (const LimitCriterion& criterion : limits.criteria) {
@@ -138,6 +203,7 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
       r.limit_text = "covers " + Number(criterion.covers_c[0]) + ".." + Number(criterion.covers_c[1]);
       r.margin_text = Number(r.margin) + " " + criterion.unit;
       r.pass = r.margin >= 0.0;
+      r.outcome = r.pass ? Outcome::kPass : Outcome::kFail;
       verdict.criteria.push_back(r);
       continue;
     }
@@ -161,11 +227,13 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
             gyro ? limits.nominal_gyro_scale / kRadToDeg : limits.nominal_accel_scale * kStandardGravityMps2;
         const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
         r.measured = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
+        if (!sigma && expanded(*scale) >= 0.0) r.expanded = expanded(*scale) / nominal * factor;
         found = !sigma || scale->sigma >= 0.0;
       } else {
         const Figure* figure = FindFigure(figures, name);
         found = figure != nullptr && (!sigma || figure->sigma >= 0.0);
         if (found) r.measured = sigma ? figure->sigma : figure->value;
+        if (found && !sigma) r.expanded = expanded(*figure);
       }
       if (!found) {
         r.measured_text = "not in calibration";
@@ -181,7 +249,7 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
         r.margin_text = criterion.quantity == "coverage"
                             ? Number(r.margin) + (r.margin == 1.0 ? " segment" : " segments")
                             : Number(r.margin) + " " + criterion.unit;
-        r.pass = r.margin > 0.0;
+        Decide(verdict, &r);
       }
       verdict.criteria.push_back(r);
     }

@@ -221,7 +221,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     c.noise.why_not = "no samples file given";
   }
   c.verdict = sources.verdict;
-  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, MeasuredFigures(c));
+  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, MeasuredFigures(c), &c.budget);
   c.validation = ValidationRows(sources.folds);
   return c;
 }

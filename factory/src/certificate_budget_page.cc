@@ -31,6 +31,15 @@ void Sources(Html* h, const UncertaintyBudget& budget) {
 
 }  // namespace
 
+void DecisionRuleNote(Html* h, const Verdict& verdict) {
+  std::string text = "Decision rule: " + verdict.RuleText();
+  if (verdict.Conditional() > 0) {
+    text += " " + Count(verdict.Conditional()) + " of " +
+            Count(static_cast<long long>(verdict.criteria.size())) + " criteria are conditional.";
+  }
+  h->Element("p", text, {{"data-key", "decision_rule"}});
+}
+
 void BudgetSection(Html* h, const Certificate& c) {
   const UncertaintyBudget& budget = c.budget;
   h->Open("div", {{"class", "keep"}, {"data-key", "budget"}});

@@ -10,6 +10,8 @@ namespace imufit::internal {
 
 // The budget's top contributors per class of figures, the Type B sources declared, the statements.
 void BudgetSection(Html* h, const Certificate& c);
+// The decision rule the verdict applied, and how many criteria are conditional.
+void DecisionRuleNote(Html* h, const Verdict& verdict);
 
 }  // namespace imufit::internal
 

@@ -336,9 +336,12 @@ void Acceptance(Html* h, const Verdict& verdict) {
     Num(h, cr.measured_text);
     Num(h, cr.limit_text);
     Num(h, cr.margin_text);
-    h->Element("td", cr.pass ? "PASS" : "FAIL", {{"class", cr.pass ? "PASS" : "FAIL"}}).Close("tr");
+    h->Element("td", OutcomeName(cr.outcome) + (cr.reason.empty() ? std::string() : ": " + cr.reason),
+               {{"class", cr.pass ? "PASS" : "FAIL"}, {"data-outcome", OutcomeName(cr.outcome)}})
+        .Close("tr");
   }
   h->Close("tbody").Close("table");
+  internal::DecisionRuleNote(h, verdict);
 }
 
 void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {

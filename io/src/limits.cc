@@ -92,10 +92,14 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
 
 }  // namespace
 
+const char* DecisionRuleName(DecisionRule rule) {
+  return rule == DecisionRule::kGuarded ? "guarded" : "simple";
+}
+
 Limits ReadLimits(const std::string& path) {
   const YAML::Node root_node = yaml::LoadFile(path);
   const yaml::Located root{&path, root_node, ""};
-  root.RejectUnknownKeys({"format", "version", "name", "nominal", "criteria"});
+  root.RejectUnknownKeys({"format", "version", "name", "nominal", "criteria", "decision_rule", "guard_band"});
   root.RequireFormat("imufit-limits", kLimitsFormatVersion);
   Limits limits;
   limits.path = path;
@@ -105,6 +109,21 @@ Limits ReadLimits(const std::string& path) {
     nominal.RejectUnknownKeys({"gyro_scale", "accel_scale"});
     if (nominal.Has("gyro_scale")) limits.nominal_gyro_scale = PositiveNumber(nominal["gyro_scale"]);
     if (nominal.Has("accel_scale")) limits.nominal_accel_scale = PositiveNumber(nominal["accel_scale"]);
+  }
+  if (root.Has("decision_rule")) {
+    const yaml::Located rule = root["decision_rule"];
+    const std::string text = rule.String();
+    if (text == "guarded") {
+      limits.decision_rule = DecisionRule::kGuarded;
+    } else if (text != "simple") {
+      rule.Fail(QuoteForMessage(text) + " is not a decision rule (known: simple, guarded)");
+    }
+  }
+  if (root.Has("guard_band")) {
+    if (limits.decision_rule != DecisionRule::kGuarded) {
+      root["guard_band"].Fail("a guard band needs `decision_rule: guarded`");
+    }
+    limits.guard_band_u = PositiveNumber(root["guard_band"]);
   }
   const yaml::Located criteria = root["criteria"];
   for (size_t i = 0; i < criteria.Size(); ++i)

@@ -11,6 +11,12 @@
 //     - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.05, axes: [xx, yy, zz]}
 //     - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}   # the 1-sigma, not the value
 //     - {quantity: fit_temp_range_c, covers: [-20, 60]}
+//   decision_rule: guarded                  # simple (the default) or guarded (ILAC-G8)
+//   guard_band: 1.0                         # guarded: w as a multiple of the figure's U (default 1)
+//
+// The decision rule (ILAC-G8:09/2019): a value whose interval +-U reaches over its limit is a
+// "conditional pass" (inside the limit) or a "conditional fail" (outside). Simple acceptance passes
+// the value inside its limit; guarded acceptance passes it only inside the limit less w = guard_band x U.
 //
 // Quantities are the 25 degC values of coefficients in familiar units (kLimitQuantities), fit
 // residual RMS values, and the fitted temperature range. The reader checks every name, axis and
@@ -62,6 +68,10 @@ inline constexpr LimitQuantity kLimitQuantities[] = {
 
 enum class LimitStatistic { kValue, kSigma };
 
+enum class DecisionRule { kSimple, kGuarded };
+// "simple", "guarded".
+const char* DecisionRuleName(DecisionRule rule);
+
 struct LimitCriterion {
   std::string quantity;  // a kLimitQuantities name
   LimitKind kind = LimitKind::kCoefficient;
@@ -78,6 +88,8 @@ struct Limits {
   double nominal_gyro_scale = 0.0;   // raw per rad/s; 0: not given
   double nominal_accel_scale = 0.0;  // raw per m/s^2; 0: not given
   std::vector<LimitCriterion> criteria;
+  DecisionRule decision_rule = DecisionRule::kSimple;
+  double guard_band_u = 1.0;  // guarded acceptance: w = guard_band_u x U
 };
 
 Limits ReadLimits(const std::string& path);
