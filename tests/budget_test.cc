@@ -37,6 +37,8 @@ constexpr double kHandComputedTolerance = 0.02;
 // estimate's own relative spread is 1 / sqrt(2 N) = 0.065 at N = 120; 0.26 is four times that.
 constexpr int kMonteCarloTrials = 120;
 constexpr double kMonteCarloTolerance = 0.26;
+// std::to_string writes a limit to 6 decimals.
+constexpr double kWrittenLimitRounding = 1e-6;
 
 class BudgetTest : public ::testing::Test {
  protected:
@@ -284,6 +286,65 @@ TEST_F(BudgetTest, LimitsFileChoosesTheRule) {
         std::string::npos)
         << e.what();
   }
+}
+
+// Limits as specifications are written: min/max on the signed value, a tolerance on `covers`, and a
+// figure evaluated outside the fitted range marked extrapolated in the criterion's reason.
+TEST_F(BudgetTest, LimitsAsSpecificationsAreWritten) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  Calibration cal = *fit_->calibration;
+  const Figure* bias = FindFigure(KeyFigures(cal), "accel_bias_mg.x");
+  ASSERT_NE(bias, nullptr);
+  const double u = 2.0 * bias->sigma;
+  const auto judge = [&](const std::string& criteria) {
+    const std::string path = (dir_ / "spec_limits.yaml").string();
+    std::ofstream(path) << "format: imufit-limits\nversion: 1\ncriteria:\n" << criteria;
+    return EvaluateLimits(ReadLimits(path), cal);
+  };
+  const auto bounds = [&](double lo, double hi) {
+    return "  - {quantity: accel_bias_mg, axes: [x], min: " + std::to_string(lo) +
+           ", max: " + std::to_string(hi) + "}\n";
+  };
+  // Asymmetric: the value 10 U inside both bounds, 0.5 U below min, 2 U above max.
+  const double v = bias->value;
+  Verdict verdict = judge(bounds(v - 10.0 * u, v + 10.0 * u));
+  ASSERT_EQ(verdict.criteria.size(), 1u);
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kPass);
+  EXPECT_EQ(verdict.criteria[0].name, "accel_bias_mg.x");
+  EXPECT_NEAR(verdict.criteria[0].margin, 10.0 * u, kWrittenLimitRounding);
+  verdict = judge(bounds(v + 0.5 * u, v + 10.0 * u));
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kConditionalFail);
+  EXPECT_FALSE(verdict.pass);
+  verdict = judge(bounds(v - 20.0 * u, v - 2.0 * u));
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kFail);
+  EXPECT_NE(verdict.criteria[0].limit_text.find(" .. "), std::string::npos);
+
+  // A chamber reading -40.2 .. 84.9 ran the -40..85 profile; -41 .. 83 did not.
+  cal.fit_temp_range_c = {-40.2, 84.9};
+  verdict = judge("  - {quantity: fit_temp_range_c, covers: [-40, 85]}\n");
+  EXPECT_TRUE(verdict.pass) << verdict.Table();
+  EXPECT_EQ(verdict.criteria[0].reason, "short of the range by less than its tolerance");
+  cal.fit_temp_range_c = {-39.0, 83.0};
+  EXPECT_FALSE(judge("  - {quantity: fit_temp_range_c, covers: [-40, 85]}\n").pass);
+  EXPECT_TRUE(judge("  - {quantity: fit_temp_range_c, covers: [-40, 85], covers_tolerance: 2}\n").pass);
+
+  // A hot-only run: its 25 degC figures are extrapolated, and the criterion says so.
+  cal.fit_temp_range_c = {40.0, 85.0};
+  const Figure* hot = FindFigure(KeyFigures(cal), "gyro_bias_dps.x");
+  ASSERT_NE(hot, nullptr);
+  EXPECT_TRUE(hot->extrapolated);
+  verdict = judge("  - {quantity: gyro_bias_dps, axes: [x], max_abs: 100}\n");
+  EXPECT_NE(verdict.criteria[0].reason.find(
+                "evaluated at 25 degC, outside the fitted range 40..85 degC: extrapolated"),
+            std::string::npos)
+      << verdict.criteria[0].reason;
+  cal.fit_temp_range_c = {-40.0, 85.0};
+  EXPECT_FALSE(FindFigure(KeyFigures(cal), "gyro_bias_dps.x")->extrapolated);
+
+  const std::string path = (dir_ / "bad_limits.yaml").string();
+  std::ofstream(path) << "format: imufit-limits\nversion: 1\ncriteria:\n"
+                         "  - {quantity: accel_bias_mg, max_abs: 5, max: 3}\n";
+  EXPECT_THROW(ReadLimits(path), InputError);
 }
 
 // The station file declares each source with u or a rectangular half width, in its units.

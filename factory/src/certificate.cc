@@ -136,7 +136,8 @@ std::vector<KeyFigureRow> FigureRows(const Calibration& cal, const UncertaintyBu
     rows.push_back({f.name, f.unit, is_coefficient, f.value, f.sigma,
                     b != nullptr && f.sigma >= 0.0 ? b->expanded
                     : f.sigma >= 0.0               ? kCoverageFactor * f.sigma
-                                                   : -1.0});
+                                                   : -1.0,
+                    f.extrapolated});
   }
   return rows;
 }

@@ -358,7 +358,9 @@ void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
         {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
     Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
     Num(h, f.expanded >= 0.0 ? Fmt("%.3g", f.expanded) : "\xe2\x80\x93");
-    h->Element("td", f.unit).Close("tr");
+    h->Element("td", f.extrapolated ? f.unit + ", extrapolated" : f.unit,
+               f.extrapolated ? HtmlAttributes{{"data-extrapolated", f.name}} : HtmlAttributes{})
+        .Close("tr");
   }
   h->Close("tbody").Close("table");
 }

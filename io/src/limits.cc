@@ -29,7 +29,8 @@ double PositiveNumber(const yaml::Located& value) {
 }
 
 LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
-  entry.RejectUnknownKeys({"quantity", "axes", "statistic", "max_abs", "covers"});
+  entry.RejectUnknownKeys(
+      {"quantity", "axes", "statistic", "max_abs", "min", "max", "covers", "covers_tolerance"});
   LimitCriterion criterion;
   const yaml::Located quantity = entry["quantity"];
   criterion.quantity = quantity.String();
@@ -83,9 +84,25 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
     const std::vector<double> range = covers.Doubles(2);
     if (!(range[0] < range[1])) covers.Fail("expected [lo, hi] with lo < hi");
     criterion.covers_c = {range[0], range[1]};
+    if (entry.Has("covers_tolerance")) {
+      const yaml::Located tolerance = entry["covers_tolerance"];
+      criterion.covers_tolerance_c = tolerance.Double();
+      if (!(criterion.covers_tolerance_c >= 0.0)) tolerance.Fail("must be a number >= 0");
+    }
   } else {
     if (entry.Has("covers")) entry["covers"].Fail("only fit_temp_range_c takes `covers`");
-    criterion.max_abs = PositiveNumber(entry["max_abs"]);
+    if (entry.Has("covers_tolerance")) entry["covers_tolerance"].Fail("only fit_temp_range_c takes it");
+    const bool bounds = entry.Has("min") || entry.Has("max");
+    if (bounds && entry.Has("max_abs")) entry["max_abs"].Fail("give max_abs, or min and/or max, not both");
+    if (!bounds) {
+      criterion.max_abs = PositiveNumber(entry["max_abs"]);
+    } else {
+      if (criterion.statistic == LimitStatistic::kSigma) entry.Fail("a 1-sigma takes max_abs, not min/max");
+      if (entry.Has("min")) criterion.min = entry["min"].Double();
+      if (entry.Has("max")) criterion.max = entry["max"].Double();
+      if (criterion.min && criterion.max && !(*criterion.min < *criterion.max))
+        entry["max"].Fail("expected min < max");
+    }
   }
   return criterion;
 }

@@ -27,6 +27,9 @@ struct Figure {
   std::string unit;         // "deg/s", "mg", ...
   double value = 0.0;
   double sigma = -1.0;  // 1-sigma; < 0 when the calibration has none
+  // A coefficient evaluated at 25 degC outside the calibration's fitted temperature range: the
+  // polynomial extrapolated.
+  bool extrapolated = false;
 };
 
 // Every coefficient at 25 degC and the residual RMS values, in a fixed order.

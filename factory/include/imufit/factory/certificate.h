@@ -83,6 +83,7 @@ struct KeyFigureRow {
   double sigma = -1.0;  // 1-sigma of the fit (Type A); < 0: none
   // U, k = 2, of the uncertainty budget (Type A and the station's Type B sources); < 0: none
   double expanded = -1.0;
+  bool extrapolated = false;  // evaluated at 25 degC outside the fitted range (Figure::extrapolated)
 };
 
 // One window's own estimate of a coefficient at the window's temperature T_w: the value of that

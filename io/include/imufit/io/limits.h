@@ -10,7 +10,8 @@
 //     - {quantity: gyro_bias_dps, max_abs: 0.5}                  # every axis
 //     - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.05, axes: [xx, yy, zz]}
 //     - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}   # the 1-sigma, not the value
-//     - {quantity: fit_temp_range_c, covers: [-20, 60]}
+//     - {quantity: fit_temp_range_c, covers: [-20, 60]}    # within kDefaultCoversToleranceC
+//     - {quantity: accel_bias_mg, min: -20, max: 35}      # the signed value, either side optional
 //   decision_rule: guarded                  # simple (the default) or guarded (ILAC-G8)
 //   guard_band: 1.0                         # guarded: w as a multiple of the figure's U (default 1)
 //
@@ -25,6 +26,7 @@
 #define IMUFIT_IO_LIMITS_H_
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,14 +74,21 @@ enum class DecisionRule { kSimple, kGuarded };
 // "simple", "guarded".
 const char* DecisionRuleName(DecisionRule rule);
 
+// How far the fitted range may fall short of a `covers` range, degC: a chamber that reads -40.2 ..
+// 84.9 degC ran the -40..85 profile (its own reading tolerance). `covers_tolerance` overrides it.
+inline constexpr double kDefaultCoversToleranceC = 0.5;
+
 struct LimitCriterion {
   std::string quantity;  // a kLimitQuantities name
   LimitKind kind = LimitKind::kCoefficient;
   std::string unit;
   std::vector<std::string> axes;  // the axes checked (all of the quantity's when not given)
   LimitStatistic statistic = LimitStatistic::kValue;
-  double max_abs = 0.0;                      // kCoefficient, kFigure: the limit, > 0
+  double max_abs = 0.0;  // kCoefficient, kFigure: the limit, > 0; 0 when min/max are given instead
+  // kCoefficient, kFigure: the signed value must lie within [min, max] (either may be absent).
+  std::optional<double> min, max;
   std::array<double, 2> covers_c{0.0, 0.0};  // kCoverage: lo < hi
+  double covers_tolerance_c = kDefaultCoversToleranceC;
 };
 
 struct Limits {
