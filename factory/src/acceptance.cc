@@ -5,6 +5,7 @@
 #include <optional>
 #include <utility>
 
+#include "imufit/factory/uncertainty_budget.h"
 #include "imufit/io/noise_file.h"
 
 namespace imufit {
@@ -25,7 +26,44 @@ std::optional<double> FitFigure(const Calibration& calibration, std::optional<do
   return value;
 }
 
+// The outcome of a criterion with U `expanded` under the verdict's rule.
+// (The margin is the distance inside the nearest limit, negative outside.)
+void Decide(const Verdict& verdict, CriterionResult* r) {
+  const double margin = r->margin, u = r->expanded;
+  if (!(u > 0.0)) {
+    r->outcome = margin > 0.0 ? Outcome::kPass : Outcome::kFail;
+    r->pass = r->outcome == Outcome::kPass;
+    return;
+  }
+  r->outcome = margin > u     ? Outcome::kPass
+               : margin > 0.0 ? Outcome::kConditionalPass
+               : margin > -u  ? Outcome::kConditionalFail
+                              : Outcome::kFail;
+  const double guard = verdict.rule == DecisionRule::kGuarded ? verdict.guard_band_u * u : 0.0;
+  r->pass = margin > guard;
+  if (r->outcome == Outcome::kConditionalPass || r->outcome == Outcome::kConditionalFail) {
+    r->reason = "within U = " + Number(u) + " " + r->unit + " of the limit";
+    if (verdict.rule == DecisionRule::kGuarded && r->outcome == Outcome::kConditionalPass) {
+      r->reason += ": inside the guard band, not accepted";
+    }
+  }
+}
+
 }  // namespace
+
+const char* OutcomeName(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kPass:
+      return "PASS";
+    case Outcome::kConditionalPass:
+      return "conditional pass";
+    case Outcome::kConditionalFail:
+      return "conditional fail";
+    case Outcome::kFail:
+      return "FAIL";
+  }
+  return "FAIL";
+}
 
 std::vector<Figure> KeyFigures(const Calibration& calibration) {
   const SensorModel* sigma = calibration.sigma ? &*calibration.sigma : nullptr;
@@ -34,9 +72,11 @@ std::vector<Figure> KeyFigures(const Calibration& calibration) {
     const CoefficientName& n = kCoefficientNames[coefficient];
     const EngineeringValue v =
         EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, kFigureTempC);
+    const auto& range = calibration.fit_temp_range_c;
     figures.push_back({quantity + "." + n.axis,
                        std::string(sensor == Sensor::kGyro ? "gyro." : "accel.") + n.group + "." + n.axis,
-                       EngineeringUnit(sensor, coefficient), v.value, v.sigma});
+                       EngineeringUnit(sensor, coefficient), v.value, v.sigma,
+                       range[1] > range[0] && (kFigureTempC < range[0] || kFigureTempC > range[1])});
   };
   for (int i = 0; i < 3; ++i) add("gyro_bias_dps", Sensor::kGyro, kBiasCoefficient + i);
   for (int i = 0; i < 3; ++i) add("accel_bias_mg", Sensor::kAccel, kBiasCoefficient + i);
@@ -90,6 +130,27 @@ int Verdict::Failed() const {
   return failed;
 }
 
+int Verdict::Conditional() const {
+  int conditional = 0;
+  for (const CriterionResult& c : criteria) {
+    conditional += c.outcome == Outcome::kConditionalPass || c.outcome == Outcome::kConditionalFail ? 1 : 0;
+  }
+  return conditional;
+}
+
+std::string Verdict::RuleText() const {
+  if (rule == DecisionRule::kGuarded) {
+    return "guarded acceptance (ILAC-G8): a value passes when it lies inside its limit by more than the "
+           "guard "
+           "band w = " +
+           Number(guard_band_u) +
+           " x U; a value within U of a limit is reported as a conditional pass (inside, not accepted) or a "
+           "conditional fail (outside).";
+  }
+  return "simple acceptance (ILAC-G8): a value passes when it lies inside its limit, whatever its U; a value "
+         "within U of a limit is reported as a conditional pass (inside) or a conditional fail (outside).";
+}
+
 std::string Verdict::FailedSummary() const {
   std::string text;
   for (const CriterionResult& c : criteria) {
@@ -110,18 +171,25 @@ std::string Verdict::Table() const {
                 "margin", "verdict");
   text += line;
   for (const CriterionResult& c : criteria) {
-    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", c.name.c_str(),
+    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s%s%s\n", c.name.c_str(),
                   c.measured_text.c_str(), c.limit_text.c_str(), c.margin_text.c_str(),
-                  c.pass ? "PASS" : "FAIL");
+                  OutcomeName(c.outcome), c.reason.empty() ? "" : ": ", c.reason.c_str());
     text += line;
   }
   return text;
 }
 
 Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
-                       const std::vector<Figure>& measured) {
+                       const std::vector<Figure>& measured, const UncertaintyBudget* budget) {
   Verdict verdict;
   verdict.limits_name = limits.name;
+  verdict.rule = limits.decision_rule;
+  verdict.guard_band_u = limits.guard_band_u;
+  // U of a figure: the budget's, else k = 2 times its 1-sigma; < 0: none.
+  const auto expanded = [&](const Figure& f) {
+    const FigureBudget* b = budget != nullptr ? budget->Find(f.name) : nullptr;
+    return b != nullptr ? b->expanded : f.sigma >= 0.0 ? 2.0 * f.sigma : -1.0;
+  };
   std::vector<Figure> figures = measured;  // found first: they take the place of the calibration's
   for (const Figure& f : KeyFigures(calibration)) figures.push_back(f);
   for (const LimitCriterion& criterion : limits.criteria) {
@@ -135,9 +203,12 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
       r.measured = r.margin;
       r.limit = 0.0;
       r.measured_text = Number(range[0]) + ".." + Number(range[1]) + " degC";
-      r.limit_text = "covers " + Number(criterion.covers_c[0]) + ".." + Number(criterion.covers_c[1]);
+      r.limit_text = "covers " + Number(criterion.covers_c[0]) + ".." + Number(criterion.covers_c[1]) +
+                     " (tolerance " + Number(criterion.covers_tolerance_c) + " degC)";
       r.margin_text = Number(r.margin) + " " + criterion.unit;
-      r.pass = r.margin >= 0.0;
+      r.pass = r.margin >= -criterion.covers_tolerance_c;
+      if (r.pass && r.margin < 0.0) r.reason = "short of the range by less than its tolerance";
+      r.outcome = r.pass ? Outcome::kPass : Outcome::kFail;
       verdict.criteria.push_back(r);
       continue;
     }
@@ -148,8 +219,17 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
       CriterionResult r;
       r.name = sigma ? "sigma(" + name + ")" : criterion.kind == LimitKind::kFigure ? name : "|" + name + "|";
       r.unit = criterion.unit;
+      const bool bounds = criterion.min || criterion.max;
+      if (bounds) r.name = name;
       r.limit = criterion.max_abs;
       r.limit_text = "< " + Number(criterion.max_abs) + " " + criterion.unit;
+      if (bounds) {
+        r.limit_text = criterion.min && criterion.max
+                           ? Number(*criterion.min) + " .. " + Number(*criterion.max) + " " + criterion.unit
+                       : criterion.min ? ">= " + Number(*criterion.min) + " " + criterion.unit
+                                       : "<= " + Number(*criterion.max) + " " + criterion.unit;
+      }
+      bool extrapolated = false;
       // Scale errors are relative to the nominal scale the limits file gives.
       const size_t error_at = name.find("_scale_error_");
       bool found = true;
@@ -161,11 +241,15 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
             gyro ? limits.nominal_gyro_scale / kRadToDeg : limits.nominal_accel_scale * kStandardGravityMps2;
         const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
         r.measured = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
+        if (!sigma && expanded(*scale) >= 0.0) r.expanded = expanded(*scale) / nominal * factor;
+        extrapolated = scale->extrapolated;
         found = !sigma || scale->sigma >= 0.0;
       } else {
         const Figure* figure = FindFigure(figures, name);
         found = figure != nullptr && (!sigma || figure->sigma >= 0.0);
         if (found) r.measured = sigma ? figure->sigma : figure->value;
+        if (found && !sigma) r.expanded = expanded(*figure);
+        extrapolated = found && figure->extrapolated;
       }
       if (!found) {
         r.measured_text = "not in calibration";
@@ -173,15 +257,29 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
         r.margin_text = "none";
         r.pass = false;
       } else {
-        // A max_abs criterion judges |value|: that is what it shows (a residual RMS is >= 0 anyway).
-        r.measured = std::abs(r.measured);
+        // A max_abs criterion judges |value|: that is what it shows (a residual RMS is >= 0 anyway);
+        // min/max judge the signed value, its margin to the nearer bound.
+        if (bounds) {
+          const double above_min = criterion.min ? r.measured - *criterion.min : HUGE_VAL;
+          const double below_max = criterion.max ? *criterion.max - r.measured : HUGE_VAL;
+          r.margin = std::min(above_min, below_max);
+          r.limit = below_max <= above_min ? *criterion.max : *criterion.min;
+        } else {
+          r.measured = std::abs(r.measured);
+          r.margin = r.limit - r.measured;
+        }
         r.measured_text = Number(r.measured) + " " + criterion.unit;
-        r.margin = r.limit - r.measured;
         // Coverage counts segments missing; its margin is segments to spare, not missing ones.
         r.margin_text = criterion.quantity == "coverage"
                             ? Number(r.margin) + (r.margin == 1.0 ? " segment" : " segments")
                             : Number(r.margin) + " " + criterion.unit;
-        r.pass = r.margin > 0.0;
+        Decide(verdict, &r);
+        if (extrapolated) {
+          const auto& range = calibration.fit_temp_range_c;
+          r.reason += std::string(r.reason.empty() ? "" : "; ") +
+                      "evaluated at 25 degC, outside the fitted range " + Number(range[0]) + ".." +
+                      Number(range[1]) + " degC: extrapolated";
+        }
       }
       verdict.criteria.push_back(r);
     }

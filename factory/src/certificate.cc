@@ -130,15 +130,19 @@ void Identify(const CertificateSources& sources, Certificate* c) {
   if (c->station) StationWarnings(*c->station, c->calibrated_utc, c->written_utc, &c->warnings);
 }
 
-// The key figures at 25 degC, with their expanded uncertainty.
-std::vector<KeyFigureRow> FigureRows(const Calibration& cal) {
+// The key figures at 25 degC, with their expanded uncertainty (the budget's, where it has the figure).
+std::vector<KeyFigureRow> FigureRows(const Calibration& cal, const UncertaintyBudget& budget) {
   std::vector<KeyFigureRow> rows;
   for (const Figure& f : KeyFigures(cal)) {
     // Coefficients have a path in the model ("gyro.bias.x"); the others are the fit's diagnostics
     // ("fit.gyro_residual_rms", "fit.missing_segments") and noise figures ("noise.gyro_x.arw...").
     const bool is_coefficient = f.coefficient.rfind("gyro.", 0) == 0 || f.coefficient.rfind("accel.", 0) == 0;
+    const FigureBudget* b = budget.Find(f.name);
     rows.push_back({f.name, f.unit, is_coefficient, f.value, f.sigma,
-                    f.sigma >= 0.0 ? kCoverageFactor * f.sigma : -1.0});
+                    b != nullptr && f.sigma >= 0.0 ? b->expanded
+                    : f.sigma >= 0.0               ? kCoverageFactor * f.sigma
+                                                   : -1.0,
+                    f.extrapolated});
   }
   return rows;
 }
@@ -208,7 +212,10 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   c.run = SummariseRun(cal, sources.plan, sources.run);
   CoverageWarnings(c.run, &c.warnings);
   c.settings = Settings(cal, sources.windows);
-  c.figures = FigureRows(cal);
+  c.budget =
+      ComputeBudget(cal, sources.plan, sources.run.windows,
+                    sources.station ? sources.station->uncertainty : std::vector<StationUncertainty>());
+  c.figures = FigureRows(cal, c.budget);
   DescribeErrors(sources, &c);
   const bool samples_given = std::any_of(c.inputs.begin(), c.inputs.end(),
                                          [](const ReportInput& in) { return in.role == "samples"; });
@@ -220,7 +227,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
     c.noise.why_not = "no samples file given";
   }
   c.verdict = sources.verdict;
-  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, MeasuredFigures(c));
+  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, MeasuredFigures(c), &c.budget);
   c.validation = ValidationRows(sources.folds);
   return c;
 }

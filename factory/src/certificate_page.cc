@@ -3,6 +3,7 @@
 
 #include <array>
 
+#include "certificate_budget_page.h"
 #include "imufit/factory/allan_plot.h"
 #include "imufit/factory/html.h"
 #include "imufit/io/output_file.h"
@@ -335,9 +336,12 @@ void Acceptance(Html* h, const Verdict& verdict) {
     Num(h, cr.measured_text);
     Num(h, cr.limit_text);
     Num(h, cr.margin_text);
-    h->Element("td", cr.pass ? "PASS" : "FAIL", {{"class", cr.pass ? "PASS" : "FAIL"}}).Close("tr");
+    h->Element("td", OutcomeName(cr.outcome) + (cr.reason.empty() ? std::string() : ": " + cr.reason),
+               {{"class", cr.pass ? "PASS" : "FAIL"}, {"data-outcome", OutcomeName(cr.outcome)}})
+        .Close("tr");
   }
   h->Close("tbody").Close("table");
+  internal::DecisionRuleNote(h, verdict);
 }
 
 void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
@@ -354,7 +358,9 @@ void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
         {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
     Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
     Num(h, f.expanded >= 0.0 ? Fmt("%.3g", f.expanded) : "\xe2\x80\x93");
-    h->Element("td", f.unit).Close("tr");
+    h->Element("td", f.extrapolated ? f.unit + ", extrapolated" : f.unit,
+               f.extrapolated ? HtmlAttributes{{"data-extrapolated", f.name}} : HtmlAttributes{})
+        .Close("tr");
   }
   h->Close("tbody").Close("table");
 }
@@ -363,8 +369,8 @@ void KeyFigures(Html* h, const Certificate& c) {
   h->Open("div", {{"class", "keep"}});
   h->Element("h2", "Coefficients at 25 degC");
   h->Element("p",
-             "1-sigma from the fit's covariance; U is the expanded uncertainty at k = 2 (about 95 % for a "
-             "normal distribution).",
+             "1-sigma from the fit's covariance (Type A); U is the expanded uncertainty of the budget below "
+             "(Type A and the station's Type B sources) at k = 2 (about 95 % for a normal distribution).",
              {{"class", "note"}});
   h->Open("div", {{"class", "cols"}});
   h->Open("div");
@@ -613,6 +619,7 @@ std::string CertificateHtml(const Certificate& c) {
   RunAndSettings(&h, c);
   if (c.verdict) Acceptance(&h, *c.verdict);
   KeyFigures(&h, c);
+  internal::BudgetSection(&h, c);
   CoefficientPlots(&h, c, svgs);
   ErrorPlots(&h, c, svgs);
   NoisePlot(&h, c, svgs);

@@ -109,7 +109,10 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
   // Without limits no unit is judged: the yield is not 0 %, it is not known (nan: "not judged").
   s.yield_pct = !limits ? std::nan("") : s.units > 0 ? 100.0 * batch.passed / s.units : 0.0;
   std::vector<std::string> names;
-  for (const UnitOutcome& u : batch.units) names.push_back(u.unit);
+  for (const UnitOutcome& u : batch.units) {
+    names.push_back(u.unit);
+    s.conditional += !u.verdict.empty() && u.verdict_detail.Conditional() > 0 ? 1 : 0;
+  }
   s.unit_prefix = SharedPrefix(names);
   for (const UnitOutcome& u : batch.units) {
     s.rows.push_back({u.unit, u.serial, u.status, u.verdict, u.message, u.status == "fitted",

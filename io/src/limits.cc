@@ -29,7 +29,8 @@ double PositiveNumber(const yaml::Located& value) {
 }
 
 LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
-  entry.RejectUnknownKeys({"quantity", "axes", "statistic", "max_abs", "covers"});
+  entry.RejectUnknownKeys(
+      {"quantity", "axes", "statistic", "max_abs", "min", "max", "covers", "covers_tolerance"});
   LimitCriterion criterion;
   const yaml::Located quantity = entry["quantity"];
   criterion.quantity = quantity.String();
@@ -83,19 +84,39 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
     const std::vector<double> range = covers.Doubles(2);
     if (!(range[0] < range[1])) covers.Fail("expected [lo, hi] with lo < hi");
     criterion.covers_c = {range[0], range[1]};
+    if (entry.Has("covers_tolerance")) {
+      const yaml::Located tolerance = entry["covers_tolerance"];
+      criterion.covers_tolerance_c = tolerance.Double();
+      if (!(criterion.covers_tolerance_c >= 0.0)) tolerance.Fail("must be a number >= 0");
+    }
   } else {
     if (entry.Has("covers")) entry["covers"].Fail("only fit_temp_range_c takes `covers`");
-    criterion.max_abs = PositiveNumber(entry["max_abs"]);
+    if (entry.Has("covers_tolerance")) entry["covers_tolerance"].Fail("only fit_temp_range_c takes it");
+    const bool bounds = entry.Has("min") || entry.Has("max");
+    if (bounds && entry.Has("max_abs")) entry["max_abs"].Fail("give max_abs, or min and/or max, not both");
+    if (!bounds) {
+      criterion.max_abs = PositiveNumber(entry["max_abs"]);
+    } else {
+      if (criterion.statistic == LimitStatistic::kSigma) entry.Fail("a 1-sigma takes max_abs, not min/max");
+      if (entry.Has("min")) criterion.min = entry["min"].Double();
+      if (entry.Has("max")) criterion.max = entry["max"].Double();
+      if (criterion.min && criterion.max && !(*criterion.min < *criterion.max))
+        entry["max"].Fail("expected min < max");
+    }
   }
   return criterion;
 }
 
 }  // namespace
 
+const char* DecisionRuleName(DecisionRule rule) {
+  return rule == DecisionRule::kGuarded ? "guarded" : "simple";
+}
+
 Limits ReadLimits(const std::string& path) {
   const YAML::Node root_node = yaml::LoadFile(path);
   const yaml::Located root{&path, root_node, ""};
-  root.RejectUnknownKeys({"format", "version", "name", "nominal", "criteria"});
+  root.RejectUnknownKeys({"format", "version", "name", "nominal", "criteria", "decision_rule", "guard_band"});
   root.RequireFormat("imufit-limits", kLimitsFormatVersion);
   Limits limits;
   limits.path = path;
@@ -105,6 +126,21 @@ Limits ReadLimits(const std::string& path) {
     nominal.RejectUnknownKeys({"gyro_scale", "accel_scale"});
     if (nominal.Has("gyro_scale")) limits.nominal_gyro_scale = PositiveNumber(nominal["gyro_scale"]);
     if (nominal.Has("accel_scale")) limits.nominal_accel_scale = PositiveNumber(nominal["accel_scale"]);
+  }
+  if (root.Has("decision_rule")) {
+    const yaml::Located rule = root["decision_rule"];
+    const std::string text = rule.String();
+    if (text == "guarded") {
+      limits.decision_rule = DecisionRule::kGuarded;
+    } else if (text != "simple") {
+      rule.Fail(QuoteForMessage(text) + " is not a decision rule (known: simple, guarded)");
+    }
+  }
+  if (root.Has("guard_band")) {
+    if (limits.decision_rule != DecisionRule::kGuarded) {
+      root["guard_band"].Fail("a guard band needs `decision_rule: guarded`");
+    }
+    limits.guard_band_u = PositiveNumber(root["guard_band"]);
   }
   const yaml::Located criteria = root["criteria"];
   for (size_t i = 0; i < criteria.Size(); ++i)

@@ -16,6 +16,10 @@
 #include "imufit/io/limits.h"
 
 namespace imufit {
+struct UncertaintyBudget;
+}
+
+namespace imufit {
 
 struct Figure {
   std::string name;         // quantity.axis, e.g. "gyro_bias_dps.x", "gyro_residual_rms_dps"
@@ -23,12 +27,21 @@ struct Figure {
   std::string unit;         // "deg/s", "mg", ...
   double value = 0.0;
   double sigma = -1.0;  // 1-sigma; < 0 when the calibration has none
+  // A coefficient evaluated at 25 degC outside the calibration's fitted temperature range: the
+  // polynomial extrapolated.
+  bool extrapolated = false;
 };
 
 // Every coefficient at 25 degC and the residual RMS values, in a fixed order.
 std::vector<Figure> KeyFigures(const Calibration& calibration);
 // The figure called `name` (or with that `coefficient` path); nullptr when there is none.
 const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name);
+
+// Where a value lies against its limit with its expanded uncertainty U (ILAC-G8): clear of the
+// limit by more than U on either side, or within U of it.
+enum class Outcome { kPass, kConditionalPass, kConditionalFail, kFail };
+// "PASS", "conditional pass", "conditional fail", "FAIL".
+const char* OutcomeName(Outcome outcome);
 
 struct CriterionResult {
   std::string name;  // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"
@@ -41,15 +54,26 @@ struct CriterionResult {
   // The margin with its unit ("0.0207 deg/s/g", "20 degC"; coverage: "1 segment", segments to spare);
   // "none" when the value is not in the calibration (there is nothing to measure a margin from).
   std::string margin_text;
+  double expanded = -1.0;  // U of the measured value (k = 2); < 0: none (then no conditional outcome)
+  Outcome outcome = Outcome::kFail;
+  // Accepted under the verdict's decision rule: simple, a value inside its limit; guarded, a value
+  // inside its limit less the guard band.
   bool pass = false;
+  std::string reason;  // why, when it is not a plain PASS: "within U = 0.002 deg/s of the limit"
 };
 
 struct Verdict {
   std::string limits_name;
   std::vector<CriterionResult> criteria;
   bool pass = true;
+  DecisionRule rule = DecisionRule::kSimple;
+  double guard_band_u = 1.0;
 
   int Failed() const;
+  // Criteria whose value lies within U of the limit (conditional pass or fail).
+  int Conditional() const;
+  // The rule in words, for the certificate: "simple acceptance (ILAC-G8): ...".
+  std::string RuleText() const;
   // "|gyro_g_sensitivity_dpsg.xx| 0.0712 > 0.05 deg/s/g; ..." — the failed criteria, one line.
   std::string FailedSummary() const;
   // The table `imufit fit --limits` prints: criterion, measured, limit, margin, PASS/FAIL.
@@ -58,8 +82,10 @@ struct Verdict {
 
 // `measured`: figures measured elsewhere (a certificate's own Allan deviation: ARW, bias
 // instability) that take the place of the calibration's figures of the same name.
+// `budget`: the expanded uncertainty of each coefficient figure (uncertainty_budget.h); without it
+// (or for a figure it lacks), U = 2 x the figure's 1-sigma.
 Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
-                       const std::vector<Figure>& measured = {});
+                       const std::vector<Figure>& measured = {}, const UncertaintyBudget* budget = nullptr);
 
 }  // namespace imufit
 

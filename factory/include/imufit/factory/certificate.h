@@ -22,6 +22,7 @@
 #include "imufit/factory/acceptance.h"
 #include "imufit/factory/batch.h"
 #include "imufit/factory/gyro_noise.h"
+#include "imufit/factory/uncertainty_budget.h"
 #include "imufit/fit/validation.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
@@ -79,8 +80,10 @@ struct KeyFigureRow {
   // negative (a residual RMS, a noise figure, segments missing).
   bool is_coefficient = false;
   double value = 0.0;
-  double sigma = -1.0;     // 1-sigma; < 0: none
-  double expanded = -1.0;  // k = 2; < 0: none
+  double sigma = -1.0;  // 1-sigma of the fit (Type A); < 0: none
+  // U, k = 2, of the uncertainty budget (Type A and the station's Type B sources); < 0: none
+  double expanded = -1.0;
+  bool extrapolated = false;  // evaluated at 25 degC outside the fitted range (Figure::extrapolated)
 };
 
 // One window's own estimate of a coefficient at the window's temperature T_w: the value of that
@@ -195,6 +198,8 @@ struct Certificate {
   RunSummary run;
   FitSettings settings;
   std::optional<Verdict> verdict;
+  // The uncertainty budget of the coefficient key figures: what `figures`' U are, what U covers.
+  UncertaintyBudget budget;
   std::vector<KeyFigureRow> figures;
   std::vector<CoefficientGroup> curves;
   WindowResiduals residuals;

@@ -60,6 +60,9 @@ struct LotSummary {
   std::string lot, written_utc, software, git_revision;
   std::string limits_name;  // the limits file's name, or its path; empty without limits
   int units = 0, passed = 0, failed = 0, not_fitted = 0, errors = 0;
+  // Units judged on a criterion within U of its limit (conditional pass or fail; also counted in
+  // passed or failed as the decision rule decided).
+  int conditional = 0;
   double yield_pct = 0.0;  // nan without limits: not judged
   std::vector<LotUnitRow> rows;
   std::string unit_prefix;  // what every unit's name starts with and the labels leave out

@@ -10,7 +10,14 @@
 //     - {quantity: gyro_bias_dps, max_abs: 0.5}                  # every axis
 //     - {quantity: gyro_g_sensitivity_dpsg, max_abs: 0.05, axes: [xx, yy, zz]}
 //     - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}   # the 1-sigma, not the value
-//     - {quantity: fit_temp_range_c, covers: [-20, 60]}
+//     - {quantity: fit_temp_range_c, covers: [-20, 60]}    # within kDefaultCoversToleranceC
+//     - {quantity: accel_bias_mg, min: -20, max: 35}      # the signed value, either side optional
+//   decision_rule: guarded                  # simple (the default) or guarded (ILAC-G8)
+//   guard_band: 1.0                         # guarded: w as a multiple of the figure's U (default 1)
+//
+// The decision rule (ILAC-G8:09/2019): a value whose interval +-U reaches over its limit is a
+// "conditional pass" (inside the limit) or a "conditional fail" (outside). Simple acceptance passes
+// the value inside its limit; guarded acceptance passes it only inside the limit less w = guard_band x U.
 //
 // Quantities are the 25 degC values of coefficients in familiar units (kLimitQuantities), fit
 // residual RMS values, and the fitted temperature range. The reader checks every name, axis and
@@ -19,6 +26,7 @@
 #define IMUFIT_IO_LIMITS_H_
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,14 +70,25 @@ inline constexpr LimitQuantity kLimitQuantities[] = {
 
 enum class LimitStatistic { kValue, kSigma };
 
+enum class DecisionRule { kSimple, kGuarded };
+// "simple", "guarded".
+const char* DecisionRuleName(DecisionRule rule);
+
+// How far the fitted range may fall short of a `covers` range, degC: a chamber that reads -40.2 ..
+// 84.9 degC ran the -40..85 profile (its own reading tolerance). `covers_tolerance` overrides it.
+inline constexpr double kDefaultCoversToleranceC = 0.5;
+
 struct LimitCriterion {
   std::string quantity;  // a kLimitQuantities name
   LimitKind kind = LimitKind::kCoefficient;
   std::string unit;
   std::vector<std::string> axes;  // the axes checked (all of the quantity's when not given)
   LimitStatistic statistic = LimitStatistic::kValue;
-  double max_abs = 0.0;                      // kCoefficient, kFigure: the limit, > 0
+  double max_abs = 0.0;  // kCoefficient, kFigure: the limit, > 0; 0 when min/max are given instead
+  // kCoefficient, kFigure: the signed value must lie within [min, max] (either may be absent).
+  std::optional<double> min, max;
   std::array<double, 2> covers_c{0.0, 0.0};  // kCoverage: lo < hi
+  double covers_tolerance_c = kDefaultCoversToleranceC;
 };
 
 struct Limits {
@@ -78,6 +97,8 @@ struct Limits {
   double nominal_gyro_scale = 0.0;   // raw per rad/s; 0: not given
   double nominal_accel_scale = 0.0;  // raw per m/s^2; 0: not given
   std::vector<LimitCriterion> criteria;
+  DecisionRule decision_rule = DecisionRule::kSimple;
+  double guard_band_u = 1.0;  // guarded acceptance: w = guard_band_u x U
 };
 
 Limits ReadLimits(const std::string& path);

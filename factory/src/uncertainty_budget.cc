@@ -1,0 +1,291 @@
+#include "imufit/factory/uncertainty_budget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+
+#include "imufit/factory/acceptance.h"
+#include "imufit/fit/thermal_fit.h"
+#include "imufit/fit/truth_perturbation.h"
+
+namespace imufit {
+namespace {
+
+// One component of a source: its name and the perturbation of one standard uncertainty.
+struct Component {
+  std::string name;
+  TruthPerturbation one_u;
+};
+
+const StationInfluenceInfo& Info(StationInfluence influence) {
+  for (const StationInfluenceInfo& info : kStationUncertainties) {
+    if (info.influence == influence) return info;
+  }
+  return kStationUncertainties[0];
+}
+
+std::vector<Component> Components(const StationUncertainty& source, double gravity_mps2) {
+  const std::string title = Info(source.influence).title;
+  const double u = source.u_si;
+  std::vector<Component> components;
+  const auto vector_components = [&](const char* const names[3], const char* word,
+                                     Eigen::Vector3d TruthPerturbation::*member) {
+    for (int i = 0; i < 3; ++i) {
+      Component c{title + " " + word + " " + names[i], {}};
+      (c.one_u.*member)[i] = u;
+      components.push_back(c);
+    }
+  };
+  static const char* const kAxes[3] = {"x", "y", "z"};
+  static const char* const kPairs[3] = {"xy", "xz", "yz"};
+  switch (source.influence) {
+    case StationInfluence::kRateAccuracy:
+      components.push_back({title, {}});
+      components.back().one_u.rate_scale = u;
+      break;
+    case StationInfluence::kTableAxisTilt:
+      vector_components(kAxes, "about", &TruthPerturbation::tilt_rad);
+      break;
+    case StationInfluence::kFixtureOrthogonality:
+      vector_components(kPairs, "", &TruthPerturbation::orthogonality_rad);
+      break;
+    case StationInfluence::kFixtureAlignment:
+      vector_components(kAxes, "about", &TruthPerturbation::alignment_rad);
+      break;
+    case StationInfluence::kLocalGravity:
+      components.push_back({title, {}});
+      components.back().one_u.gravity_scale = u / gravity_mps2;
+      break;
+    case StationInfluence::kThermometer:
+      components.push_back({title, {}});
+      components.back().one_u.temp_offset_c = u;
+      break;
+  }
+  for (Component& c : components) {
+    if (const size_t twice = c.name.find("  "); twice != std::string::npos) c.name.erase(twice, 1);
+  }
+  return components;
+}
+
+// A perturbation times a number (a draw in units of u).
+TruthPerturbation Scaled(const TruthPerturbation& p, double z) {
+  TruthPerturbation s;
+  s.rate_scale = p.rate_scale * z;
+  s.gravity_scale = p.gravity_scale * z;
+  s.tilt_rad = p.tilt_rad * z;
+  s.orthogonality_rad = p.orthogonality_rad * z;
+  s.alignment_rad = p.alignment_rad * z;
+  s.temp_offset_c = p.temp_offset_c * z;
+  return s;
+}
+
+TruthPerturbation Sum(const TruthPerturbation& a, const TruthPerturbation& b) {
+  TruthPerturbation s;
+  s.rate_scale = a.rate_scale + b.rate_scale;
+  s.gravity_scale = a.gravity_scale + b.gravity_scale;
+  s.tilt_rad = a.tilt_rad + b.tilt_rad;
+  s.orthogonality_rad = a.orthogonality_rad + b.orthogonality_rad;
+  s.alignment_rad = a.alignment_rad + b.alignment_rad;
+  s.temp_offset_c = a.temp_offset_c + b.temp_offset_c;
+  return s;
+}
+
+// The settings the calibration was fitted with (its `fit:` record), the held groups at their values.
+FitOptions RefitOptions(const Calibration& calibration) {
+  const FitRecord& record = *calibration.fit;
+  FitOptions options;
+  options.held = calibration.model;
+  options.gyro_temp_order = record.gyro_temp_order.value_or(options.gyro_temp_order);
+  options.accel_temp_order = record.accel_temp_order.value_or(options.accel_temp_order);
+  options.fit_g_sensitivity = record.g_sensitivity_fitted.value_or(true);
+  if (record.loss) {
+    std::string error;
+    ParseRobustLoss(*record.loss, &options.loss, &error);
+  }
+  if (record.fitted) {
+    const auto has = [&](const char* group) {
+      return std::find(record.fitted->begin(), record.fitted->end(), group) != record.fitted->end();
+    };
+    options.gyro_fit = has("gyro.scale")  ? SensorFit::kAll
+                       : has("gyro.bias") ? SensorFit::kBias
+                                          : SensorFit::kNone;
+    options.accel_fit = has("accel.scale")  ? SensorFit::kAll
+                        : has("accel.bias") ? SensorFit::kBias
+                                            : SensorFit::kNone;
+  }
+  options.num_threads = 1;
+  return options;
+}
+
+bool IsCoefficient(const Figure& f) {
+  return f.coefficient.rfind("gyro.", 0) == 0 || f.coefficient.rfind("accel.", 0) == 0;
+}
+
+// The coefficient key figures of the model the fit gives under the truth perturbed by `p`; empty
+// when that fit is not usable.
+std::vector<double> RefitFigures(const Calibration& calibration, const Plan& plan,
+                                 const std::vector<Window>& windows, const FitOptions& options,
+                                 const TruthPerturbation& p) {
+  TableSite site = plan.site;
+  std::vector<TableSegment> segments = plan.segments;
+  std::vector<Window> perturbed = windows;
+  PerturbTruth(p, &site, &segments, &perturbed);
+  const FitSummary fit = FitThermalModel(perturbed, site, segments, options);
+  if (!fit.IsSolutionUsable()) return {};
+  Calibration refitted = calibration;
+  refitted.model = fit.model;
+  std::vector<double> values;
+  for (const Figure& f : KeyFigures(refitted)) {
+    if (IsCoefficient(f)) values.push_back(f.value);
+  }
+  return values;
+}
+
+std::string InputText(const StationUncertainty& s) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%.4g %s%s", s.written, s.unit.c_str(),
+                s.rectangular ? " (half width, rectangular)" : "");
+  return text;
+}
+
+std::vector<BudgetClass> Classes(const std::vector<FigureBudget>& figures) {
+  std::vector<BudgetClass> classes;
+  std::map<std::string, double> sums;
+  int axes = 0;
+  const auto close = [&]() {
+    if (classes.empty()) return;
+    BudgetClass& c = classes.back();
+    c.type_a_rms = std::sqrt(c.type_a_rms / axes);
+    for (const auto& [source, sum] : sums) c.top.push_back({source, std::sqrt(sum / axes)});
+    std::sort(c.top.begin(), c.top.end(),
+              [](const BudgetClassLine& a, const BudgetClassLine& b) { return a.rms > b.rms; });
+    if (c.top.size() > kBudgetTopContributors) c.top.resize(kBudgetTopContributors);
+  };
+  for (const FigureBudget& f : figures) {
+    const std::string quantity = f.name.substr(0, f.name.rfind('.'));
+    if (classes.empty() || classes.back().quantity != quantity) {
+      close();
+      classes.push_back({quantity, f.unit, 0.0, {}});
+      sums.clear();
+      axes = 0;
+    }
+    ++axes;
+    classes.back().type_a_rms += f.type_a * f.type_a;
+    // A source's components together (the three of a tilt are one source's).
+    std::map<std::string, double> by_source;
+    for (const BudgetLine& line : f.type_b) {
+      by_source[line.source.substr(0, line.source.find(" about "))] += line.contribution * line.contribution;
+    }
+    for (const auto& [source, sum] : by_source) sums[source] += sum;
+  }
+  close();
+  return classes;
+}
+
+void Statements(UncertaintyBudget* budget) {
+  std::string covers = "U (k = 2, about 95 %) covers the fit's statistical uncertainty (white noise";
+  covers +=
+      budget->bias_stability_included ? " and the stated bias stability)" : " only: no bias stability given)";
+  if (budget->inputs.empty()) {
+    covers += "; the station declares no Type B source, so none is included";
+  } else {
+    covers += " and the station's Type B sources:";
+    for (size_t i = 0; i < budget->inputs.size(); ++i) {
+      covers += std::string(i == 0 ? " " : ", ") + Info(budget->inputs[i].influence).title;
+    }
+  }
+  budget->covers = covers + ".";
+  budget->not_covered =
+      "U does not cover the unit's drift after calibration, its hysteresis and repeatability between runs, "
+      "terms the model does not have, the table's position (turn angle) accuracy, or any source the station "
+      "does not declare.";
+}
+
+}  // namespace
+
+const FigureBudget* UncertaintyBudget::Find(const std::string& name) const {
+  for (const FigureBudget& f : figures) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+UncertaintyBudget ComputeBudget(const Calibration& calibration, const Plan& plan,
+                                const std::vector<Window>& windows,
+                                const std::vector<StationUncertainty>& sources) {
+  UncertaintyBudget budget;
+  budget.bias_stability_included =
+      calibration.fit && (calibration.fit->gyro_bias_stability_radps.value_or(0.0) > 0.0 ||
+                          calibration.fit->accel_bias_stability_mps2.value_or(0.0) > 0.0);
+  for (const Figure& f : KeyFigures(calibration)) {
+    if (!IsCoefficient(f)) continue;
+    FigureBudget b;
+    b.name = f.name;
+    b.unit = f.unit;
+    b.value = f.value;
+    b.type_a = std::max(f.sigma, 0.0);
+    budget.figures.push_back(b);
+  }
+  if (calibration.fit && !windows.empty() && !sources.empty()) {
+    const FitOptions options = RefitOptions(calibration);
+    const std::vector<double> base = RefitFigures(calibration, plan, windows, options, {});
+    if (base.size() == budget.figures.size()) {
+      budget.inputs = sources;
+      for (const StationUncertainty& source : sources) {
+        for (const Component& c : Components(source, plan.site.gravity_mps2)) {
+          const std::vector<double> moved = RefitFigures(calibration, plan, windows, options, c.one_u);
+          if (moved.size() != base.size()) continue;
+          for (size_t i = 0; i < base.size(); ++i) {
+            budget.figures[i].type_b.push_back(
+                {c.name, source.source, InputText(source), moved[i] - base[i]});
+          }
+        }
+      }
+    }
+  }
+  for (FigureBudget& f : budget.figures) {
+    double variance = f.type_a * f.type_a;
+    for (const BudgetLine& line : f.type_b) variance += line.contribution * line.contribution;
+    std::sort(f.type_b.begin(), f.type_b.end(), [](const BudgetLine& a, const BudgetLine& b) {
+      return std::abs(a.contribution) > std::abs(b.contribution);
+    });
+    f.combined = std::sqrt(variance);
+    f.expanded = budget.coverage_factor * f.combined;
+  }
+  budget.classes = Classes(budget.figures);
+  Statements(&budget);
+  return budget;
+}
+
+std::vector<double> MonteCarloTypeB(const Calibration& calibration, const Plan& plan,
+                                    const std::vector<Window>& windows,
+                                    const std::vector<StationUncertainty>& sources, int trials,
+                                    unsigned seed) {
+  const FitOptions options = RefitOptions(calibration);
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> uniform(-std::sqrt(3.0), std::sqrt(3.0));  // unit variance
+  std::vector<std::vector<double>> draws;
+  for (int trial = 0; trial < trials; ++trial) {
+    TruthPerturbation draw;
+    for (const StationUncertainty& source : sources) {
+      for (const Component& c : Components(source, plan.site.gravity_mps2)) {
+        draw = Sum(draw, Scaled(c.one_u, source.rectangular ? uniform(random) : normal(random)));
+      }
+    }
+    std::vector<double> values = RefitFigures(calibration, plan, windows, options, draw);
+    if (!values.empty()) draws.push_back(std::move(values));
+  }
+  std::vector<double> spread(draws.empty() ? 0 : draws[0].size(), 0.0);
+  for (size_t i = 0; i < spread.size() && draws.size() > 1; ++i) {
+    double mean = 0.0, variance = 0.0;
+    for (const std::vector<double>& d : draws) mean += d[i] / static_cast<double>(draws.size());
+    for (const std::vector<double>& d : draws) variance += (d[i] - mean) * (d[i] - mean);
+    spread[i] = std::sqrt(variance / static_cast<double>(draws.size() - 1));
+  }
+  return spread;
+}
+
+}  // namespace imufit

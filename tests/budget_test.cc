@@ -1,0 +1,382 @@
+// Tests of the uncertainty budget (factory/uncertainty_budget.h): a hand-computed case for the rate
+// table's rate accuracy and for local gravity, the propagation against a Monte Carlo of GUM
+// Supplement 1, and the station file's declarations of its sources.
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "imufit/factory/certificate.h"
+#include "imufit/factory/certificate_page.h"
+#include "imufit/factory/lot_summary.h"
+#include "imufit/factory/uncertainty_budget.h"
+#include "imufit/io/calibration.h"
+#include "imufit/io/error.h"
+#include "imufit/io/plan.h"
+#include "imufit/io/samples.h"
+#include "imufit/io/station.h"
+#include "imufit/pipeline/fit_run.h"
+#include "imufit/sim/simulator.h"
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kPlan = std::string(IMUFIT_FIXTURES_DIR) + "/plan_6pos.yaml";
+const std::string kTruth = std::string(IMUFIT_FIXTURES_DIR) + "/mems_truth.yaml";
+
+// The propagated contribution of a 10 ppm rate error to a gyro scale factor: 10 ppm of it, to
+// within this fraction (the re-solved fit moves other coefficients a little too).
+constexpr double kHandComputedTolerance = 0.02;
+// Monte Carlo trials, and how far its standard deviation may be from the propagated one: the
+// estimate's own relative spread is 1 / sqrt(2 N) = 0.065 at N = 120; 0.26 is four times that.
+constexpr int kMonteCarloTrials = 120;
+constexpr double kMonteCarloTolerance = 0.26;
+// std::to_string writes a limit to 6 decimals.
+constexpr double kWrittenLimitRounding = 1e-6;
+
+class BudgetTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("imufit_budget_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    const Plan plan = ReadPlan(kPlan);
+    SimulationOptions simulation;
+    simulation.soak_temps_c = {-20.0, 25.0, 60.0};
+    simulation.rate_hz = 20.0;
+    simulation.dwell_s = 4.0;
+    simulation.transition_s = 1.0;
+    simulation.gyro_noise_density = 8.7e-5;
+    simulation.accel_noise_density = 1.5e-3;
+    simulation.seed = 11;
+    const std::string samples = (dir_ / "samples.csv").string();
+    SamplesWriter writer(samples, SampleColumns{true, true}, "serial: SN-BUDGET");
+    SimulateRun(simulation, plan.site, plan.segments, ReadCalibration(kTruth).model,
+                [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+    writer.Commit();
+    FitRunOptions options;
+    options.fit.gyro_temp_order = options.fit.accel_temp_order = 2;
+    fit_ = new FitRunResult(FitRun(kPlan, samples, options));
+  }
+  static void TearDownTestSuite() {
+    delete fit_;
+    fs::remove_all(dir_);
+  }
+
+  static StationUncertainty Source(StationInfluence influence, double u_si) {
+    StationUncertainty s;
+    s.influence = influence;
+    s.u_si = u_si;
+    s.source = "test";
+    return s;
+  }
+  static UncertaintyBudget Budget(const std::vector<StationUncertainty>& sources) {
+    return ComputeBudget(*fit_->calibration, fit_->plan, fit_->run.windows, sources);
+  }
+
+  static fs::path dir_;
+  static FitRunResult* fit_;
+};
+fs::path BudgetTest::dir_;
+FitRunResult* BudgetTest::fit_ = nullptr;
+
+// By hand: the table turns at (1 + 10 ppm) x the planned rate, so the raw output per true deg/s is
+// 10 ppm smaller than the fit believed; the scale's u gains 10 ppm, and U = 2 sqrt(u_A^2 + (10 ppm)^2)
+// is at least 20 ppm of the scale.
+TEST_F(BudgetTest, TenPpmRateAccuracyGivesAGyroScaleUOfAtLeast20Ppm) {
+  ASSERT_TRUE(fit_->calibration.has_value()) << fit_->fit.BriefReport();
+  const UncertaintyBudget budget = Budget({Source(StationInfluence::kRateAccuracy, 10e-6)});
+  for (const char* axis : {"x", "y", "z"}) {
+    const FigureBudget* scale = budget.Find(std::string("gyro_scale_per_dps.") + axis);
+    ASSERT_NE(scale, nullptr);
+    ASSERT_EQ(scale->type_b.size(), 1u);
+    const double contribution_ppm = scale->type_b[0].contribution / scale->value * 1e6;
+    EXPECT_NEAR(contribution_ppm, -10.0, 10.0 * kHandComputedTolerance) << axis;
+    const double expanded_ppm = scale->expanded / scale->value * 1e6;
+    EXPECT_GE(expanded_ppm, 20.0) << axis;
+    const double type_a_ppm = scale->type_a / scale->value * 1e6;
+    EXPECT_NEAR(expanded_ppm, 2.0 * std::hypot(type_a_ppm, contribution_ppm), 1e-9) << axis;
+    // The accelerometer does not see the table's rate.
+    const FigureBudget* accel = budget.Find(std::string("accel_scale_per_g.") + axis);
+    ASSERT_NE(accel, nullptr);
+    EXPECT_NEAR(accel->expanded, 2.0 * accel->type_a, 1e-3 * accel->expanded) << axis;
+  }
+  ASSERT_FALSE(budget.classes.empty());
+  EXPECT_NE(budget.covers.find("Rate table rate accuracy"), std::string::npos);
+  EXPECT_NE(budget.not_covered.find("drift"), std::string::npos);
+}
+
+// By hand: gravity 10 ppm larger than the plan's makes every accelerometer scale 10 ppm smaller.
+TEST_F(BudgetTest, LocalGravityMovesTheAccelScaleByItsRelativeU) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const double g = fit_->plan.site.gravity_mps2;
+  const UncertaintyBudget budget = Budget({Source(StationInfluence::kLocalGravity, 10e-6 * g)});
+  for (const char* axis : {"x", "y", "z"}) {
+    const FigureBudget* scale = budget.Find(std::string("accel_scale_per_g.") + axis);
+    ASSERT_NE(scale, nullptr);
+    ASSERT_EQ(scale->type_b.size(), 1u);
+    // The figure is raw per g of the standard gravity: the change is the scale's own.
+    EXPECT_NEAR(scale->type_b[0].contribution / scale->value * 1e6, -10.0, 10.0 * kHandComputedTolerance);
+  }
+}
+
+// Without declared sources the budget is the fit's Type A alone, k = 2.
+TEST_F(BudgetTest, WithoutSourcesUIsTwiceTheFitsSigma) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const UncertaintyBudget budget = Budget({});
+  ASSERT_FALSE(budget.figures.empty());
+  for (const FigureBudget& f : budget.figures) {
+    EXPECT_TRUE(f.type_b.empty());
+    EXPECT_DOUBLE_EQ(f.expanded, 2.0 * f.type_a) << f.name;
+  }
+  EXPECT_NE(budget.covers.find("declares no Type B source"), std::string::npos);
+}
+
+// GUM Supplement 1: every source drawn at once, the fit re-solved per draw; the spread of every
+// figure that the sources move agrees with the propagated sum of squares.
+TEST_F(BudgetTest, PropagationAgreesWithMonteCarlo) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  StationUncertainty tilt = Source(StationInfluence::kTableAxisTilt, 20.0 / 206264.806 / std::sqrt(3.0));
+  tilt.rectangular = true;
+  const std::vector<StationUncertainty> sources = {Source(StationInfluence::kRateAccuracy, 50e-6),
+                                                   tilt,
+                                                   Source(StationInfluence::kFixtureAlignment, 0.5e-3),
+                                                   Source(StationInfluence::kFixtureOrthogonality, 0.2e-3),
+                                                   Source(StationInfluence::kThermometer, 0.5),
+                                                   Source(StationInfluence::kLocalGravity, 1e-4)};
+  const UncertaintyBudget budget = Budget(sources);
+  const std::vector<double> spread =
+      MonteCarloTypeB(*fit_->calibration, fit_->plan, fit_->run.windows, sources, kMonteCarloTrials, 7);
+  ASSERT_EQ(spread.size(), budget.figures.size());
+  int compared = 0;
+  for (size_t i = 0; i < spread.size(); ++i) {
+    const FigureBudget& f = budget.figures[i];
+    double type_b = 0.0;
+    for (const BudgetLine& line : f.type_b) type_b += line.contribution * line.contribution;
+    type_b = std::sqrt(type_b);
+    // Figures the sources hardly move (below 1e-3 of their Type A) are compared for being small.
+    if (type_b < 1e-3 * f.type_a) {
+      EXPECT_LT(spread[i], 1e-2 * f.type_a) << f.name;
+      continue;
+    }
+    EXPECT_NEAR(spread[i] / type_b, 1.0, kMonteCarloTolerance)
+        << f.name << ": MC " << spread[i] << ", law " << type_b;
+    ++compared;
+  }
+  EXPECT_GE(compared, 9) << "scales and misalignments at least";
+}
+
+// The certificate's U are the budget's, and the page prints the budget with what U covers.
+TEST_F(BudgetTest, TheCertificateCarriesTheBudget) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  CertificateSources sources;
+  sources.calibration = *fit_->calibration;
+  sources.plan = fit_->plan;
+  sources.run = fit_->run;
+  Station station;
+  station.name = "bench";
+  station.path = kPlan;  // any file: the certificate lists it with its hash
+  station.uncertainty = {Source(StationInfluence::kRateAccuracy, 10e-6)};
+  sources.station = station;
+  ReadCertificateFiles(&sources);
+  const Certificate c = MakeCertificate(sources);
+  const FigureBudget* budget = c.budget.Find("gyro_scale_per_dps.x");
+  ASSERT_NE(budget, nullptr);
+  bool found = false;
+  for (const KeyFigureRow& row : c.figures) {
+    if (row.name != "gyro_scale_per_dps.x") continue;
+    found = true;
+    EXPECT_DOUBLE_EQ(row.expanded, budget->expanded);
+    EXPECT_GE(row.expanded / row.value * 1e6, 20.0);
+  }
+  EXPECT_TRUE(found);
+  const std::string html = CertificateHtml(c);
+  EXPECT_NE(html.find("data-budget-class=\"gyro_scale_per_dps\""), std::string::npos);
+  EXPECT_NE(html.find("Rate table rate accuracy"), std::string::npos);
+  EXPECT_NE(html.find("U does not cover the unit"), std::string::npos);
+}
+
+// ILAC-G8: a value within U of its limit is conditional; simple acceptance passes it when inside,
+// guarded acceptance (w = U) does not; a lot counts such units apart.
+TEST_F(BudgetTest, DecisionRuleJudgesWithU) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const UncertaintyBudget budget = Budget({Source(StationInfluence::kRateAccuracy, 10e-6)});
+  const FigureBudget* bias = budget.Find("gyro_bias_dps.x");
+  ASSERT_NE(bias, nullptr);
+  const double value = std::abs(bias->value), u = bias->expanded;
+  ASSERT_GT(u, 0.0);
+  const auto judge = [&](double limit, DecisionRule rule) {
+    Limits limits;
+    limits.decision_rule = rule;
+    LimitCriterion criterion;
+    criterion.quantity = "gyro_bias_dps";
+    criterion.unit = "deg/s";
+    criterion.axes = {"x"};
+    criterion.max_abs = limit;
+    limits.criteria = {criterion};
+    return EvaluateLimits(limits, *fit_->calibration, {}, &budget);
+  };
+  struct Case {
+    double limit;
+    DecisionRule rule;
+    Outcome outcome;
+    bool pass;
+  };
+  const Case cases[] = {{value + 2.0 * u, DecisionRule::kSimple, Outcome::kPass, true},
+                        {value + 0.5 * u, DecisionRule::kSimple, Outcome::kConditionalPass, true},
+                        {value + 0.5 * u, DecisionRule::kGuarded, Outcome::kConditionalPass, false},
+                        {value - 0.5 * u, DecisionRule::kSimple, Outcome::kConditionalFail, false},
+                        {value - 2.0 * u, DecisionRule::kGuarded, Outcome::kFail, false}};
+  for (const Case& c : cases) {
+    const Verdict verdict = judge(c.limit, c.rule);
+    ASSERT_EQ(verdict.criteria.size(), 1u);
+    const CriterionResult& r = verdict.criteria[0];
+    EXPECT_EQ(r.outcome, c.outcome) << c.limit << " " << OutcomeName(r.outcome);
+    EXPECT_EQ(r.pass, c.pass) << c.limit;
+    EXPECT_EQ(verdict.pass, c.pass);
+    EXPECT_DOUBLE_EQ(r.expanded, u);
+    const bool conditional = c.outcome == Outcome::kConditionalPass || c.outcome == Outcome::kConditionalFail;
+    EXPECT_EQ(verdict.Conditional(), conditional ? 1 : 0);
+    EXPECT_EQ(r.reason.find("within U = ") == 0, conditional) << r.reason;
+    EXPECT_NE(verdict.RuleText().find(c.rule == DecisionRule::kGuarded ? "guarded" : "simple"),
+              std::string::npos);
+  }
+
+  // The lot: one clear pass, one conditional pass, one conditional fail.
+  BatchResult batch;
+  for (double limit : {value + 2.0 * u, value + 0.5 * u, value - 0.5 * u}) {
+    UnitOutcome unit;
+    unit.unit = "unit-" + std::to_string(batch.units.size());
+    unit.status = "fitted";
+    unit.verdict_detail = judge(limit, DecisionRule::kSimple);
+    unit.verdict = unit.verdict_detail.pass ? "PASS" : "FAIL";
+    (unit.verdict_detail.pass ? batch.passed : batch.failed) += 1;
+    batch.units.push_back(unit);
+  }
+  const LotSummary lot = MakeLotSummary("lot", batch, "imufit test", std::nullopt);
+  EXPECT_EQ(lot.passed, 2);
+  EXPECT_EQ(lot.conditional, 2);
+}
+
+// The limits file chooses the rule; a guard band needs the guarded rule.
+TEST_F(BudgetTest, LimitsFileChoosesTheRule) {
+  const std::string path = (dir_ / "limits.yaml").string();
+  const std::string head =
+      "format: imufit-limits\nversion: 1\ncriteria:\n  - {quantity: gyro_bias_dps, max_abs: 1}\n";
+  std::ofstream(path) << head;
+  EXPECT_EQ(ReadLimits(path).decision_rule, DecisionRule::kSimple);
+  std::ofstream(path) << head << "decision_rule: guarded\nguard_band: 0.5\n";
+  const Limits guarded = ReadLimits(path);
+  EXPECT_EQ(guarded.decision_rule, DecisionRule::kGuarded);
+  EXPECT_DOUBLE_EQ(guarded.guard_band_u, 0.5);
+  std::ofstream(path) << head << "guard_band: 0.5\n";
+  EXPECT_THROW(ReadLimits(path), InputError);
+  std::ofstream(path) << head << "decision_rule: strict\n";
+  try {
+    ReadLimits(path);
+    ADD_FAILURE() << "an unknown rule";
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("limits.yaml:5:16: decision_rule: \"strict\" is not a decision rule"),
+        std::string::npos)
+        << e.what();
+  }
+}
+
+// Limits as specifications are written: min/max on the signed value, a tolerance on `covers`, and a
+// figure evaluated outside the fitted range marked extrapolated in the criterion's reason.
+TEST_F(BudgetTest, LimitsAsSpecificationsAreWritten) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  Calibration cal = *fit_->calibration;
+  const Figure* bias = FindFigure(KeyFigures(cal), "accel_bias_mg.x");
+  ASSERT_NE(bias, nullptr);
+  const double u = 2.0 * bias->sigma;
+  const auto judge = [&](const std::string& criteria) {
+    const std::string path = (dir_ / "spec_limits.yaml").string();
+    std::ofstream(path) << "format: imufit-limits\nversion: 1\ncriteria:\n" << criteria;
+    return EvaluateLimits(ReadLimits(path), cal);
+  };
+  const auto bounds = [&](double lo, double hi) {
+    return "  - {quantity: accel_bias_mg, axes: [x], min: " + std::to_string(lo) +
+           ", max: " + std::to_string(hi) + "}\n";
+  };
+  // Asymmetric: the value 10 U inside both bounds, 0.5 U below min, 2 U above max.
+  const double v = bias->value;
+  Verdict verdict = judge(bounds(v - 10.0 * u, v + 10.0 * u));
+  ASSERT_EQ(verdict.criteria.size(), 1u);
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kPass);
+  EXPECT_EQ(verdict.criteria[0].name, "accel_bias_mg.x");
+  EXPECT_NEAR(verdict.criteria[0].margin, 10.0 * u, kWrittenLimitRounding);
+  verdict = judge(bounds(v + 0.5 * u, v + 10.0 * u));
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kConditionalFail);
+  EXPECT_FALSE(verdict.pass);
+  verdict = judge(bounds(v - 20.0 * u, v - 2.0 * u));
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kFail);
+  EXPECT_NE(verdict.criteria[0].limit_text.find(" .. "), std::string::npos);
+
+  // A chamber reading -40.2 .. 84.9 ran the -40..85 profile; -41 .. 83 did not.
+  cal.fit_temp_range_c = {-40.2, 84.9};
+  verdict = judge("  - {quantity: fit_temp_range_c, covers: [-40, 85]}\n");
+  EXPECT_TRUE(verdict.pass) << verdict.Table();
+  EXPECT_EQ(verdict.criteria[0].reason, "short of the range by less than its tolerance");
+  cal.fit_temp_range_c = {-39.0, 83.0};
+  EXPECT_FALSE(judge("  - {quantity: fit_temp_range_c, covers: [-40, 85]}\n").pass);
+  EXPECT_TRUE(judge("  - {quantity: fit_temp_range_c, covers: [-40, 85], covers_tolerance: 2}\n").pass);
+
+  // A hot-only run: its 25 degC figures are extrapolated, and the criterion says so.
+  cal.fit_temp_range_c = {40.0, 85.0};
+  const Figure* hot = FindFigure(KeyFigures(cal), "gyro_bias_dps.x");
+  ASSERT_NE(hot, nullptr);
+  EXPECT_TRUE(hot->extrapolated);
+  verdict = judge("  - {quantity: gyro_bias_dps, axes: [x], max_abs: 100}\n");
+  EXPECT_NE(verdict.criteria[0].reason.find(
+                "evaluated at 25 degC, outside the fitted range 40..85 degC: extrapolated"),
+            std::string::npos)
+      << verdict.criteria[0].reason;
+  cal.fit_temp_range_c = {-40.0, 85.0};
+  EXPECT_FALSE(FindFigure(KeyFigures(cal), "gyro_bias_dps.x")->extrapolated);
+
+  const std::string path = (dir_ / "bad_limits.yaml").string();
+  std::ofstream(path) << "format: imufit-limits\nversion: 1\ncriteria:\n"
+                         "  - {quantity: accel_bias_mg, max_abs: 5, max: 3}\n";
+  EXPECT_THROW(ReadLimits(path), InputError);
+}
+
+// The station file declares each source with u or a rectangular half width, in its units.
+TEST_F(BudgetTest, StationDeclaresSources) {
+  const std::string path = (dir_ / "station.yaml").string();
+  std::ofstream(path) << "format: imufit-station\nversion: 1\nstation: bench\nuncertainty:\n"
+                         "  rate_accuracy: {u: 10, unit: ppm, source: table cert}\n"
+                         "  table_axis_tilt: {half_width: 20, unit: arcsec, source: levelled}\n"
+                         "  local_gravity: {u: 2, unit: mGal, source: survey}\n";
+  const Station station = ReadStation(path);
+  ASSERT_EQ(station.uncertainty.size(), 3u);
+  EXPECT_DOUBLE_EQ(station.uncertainty[0].u_si, 10e-6);
+  EXPECT_NEAR(station.uncertainty[1].u_si, 20.0 / 206264.806 / std::sqrt(3.0), 1e-12);
+  EXPECT_TRUE(station.uncertainty[1].rectangular);
+  EXPECT_DOUBLE_EQ(station.uncertainty[2].u_si, 2e-5);
+  EXPECT_EQ(station.uncertainty[0].source, "table cert");
+
+  std::ofstream(path) << "format: imufit-station\nversion: 1\nstation: bench\nuncertainty:\n"
+                         "  rate_accuracy: {u: 10, unit: mrad, source: table cert}\n";
+  try {
+    ReadStation(path);
+    ADD_FAILURE() << "a unit the source cannot be written in";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("station.yaml:5:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("\"mrad\" is not a unit of rate_accuracy (known: ppm %)"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ofstream(path) << "format: imufit-station\nversion: 1\nstation: bench\nuncertainty:\n"
+                         "  rate_acuracy: {u: 10, unit: ppm, source: table cert}\n";
+  EXPECT_THROW(ReadStation(path), InputError);
+}
+
+}  // namespace
+}  // namespace imufit
