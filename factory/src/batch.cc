@@ -150,7 +150,7 @@ struct Shared {
 // Where a unit's outputs go: OUT_DIR/<unit>/.
 struct UnitPaths {
   fs::path folder;
-  std::string calibration, report, manifest;
+  std::string calibration, report, pdf, manifest;
 };
 
 UnitPaths PathsOf(const BatchOptions& options, const std::string& unit) {
@@ -158,6 +158,7 @@ UnitPaths PathsOf(const BatchOptions& options, const std::string& unit) {
   paths.folder = fs::path(options.output_dir) / unit;
   paths.calibration = (paths.folder / "calibration.yaml").string();
   paths.report = (paths.folder / "report.html").string();
+  if (options.write_pdf) paths.pdf = (paths.folder / "report.pdf").string();
   paths.manifest = (paths.folder / "manifest.yaml").string();
   return paths;
 }
@@ -213,7 +214,8 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
     return false;
   }
   if (previous->status == "fitted" &&
-      !(fs::exists(paths.calibration) && (!shared.options->write_reports || fs::exists(paths.report)))) {
+      !(fs::exists(paths.calibration) && (!shared.options->write_reports || fs::exists(paths.report)) &&
+        (paths.pdf.empty() || fs::exists(paths.pdf)))) {
     return false;
   }
   unit->skipped = true;
@@ -278,7 +280,9 @@ UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
     if (TakeUnchanged(shared, manifest, paths, &unit)) return unit;
     FitUnit(shared, unit_dir, paths, &unit);
     if (unit.fit->calibration) {
-      const UnitFiles files{paths.calibration, shared.options->write_reports ? paths.report : ""};
+      const bool reports = shared.options->write_reports;
+      const UnitFiles files{paths.calibration, reports ? paths.report : "", reports ? paths.pdf : "",
+                            shared.options->paper};
       recorded = CertifyUnit(shared.certify, files, &unit);
       offered = true;
       unit.fit->run.static_stretch.reset();  // measured: not kept for the rest of the lot
@@ -305,27 +309,9 @@ UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
   return unit;
 }
 
-std::string SummaryCell(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return quoted + "\"";
-}
-
 void WriteLotSummary(const std::string& path, const BatchResult& result) {
   OutputFile out(path);
-  out.Write("unit,serial,status,verdict,message");
-  for (const std::string& name : kSummaryFigures) out.Write("," + name);
-  out.Write("\n");
-  for (const UnitOutcome& u : result.units) {
-    out.Write(SummaryCell(u.unit) + "," + SummaryCell(u.serial) + "," + u.status + "," + u.verdict + "," +
-              SummaryCell(u.message));
-    for (const std::string& name : kSummaryFigures) {
-      out.Write(",");
-      if (const Figure* f = FindFigure(u.figures, name)) out.WriteNumber(f->value);
-    }
-    out.Write("\n");
-  }
+  out.Write(LotSummaryCsv(result));
   out.Commit();
 }
 
@@ -432,7 +418,12 @@ void WriteLotOutputs(const Shared& shared, const BatchResult& result) {
   if (shared.store) {
     summary.history = MakeLotHistory(shared.store.get(), shared.certify.lot, limits ? &*limits : nullptr);
   }
-  WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), LotPageHtml(summary));
+  const std::string page = LotPageHtml(summary);
+  OutputTransaction outputs;
+  WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), page, &outputs);
+  if (options.write_pdf)
+    WritePdf(page, (fs::path(options.output_dir) / "lot.pdf").string(), options.paper, &outputs);
+  outputs.Commit();
 }
 
 }  // namespace

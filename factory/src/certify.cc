@@ -42,7 +42,11 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
 void Commit(const UnitFiles& files, const UnitOutcome& unit, const std::optional<Certificate>& certificate) {
   OutputTransaction outputs;
   WriteFileAtomically(files.calibration, unit.calibration_yaml, &outputs);
-  if (certificate) WriteCertificate(files.report, *certificate, &outputs);
+  if (certificate) {
+    const std::string html = CertificateHtml(*certificate);
+    WriteFileAtomically(files.report, html, &outputs);
+    if (!files.pdf.empty()) WritePdf(html, files.pdf, files.paper, &outputs);
+  }
   outputs.Commit();
 }
 
@@ -51,6 +55,7 @@ void Commit(const UnitFiles& files, const UnitOutcome& unit, const std::optional
 void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
                const std::optional<Verdict>& certified, UnitOutcome* unit) {
   unit->figures = KeyFigures(calibration);
+  unit->calibrated_utc = calibration.created_utc;
   if (!settings.limits) return;
   unit->verdict_detail = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
   unit->verdict = unit->verdict_detail.pass ? "PASS" : "FAIL";

@@ -15,6 +15,7 @@
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
+#include "imufit/model/check.h"
 
 extern char** environ;
 
@@ -260,8 +261,8 @@ void WriteAnnotations(std::ostream& gp, const Plot& plot) {
     } else {
       gp << "set arrow " << object << " from graph 0, first " << m.value << " to graph 1, first " << m.value
          << " nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
-      gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first " << m.value
-         << " left textcolor rgb '" << m.color << "'\n";
+      gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first "
+         << m.label_at.value_or(m.value) << " left textcolor rgb '" << m.color << "'\n";
     }
     ++object;
   }
@@ -358,6 +359,33 @@ CategoryAxis CategoryTics(const std::vector<std::string>& labels, int max_labels
   }
   if (chars > static_cast<size_t>(std::max(width_chars, 0))) axis.rotate_deg = 90;
   return axis;
+}
+
+double MarkerLabelGap(const Plot& plot, int height_px) {
+  IMUFIT_CHECK(plot.y_range.has_value() && height_px > 0,
+               "a marker label gap needs the y range and the height");
+  return ((*plot.y_range)[1] - (*plot.y_range)[0]) * kLabelHeightPx / (kPlotAreaShare * height_px);
+}
+
+void SpreadMarkerLabels(int height_px, Plot* plot) {
+  std::vector<PlotMarker*> labelled;
+  for (PlotMarker& m : plot->markers) {
+    if (!m.vertical && !m.label.empty()) labelled.push_back(&m);
+  }
+  if (labelled.size() < 2) return;
+  const double gap = MarkerLabelGap(*plot, height_px);
+  std::stable_sort(labelled.begin(), labelled.end(),
+                   [](const PlotMarker* a, const PlotMarker* b) { return a->value < b->value; });
+  std::vector<double> at;
+  for (const PlotMarker* m : labelled)
+    at.push_back(at.empty() ? m->value : std::max(m->value, at.back() + gap));
+  // Pushed up beyond the axis: pushed back down from its end, keeping the gaps.
+  const double top = std::max((*plot->y_range)[1], labelled.back()->value);
+  if (at.back() > top) {
+    at.back() = top;
+    for (size_t i = at.size() - 1; i-- > 0;) at[i] = std::min(at[i], at[i + 1] - gap);
+  }
+  for (size_t i = 0; i < at.size(); ++i) labelled[i]->label_at = at[i];
 }
 
 const char* PlotColor(int index) {
