@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "imufit/io/path.h"
+#include "temp_folder.h"
 
 extern char** environ;
 
@@ -23,20 +24,6 @@ namespace imufit {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A private temporary folder (Chromium's profile and the page's copy), removed when the object goes.
-struct PrintFolder {
-  std::string path;
-  PrintFolder() {
-    path = (fs::temp_directory_path() / "imufit-pdf-XXXXXX").string();
-    if (::mkdtemp(path.data()) == nullptr)
-      throw std::runtime_error("cannot create a temporary folder to print in");
-  }
-  ~PrintFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
 
 bool IsExecutable(const fs::path& path) {
   std::error_code error;
@@ -117,7 +104,7 @@ void WritePdf(const std::string& html, const std::string& pdf_path, Paper paper,
               OutputTransaction* transaction) {
   const std::string chromium = FindChromium();
   if (chromium.empty()) throw std::runtime_error(pdf_path + ": " + PdfProblem());
-  PrintFolder folder;
+  internal::TempFolder folder("imufit-pdf");
   const std::string page = folder.path + "/page.html";
   std::ofstream(page, std::ios::binary) << WithPaper(html, paper);
   OutputFile out(pdf_path, transaction);

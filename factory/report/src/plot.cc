@@ -16,6 +16,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
 #include "imufit/model/check.h"
+#include "temp_folder.h"
 
 extern char** environ;
 
@@ -108,19 +109,7 @@ std::string RunGnuplot(const std::string& script_text, const std::string& folder
   return "";
 }
 
-// A private temporary folder, removed with its contents when the object goes.
-struct TempFolder {
-  std::string path;
-  TempFolder() {
-    path = (fs::temp_directory_path() / "imufit-plot-XXXXXX").string();
-    if (::mkdtemp(path.data()) == nullptr)
-      throw std::runtime_error("cannot create a temporary folder for gnuplot");
-  }
-  ~TempFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
+using internal::TempFolder;
 
 // Margins around the data, as fractions of its extent, so that no point sits on the frame.
 constexpr double kXMargin = 0.04, kYMargin = 0.06;
@@ -424,7 +413,7 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
 
 std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
   if (figures.empty()) return {};
-  TempFolder folder;
+  TempFolder folder("imufit-plot");
   std::string script;
   for (size_t i = 0; i < figures.size(); ++i) {
     script += GnuplotScript(figures[i], "svg", folder.path + "/" + std::to_string(i) + ".svg");
@@ -443,7 +432,7 @@ std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
 
 void DrawFile(const PlotFigure& figure, const std::string& path, OutputTransaction* transaction) {
   const bool png = HasSuffix(path, ".png");
-  TempFolder folder;
+  TempFolder folder("imufit-plot");
   const std::string image = folder.path + (png ? "/figure.png" : "/figure.svg");
   if (const std::string failure = RunGnuplot(GnuplotScript(figure, png ? "png" : "svg", image), folder.path);
       !failure.empty()) {
