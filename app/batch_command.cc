@@ -17,6 +17,7 @@ struct BatchArguments {
   BatchOptions batch;
   FitRunArguments run;  // every unit is fitted with these, as imufit fit would fit it
   bool no_report = false;
+  PdfArguments pdf;
   bool quiet = false;
 };
 
@@ -48,6 +49,10 @@ int RunBatchCommand(BatchArguments args) {
   const bool terminal = isatty(STDERR_FILENO) != 0;
   if (!args.quiet) options.progress = [terminal](const BatchProgress& p) { ShowProgress(p, terminal); };
   options.write_reports = !args.no_report;
+  if (args.pdf.pdf && args.no_report)
+    throw InputError("--pdf", "prints the certificates: leave out --no-report");
+  options.paper = args.pdf.Resolve();
+  options.write_pdf = args.pdf.pdf;
   const BatchResult result = RunBatch(options);
   // Warnings even with --quiet, as imufit fit gives them (a unit skipped as unchanged gave its own
   // when it was fitted; its certificate keeps them).
@@ -106,6 +111,7 @@ CommandRunner AddBatchCommand(CLI::App* root) {
                    "stop after fitting this many units (0: all); a later run resumes the lot")
       ->capture_default_str();
   command->add_flag("--no-report", args->no_report, "write no report.html per unit");
+  AddPdfOptions(command, &args->pdf);
   // Not --threads (units run in parallel instead) nor a check run (a lot has no held-out runs).
   AddFitRunOptions(command, &args->run, {"threads", "check_samples", "check_plan"});
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_options.h"
+#include "imufit/factory/pdf.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/segment_run.h"
 
@@ -92,6 +93,17 @@ void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileRe
 // page); this says so on stderr too, naming `file` (report_command.cc; fit --report and report
 // share it).
 void WarnIfNoSerial(const std::string& serial, const std::string& file);
+
+// --pdf and --paper: the certificate (and a batch's lot page) printed to PDF beside its HTML
+// (report_command.cc; fit --report, report and batch share them).
+struct PdfArguments {
+  bool pdf = false;
+  std::string paper = NameOf(kPaperNames, Paper::kA4);
+  // The paper (InputError naming --paper for another name); with --pdf, throws std::runtime_error
+  // (exit 1) before any work when Chromium cannot be found.
+  Paper Resolve() const;
+};
+void AddPdfOptions(CLI::App* command, PdfArguments* args);
 
 // Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).

@@ -26,6 +26,7 @@ struct FitArguments {
   std::string store;    // results store to record the fit in
   std::string serial;   // the unit's serial; empty: the samples header's, else the plan's
   std::string station;  // station file shown on the certificate (with --report)
+  PdfArguments pdf;     // the certificate printed too (with --report)
   FitRunArguments run;  // the fit options, shared with imufit batch
 };
 
@@ -248,6 +249,14 @@ int RunFit(const FitArguments& args) {
   if (!args.station.empty() && args.report.empty()) {
     throw InputError("--station", "is shown on the certificate: give --report too");
   }
+  if (args.pdf.pdf && args.report.empty())
+    throw InputError("--pdf", "prints the certificate: give --report too");
+  const Paper paper = args.pdf.Resolve();
+  const std::string pdf = args.pdf.pdf ? PdfPathFor(args.report) : "";
+  if (!pdf.empty()) {
+    RefuseToOverwriteInputs(
+        pdf, {args.plan, args.samples, check_plan, check_samples, args.limits, args.output, args.station});
+  }
   const FitRunOptions options = ResolveOptions(args);
   std::unique_ptr<ResultsStore> store;
   const CertifySettings settings = ReadFactoryInputs(args, options, &store);
@@ -283,7 +292,8 @@ int RunFit(const FitArguments& args) {
   unit.warnings = result.serial_warnings;
   unit.plan_sha256 = result.plan_sha256;
   unit.samples_sha256 = result.run.samples_sha256;
-  const bool recorded = CertifyUnit(settings, {args.output, args.report}, &unit);
+  const bool recorded = CertifyUnit(settings, {args.output, args.report, pdf, paper}, &unit);
+  if (!pdf.empty() && !args.quiet) std::printf("  wrote %s\n", pdf.c_str());
   return ReportCertified(args, unit, recorded);
 }
 
@@ -311,6 +321,7 @@ CommandRunner AddFitCommand(CLI::App* root) {
       "that contradicts the samples header is refused (exit 2) unless --allow-mismatch");
   command->add_option("--report", args->report,
                       "write the unit's calibration certificate (self-contained HTML)");
+  AddPdfOptions(command, &args->pdf);
   command->add_option(
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");

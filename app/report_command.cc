@@ -2,6 +2,7 @@
 // fitted to.
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 
 #include "commands.h"
 #include "imufit/factory/certificate.h"
@@ -26,12 +27,17 @@ struct ReportArguments {
   std::string serial;
   std::string station;  // station file: where and by whom
   bool allow_mismatch = false;
+  PdfArguments pdf;
   RunReadingArguments run;  // the run is read as imufit fit read it
 };
 
 int RunReport(const ReportArguments& args) {
   RefuseToOverwriteInputs(args.output,
                           {args.calibration, args.plan, args.samples, args.limits, args.station});
+  const Paper paper = args.pdf.Resolve();
+  const std::string pdf = args.pdf.pdf ? PdfPathFor(args.output) : "";
+  if (!pdf.empty())
+    RefuseToOverwriteInputs(pdf, {args.calibration, args.plan, args.samples, args.limits, args.station});
   const WindowOptions windows = args.run.Windows();
   const SamplesInput input = args.run.input.Get();
   if (std::string problem = windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
@@ -80,14 +86,37 @@ int RunReport(const ReportArguments& args) {
   ReadCertificateFiles(&sources);
   const Certificate certificate = MakeCertificate(sources);
   WarnIfNoSerial(certificate.serial, args.calibration);
-  WriteCertificate(args.output, certificate);
+  const std::string html = CertificateHtml(certificate);
+  OutputTransaction outputs;  // the page and its PDF, both or neither
+  WriteFileAtomically(args.output, html, &outputs);
+  if (!pdf.empty()) WritePdf(html, pdf, paper, &outputs);
+  outputs.Commit();
   const std::optional<Verdict>& verdict = certificate.verdict;
-  std::printf("imufit report: wrote %s%s\n", args.output.c_str(),
+  std::printf("imufit report: wrote %s%s%s\n", args.output.c_str(),
+              pdf.empty() ? "" : (" and " + pdf).c_str(),
               verdict ? (verdict->pass ? " (acceptance PASS)" : " (acceptance FAIL)") : "");
   return verdict && !verdict->pass ? kExitFailedLimits : 0;
 }
 
 }  // namespace
+
+Paper PdfArguments::Resolve() const {
+  Paper value = Paper::kA4;
+  if (!ValueOf(kPaperNames, paper, &value))
+    throw InputError("--paper", "is \"" + paper + "\"; one of " + AllNames(kPaperNames));
+  if (pdf) {
+    if (const std::string problem = PdfProblem(); !problem.empty())
+      throw std::runtime_error("--pdf: " + problem);
+  }
+  return value;
+}
+
+void AddPdfOptions(CLI::App* command, PdfArguments* args) {
+  command->add_flag("--pdf", args->pdf,
+                    "also print the certificate to PDF beside its HTML (report.html -> report.pdf; a batch's "
+                    "lot.pdf too), with headless Chromium");
+  command->add_option("--paper", args->paper, "paper of --pdf: " + AllNames(kPaperNames) + " (default A4)");
+}
 
 void WarnIfNoSerial(const std::string& serial, const std::string& file) {
   if (!serial.empty()) return;
@@ -115,6 +144,7 @@ CommandRunner AddReportCommand(CLI::App* root) {
   command->add_option(
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
+  AddPdfOptions(command, &args->pdf);
   command->add_flag("--allow-mismatch", args->allow_mismatch,
                     "certify even when the calibration records other plan/samples hashes than these files', "
                     "or --serial names another unit than the samples header (the certificate says so)");

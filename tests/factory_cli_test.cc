@@ -793,6 +793,54 @@ TEST_F(FactoryCliTest, CertificatesAndLotPagePrintToPdf) {
   }
 }
 
+// --pdf prints the certificate itself (fit --report, report) and, in a batch, every certificate and
+// the lot page, with headless Chromium on the paper --paper names; checked with pdfinfo and pdftotext.
+TEST_F(FactoryCliTest, PdfOptionPrintsTheCertificateAndTheLotPage) {
+  // Refused before any work, whatever is installed: a paper imufit does not know, --pdf without --report.
+  const std::string plan = Path("units/unit-01/plan.yaml"), samples = Path("units/unit-01/samples.csv.gz");
+  RunResult r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal_x.yaml"), "--report", Path("x.html"),
+                     "--pdf", "--paper", "legal", "-q"});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_EQ(r.err, "imufit: --paper: is \"legal\"; one of A4, letter\n");
+  r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal_x.yaml"), "--pdf", "-q"});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_EQ(r.err, "imufit: --pdf: prints the certificate: give --report too\n");
+  EXPECT_FALSE(fs::exists(Path("cal_x.yaml")));
+  if (!fs::exists("/usr/bin/chromium") || !fs::exists("/usr/bin/pdfinfo") ||
+      !fs::exists("/usr/bin/pdftotext")) {
+    GTEST_SKIP()
+        << "no chromium, pdfinfo or pdftotext (Debian: chromium poppler-utils): PDF output not tested";
+  }
+  const auto info = [&](const std::string& pdf) { return RunProgram("/usr/bin/pdfinfo", {pdf}).out; };
+  const auto text = [&](const std::string& pdf) {
+    EXPECT_EQ(RunProgram("/usr/bin/pdftotext", {"-layout", pdf, Path("pdf.txt")}).status, 0) << pdf;
+    return ReadBytes(Path("pdf.txt"));
+  };
+  r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal1.yaml"), "--limits", Path("limits.yaml"),
+           "--report", Path("unit1.html"), "--pdf", "--paper", "letter"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote " + Path("unit1.pdf")), std::string::npos) << r.out;
+  EXPECT_NE(info(Path("unit1.pdf")).find("(letter)"), std::string::npos) << info(Path("unit1.pdf"));
+  std::string printed = text(Path("unit1.pdf"));
+  EXPECT_NE(printed.find("IMU calibration certificate SN-01"), std::string::npos);
+  EXPECT_NE(printed.find("PASS"), std::string::npos);
+  EXPECT_NE(printed.find("page 1 of"), std::string::npos);  // the page's own footer, not the browser's
+
+  r = Run({"report", "-c", Path("cal1.yaml"), "-p", plan, "-s", samples, "-o", Path("again.html"), "--pdf"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(info(Path("again.pdf")).find("(A4)"), std::string::npos);
+  EXPECT_NE(text(Path("again.pdf")).find("IMU calibration certificate SN-01"), std::string::npos);
+
+  std::vector<std::string> args = BatchArgs("out");
+  args.push_back("--pdf");
+  r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_NE(text(Path("out/unit-04/report.pdf")).find("FAIL"), std::string::npos);
+  EXPECT_NE(info(Path("out/lot.pdf")).find("(A4)"), std::string::npos);
+  EXPECT_NE(text(Path("out/lot.pdf")).find("Lot LOT-A"), std::string::npos);
+  EXPECT_FALSE(fs::exists(Path("out/unit-05/report.pdf")));  // the unit that could not be read
+}
+
 // The standard simulated 6-position soak (fixtures/mems_6pos_soak.csv.gz: 18 segments at five
 // temperatures), fitted with validation and certified with limits and a station file: a passing
 // unit on at most kMostPagesOfAPassingCertificate pages of A4 and of Letter.

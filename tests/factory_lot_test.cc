@@ -175,6 +175,18 @@ TEST_F(LotTest, LotSummaryMarksFailedAndOutlyingUnitsAndChoosesWhatAStripPlotSho
   EXPECT_EQ(strip.x_tics.size(), 5u);
   EXPECT_EQ(strip.x_tics[4].label, "05");
   EXPECT_EQ(plots[1].panels.at(0).markers.size(), 3u);  // mean and 3 sigma; the limits off scale
+  // No two labels of the strip's lines (limits, mean, 3 sigma) closer than a label's height.
+  for (const PlotFigure& p : plots) {
+    const Plot& panel = p.panels.at(0);
+    for (size_t i = 0; i < panel.markers.size(); ++i) {
+      for (size_t j = i + 1; j < panel.markers.size(); ++j) {
+        const double a = panel.markers[i].label_at.value_or(panel.markers[i].value);
+        const double b = panel.markers[j].label_at.value_or(panel.markers[j].value);
+        EXPECT_GE(std::abs(a - b), MarkerLabelGap(panel, p.height_px) * (1.0 - 1e-9))
+            << panel.markers[i].label << " / " << panel.markers[j].label;
+      }
+    }
+  }
   EXPECT_NE(plots[1].panels.at(0).x_label.find("limit |value| < 1000 beyond this scale"), std::string::npos);
   // One side drawn, the other off scale: the caption names the side it does not draw, not the limit.
   LotSummary one_side = s;
@@ -185,6 +197,96 @@ TEST_F(LotTest, LotSummaryMarksFailedAndOutlyingUnitsAndChoosesWhatAStripPlotSho
   EXPECT_NE(lower_drawn.x_label.find("upper limit 1000 above this scale"), std::string::npos)
       << lower_drawn.x_label;
   EXPECT_EQ(lower_drawn.x_label.find("beyond"), std::string::npos) << lower_drawn.x_label;
+}
+
+// Five units of which unit-03 failed on a figure that is not a main one (a misalignment's sigma):
+// every key figure is in the summary and the CSV, with its sigma and U; the failing one is plotted.
+TEST_F(LotTest, LotSummaryHidesNoFigureAndPlotsEveryFigureAUnitFailedOn) {
+  BatchResult batch = FiveUnits();
+  for (UnitOutcome& u : batch.units) {
+    if (u.status != "fitted") continue;
+    u.calibrated_utc = "2026-11-2" + u.unit.substr(6) + "T06:00:00Z";
+    u.figures.push_back(MakeFigure("accel_misalignment_mrad.xy", "mrad", 0.5, 0.02));
+    u.figures.push_back(MakeFigure("accel_residual_rms_mg", "mg", 0.8, -1.0));
+  }
+  CriterionResult failed;
+  failed.name = "sigma(accel_misalignment_mrad.xy)";
+  batch.units[2].verdict_detail.criteria.push_back(failed);
+  batch.units[2].verdict_detail.pass = false;
+  batch.units[2].message = "sigma(accel_misalignment_mrad.xy) 0.02 > 0.01 mrad, badly";
+
+  const Limits limits = WriteLimits("criteria:\n  - {quantity: gyro_bias_dps, max_abs: 0.3}\n");
+  const LotSummary s = MakeLotSummary("LOT-1", batch, "imufit test", limits);
+  EXPECT_EQ(s.figure_names,
+            (std::vector<std::string>{"gyro_bias_dps.x", "accel_bias_mg.x", "accel_misalignment_mrad.xy",
+                                      "accel_residual_rms_mg"}));
+  ASSERT_EQ(s.figures.size(), 4u);
+  EXPECT_TRUE(s.figures[0].plotted);  // a main figure
+  EXPECT_TRUE(s.figures[1].plotted);  // a main figure
+  EXPECT_TRUE(s.figures[2].plotted);  // unit-03 failed on it
+  EXPECT_TRUE(s.figures[3].plotted);  // a main figure
+  EXPECT_EQ(LotPlots(s).size(), 4u);
+  BatchResult passing = batch;
+  passing.units[2].verdict_detail = Verdict();
+  EXPECT_FALSE(MakeLotSummary("LOT-1", passing, "imufit test", limits).figures[2].plotted);
+  EXPECT_EQ(LotPlots(MakeLotSummary("LOT-1", passing, "imufit test", limits)).size(), 3u);
+
+  // Capability from 4 units: indicative, with Ppk's interval by Bissell's approximation.
+  const LotFigure& bias = s.figures[0];
+  ASSERT_TRUE(bias.ppk && bias.ppk_interval);
+  EXPECT_TRUE(bias.few_units);
+  const double half = kCapabilityZ * std::sqrt(1.0 / 36.0 + *bias.ppk * *bias.ppk / 6.0);
+  EXPECT_NEAR((*bias.ppk_interval)[0], *bias.ppk - half, kArithmeticAbsolute);
+  EXPECT_NEAR((*bias.ppk_interval)[1], *bias.ppk + half, kArithmeticAbsolute);
+  EXPECT_NE(LotPlots(s)[0].panels.at(0).title.find("(n = 4, indicative)"), std::string::npos);
+  EXPECT_FALSE(CapabilityInterval(1.0, 1));
+
+  // The CSV: every figure with its sigma and U, the calibration date, empty cells where nothing is
+  // known, a quoted message.
+  const std::vector<std::string> lines = [&] {
+    std::vector<std::string> out;
+    std::string csv = LotSummaryCsv(batch), line;
+    for (char c : csv) {
+      if (c == '\n') {
+        out.push_back(line);
+        line.clear();
+      } else {
+        line += c;
+      }
+    }
+    return out;
+  }();
+  ASSERT_EQ(lines.size(), 6u);
+  EXPECT_EQ(lines[0],
+            "unit,serial,status,verdict,message,calibrated_utc,"
+            "gyro_bias_dps.x,gyro_bias_dps.x.sigma,gyro_bias_dps.x.U,"
+            "accel_bias_mg.x,accel_bias_mg.x.sigma,accel_bias_mg.x.U,"
+            "accel_misalignment_mrad.xy,accel_misalignment_mrad.xy.sigma,accel_misalignment_mrad.xy.U,"
+            "accel_residual_rms_mg,accel_residual_rms_mg.sigma,accel_residual_rms_mg.U");
+  EXPECT_EQ(lines[1],
+            "unit-01,SN1,fitted,PASS,,2026-11-21T06:00:00Z,0.1,0.001,0.002,10,0.01,0.02,0.5,0.02,0.04,0.8,,");
+  EXPECT_EQ(
+      lines[3].rfind(
+          "unit-03,SN3,fitted,FAIL,\"sigma(accel_misalignment_mrad.xy) 0.02 > 0.01 mrad, badly\",2026", 0),
+      0u);
+  EXPECT_EQ(lines[4], "unit-04,SN4,error,,,,,,,,,,,,,,,");
+}
+
+// Two markers' labels closer than a label's height are moved apart (the lines stay); a label pushed
+// beyond the top of the axis comes back down with the others.
+TEST(PlotAxes, MarkerLabelsNeverOverlap) {
+  Plot plot;
+  plot.y_range = std::array<double, 2>{0.0, 1.0};
+  plot.markers = {{0.99, "0.99", "#b00000"}, {0.5, "mean"}, {0.98, "+3s"}, {0.3, "x", "#000000", true}};
+  const int height_px = 180;
+  SpreadMarkerLabels(height_px, &plot);
+  const double gap = MarkerLabelGap(plot, height_px);
+  EXPECT_NEAR(gap, 14.0 / (0.6 * 180.0), kArithmeticAbsolute);
+  EXPECT_EQ(plot.markers[0].value, 0.99);  // the line where it was
+  EXPECT_NEAR(*plot.markers[0].label_at, 1.0, kArithmeticAbsolute);
+  EXPECT_NEAR(*plot.markers[2].label_at, 1.0 - gap, kArithmeticAbsolute);
+  EXPECT_EQ(*plot.markers[1].label_at, 0.5);
+  EXPECT_FALSE(plot.markers[3].label_at);  // a vertical marker's label is above the panel
 }
 
 // Records one unit's fit of `lot` with a gyro bias x of `bias_dps`.
@@ -247,6 +349,9 @@ TEST_F(LotTest, LotHistoryHasEveryLotsYieldAndMeans) {
   EXPECT_EQ(yield.series[0].y, (std::vector<double>{100.0, 50.0}));
   EXPECT_EQ(yield.series[1].x, (std::vector<double>{1.0}));
   EXPECT_EQ(yield.x_tics.at(2).label, "lot-c");
+  // The bars read as the table does ("50.0 %"), not rounded otherwise.
+  ASSERT_EQ(yield.notes.size(), 3u);
+  EXPECT_EQ(yield.notes[2].text, "50.0 %");
   const Plot& trend = plots[1].panels.at(0);
   EXPECT_EQ(trend.series[1].y.size(), 1u);
   EXPECT_NEAR(trend.series[1].error.at(0), 0.2, kArithmeticAbsolute);

@@ -151,7 +151,7 @@ struct Shared {
 // Where a unit's outputs go: OUT_DIR/<unit>/.
 struct UnitPaths {
   fs::path folder;
-  std::string calibration, report, manifest;
+  std::string calibration, report, pdf, manifest;
 };
 
 UnitPaths PathsOf(const BatchOptions& options, const std::string& unit) {
@@ -159,6 +159,7 @@ UnitPaths PathsOf(const BatchOptions& options, const std::string& unit) {
   paths.folder = fs::path(options.output_dir) / unit;
   paths.calibration = (paths.folder / "calibration.yaml").string();
   paths.report = (paths.folder / "report.html").string();
+  if (options.write_pdf) paths.pdf = (paths.folder / "report.pdf").string();
   paths.manifest = (paths.folder / "manifest.yaml").string();
   return paths;
 }
@@ -214,7 +215,8 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
     return false;
   }
   if (previous->status == "fitted" &&
-      !(fs::exists(paths.calibration) && (!shared.options->write_reports || fs::exists(paths.report)))) {
+      !(fs::exists(paths.calibration) && (!shared.options->write_reports || fs::exists(paths.report)) &&
+        (paths.pdf.empty() || fs::exists(paths.pdf)))) {
     return false;
   }
   unit->skipped = true;
@@ -343,7 +345,12 @@ UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
   }
   try {
     if (!outside && unit.fit && unit.fit->calibration) {
-      UnitFiles files{paths.calibration, shared.options->write_reports ? paths.report : ""};
+      const bool reports = shared.options->write_reports;
+      UnitFiles files;
+      files.calibration = paths.calibration;
+      files.report = reports ? paths.report : "";
+      files.pdf = reports ? paths.pdf : "";
+      files.paper = shared.options->paper;
       files.more = [&](const UnitOutcome& judged, OutputTransaction* outputs) {
         WriteUnitManifest(paths, judged, manifest, outputs);
       };
@@ -366,27 +373,9 @@ UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
   return unit;
 }
 
-std::string SummaryCell(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return quoted + "\"";
-}
-
 void WriteLotSummary(const std::string& path, const BatchResult& result) {
   OutputFile out(path);
-  out.Write("unit,serial,status,verdict,message");
-  for (const std::string& name : kSummaryFigures) out.Write("," + name);
-  out.Write("\n");
-  for (const UnitOutcome& u : result.units) {
-    out.Write(SummaryCell(u.unit) + "," + SummaryCell(u.serial) + "," + u.status + "," + u.verdict + "," +
-              SummaryCell(u.message));
-    for (const std::string& name : kSummaryFigures) {
-      out.Write(",");
-      if (const Figure* f = FindFigure(u.figures, name)) out.WriteNumber(f->value);
-    }
-    out.Write("\n");
-  }
+  out.Write(LotSummaryCsv(result));
   out.Commit();
 }
 
@@ -496,7 +485,12 @@ void WriteLotOutputs(const Shared& shared, const BatchResult& result) {
   if (shared.store) {
     summary.history = MakeLotHistory(shared.store.get(), shared.certify.lot, limits ? &*limits : nullptr);
   }
-  WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), LotPageHtml(summary));
+  const std::string page = LotPageHtml(summary);
+  OutputTransaction outputs;
+  WriteFileAtomically((fs::path(options.output_dir) / "lot.html").string(), page, &outputs);
+  if (options.write_pdf)
+    WritePdf(page, (fs::path(options.output_dir) / "lot.pdf").string(), options.paper, &outputs);
+  outputs.Commit();
 }
 
 }  // namespace

@@ -631,9 +631,4 @@ std::string CertificateHtml(const Certificate& c) {
   return internal::ClosePage(&h);
 }
 
-void WriteCertificate(const std::string& path, const Certificate& certificate,
-                      OutputTransaction* transaction) {
-  WriteFileAtomically(path, CertificateHtml(certificate), transaction);
-}
-
 }  // namespace imufit

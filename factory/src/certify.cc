@@ -44,6 +44,7 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
 void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
                const std::optional<Verdict>& certified, UnitOutcome* unit) {
   unit->figures = KeyFigures(calibration);
+  unit->calibrated_utc = calibration.created_utc;
   if (!settings.limits) return;
   unit->verdict_detail = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
   unit->verdict = unit->verdict_detail.pass ? "PASS" : "FAIL";
@@ -73,7 +74,11 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
   // The calibration, the certificate, the caller's further outputs and the store's row: all or none.
   OutputTransaction outputs;
   WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
-  if (certificate) WriteCertificate(files.report, *certificate, &outputs);
+  if (certificate) {
+    const std::string html = CertificateHtml(*certificate);
+    WriteFileAtomically(files.report, html, &outputs);
+    if (!files.pdf.empty()) WritePdf(html, files.pdf, files.paper, &outputs);
+  }
   if (files.more) files.more(*unit, &outputs);
   return RecordUnit(settings, unit, &outputs);
 }

@@ -21,7 +21,7 @@ using internal::Plots;
 using internal::Row;
 using internal::Series;
 
-constexpr size_t kMaxBarNotes = 24;         // yields printed on their bars up to this many lots
+constexpr size_t kMaxBarNotes = 12;         // yields printed on their bars up to this many lots (they fit)
 constexpr double kNoteInsideBarPct = 15.0;  // a yield note goes inside its bar from this yield up
 
 std::vector<std::string> LotNames(const LotHistory& history) {
@@ -49,7 +49,7 @@ PlotFigure YieldFigure(const LotHistory& history) {
       PlotNote note;
       note.x = i;
       note.y = history.yield_pct[i];
-      note.text = Fmt("%.0f %%", history.yield_pct[i]) + " of " + Count(history.lots[i].units);
+      note.text = internal::YieldText(history.yield_pct[i]);  // as the table prints it
       const bool inside = history.yield_pct[i] >= kNoteInsideBarPct;
       note.dy_chars = inside ? -0.9 : 0.7;
       note.color = inside ? "#ffffff" : note.color;
@@ -130,7 +130,7 @@ void AcrossLots(Html* h, const LotHistory& history, const LotHistorySvgs& svgs, 
     Num(h, Count(y.passed));
     Num(h, Count(y.failed));
     Num(h, Count(y.not_fitted));
-    Num(h, Fmt("%.1f %%", history.yield_pct[i]), {{"data-yield", FormatDouble(history.yield_pct[i])}});
+    Num(h, YieldText(history.yield_pct[i]), {{"data-yield", FormatDouble(history.yield_pct[i])}});
     h->Close("tr");
   }
   h->Close("tbody").Close("table");

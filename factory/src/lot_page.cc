@@ -30,13 +30,24 @@ using internal::Series;
 const char* kMeanGrey = "#444444";
 const char* kSigmaGrey = "#8a8a8a";
 
-// "gyro_bias_dps.x: Ppk 1.8, Cpk 2.1": the panel is half a page wide, the mean and sigma are in the
-// table above it.
+// "gyro_bias_dps.x: Ppk 1.8, Cpk 2.1 (n = 5, indicative)": the panel is half a page wide, the mean,
+// sigma and Ppk's interval are in the table above it.
 std::string StripTitle(const LotFigure& f) {
   std::string title = f.name;
   if (f.ppk) title += Fmt(": Ppk %.3g", *f.ppk);
   if (f.cpk) title += Fmt(f.ppk ? ", Cpk %.3g" : ": Cpk %.3g", *f.cpk);
+  if ((f.ppk || f.cpk) && f.few_units)
+    title += " (n = " + Count(static_cast<long long>(f.value.size())) + ", indicative)";
   return title;
+}
+
+// A capability's cell: "1.80", below kCapabilityMinUnits with Ppk's interval "1.80 (0.95 .. 2.65)".
+std::string CapabilityText(const std::optional<double>& value,
+                           const std::optional<std::array<double, 2>>& interval) {
+  if (!value) return "\xe2\x80\x93";
+  std::string text = Fmt("%.2f", *value);
+  if (interval) text += " (" + Fmt("%.2f", (*interval)[0]) + " .. " + Fmt("%.2f", (*interval)[1]) + ")";
+  return text;
 }
 
 // A strip plot of one figure over the lot: a point per unit at its row, the limits, the mean and
@@ -79,8 +90,9 @@ PlotFigure StripFigure(const LotSummary& lot, const LotFigure& f) {
     plot.markers.push_back({f.three_sigma[1], "+3\xcf\x83", kSigmaGrey, false, 3});
   }
   internal::LimitLines(f.limits, f.view, &plot);
-  return internal::OnePanel(plot, internal::kHalfWidthPx,
-                            plot.x_tic_rotate_deg ? kStripUprightHeightPx : kStripHeightPx);
+  const int height_px = plot.x_tic_rotate_deg ? kStripUprightHeightPx : kStripHeightPx;
+  SpreadMarkerLabels(height_px, &plot);
+  return internal::OnePanel(plot, internal::kHalfWidthPx, height_px);
 }
 
 // ---------------------------------------------------------------- the page, by stages
@@ -162,10 +174,14 @@ void KeyFigureTable(Html* h, const LotSummary& lot) {
   h->Element("p",
              "\xcf\x83: the units' standard deviation; \xcf\x83 within: the mean moving range of consecutive "
              "units / 1.128. Ppk = min(upper - mean, mean - lower) / 3\xcf\x83; Cpk the same with \xcf\x83 "
-             "within (Cpk well above Ppk: the lot drifts from unit to unit).",
+             "within (Cpk well above Ppk: the lot drifts from unit to unit). From fewer than " +
+                 Count(kCapabilityMinUnits) + " units both are indicative only: Ppk is given with its " +
+                 Fmt("%.0f", 100.0 * kCapabilityConfidence) +
+                 " % confidence interval, which is wide for a small lot. Every key figure, each unit's "
+                 "value, 1-sigma and U, is in lot_summary.csv.",
              {{"class", "note"}});
   h->Open("table").Open("thead");
-  Row(h, {"figure", "units", "mean", "\xcf\x83", "\xcf\x83 within", "limits", "Ppk", "Cpk"}, "th");
+  Row(h, {"figure", "units (n)", "mean", "\xcf\x83", "\xcf\x83 within", "limits", "Ppk", "Cpk"}, "th");
   h->Close("thead").Open("tbody");
   for (const LotFigure& f : lot.figures) {
     h->Open("tr", {{"data-lot-figure", f.name}}).Element("td", f.name + " (" + f.unit + ")");
@@ -174,8 +190,9 @@ void KeyFigureTable(Html* h, const LotSummary& lot) {
     Num(h, Fmt("%.3g", f.stdev), {{"data-sigma", FormatDouble(f.stdev)}});
     Num(h, Fmt("%.3g", f.stdev_within));
     Num(h, LimitsText(f.limits));
-    Num(h, f.ppk ? Fmt("%.2f", *f.ppk) : "\xe2\x80\x93", {{"data-ppk", f.ppk ? FormatDouble(*f.ppk) : ""}});
-    Num(h, f.cpk ? Fmt("%.2f", *f.cpk) : "\xe2\x80\x93", {{"data-cpk", f.cpk ? FormatDouble(*f.cpk) : ""}});
+    Num(h, CapabilityText(f.ppk, f.few_units ? f.ppk_interval : std::nullopt),
+        {{"data-ppk", f.ppk ? FormatDouble(*f.ppk) : ""}});
+    Num(h, CapabilityText(f.cpk, std::nullopt), {{"data-cpk", f.cpk ? FormatDouble(*f.cpk) : ""}});
     h->Close("tr");
   }
   h->Close("tbody").Close("table").Close("div");
@@ -201,7 +218,8 @@ LotPageSvgs Draw(const std::vector<PlotFigure>& strips, const std::optional<LotH
 void Distributions(Html* h, const LotPageSvgs& svgs) {
   h->Element("h2", "Distributions");
   h->Element("p",
-             "One point per fitted unit, in the order of the units table. Red square: the unit failed its "
+             "Every key figure in the table above on which a unit failed, and the main ones. One point per "
+             "fitted unit, in the order of the units table. Red square: the unit failed its "
              "limits (filled: on this figure); orange ring: outlier; grey: the lot's mean (solid) and mean "
              "\xc2\xb1 3\xcf\x83 (dotted); red dashed: the limits.",
              {{"class", "note"}});
@@ -212,7 +230,9 @@ void Distributions(Html* h, const LotPageSvgs& svgs) {
 
 std::vector<PlotFigure> LotPlots(const LotSummary& lot) {
   std::vector<PlotFigure> figures;
-  for (const LotFigure& f : lot.figures) figures.push_back(StripFigure(lot, f));
+  for (const LotFigure& f : lot.figures) {
+    if (f.plotted) figures.push_back(StripFigure(lot, f));
+  }
   return figures;
 }
 

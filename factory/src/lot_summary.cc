@@ -4,7 +4,9 @@
 #include <cctype>
 #include <cmath>
 
+#include "imufit/factory/certificate.h"
 #include "imufit/io/calibration.h"
+#include "imufit/io/output_file.h"
 
 namespace imufit {
 
@@ -30,7 +32,71 @@ std::vector<RobustZ> RobustZScores(const std::vector<double>& values, const std:
   return scores;
 }
 
+std::optional<std::array<double, 2>> CapabilityInterval(double ppk, int n) {
+  if (n < 2) return std::nullopt;
+  const double half = kCapabilityZ * std::sqrt(1.0 / (9.0 * n) + ppk * ppk / (2.0 * (n - 1)));
+  return std::array<double, 2>{ppk - half, ppk + half};
+}
+
+std::vector<std::string> LotFigureNames(const BatchResult& batch) {
+  std::vector<std::string> names;
+  for (const UnitOutcome& u : batch.units) {
+    for (const Figure& f : u.figures) {
+      if (std::find(names.begin(), names.end(), f.name) == names.end()) names.push_back(f.name);
+    }
+  }
+  return names;
+}
+
 namespace {
+
+// A CSV cell: quoted when it holds a comma, a quote or a line break (a line break becomes a space).
+std::string CsvCell(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+  return quoted + "\"";
+}
+
+// A number's cell: empty when it is not finite or (`known`) not known.
+std::string NumberCell(double value, bool known = true) {
+  return known && std::isfinite(value) ? FormatDouble(value) : "";
+}
+
+}  // namespace
+
+std::string LotSummaryCsv(const BatchResult& batch) {
+  const std::vector<std::string> names = LotFigureNames(batch);
+  std::string csv = "unit,serial,status,verdict,message,calibrated_utc";
+  for (const std::string& name : names) csv += "," + name + "," + name + ".sigma," + name + ".U";
+  csv += "\n";
+  for (const UnitOutcome& u : batch.units) {
+    csv += CsvCell(u.unit) + "," + CsvCell(u.serial) + "," + CsvCell(u.status) + "," + CsvCell(u.verdict) +
+           "," + CsvCell(u.message) + "," + CsvCell(u.calibrated_utc);
+    for (const std::string& name : names) {
+      const Figure* f = FindFigure(u.figures, name);
+      if (f == nullptr) {
+        csv += ",,,";
+        continue;
+      }
+      csv += "," + NumberCell(f->value) + "," + NumberCell(f->sigma, f->sigma >= 0.0) + "," +
+             NumberCell(kCoverageFactor * f->sigma, f->sigma >= 0.0);
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+namespace {
+
+// Whether `unit` failed a criterion about the figure `name`: "|name|", "sigma(name)" or "name".
+bool FailedOn(const UnitOutcome& unit, const std::string& name) {
+  for (const CriterionResult& c : unit.verdict_detail.criteria) {
+    if (c.pass) continue;
+    if (c.name == name || c.name == "|" + name + "|" || c.name == "sigma(" + name + ")") return true;
+  }
+  return false;
+}
 
 // The longest prefix every name shares, cut back to a boundary (after a character that is not a
 // letter or digit, or between a letter and a digit) and leaving every name at least one character:
@@ -62,6 +128,7 @@ LotFigure FigureOverLot(const std::string& name, const BatchResult& batch,
   LotFigure f;
   f.name = name;
   if (limits) f.limits = FigureLimits(name, *limits);
+  f.plotted = std::find(kSummaryFigures.begin(), kSummaryFigures.end(), name) != kSummaryFigures.end();
   for (size_t row = 0; row < batch.units.size(); ++row) {
     const UnitOutcome& u = batch.units[row];
     const Figure* figure = FindFigure(u.figures, name);
@@ -74,6 +141,7 @@ LotFigure FigureOverLot(const std::string& name, const BatchResult& batch,
     f.failed.push_back(u.verdict == "FAIL");
     f.outside_limits.push_back(f.limits && ((f.limits->lower && !(figure->value > *f.limits->lower)) ||
                                             (f.limits->upper && !(figure->value < *f.limits->upper))));
+    f.plotted = f.plotted || f.outside_limits.back() || FailedOn(u, name);
   }
   if (f.value.empty()) return f;
   f.z = RobustZScores(f.value, f.sigma);
@@ -86,6 +154,9 @@ LotFigure FigureOverLot(const std::string& name, const BatchResult& batch,
     f.ppk = Capability(f.mean, f.stdev, *f.limits);
     f.cpk = Capability(f.mean, f.stdev_within, *f.limits);
   }
+  const int n = static_cast<int>(f.value.size());
+  f.few_units = n < kCapabilityMinUnits;
+  if (f.ppk) f.ppk_interval = CapabilityInterval(*f.ppk, n);
   const auto [low, high] = std::minmax_element(f.value.begin(), f.value.end());
   f.view = ViewWithLimits(std::min(*low, f.three_sigma[0]), std::max(*high, f.three_sigma[1]), f.limits);
   return f;
@@ -118,7 +189,8 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
     s.rows.push_back({u.unit, u.serial, u.status, u.verdict, u.message, u.status == "fitted",
                       u.unit.substr(s.unit_prefix.size())});
   }
-  for (const std::string& name : kSummaryFigures) {
+  s.figure_names = LotFigureNames(batch);
+  for (const std::string& name : s.figure_names) {
     LotFigure f = FigureOverLot(name, batch, limits);
     if (f.value.empty()) continue;
     for (size_t i = 0; i < f.value.size(); ++i) {

@@ -75,6 +75,8 @@ std::string Fmt(const char* format, double value) { return FormatNumber(format, 
 
 std::string Count(long long value) { return std::to_string(value); }
 
+std::string YieldText(double pct) { return Fmt("%.1f %%", pct); }
+
 void OpenPage(Html* h, const std::string& title, const std::string& header_left,
               const std::string& header_right) {
   h->Open("html", {{"lang", "en"}}).Open("head").Void("meta", {{"charset", "utf-8"}});

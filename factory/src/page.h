@@ -20,6 +20,8 @@ namespace imufit::internal {
 
 std::string Fmt(const char* format, double value);  // FormatNumber()
 std::string Count(long long value);
+// A yield as every page prints it, in its tables and on its bars: "66.7 %".
+std::string YieldText(double pct);
 
 // <html><head> with `title`, the style and a running header (left, right), then <body>.
 void OpenPage(Html* h, const std::string& title, const std::string& header_left,

@@ -15,6 +15,8 @@
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
+#include "imufit/model/check.h"
+#include "temp_folder.h"
 
 extern char** environ;
 
@@ -107,19 +109,7 @@ std::string RunGnuplot(const std::string& script_text, const std::string& folder
   return "";
 }
 
-// A private temporary folder, removed with its contents when the object goes.
-struct TempFolder {
-  std::string path;
-  TempFolder() {
-    path = (fs::temp_directory_path() / "imufit-plot-XXXXXX").string();
-    if (::mkdtemp(path.data()) == nullptr)
-      throw std::runtime_error("cannot create a temporary folder for gnuplot");
-  }
-  ~TempFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
+using internal::TempFolder;
 
 // Margins around the data, as fractions of its extent, so that no point sits on the frame.
 constexpr double kXMargin = 0.04, kYMargin = 0.06;
@@ -260,8 +250,8 @@ void WriteAnnotations(std::ostream& gp, const Plot& plot) {
     } else {
       gp << "set arrow " << object << " from graph 0, first " << m.value << " to graph 1, first " << m.value
          << " nohead dt " << m.dash_type << " lw 1.5 lc rgb '" << m.color << "'\n";
-      gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first " << m.value
-         << " left textcolor rgb '" << m.color << "'\n";
+      gp << "set label " << object << " " << Quote(m.label) << " at graph 1.01, first "
+         << m.label_at.value_or(m.value) << " left textcolor rgb '" << m.color << "'\n";
     }
     ++object;
   }
@@ -360,6 +350,33 @@ CategoryAxis CategoryTics(const std::vector<std::string>& labels, int max_labels
   return axis;
 }
 
+double MarkerLabelGap(const Plot& plot, int height_px) {
+  IMUFIT_CHECK(plot.y_range.has_value() && height_px > 0,
+               "a marker label gap needs the y range and the height");
+  return ((*plot.y_range)[1] - (*plot.y_range)[0]) * kLabelHeightPx / (kPlotAreaShare * height_px);
+}
+
+void SpreadMarkerLabels(int height_px, Plot* plot) {
+  std::vector<PlotMarker*> labelled;
+  for (PlotMarker& m : plot->markers) {
+    if (!m.vertical && !m.label.empty()) labelled.push_back(&m);
+  }
+  if (labelled.size() < 2) return;
+  const double gap = MarkerLabelGap(*plot, height_px);
+  std::stable_sort(labelled.begin(), labelled.end(),
+                   [](const PlotMarker* a, const PlotMarker* b) { return a->value < b->value; });
+  std::vector<double> at;
+  for (const PlotMarker* m : labelled)
+    at.push_back(at.empty() ? m->value : std::max(m->value, at.back() + gap));
+  // Pushed up beyond the axis: pushed back down from its end, keeping the gaps.
+  const double top = std::max((*plot->y_range)[1], labelled.back()->value);
+  if (at.back() > top) {
+    at.back() = top;
+    for (size_t i = at.size() - 1; i-- > 0;) at[i] = std::min(at[i], at[i + 1] - gap);
+  }
+  for (size_t i = 0; i < at.size(); ++i) labelled[i]->label_at = at[i];
+}
+
 const char* PlotColor(int index) {
   static const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
                                         "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
@@ -396,7 +413,7 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
 
 std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
   if (figures.empty()) return {};
-  TempFolder folder;
+  TempFolder folder("imufit-plot");
   std::string script;
   for (size_t i = 0; i < figures.size(); ++i) {
     script += GnuplotScript(figures[i], "svg", folder.path + "/" + std::to_string(i) + ".svg");
@@ -415,7 +432,7 @@ std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
 
 void DrawFile(const PlotFigure& figure, const std::string& path, OutputTransaction* transaction) {
   const bool png = HasSuffix(path, ".png");
-  TempFolder folder;
+  TempFolder folder("imufit-plot");
   const std::string image = folder.path + (png ? "/figure.png" : "/figure.svg");
   if (const std::string failure = RunGnuplot(GnuplotScript(figure, png ? "png" : "svg", image), folder.path);
       !failure.empty()) {

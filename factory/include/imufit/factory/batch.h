@@ -48,6 +48,10 @@ struct BatchOptions {
   FitRunOptions fit;
   // Write OUT_DIR/<unit>/report.html for each fitted unit and OUT_DIR/lot.html (report.h).
   bool write_reports = true;
+  // With write_reports: each certificate printed to OUT_DIR/<unit>/report.pdf and the lot page to
+  // OUT_DIR/lot.pdf (pdf.h), on `paper`.
+  bool write_pdf = false;
+  Paper paper = Paper::kA4;
   // Called under a lock after each unit finishes (from whichever thread finished it).
   std::function<void(const BatchProgress&)> progress;
 

@@ -33,10 +33,6 @@ CertificateFigures MakeCertificateFigures(const Certificate& certificate);
 std::vector<PlotFigure> CertificatePlots(const Certificate& certificate);
 
 std::string CertificateHtml(const Certificate& certificate);
-// Writes it atomically.
-// Writes it atomically, in `transaction` when not null.
-void WriteCertificate(const std::string& path, const Certificate& certificate,
-                      OutputTransaction* transaction = nullptr);
 
 }  // namespace imufit
 

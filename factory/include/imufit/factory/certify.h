@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/pdf.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
@@ -42,6 +43,7 @@ struct UnitOutcome {
   std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
   std::string message;  // the failed criteria, or why it was not fitted
   std::vector<Figure> figures;
+  std::string calibrated_utc;  // when the calibration was made (its created_utc); fitted units
   std::string plan_path;
   std::string samples_path;
   std::string plan_sha256;
@@ -82,6 +84,8 @@ void ReadLimitsAndStation(const std::string& limits_path, const std::string& sta
 struct UnitFiles {
   std::string calibration;
   std::string report;  // the certificate; "" for none
+  std::string pdf;     // the certificate printed (pdf.h), with `report`; "" for none
+  Paper paper = Paper::kA4;
   // Further outputs written into the unit's transaction once it is judged (a batch's manifest).
   std::function<void(const UnitOutcome&, OutputTransaction*)> more;
 };

@@ -44,6 +44,8 @@ struct PlotMarker {
   std::string color = "#b00000";
   bool vertical = false;
   int dash_type = 2;  // gnuplot's: 1 solid, 2 dashed, 3 dotted
+  std::optional<double> label_at =
+      std::nullopt;  // where the label sits (SpreadMarkerLabels()); nullopt: at `value`
 };
 
 // A line of text inside the panel; labels stack from the top left (or the bottom left).
@@ -95,6 +97,17 @@ struct Plot {
   int x_tic_rotate_deg = 0;     // 90: labels read bottom to top (many or long labels)
   std::vector<PlotNote> notes;
 };
+
+// Text of 10 pt is this tall on a panel; a panel's plotting area is at least this share of its
+// height (the rest: title, tick labels and axis label).
+inline constexpr double kLabelHeightPx = 14.0;
+inline constexpr double kPlotAreaShare = 0.6;
+// The least distance, in y data units, between the labels of two horizontal markers of `plot`
+// (whose y_range is set) in a panel `height_px` high.
+double MarkerLabelGap(const Plot& plot, int height_px);
+// Moves the labels of `plot`'s horizontal markers apart (label_at) so that no two are closer than
+// MarkerLabelGap(): a limit's label never sits on the mean's or 3 sigma's. The lines stay where they are.
+void SpreadMarkerLabels(int height_px, Plot* plot);
 
 // A linear axis that shows [lo, hi] with 3 % to spare each side: widened to whole steps of 1, 2 or
 // 5 x 10^k, about `tics` steps in all, with the printf format of the fewest decimals that tell neighbouring
