@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 
 #include "commands.h"
@@ -19,6 +20,7 @@ struct BatchArguments {
   bool no_report = false;
   PdfArguments pdf;
   bool quiet = false;
+  std::string shard;  // --shard I/N, auto, auto/N
 };
 
 // Units done, rate and time left: one updating line on a terminal, plain lines otherwise.
@@ -53,6 +55,8 @@ int RunBatchCommand(BatchArguments args) {
     throw InputError("--pdf", "prints the certificates: leave out --no-report");
   options.paper = args.pdf.Resolve();
   options.write_pdf = args.pdf.pdf;
+  if (!args.shard.empty())
+    options.shard = ParseShard(args.shard, [](const char* name) { return std::getenv(name); });
   const BatchResult result = RunBatch(options);
   // Warnings even with --quiet, as imufit fit gives them (a unit skipped as unchanged gave its own
   // when it was fitted; its certificate keeps them).
@@ -100,7 +104,15 @@ CommandRunner AddBatchCommand(CLI::App* root) {
   command->add_option("--output,-o", b.output_dir, "output folder")->required();
   command->add_option("--limits,-l", b.limits_path, "acceptance limits YAML (format imufit-limits)");
   command->add_option("--plan,-p", b.shared_plan, "plan for units without their own plan.yaml");
-  command->add_option("--store", b.store_path, "results store (SQLite) to record every fit in");
+  command->add_option(
+      "--store", b.store_path,
+      "results store to record every fit in: an SQLite file, or a PostgreSQL URL or connection "
+      "string (postgresql://host/db; the password from ~/.pgpass or PGPASSFILE)");
+  command->add_option(
+      "--shard", args->shard,
+      "fit only this shard of the lot: I/N (units whose folder name hashes to I of N), auto "
+      "(Slurm array), auto/N (Kubernetes JOB_COMPLETION_INDEX or GNU parallel's PARALLEL_SEQ); "
+      "with shards, the lot page comes from the store (imufit history --lot)");
   command->add_option(
       "--station", b.station_path,
       "station file (format imufit-station: station, operator, equipment) shown on every certificate");

@@ -325,8 +325,9 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option(
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
-  command->add_option("--store", args->store,
-                      "record the fit in this results store (SQLite; created when missing)");
+  command->add_option(
+      "--store", args->store,
+      "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");
   return [args] { return RunFit(*args); };
 }
 

@@ -138,7 +138,9 @@ CommandRunner AddHistoryCommand(CLI::App* root) {
                                            "(--serial), the yield of lots (--lot [NAME]), or a "
                                            "key figure over time (--trend gyro.bias.x, or a figure name such "
                                            "as gyro_bias_dps.x; with --serial, one unit's).");
-  command->add_option("store", args->store, "results store (SQLite) written by imufit batch/fit --store")
+  command
+      ->add_option("store", args->store,
+                   "results store written by imufit batch/fit --store: an SQLite file or a PostgreSQL URL")
       ->required();
   command->add_option("--serial", args->serial, "a unit's serial");
   CLI::Option* lot =

@@ -11,7 +11,7 @@ IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev
                      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
                      python3-matplotlib python3-setuptools python3-wheel python3-pip clang clang-format
                      libfuzzer-14-dev chromium poppler-utils ccache gcc-arm-none-eabi libnewlib-arm-none-eabi
-                     python3-jsonschema libssl-dev libisal-dev)
+                     python3-jsonschema libssl-dev libisal-dev libpq-dev postgresql)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {

@@ -214,7 +214,8 @@ TEST_F(FactoryTest, StoreRecordsAndAnswers) {
       fit.status = "fitted";
       fit.verdict = i == 1 ? "FAIL" : "PASS";
       fit.calibration_yaml = CalibrationToYaml(truth);
-      fit.figures = KeyFigures(truth);
+      const std::vector<Figure> figures = KeyFigures(truth);
+      fit.figures.assign(figures.begin(), figures.end());
       fit.figures[0].value += i;
       EXPECT_GT(store.Record(fit), 0);
     }

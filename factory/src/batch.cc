@@ -117,8 +117,11 @@ void RemoveLeftovers(const fs::path& folder) {
 // Holds an exclusive lock on OUT_DIR/.imufit-batch.lock: two batches never write one folder.
 class FolderLock {
  public:
-  explicit FolderLock(const std::string& folder) {
-    const std::string path = (fs::path(folder) / ".imufit-batch.lock").string();
+  FolderLock(const std::string& folder, const Shard& shard) {
+    const std::string name = shard.count > 1 ? ".imufit-batch-shard-" + std::to_string(shard.index) + "-of-" +
+                                                   std::to_string(shard.count) + ".lock"
+                                             : ".imufit-batch.lock";
+    const std::string path = (fs::path(folder) / name).string();
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd_ < 0) throw InputError(path, "cannot create the lock file");
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
@@ -387,11 +390,14 @@ std::string LotName(const BatchOptions& options) {
   return name.empty() ? units.parent_path().filename().string() : name;  // "units/" ends in ""
 }
 
-// The unit folders, in name order (not .git and the like).
-std::vector<fs::path> ListUnits(const std::string& units_dir) {
+// The unit folders of `shard`, in name order (not .git and the like).
+std::vector<fs::path> ListUnits(const std::string& units_dir, const Shard& shard) {
   std::vector<fs::path> units;
   for (const fs::directory_entry& entry : fs::directory_iterator(units_dir)) {
-    if (entry.is_directory() && entry.path().filename().string()[0] != '.') units.push_back(entry.path());
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && name[0] != '.' && ShardOf(name, shard.count) == shard.index) {
+      units.push_back(entry.path());
+    }
   }
   std::sort(units.begin(), units.end());
   return units;
@@ -500,22 +506,24 @@ std::string BatchOptions::Validate() const {
   if (output_dir.empty()) return "no output folder";
   if (jobs < 0) return "jobs must be >= 0";
   if (max_units < 0) return "max_units must be >= 0";
+  if (shard.count < 1 || shard.index < 0 || shard.index >= shard.count)
+    return "shard index must be below the count";
   return fit.Validate();
 }
 
 BatchResult RunBatch(const BatchOptions& options) {
   Shared shared;
   Prepare(options, &shared);
-  const FolderLock lock(options.output_dir);
+  const FolderLock lock(options.output_dir, options.shard);
   shared.certify.lot = LotName(options);
   if (!options.store_path.empty()) {
     shared.store = std::make_unique<ResultsStore>(options.store_path);
     shared.certify.store = shared.store.get();
   }
   SetInterruptNote(InterruptNote);
-  BatchResult result = Tally(ProcessUnits(shared, ListUnits(options.units_dir)));
+  BatchResult result = Tally(ProcessUnits(shared, ListUnits(options.units_dir, options.shard)));
   SetInterruptNote(nullptr);
-  if (result.complete) WriteLotOutputs(shared, result);
+  if (result.complete && options.shard.count == 1) WriteLotOutputs(shared, result);
   return result;
 }
 

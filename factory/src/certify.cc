@@ -1,5 +1,8 @@
 #include "imufit/factory/certify.h"
 
+#include <sys/stat.h>
+
+#include <ctime>
 #include <exception>
 #include <utility>
 
@@ -83,6 +86,21 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
   return RecordUnit(settings, unit, &outputs);
 }
 
+namespace {
+
+// The last-modified time of a file as "YYYY-MM-DDTHH:MM:SSZ"; "" when it cannot be read.
+std::string FileTimeUtc(const std::string& path) {
+  struct stat info {};
+  if (path.empty() || stat(path.c_str(), &info) != 0) return "";
+  std::tm utc{};
+  if (gmtime_r(&info.st_mtime, &utc) == nullptr) return "";
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+}  // namespace
+
 bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransaction* outputs) {
   if (settings.store == nullptr) {
     if (outputs != nullptr) outputs->Commit();
@@ -102,7 +120,19 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.verdict = unit->verdict;
   row.message = unit->message;
   row.calibration_yaml = unit->calibration_yaml;
-  row.figures = unit->figures;
+  if (settings.station)
+    row.station = settings.station->id.empty() ? settings.station->name : settings.station->id;
+  row.acquired_utc = FileTimeUtc(unit->samples_path);
+  for (const Figure& figure : unit->figures) {
+    StoredFigure g(figure);
+    if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;
+    for (const CriterionResult& c : unit->verdict_detail.criteria) {
+      if (c.name != "|" + g.name + "|") continue;
+      g.limit_abs = c.limit;
+      g.outcome = c.pass ? "pass" : "fail";
+    }
+    row.figures.push_back(std::move(g));
+  }
   std::exception_ptr output_error;  // the outputs' failure passes on; the store's is the unit's
   const auto commit_outputs = [&] {
     if (outputs == nullptr) return;

@@ -5,11 +5,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <map>
 #include <optional>
 #include <thread>
 
+#include "imufit/factory/certificate.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
+#include "sql_connection.h"
 
 namespace imufit {
 namespace {
@@ -38,269 +41,492 @@ class Statement {
   }
   double Double(int column) const { return sqlite3_column_double(statement_, column); }
   int64_t Integer(int column) const { return sqlite3_column_int64(statement_, column); }
-  void Reset() {
-    sqlite3_reset(statement_);
-    sqlite3_clear_bindings(statement_);
-  }
 
  private:
   sqlite3_stmt* statement_ = nullptr;
 };
 
-constexpr const char* kSchema = R"sql(
-CREATE TABLE schema_version (version INTEGER NOT NULL);
-CREATE TABLE fits (
-  id INTEGER PRIMARY KEY,
-  serial TEXT NOT NULL, unit TEXT NOT NULL, lot TEXT NOT NULL, time_utc TEXT NOT NULL, software TEXT NOT NULL,
-  plan_sha256 TEXT NOT NULL, samples_sha256 TEXT NOT NULL, limits_sha256 TEXT NOT NULL,
-  status TEXT NOT NULL, verdict TEXT NOT NULL, message TEXT NOT NULL, calibration_yaml TEXT NOT NULL);
-CREATE INDEX fits_serial ON fits (serial, time_utc);
-CREATE INDEX fits_lot ON fits (lot, unit);
-CREATE TABLE figures (
-  fit_id INTEGER NOT NULL REFERENCES fits (id), name TEXT NOT NULL, coefficient TEXT NOT NULL,
-  unit TEXT NOT NULL, value REAL NOT NULL, sigma REAL NOT NULL, PRIMARY KEY (fit_id, name));
-)sql";
+class SqliteRow : public SqlRow {
+ public:
+  explicit SqliteRow(const Statement& statement) : statement_(statement) {}
+  std::string Text(int column) const override { return statement_.Text(column); }
+  double Double(int column) const override { return statement_.Double(column); }
+  int64_t Integer(int column) const override { return statement_.Integer(column); }
 
-}  // namespace
+ private:
+  const Statement& statement_;
+};
 
-ResultsStore::ResultsStore(const std::string& path, StoreAccess access) : path_(path) {
-  struct stat status;
-  const bool exists = ::stat(path.c_str(), &status) == 0;
-  if (!exists && access == StoreAccess::kRead) {
-    throw InputError(path, "no such results store (imufit fit --store and imufit batch --store create one)");
-  }
-  // As for outputs (output_file.h): a file without write permission is not written, even by root.
-  if (exists && access == StoreAccess::kRecord &&
-      ((status.st_mode & 0222) == 0 || ::access(path.c_str(), W_OK) != 0)) {
-    throw InputError(path,
-                     "the results store is read-only: imufit records every fit in it (make it "
-                     "writable, or give another --store)");
-  }
-  const int flags =
-      access == StoreAccess::kRead ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
-  if (sqlite3_open_v2(path.c_str(), &db_, flags | SQLITE_OPEN_FULLMUTEX, nullptr) != SQLITE_OK) {
-    const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
-    sqlite3_close(db_);
-    db_ = nullptr;
-    throw InputError(path, "cannot open the results store: " + message);
-  }
-  try {
-    if (access == StoreAccess::kRecord && sqlite3_db_readonly(db_, "main") == 1) {
+// The embedded backend: one SQLite file in WAL mode. Several processes may open, create and write
+// one file at once: a busy database is waited for (up to kStoreBusyWaitSeconds), never an error.
+class SqliteConnection : public SqlConnection {
+ public:
+  SqliteConnection(const std::string& path, StoreAccess access) : path_(path) {
+    struct stat status;
+    const bool exists = ::stat(path.c_str(), &status) == 0;
+    if (!exists && access == StoreAccess::kRead) {
+      throw InputError(path, "no such results store (imufit fit --store and imufit batch --store create one)");
+    }
+    // As for outputs (output_file.h): a file without write permission is not written, even by root.
+    const bool writable = exists && (status.st_mode & 0222) != 0 && ::access(path.c_str(), W_OK) == 0;
+    if (exists && !writable && access == StoreAccess::kRecord) {
       throw InputError(path,
-                       "the results store cannot be written (a read-only file system?): imufit "
-                       "records every fit in it (give another --store)");
+                       "the results store is read-only: imufit records every fit in it (make it "
+                       "writable, or give another --store)");
     }
-    Open(access);
-  } catch (...) {
-    sqlite3_close(db_);  // the destructor does not run for a constructor that throws
-    db_ = nullptr;
-    throw;
-  }
-}
-
-void ResultsStore::Open(StoreAccess access) {
-  sqlite3_busy_timeout(db_, kStoreBusyWaitSeconds * 1000);
-  if (access == StoreAccess::kRead) {
-    CheckVersion();
-    return;
-  }
-  // Changing the journal mode takes the database exclusively and does not wait on its own.
-  ExecuteWaiting("PRAGMA journal_mode = WAL");
-  Execute("PRAGMA synchronous = NORMAL");  // durable across a process crash; WAL keeps it consistent
-  Execute("PRAGMA foreign_keys = ON");
-  ExecuteWaiting("BEGIN IMMEDIATE");  // another process creating the schema finishes first
-  Statement tables(db_, "SELECT count(*) FROM sqlite_master WHERE type = 'table'");
-  if (!tables.ok() || tables.Step() != SQLITE_ROW) Fail("not an SQLite database");
-  if (tables.Integer(0) == 0) {
-    Execute(kSchema);
-    Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
-    Execute("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
-  }
-  CheckVersion();
-  Execute("COMMIT");
-}
-
-void ResultsStore::CheckVersion() {
-  const auto refuse = [&](int64_t found) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // harmless outside a transaction
-    throw InputError(path_, "results store schema version " + std::to_string(found) +
-                                " is not supported (this imufit reads and writes version " +
-                                std::to_string(kStoreSchemaVersion) + "; use the imufit that wrote it)");
-  };
-  Statement user_version(db_, "PRAGMA user_version");
-  if (!user_version.ok() || user_version.Step() != SQLITE_ROW) Fail("not an SQLite database");
-  if (user_version.Integer(0) > kStoreSchemaVersion) refuse(user_version.Integer(0));
-  Statement version(db_, "SELECT version FROM schema_version");
-  if (!version.ok() || version.Step() != SQLITE_ROW) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    throw InputError(path_, "not an imufit results store (no schema_version table)");
-  }
-  const int64_t found = version.Integer(0);
-  if (found > kStoreSchemaVersion || found < 1) refuse(found);
-}
-
-void ResultsStore::ExecuteWaiting(const std::string& sql) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(kStoreBusyWaitSeconds);
-  for (;;) {
-    const int code = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr);
-    if (code == SQLITE_OK) return;
-    if (code != SQLITE_BUSY && code != SQLITE_LOCKED) Fail("results store");
-    if (std::chrono::steady_clock::now() > give_up) {
-      Fail("results store (held by another process for " + std::to_string(kStoreBusyWaitSeconds) + " s)");
+    // Read access writes only to migrate an older store, when the file may be written.
+    const int flags = access == StoreAccess::kRecord ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
+                      : writable                     ? SQLITE_OPEN_READWRITE
+                                                     : SQLITE_OPEN_READONLY;
+    if (sqlite3_open_v2(path.c_str(), &db_, flags | SQLITE_OPEN_FULLMUTEX, nullptr) != SQLITE_OK) {
+      const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      throw InputError(path, "cannot open the results store: " + message);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-}
-
-ResultsStore::~ResultsStore() { sqlite3_close(db_); }
-
-void ResultsStore::Fail(const std::string& what) {
-  const std::string message = what + ": " + sqlite3_errmsg(db_);
-  sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // harmless when no transaction is open
-  throw InputError(path_, message);
-}
-
-void ResultsStore::Execute(const std::string& sql) {
-  char* error = nullptr;
-  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
-    const std::string message = error ? error : "unknown error";
-    sqlite3_free(error);
-    if (sql != "ROLLBACK") sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    throw InputError(path_, "results store: " + message);
-  }
-}
-
-int64_t ResultsStore::Record(const StoredFit& fit, const std::function<void()>& before_commit) {
-  const std::lock_guard<std::mutex> lock(record_mutex_);
-  ExecuteWaiting("BEGIN IMMEDIATE");
-  int64_t id = 0;
-  {
-    Statement insert(db_,
-                     "INSERT INTO fits (serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, "
-                     "limits_sha256, status, verdict, message, calibration_yaml) "
-                     "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)");
-    if (!insert.ok()) Fail("preparing the insert");
-    const std::string* texts[] = {&fit.serial,         &fit.unit,          &fit.lot,
-                                  &fit.time_utc,       &fit.software,      &fit.plan_sha256,
-                                  &fit.samples_sha256, &fit.limits_sha256, &fit.status,
-                                  &fit.verdict,        &fit.message,       &fit.calibration_yaml};
-    for (int i = 0; i < 12; ++i) insert.Bind(i + 1, *texts[i]);
-    if (insert.Step() != SQLITE_DONE) Fail("recording the fit");
-    id = sqlite3_last_insert_rowid(db_);
-    Statement figure(db_,
-                     "INSERT INTO figures (fit_id, name, coefficient, unit, value, sigma) VALUES (?1, ?2, "
-                     "?3, ?4, ?5, ?6)");
-    if (!figure.ok()) Fail("preparing the insert");
-    for (const Figure& f : fit.figures) {
-      figure.Bind(1, id);
-      figure.Bind(2, f.name);
-      figure.Bind(3, f.coefficient);
-      figure.Bind(4, f.unit);
-      figure.Bind(5, f.value);
-      figure.Bind(6, f.sigma);
-      if (figure.Step() != SQLITE_DONE) Fail("recording figure " + f.name);
-      figure.Reset();
-    }
-  }
-  std::optional<SignalsDeferred> deferred;  // the files and the row: both, even on Ctrl-C
-  if (before_commit) {
-    deferred.emplace();
     try {
-      before_commit();
+      sqlite3_busy_timeout(db_, kStoreBusyWaitSeconds * 1000);
+      if (access == StoreAccess::kRecord && sqlite3_db_readonly(db_, "main") == 1) {
+        throw InputError(path,
+                         "the results store cannot be written (a read-only file system?): imufit "
+                         "records every fit in it (give another --store)");
+      }
+      CheckUserVersion();
+      if (flags != SQLITE_OPEN_READONLY) {
+        // Changing the journal mode takes the database exclusively and does not wait on its own.
+        ExecuteWaiting("PRAGMA journal_mode = WAL");
+        Execute("PRAGMA synchronous = NORMAL");  // durable across a process crash; WAL keeps it consistent
+      }
+      Execute("PRAGMA foreign_keys = ON");
     } catch (...) {
-      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      sqlite3_close(db_);  // the destructor does not run for a constructor that throws
       throw;
     }
   }
-  Execute("COMMIT");
+  ~SqliteConnection() override { sqlite3_close(db_); }
+
+  const std::string& name() const override { return path_; }
+  const char* backend() const override { return "sqlite"; }
+  const char* AutoIdType() const override { return "INTEGER PRIMARY KEY"; }
+  const char* TextType() const override { return "TEXT"; }
+
+  void Execute(const std::string& sql) override {
+    char* error = nullptr;
+    if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
+      const std::string message = error ? error : "unknown error";
+      sqlite3_free(error);
+      if (sql != "ROLLBACK") Rollback();
+      throw InputError(path_, "results store: " + message);
+    }
+  }
+
+  void Query(const std::string& sql, const std::vector<SqlValue>& parameters,
+             const std::function<void(const SqlRow&)>& row) override {
+    Statement statement(db_, sql);
+    if (!statement.ok()) Fail("preparing a statement");
+    for (size_t i = 0; i < parameters.size(); ++i) {
+      std::visit([&](const auto& value) { statement.Bind(static_cast<int>(i) + 1, value); }, parameters[i]);
+    }
+    const SqliteRow current(statement);
+    for (;;) {
+      const int step = statement.Step();
+      if (step == SQLITE_DONE) return;
+      if (step != SQLITE_ROW) Fail("running a statement");
+      row(current);
+    }
+  }
+
+  // Another process's transaction (creating the schema, recording a unit) finishes first.
+  void Begin(bool /*exclusive*/) override { ExecuteWaiting("BEGIN IMMEDIATE"); }
+  void SchemaWritten(int version) override { Execute("PRAGMA user_version = " + std::to_string(version)); }
+  void Commit() override { Execute("COMMIT"); }
+  void Rollback() override { sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr); }
+
+  bool HasTable(const std::string& table) override {
+    bool found = false;
+    Query("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?1", {table},
+          [&](const SqlRow&) { found = true; });
+    return found;
+  }
+
+ private:
+  [[noreturn]] void Fail(const std::string& what) {
+    const std::string message = what + ": " + sqlite3_errmsg(db_);
+    Rollback();
+    throw InputError(path_, "results store: " + message);
+  }
+
+  // Execute(), waiting while another process holds the database (SQLITE_BUSY, SQLITE_LOCKED).
+  void ExecuteWaiting(const std::string& sql) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(kStoreBusyWaitSeconds);
+    for (;;) {
+      const int code = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr);
+      if (code == SQLITE_OK) return;
+      if (code != SQLITE_BUSY && code != SQLITE_LOCKED) Fail("results store");
+      if (std::chrono::steady_clock::now() > give_up) {
+        Fail("held by another process for " + std::to_string(kStoreBusyWaitSeconds) + " s");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  // SQLite's user_version holds the schema version too: a store of a newer imufit is refused
+  // before anything reads its tables.
+  void CheckUserVersion() {
+    Statement version(db_, "PRAGMA user_version");
+    if (!version.ok() || version.Step() != SQLITE_ROW) Fail("not an SQLite database");
+    const int64_t found = version.Integer(0);
+    if (found > kStoreSchemaVersion) throw UnsupportedVersion(path_, found);
+  }
+
+  std::string path_;
+  sqlite3* db_ = nullptr;
+};
+
+// The schema, once for both backends: TEXT and the numbered id are the backend's (TextType(),
+// AutoIdType()).
+constexpr const char* kSchema = R"sql(
+CREATE TABLE schema_version (version INTEGER NOT NULL);
+CREATE TABLE stations (station TEXT PRIMARY KEY, first_seen_utc TEXT NOT NULL);
+CREATE TABLE units (serial TEXT PRIMARY KEY, part_number TEXT NOT NULL, lot TEXT NOT NULL);
+CREATE TABLE runs (
+  run_key TEXT PRIMARY KEY, serial TEXT NOT NULL REFERENCES units (serial), unit TEXT NOT NULL,
+  lot TEXT NOT NULL, station TEXT NOT NULL, acquired_utc TEXT NOT NULL, plan_sha256 TEXT NOT NULL,
+  samples_sha256 TEXT NOT NULL);
+CREATE TABLE fits (
+  id AUTO_ID, fit_key TEXT NOT NULL UNIQUE, run_key TEXT NOT NULL REFERENCES runs (run_key),
+  time_utc TEXT NOT NULL, software TEXT NOT NULL, fit_options TEXT NOT NULL, limits_sha256 TEXT NOT NULL,
+  status TEXT NOT NULL, verdict TEXT NOT NULL, message TEXT NOT NULL, calibration_yaml TEXT NOT NULL);
+CREATE TABLE figures (
+  fit_id BIGINT NOT NULL REFERENCES fits (id), position INTEGER NOT NULL, name TEXT NOT NULL,
+  coefficient TEXT NOT NULL, unit TEXT NOT NULL, value DOUBLE PRECISION NOT NULL,
+  sigma DOUBLE PRECISION NOT NULL, expanded_u DOUBLE PRECISION NOT NULL,
+  limit_abs DOUBLE PRECISION NOT NULL, outcome TEXT NOT NULL, PRIMARY KEY (fit_id, name));
+CREATE TABLE attachments (
+  fit_id BIGINT NOT NULL REFERENCES fits (id), kind TEXT NOT NULL, path TEXT NOT NULL,
+  sha256 TEXT NOT NULL, PRIMARY KEY (fit_id, kind, path));
+CREATE INDEX units_lot ON units (lot);
+CREATE INDEX runs_serial ON runs (serial);
+CREATE INDEX runs_lot ON runs (lot, unit);
+CREATE INDEX runs_station ON runs (station, acquired_utc);
+CREATE INDEX fits_run ON fits (run_key, time_utc);
+CREATE INDEX fits_time ON fits (time_utc);
+CREATE INDEX figures_name ON figures (name, fit_id);
+CREATE INDEX figures_coefficient ON figures (coefficient, fit_id);
+)sql";
+
+InputError UnsupportedVersion(const std::string& name, int64_t found) {
+  return InputError(name, "results store schema version " + std::to_string(found) +
+                              " is not supported (this imufit reads and writes version " +
+                              std::to_string(kStoreSchemaVersion) + "; use the imufit that wrote it)");
+}
+
+std::string SchemaFor(const SqlConnection& db) {
+  std::string sql = kSchema;
+  const auto replace_all = [&](const std::string& from, const std::string& to) {
+    for (size_t at = sql.find(from); at != std::string::npos; at = sql.find(from, at + to.size())) {
+      sql.replace(at, from.size(), to);
+    }
+  };
+  replace_all(" TEXT", std::string(" ") + db.TextType());
+  replace_all("AUTO_ID", db.AutoIdType());
+  return sql;
+}
+
+// The columns of a fit with its run and unit, in StoredFit order (Fits()).
+constexpr const char* kFitColumns =
+    "SELECT f.id, r.serial, r.unit, r.lot, u.part_number, r.station, r.acquired_utc, f.time_utc, "
+    "f.software, f.fit_options, r.plan_sha256, r.samples_sha256, f.limits_sha256, f.status, f.verdict, "
+    "f.message, f.calibration_yaml FROM fits f JOIN runs r ON r.run_key = f.run_key "
+    "JOIN units u ON u.serial = r.serial";
+
+std::vector<std::string*> TextFields(StoredFit* f) {
+  return {&f->serial,          &f->unit,          &f->lot,      &f->part_number, &f->station,
+          &f->acquired_utc,    &f->time_utc,      &f->software, &f->fit_options, &f->plan_sha256,
+          &f->samples_sha256,  &f->limits_sha256, &f->status,   &f->verdict,     &f->message,
+          &f->calibration_yaml};
+}
+
+// Each unit of a lot by its latest fit (a unit refitted after a fix counts as fixed): n = 1.
+constexpr const char* kLatestPerUnit =
+    "WITH latest AS (SELECT f.id AS id, r.lot AS lot, r.unit AS unit, f.time_utc AS time_utc, "
+    "f.status AS status, f.verdict AS verdict, ROW_NUMBER() OVER (PARTITION BY r.lot, r.unit "
+    "ORDER BY f.time_utc DESC, f.id DESC) AS n FROM fits f JOIN runs r ON r.run_key = f.run_key "
+    "WHERE r.lot <> '') ";
+
+class Transaction {
+ public:
+  Transaction(SqlConnection* db, bool exclusive) : db_(db) { db_->Begin(exclusive); }
+  ~Transaction() {
+    if (!done_) db_->Rollback();
+  }
+  Transaction(const Transaction&) = delete;
+  Transaction& operator=(const Transaction&) = delete;
+  void Commit() {
+    db_->Commit();
+    done_ = true;
+  }
+
+ private:
+  SqlConnection* db_;
+  bool done_ = false;
+};
+
+}  // namespace
+
+const StoredFigure* FindFigure(const std::vector<StoredFigure>& figures, const std::string& name) {
+  for (const StoredFigure& f : figures) {
+    if (f.name == name || f.coefficient == name) return &f;
+  }
+  return nullptr;
+}
+
+std::unique_ptr<SqlConnection> OpenSqlite(const std::string& path, StoreAccess access) {
+  return std::make_unique<SqliteConnection>(path, access);
+}
+
+ResultsStore::ResultsStore(const std::string& target, StoreAccess access)
+    : path_(target), db_(IsPostgresStore(target) ? ConnectPostgres(target) : OpenSqlite(target, access)) {
+  path_ = db_->name();
+  Open();
+}
+
+ResultsStore::~ResultsStore() = default;
+
+const char* ResultsStore::backend() const { return db_->backend(); }
+
+void ResultsStore::Open() {
+  Transaction transaction(db_.get(), /*exclusive=*/true);
+  if (!db_->HasTable("schema_version")) {
+    bool empty = true;
+    if (db_->HasTable("fits")) empty = false;
+    if (!empty) throw InputError(path_, "not an imufit results store (no schema_version table)");
+    db_->Execute(SchemaFor(*db_));
+    db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
+    db_->SchemaWritten(kStoreSchemaVersion);
+  }
+  int64_t found = -1;
+  db_->Query("SELECT version FROM schema_version", {}, [&](const SqlRow& row) { found = row.Integer(0); });
+  if (found > kStoreSchemaVersion || found < 1) throw UnsupportedVersion(path_, found);
+  if (found == 1) MigrateFromVersion1();
+  transaction.Commit();
+}
+
+// Version 1 (SQLite only): fits(id, serial, unit, lot, time_utc, software, plan_sha256,
+// samples_sha256, limits_sha256, status, verdict, message, calibration_yaml) and figures(fit_id,
+// name, coefficient, unit, value, sigma). Every fit and figure is kept; runs, units and keys are
+// derived from them.
+void ResultsStore::MigrateFromVersion1() {
+  std::vector<StoredFit> fits;
+  std::map<int64_t, size_t> by_id;
+  db_->Query(
+      "SELECT id, serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, limits_sha256, "
+      "status, verdict, message, calibration_yaml FROM fits ORDER BY id",
+      {}, [&](const SqlRow& row) {
+        StoredFit f;
+        f.id = row.Integer(0);
+        std::string* texts[] = {
+            &f.serial,         &f.unit,          &f.lot,    &f.time_utc, &f.software, &f.plan_sha256,
+            &f.samples_sha256, &f.limits_sha256, &f.status, &f.verdict,  &f.message,  &f.calibration_yaml};
+        for (int i = 0; i < 12; ++i) *texts[i] = row.Text(i + 1);
+        by_id[f.id] = fits.size();
+        fits.push_back(std::move(f));
+      });
+  db_->Query("SELECT fit_id, name, coefficient, unit, value, sigma FROM figures ORDER BY fit_id, rowid", {},
+             [&](const SqlRow& row) {
+               const auto it = by_id.find(row.Integer(0));
+               if (it == by_id.end()) return;
+               StoredFigure g(Figure{row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5)});
+               if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;
+               fits[it->second].figures.push_back(std::move(g));
+             });
+  db_->Execute("DROP TABLE figures; DROP TABLE fits; DROP TABLE schema_version;");
+  db_->Execute(SchemaFor(*db_));
+  db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
+  db_->SchemaWritten(kStoreSchemaVersion);
+  for (const StoredFit& f : fits) Insert(f);
+}
+
+int64_t ResultsStore::Record(const StoredFit& fit, const std::function<void()>& before_commit) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  Transaction transaction(db_.get(), /*exclusive=*/false);
+  const int64_t id = Insert(fit);
+  std::optional<SignalsDeferred> deferred;  // the files and the row: both, even on Ctrl-C
+  if (before_commit) {
+    deferred.emplace();
+    before_commit();  // when it throws, the transaction rolls back
+  }
+  transaction.Commit();
   return id;
 }
 
 bool ResultsStore::HasUnit(const std::string& lot, const std::string& unit) {
-  Statement query(db_, "SELECT 1 FROM fits WHERE lot = ?1 AND unit = ?2 LIMIT 1");
-  if (!query.ok()) Fail("querying fits");
-  query.Bind(1, lot);
-  query.Bind(2, unit);
-  return query.Step() == SQLITE_ROW;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  bool found = false;
+  db_->Query("SELECT 1 FROM runs WHERE lot = ?1 AND unit = ?2 LIMIT 1", {lot, unit},
+             [&](const SqlRow&) { found = true; });
+  return found;
 }
 
-std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
+int64_t ResultsStore::RecordAll(const std::vector<StoredFit>& fits) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  Transaction transaction(db_.get(), /*exclusive=*/false);
+  int64_t added = 0;
+  for (const StoredFit& fit : fits) {
+    bool inserted = false;
+    Insert(fit, &inserted);
+    if (inserted) ++added;
+  }
+  transaction.Commit();
+  return added;
+}
+
+int64_t ResultsStore::Insert(const StoredFit& fit, bool* added) {
+  const std::string run_key = RunKey(fit), fit_key = FitKey(fit);
+  const auto ignore = [](const SqlRow&) {};
+  if (!fit.station.empty()) {
+    db_->Query("INSERT INTO stations (station, first_seen_utc) VALUES (?1, ?2) ON CONFLICT DO NOTHING",
+               {fit.station, fit.time_utc}, ignore);
+  }
+  db_->Query(
+      "INSERT INTO units (serial, part_number, lot) VALUES (?1, ?2, ?3) ON CONFLICT (serial) DO UPDATE SET "
+      "part_number = excluded.part_number WHERE units.part_number = '' AND excluded.part_number <> ''",
+      {fit.serial, fit.part_number, fit.lot}, ignore);
+  db_->Query(
+      "INSERT INTO runs (run_key, serial, unit, lot, station, acquired_utc, plan_sha256, samples_sha256) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8) ON CONFLICT DO NOTHING",
+      {run_key, fit.serial, fit.unit, fit.lot, fit.station, fit.acquired_utc, fit.plan_sha256,
+       fit.samples_sha256},
+      ignore);
+  int64_t id = 0;
+  bool inserted = false;
+  db_->Query(
+      "INSERT INTO fits (fit_key, run_key, time_utc, software, fit_options, limits_sha256, status, verdict, "
+      "message, calibration_yaml) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) "
+      "ON CONFLICT (fit_key) DO NOTHING RETURNING id",
+      {fit_key, run_key, fit.time_utc, fit.software, fit.fit_options, fit.limits_sha256, fit.status,
+       fit.verdict, fit.message, fit.calibration_yaml},
+      [&](const SqlRow& row) {
+        id = row.Integer(0);
+        inserted = true;
+      });
+  if (added) *added = inserted;
+  if (!inserted) {  // recorded before: a re-run or a merge
+    db_->Query("SELECT id FROM fits WHERE fit_key = ?1", {fit_key},
+               [&](const SqlRow& row) { id = row.Integer(0); });
+    return id;
+  }
+  for (size_t i = 0; i < fit.figures.size(); ++i) {
+    const StoredFigure& g = fit.figures[i];
+    db_->Query(
+        "INSERT INTO figures (fit_id, position, name, coefficient, unit, value, sigma, expanded_u, "
+        "limit_abs, "
+        "outcome) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
+        {id, static_cast<int64_t>(i), g.name, g.coefficient, g.unit, g.value, g.sigma, g.expanded_u,
+         g.limit_abs, g.outcome},
+        ignore);
+  }
+  for (const StoredAttachment& a : fit.attachments) {
+    db_->Query("INSERT INTO attachments (fit_id, kind, path, sha256) VALUES (?1, ?2, ?3, ?4)",
+               {id, a.kind, a.path, a.sha256}, ignore);
+  }
+  return id;
+}
+
+std::vector<StoredFit> ResultsStore::Fits(const std::string& where,
+                                          const std::vector<std::string>& parameters) {
+  const std::vector<SqlValue> values(parameters.begin(), parameters.end());
   std::vector<StoredFit> fits;
-  Statement query(
-      db_,
-      "SELECT id, serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, limits_sha256, "
-      "status, verdict, message, calibration_yaml FROM fits WHERE serial = ?1 ORDER BY time_utc, id");
-  if (!query.ok()) Fail("querying fits");
-  query.Bind(1, serial);
-  while (query.Step() == SQLITE_ROW) {
-    StoredFit f;
-    f.id = query.Integer(0);
-    std::string* texts[] = {
-        &f.serial,         &f.unit,          &f.lot,    &f.time_utc, &f.software, &f.plan_sha256,
-        &f.samples_sha256, &f.limits_sha256, &f.status, &f.verdict,  &f.message,  &f.calibration_yaml};
-    for (int i = 0; i < 12; ++i) *texts[i] = query.Text(i + 1);
-    fits.push_back(std::move(f));
-  }
-  for (StoredFit& f : fits) {
-    Statement figures(
-        db_, "SELECT name, coefficient, unit, value, sigma FROM figures WHERE fit_id = ?1 ORDER BY rowid");
-    if (!figures.ok()) Fail("querying figures");
-    figures.Bind(1, f.id);
-    while (figures.Step() == SQLITE_ROW) {
-      f.figures.push_back(
-          {figures.Text(0), figures.Text(1), figures.Text(2), figures.Double(3), figures.Double(4)});
-    }
-  }
+  std::map<int64_t, size_t> by_id;
+  db_->Query(std::string(kFitColumns) + " WHERE " + where + " ORDER BY f.time_utc, f.id", values,
+             [&](const SqlRow& row) {
+               StoredFit f;
+               f.id = row.Integer(0);
+               const std::vector<std::string*> texts = TextFields(&f);
+               for (size_t i = 0; i < texts.size(); ++i) *texts[i] = row.Text(static_cast<int>(i) + 1);
+               by_id[f.id] = fits.size();
+               fits.push_back(std::move(f));
+             });
+  const std::string of_these =
+      " JOIN fits f ON f.id = g.fit_id JOIN runs r ON r.run_key = f.run_key JOIN units u ON u.serial = "
+      "r.serial WHERE " +
+      where;
+  db_->Query(
+      "SELECT g.fit_id, g.name, g.coefficient, g.unit, g.value, g.sigma, g.expanded_u, g.limit_abs, "
+      "g.outcome FROM figures g" +
+          of_these + " ORDER BY g.fit_id, g.position",
+      values, [&](const SqlRow& row) {
+        StoredFigure g(Figure{row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5)});
+        g.expanded_u = row.Double(6);
+        g.limit_abs = row.Double(7);
+        g.outcome = row.Text(8);
+        fits[by_id.at(row.Integer(0))].figures.push_back(std::move(g));
+      });
+  db_->Query("SELECT g.fit_id, g.kind, g.path, g.sha256 FROM attachments g" + of_these +
+                 " ORDER BY g.fit_id, g.kind, g.path",
+             values, [&](const SqlRow& row) {
+               fits[by_id.at(row.Integer(0))].attachments.push_back({row.Text(1), row.Text(2), row.Text(3)});
+             });
   return fits;
 }
 
+std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return Fits("r.serial = ?1", {serial});
+}
+
+std::vector<StoredFit> ResultsStore::All() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return Fits("1 = 1", {});
+}
+
+int64_t ResultsStore::CountFits() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  int64_t count = 0;
+  db_->Query("SELECT count(*) FROM fits", {}, [&](const SqlRow& row) { count = row.Integer(0); });
+  return count;
+}
+
 std::vector<LotYield> ResultsStore::Yield(const std::string& lot) {
-  // Each unit of a lot counts once, by its latest fit (a unit refitted after a fix counts as fixed).
-  Statement query(
-      db_,
-      "SELECT lot, count(*), sum(verdict = 'PASS'), sum(verdict = 'FAIL'), sum(status != 'fitted') "
-      "FROM fits f WHERE id = (SELECT max(id) FROM fits g WHERE g.lot = f.lot AND g.unit = f.unit) "
-      "AND lot != '' AND (?1 = '' OR lot = ?1) GROUP BY lot ORDER BY min(time_utc), lot");
-  if (!query.ok()) Fail("querying the yield");
-  query.Bind(1, lot);
+  const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<LotYield> yields;
-  while (query.Step() == SQLITE_ROW) {
-    yields.push_back({query.Text(0), static_cast<int>(query.Integer(1)), static_cast<int>(query.Integer(2)),
-                      static_cast<int>(query.Integer(3)), static_cast<int>(query.Integer(4))});
-  }
+  db_->Query(
+      std::string(kLatestPerUnit) +
+          "SELECT lot, count(*), sum(CASE WHEN verdict = 'PASS' THEN 1 ELSE 0 END), "
+          "sum(CASE WHEN verdict = 'FAIL' THEN 1 ELSE 0 END), "
+          "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest "
+          "WHERE n = 1 AND (?1 = '' OR lot = ?1) GROUP BY lot ORDER BY min(time_utc), lot",
+      {lot}, [&](const SqlRow& row) {
+        yields.push_back({row.Text(0), static_cast<int>(row.Integer(1)), static_cast<int>(row.Integer(2)),
+                          static_cast<int>(row.Integer(3)), static_cast<int>(row.Integer(4))});
+      });
   return yields;
 }
 
 std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std::string& serial) {
-  Statement query(
-      db_,
-      "SELECT f.time_utc, f.serial, f.lot, g.value, g.sigma, g.unit FROM figures g JOIN fits f ON f.id = "
-      "g.fit_id "
-      "WHERE (g.name = ?1 OR g.coefficient = ?1) AND (?2 = '' OR f.serial = ?2) ORDER BY f.time_utc, f.id");
-  if (!query.ok()) Fail("querying the trend");
-  query.Bind(1, figure);
-  query.Bind(2, serial);
+  const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<TrendPoint> points;
-  while (query.Step() == SQLITE_ROW) {
-    points.push_back(
-        {query.Text(0), query.Text(1), query.Text(2), query.Double(3), query.Double(4), query.Text(5)});
-  }
+  db_->Query(
+      "SELECT f.time_utc, r.serial, r.lot, g.value, g.sigma, g.unit FROM figures g JOIN fits f ON f.id = "
+      "g.fit_id "
+      "JOIN runs r ON r.run_key = f.run_key WHERE (g.name = ?1 OR g.coefficient = ?1) "
+      "AND (?2 = '' OR r.serial = ?2) ORDER BY f.time_utc, f.id",
+      {figure, serial}, [&](const SqlRow& row) {
+        points.push_back({row.Text(0), row.Text(1), row.Text(2), row.Double(3), row.Double(4), row.Text(5)});
+      });
   return points;
 }
 
 std::vector<LotValue> ResultsStore::LotValues(const std::string& figure) {
-  Statement query(
-      db_,
-      "SELECT f.lot, f.unit, g.value, g.sigma, g.unit FROM fits f JOIN figures g ON g.fit_id = f.id "
-      "WHERE f.id = (SELECT max(id) FROM fits h WHERE h.lot = f.lot AND h.unit = f.unit) "
-      "AND f.lot != '' AND f.status = 'fitted' AND (g.name = ?1 OR g.coefficient = ?1) "
-      "ORDER BY f.lot, f.unit");
-  if (!query.ok()) Fail("querying a figure per lot");
-  query.Bind(1, figure);
+  const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<LotValue> values;
-  while (query.Step() == SQLITE_ROW) {
-    values.push_back({query.Text(0), query.Text(1), query.Double(2), query.Double(3), query.Text(4)});
-  }
+  db_->Query(
+      std::string(kLatestPerUnit) +
+          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit FROM latest l JOIN figures g ON g.fit_id = l.id "
+          "WHERE l.n = 1 AND l.status = 'fitted' AND (g.name = ?1 OR g.coefficient = ?1) "
+          "ORDER BY l.lot, l.unit",
+      {figure}, [&](const SqlRow& row) {
+        values.push_back({row.Text(0), row.Text(1), row.Double(2), row.Double(3), row.Text(4)});
+      });
   return values;
 }
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "imufit/factory/certify.h"
+#include "imufit/factory/shard.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
@@ -44,6 +45,10 @@ struct BatchOptions {
   int jobs = 0;
   // Stop after this many units have been fitted in this run (0: no limit) — for tests of resuming.
   int max_units = 0;
+  // This run's share of the lot (shard.h): the units whose folder name hashes to shard.index.
+  // With more than one shard, shards may write to one output folder at once, and the lot's
+  // outputs (lot_summary.csv, lot.html) are not written: the lot page comes from the store.
+  Shard shard;
   // Every unit's fit (its `serial` is the unit's serial.txt; serial_source is set per unit).
   FitRunOptions fit;
   // Write OUT_DIR/<unit>/report.html for each fitted unit and OUT_DIR/lot.html (report.h).

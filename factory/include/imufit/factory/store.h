@@ -1,47 +1,80 @@
-// imufit — the results store: every fit of a unit recorded in an embedded SQLite database.
+// imufit — the results store: every fit of a unit, on one of two backends behind this one class:
+// an embedded SQLite file (the default, one per station) or a PostgreSQL database (a URL such as
+// postgresql://host/db or a libpq keyword/value string; the password from ~/.pgpass or
+// PGPASSFILE, never from the command line). docs/factory.md and docs/scale.md.
 //
-// Schema (version kStoreSchemaVersion, docs/factory.md):
-//   schema_version(version)                       one row
-//   fits(id, serial, unit, lot, time_utc, software, plan_sha256, samples_sha256, limits_sha256,
-//        status, verdict, message, calibration_yaml)
-//   figures(fit_id -> fits.id, name, coefficient, unit, value, sigma)   the key figures at 25 degC
-// The database runs in WAL mode; Record() writes one fit and its figures in one transaction, so a
-// crash loses at most the fit being written and never leaves half a fit. Errors (the file cannot
-// be opened, is not an imufit store, has a newer schema, may not be written) are InputErrors naming
-// the file, raised when the store is opened: before any work. The schema version is kept twice:
-// in schema_version and in SQLite's user_version (a store of a newer imufit is refused by either).
-// Several processes may open and create one store at once: a busy database is waited for (up to
-// kStoreBusyWaitSeconds), never an error.
+// Schema (version kStoreSchemaVersion; the same tables on both backends):
+//   schema_version(version)                                one row
+//   stations(station, first_seen_utc)                      where runs were acquired
+//   units(serial, part_number, lot)                        one row per serial
+//   runs(run_key, serial, unit, lot, station, acquired_utc, plan_sha256, samples_sha256)
+//        run_key: UUIDv5 of the serial and the input hashes, so a run is one row however often
+//        and from wherever it is imported
+//   fits(id, fit_key, run_key, time_utc, software, fit_options, limits_sha256, status, verdict,
+//        message, calibration_yaml)                        fit_key: UUIDv5 of the run and the fit
+//   figures(fit_id, name, coefficient, unit, value, sigma, expanded_u, limit_abs, outcome)
+//   attachments(fit_id, kind, path, sha256)                the certificate and its files, by reference
+// Record() writes one fit, its run, unit, station, figures and attachments in one transaction with
+// INSERT ... ON CONFLICT DO NOTHING: re-recording the same fit (a re-run, a merge, two writers at
+// once) changes nothing. A version 1 SQLite store is migrated in place, in one transaction, when
+// opened. Errors (cannot open or connect, not an imufit store, a newer schema, may not be written)
+// are InputErrors naming the file or database, raised when the store is opened: before any work.
+// Several processes may open, create and write one store at once: a busy SQLite database is waited
+// for (up to kStoreBusyWaitSeconds), never an error.
 #ifndef IMUFIT_FACTORY_STORE_H_
 #define IMUFIT_FACTORY_STORE_H_
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "imufit/factory/acceptance.h"
 
-struct sqlite3;
-
 namespace imufit {
 
-inline constexpr int kStoreSchemaVersion = 1;
-// How long opening or writing the store waits for another process that holds it.
+class SqlConnection;
+
+inline constexpr int kStoreSchemaVersion = 2;
+// How long opening or writing an SQLite store waits for another process that holds it.
 inline constexpr int kStoreBusyWaitSeconds = 60;
 
 // How a store is opened: to record fits (created when missing; refused when it may not be
-// written), or only to read an existing one (`imufit history`).
+// written), or to read an existing one (`imufit history`).
 enum class StoreAccess { kRecord, kRead };
 
+// A key figure as stored: the figure, its expanded uncertainty and how it was judged.
+struct StoredFigure : Figure {
+  StoredFigure() = default;
+  StoredFigure(const Figure& figure) : Figure(figure) {}  // NOLINT: a figure without a judgement
+  double expanded_u = -1.0;  // U = k sigma (k = kCoverageFactor, certificate.h); < 0 without sigma
+  double limit_abs = -1.0;   // the acceptance limit on |value|; < 0 without one
+  std::string outcome;       // "pass", "fail", "" (not judged)
+};
+
+// The stored figure called `name` (or with that coefficient path); nullptr when there is none.
+const StoredFigure* FindFigure(const std::vector<StoredFigure>& figures, const std::string& name);
+
+// A file that belongs to a fit (its certificate, the PDF, the calibration), by reference.
+struct StoredAttachment {
+  std::string kind;  // "calibration", "certificate", "report", "pdf", ...
+  std::string path;
+  std::string sha256;
+};
+
 struct StoredFit {
-  int64_t id = 0;
+  int64_t id = 0;  // numbered by the store that holds it (differs between stores)
   std::string serial;
-  std::string unit;  // the unit folder of a batch, or the samples file of `imufit fit`
-  std::string lot;   // the batch's lot name; empty for a single fit
-  std::string time_utc;
+  std::string unit;          // the unit folder of a batch, or the samples file of `imufit fit`
+  std::string lot;           // the batch's lot name; empty for a single fit
+  std::string part_number;   // the unit's model or part number; "" when not known
+  std::string station;       // the station's id (or name); "" when not given
+  std::string acquired_utc;  // when the run was acquired (the samples file's time); "" unknown
+  std::string time_utc;      // when it was fitted
   std::string software;
+  std::string fit_options;  // the fit options' fingerprint
   std::string plan_sha256;
   std::string samples_sha256;
   std::string limits_sha256;  // empty without limits
@@ -49,8 +82,14 @@ struct StoredFit {
   std::string verdict;        // "PASS", "FAIL", "" (no limits, or not fitted)
   std::string message;        // failed criteria, or why it was not fitted
   std::string calibration_yaml;
-  std::vector<Figure> figures;
+  std::vector<StoredFigure> figures;
+  std::vector<StoredAttachment> attachments;
 };
+
+// The content keys (UUIDv5, lower-case text): a run's from its serial and input hashes, a fit's
+// from its run and what the fit produced.
+std::string RunKey(const StoredFit& fit);
+std::string FitKey(const StoredFit& fit);
 
 struct LotYield {
   std::string lot;
@@ -80,20 +119,28 @@ struct LotValue {
 
 class ResultsStore {
  public:
-  // Opens the database at `path`; to record, creating it (and its schema) when it does not exist.
-  explicit ResultsStore(const std::string& path, StoreAccess access = StoreAccess::kRecord);
+  // Opens the store `target` names: a PostgreSQL URL or connection string (IsPostgresStore()), or
+  // else an SQLite file, created (with its schema) when it does not exist.
+  explicit ResultsStore(const std::string& target, StoreAccess access = StoreAccess::kRecord);
   ~ResultsStore();
   ResultsStore(const ResultsStore&) = delete;
   ResultsStore& operator=(const ResultsStore&) = delete;
 
   const std::string& path() const { return path_; }
+  const char* backend() const;  // "sqlite" or "postgresql"
 
-  // Records one fit in one transaction; returns its id. Safe from several threads at once (the
-  // units of a batch). `before_commit` (may be empty) runs inside the transaction, after the row is
-  // written and before it is committed: the outputs that belong to the row are committed there, so
-  // that the row and the files appear together. When it throws, the row is rolled back and the
-  // exception passes on.
+  // Records one fit in one transaction; returns its id (the existing fit's when this store holds
+  // it already). Safe from several threads and processes at once (the units of a batch, shards).
+  // `before_commit` (may be empty) runs inside the transaction, after the row is written and before
+  // it is committed: the outputs that belong to the row are committed there, so that the row and
+  // the files appear together. When it throws, the row is rolled back and the exception passes on.
   int64_t Record(const StoredFit& fit, const std::function<void()>& before_commit = {});
+  // Records every fit in one transaction; returns how many this store did not hold yet.
+  int64_t RecordAll(const std::vector<StoredFit>& fits);
+  // Every fit, oldest first, with figures and attachments (what `imufit store merge` copies).
+  std::vector<StoredFit> All();
+  // How many fits the store holds.
+  int64_t CountFits();
 
   // Whether any fit of `unit` in `lot` is recorded.
   bool HasUnit(const std::string& lot, const std::string& unit);
@@ -109,17 +156,30 @@ class ResultsStore {
   std::vector<LotValue> LotValues(const std::string& figure);
 
  private:
-  void Open(StoreAccess access);  // pragmas, schema, version checks
-  void CheckVersion();
-  void Execute(const std::string& sql);
-  // Execute(), waiting while another process holds the database (SQLITE_BUSY, SQLITE_LOCKED).
-  void ExecuteWaiting(const std::string& sql);
-  [[noreturn]] void Fail(const std::string& what);
+  void Open();  // schema, version check, migration
+  void MigrateFromVersion1();
+  int64_t Insert(const StoredFit& fit, bool* added = nullptr);  // inside a transaction
+  std::vector<StoredFit> Fits(const std::string& where, const std::vector<std::string>& parameters);
 
   std::string path_;
-  sqlite3* db_ = nullptr;
-  std::mutex record_mutex_;  // one Record() at a time
+  std::unique_ptr<SqlConnection> db_;
+  std::mutex mutex_;  // one statement at a time on the connection
 };
+
+// True when `target` names a PostgreSQL database rather than an SQLite file.
+bool IsPostgresStore(const std::string& target);
+
+// What `imufit store merge` did with one source.
+struct MergeResult {
+  std::string source;
+  int64_t fits = 0;   // fits the source holds
+  int64_t added = 0;  // of them, new in the destination
+};
+
+// Copies every fit of each source store (SQLite files or PostgreSQL databases, which must exist)
+// into `destination` (created when it is a missing SQLite file), one transaction per source.
+// Idempotent: a fit the destination holds already (same content key) is left as it is.
+std::vector<MergeResult> MergeStores(const std::vector<std::string>& sources, const std::string& destination);
 
 }  // namespace imufit
 

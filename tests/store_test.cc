@@ -1,0 +1,218 @@
+// The results store on both backends against real databases: SQLite files, and a throwaway
+// PostgreSQL cluster (tests/postgres_fixture.sh). Run as
+//   store_test --backend sqlite
+//   store_test --backend postgresql --state FILE   (FILE: the fixture's connection string)
+// With PostgreSQL unavailable it prints why and exits 77 (ctest SKIP).
+#include <libpq-fe.h>
+#include <sqlite3.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "imufit/factory/store.h"
+#include "imufit/io/error.h"
+#include "store_test_util.h"
+#include "test_util.h"
+
+namespace imufit {
+namespace {
+
+TEST(StoreTest, RecordsFiguresAndAttachmentsAndAnswers) {
+  ResultsStore store(FreshStore("answers"));
+  EXPECT_STREQ(store.backend(), StoreBackend().c_str());
+  StoredFit fit = MakeFit("SN1", "lot-a", "2026-01-01T00:00:00Z", 1.5, "PASS");
+  fit.attachments = {{"certificate", "lot-a/SN1/certificate.html", std::string(64, 'a')}};
+  fit.figures[0].limit_abs = 2.0;
+  fit.figures[0].outcome = "pass";
+  EXPECT_GT(store.Record(fit), 0);
+  store.Record(MakeFit("SN2", "lot-a", "2026-01-01T00:01:00Z", 2.5, "FAIL"));
+  StoredFit recalibrated = MakeFit("SN1", "lot-b", "2026-02-01T00:00:00Z", 1.25, "PASS");
+  recalibrated.samples_sha256 = std::string(64, '3');  // a new run of the unit
+  store.Record(recalibrated);
+  const std::vector<StoredFit> fits = store.BySerial("SN1");
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[0].station, "station-1");
+  EXPECT_EQ(fits[0].part_number, "IMU-9");
+  ASSERT_EQ(fits[0].figures.size(), 2u);
+  EXPECT_EQ(fits[0].figures[0].value, 1.5);  // bit-exact through text on PostgreSQL too
+  EXPECT_EQ(fits[0].figures[0].expanded_u, 0.02);
+  EXPECT_EQ(fits[0].figures[0].limit_abs, 2.0);
+  EXPECT_EQ(fits[0].figures[0].outcome, "pass");
+  EXPECT_EQ(fits[0].figures[1].name, "gyro_bias_dps.y");  // in the order recorded
+  ASSERT_EQ(fits[0].attachments.size(), 1u);
+  EXPECT_EQ(fits[0].attachments[0].path, "lot-a/SN1/certificate.html");
+  const std::vector<LotYield> yields = store.Yield("");
+  ASSERT_EQ(yields.size(), 2u);
+  EXPECT_EQ(yields[0].lot, "lot-a");
+  EXPECT_EQ(yields[0].units, 2);
+  EXPECT_EQ(yields[0].passed, 1);
+  EXPECT_EQ(yields[0].failed, 1);
+  EXPECT_EQ(store.Trend("gyro.bias.x", "").size(), 3u);
+  EXPECT_EQ(store.Trend("gyro_bias_dps.x", "SN1").back().value, 1.25);
+  EXPECT_EQ(store.LotValues("gyro.bias.x").size(), 3u);
+}
+
+TEST(StoreTest, TheSameFitRecordedTwiceIsOneRowAndARefitOfTheSameRunSharesItsRun) {
+  const std::string target = FreshStore("rerun");
+  {
+    ResultsStore store(target);
+    const StoredFit fit = MakeFit("SN1", "lot-a", "2026-01-01T00:00:00Z", 1.5, "PASS");
+    const int64_t id = store.Record(fit);
+    EXPECT_EQ(store.Record(fit), id);  // a re-run changes nothing
+    StoredFit refit = fit;
+    refit.time_utc = "2026-01-02T00:00:00Z";
+    refit.verdict = "FAIL";
+    EXPECT_NE(store.Record(refit), id);
+    EXPECT_EQ(RunKey(refit), RunKey(fit));
+    EXPECT_NE(FitKey(refit), FitKey(fit));
+  }
+  ResultsStore store(target);  // reopened
+  EXPECT_EQ(store.CountFits(), 2);
+  EXPECT_EQ(store.Yield("lot-a")[0].failed, 1);  // the latest fit counts
+}
+
+TEST(StoreTest, RunKeysAreVersion5Uuids) {
+  const std::string key = RunKey(MakeFit("SN1", "lot-a", "2026-01-01T00:00:00Z", 1.5, "PASS"));
+  ASSERT_EQ(key.size(), 36u);
+  EXPECT_EQ(key[14], '5');
+  EXPECT_NE(std::string("89ab").find(key[19]), std::string::npos) << key;
+}
+
+TEST(StoreTest, ConcurrentWritersRecordEveryFitOnce) {
+  const std::string target = FreshStore("concurrent");
+  { ResultsStore create(target); }
+  constexpr int kWriters = 4, kUnits = 40;
+  std::vector<std::thread> writers;
+  std::atomic<int> failures{0};
+  for (int w = 0; w < kWriters; ++w) {
+    writers.emplace_back([&, w] {
+      try {
+        ResultsStore store(target);  // a connection of its own, as a shard has
+        // Every writer records every unit: each fit must end up once.
+        for (int u = 0; u < kUnits; ++u) {
+          const int unit = (u + w * 7) % kUnits;
+          store.Record(MakeFit("SN" + std::to_string(unit), "lot-c", "2026-03-01T00:00:00Z", unit, "PASS"));
+        }
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "writer %d: %s\n", w, e.what());
+        ++failures;
+      }
+    });
+  }
+  for (std::thread& t : writers) t.join();
+  EXPECT_EQ(failures.load(), 0);
+  ResultsStore store(target);
+  EXPECT_EQ(store.CountFits(), kUnits);
+  ASSERT_EQ(store.Yield("lot-c").size(), 1u);
+  EXPECT_EQ(store.Yield("lot-c")[0].units, kUnits);
+}
+
+TEST(StoreTest, APasswordOnTheCommandLineIsRefused) {
+  for (const std::string target :
+       {"postgresql://imufit:secret@localhost/imufit", "host=localhost dbname=imufit password=secret"}) {
+    try {
+      ResultsStore store(target);
+      ADD_FAILURE() << "accepted " << target;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("put it in ~/.pgpass or PGPASSFILE"), std::string::npos)
+          << e.what();
+      EXPECT_EQ(std::string(e.what()).find("secret"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(IsPostgresStore("postgresql://host/db"));
+  EXPECT_TRUE(IsPostgresStore("host=/tmp dbname=x"));
+  EXPECT_FALSE(IsPostgresStore("results.db"));
+}
+
+TEST(StoreTest, AVersion1SqliteStoreIsMigratedKeepingEveryRow) {
+  if (StoreBackend() != "sqlite") GTEST_SKIP() << "version 1 stores were SQLite only";
+  const std::string path = FreshStore("v1");
+  WriteVersion1Store(path);
+  ResultsStore store(path);
+  EXPECT_EQ(store.CountFits(), 3);
+  const std::vector<StoredFit> fits = store.BySerial("SN1");
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[0].lot, "lot-a");
+  EXPECT_EQ(fits[0].calibration_yaml, "yaml 1");
+  EXPECT_EQ(fits[1].verdict, "FAIL");
+  EXPECT_EQ(fits[1].message, "|gyro_bias_dps.x| 9 > 2 deg/s");
+  ASSERT_EQ(fits[1].figures.size(), 2u);
+  EXPECT_EQ(fits[1].figures[1].name, "gyro_bias_dps.y");
+  EXPECT_EQ(fits[1].figures[0].value, 9.0);
+  EXPECT_EQ(fits[1].figures[0].sigma, 0.25);
+  EXPECT_EQ(store.BySerial("SN2").size(), 1u);
+  EXPECT_EQ(store.Yield("lot-a")[0].units, 2);
+  ResultsStore again(path);  // opening a migrated store changes nothing
+  EXPECT_EQ(again.CountFits(), 3);
+}
+
+// Two stations' SQLite stores, one with a fit the other has too (the same run uploaded twice).
+std::vector<std::string> TwoStationStores() {
+  const std::string a = FreshSqliteStore("station_a"), b = FreshSqliteStore("station_b");
+  ResultsStore station_a(a), station_b(b);
+  station_a.Record(MakeFit("SN1", "lot-m", "2026-04-01T00:00:00Z", 1.0, "PASS"));
+  station_a.Record(MakeFit("SN2", "lot-m", "2026-04-01T00:01:00Z", 2.0, "FAIL"));
+  station_b.Record(MakeFit("SN2", "lot-m", "2026-04-01T00:01:00Z", 2.0, "FAIL"));
+  StoredFit other = MakeFit("SN3", "lot-m", "2026-04-02T00:00:00Z", 3.0, "PASS");
+  other.station = "station-2";
+  station_b.Record(other);
+  return {a, b};
+}
+
+TEST(StoreTest, MergeIsIdempotent) {
+  const std::string into = FreshStore("merge_into");
+  const std::vector<std::string> sources = TwoStationStores();
+  const std::vector<MergeResult> first = MergeStores(sources, into);
+  ASSERT_EQ(first.size(), 2u);
+  EXPECT_EQ(first[0].fits, 2);
+  EXPECT_EQ(first[0].added, 2);
+  EXPECT_EQ(first[1].added, 1);  // SN2's fit came from station a already
+  const std::vector<StoredFit> before = ResultsStore(into).All();
+  ASSERT_EQ(before.size(), 3u);
+  const std::vector<MergeResult> second = MergeStores(sources, into);
+  EXPECT_EQ(second[0].added + second[1].added, 0);
+  const std::vector<StoredFit> after = ResultsStore(into).All();
+  ASSERT_EQ(after.size(), before.size());
+  for (size_t i = 0; i < after.size(); ++i) {
+    EXPECT_EQ(FitKey(after[i]), FitKey(before[i]));
+    EXPECT_EQ(after[i].id, before[i].id);
+    EXPECT_EQ(after[i].figures.size(), before[i].figures.size());
+  }
+  EXPECT_EQ(ResultsStore(into).Yield("lot-m")[0].units, 3);
+}
+
+testing::RunResult Imufit(const std::vector<std::string>& args) {
+  const std::string base = FreshSqliteStore("imufit_output");
+  return testing::RunProgram(IMUFIT_EXE, args, base + ".out", base + ".err");
+}
+
+TEST(StoreTest, MergeCommandRunTwiceChangesNothing) {
+  const std::string into = FreshStore("merge_cli");
+  std::vector<std::string> args = {"store", "merge"};
+  for (const std::string& source : TwoStationStores()) args.push_back(source);
+  args.insert(args.end(), {"--into", into});
+  const testing::RunResult first = Imufit(args);
+  ASSERT_EQ(first.status, 0) << first.out;
+  EXPECT_NE(first.out.find(": 2 fits, 1 new"), std::string::npos) << first.out;
+  const testing::RunResult second = Imufit(args);
+  ASSERT_EQ(second.status, 0) << second.out;
+  EXPECT_NE(second.out.find(": 2 fits, 0 new"), std::string::npos) << second.out;
+  EXPECT_EQ(second.out.find(", 1 new"), std::string::npos) << second.out;
+  EXPECT_EQ(second.out.find(", 2 new"), std::string::npos) << second.out;
+  const testing::RunResult missing = Imufit({"store", "merge", "no_such.db", "--into", into});
+  EXPECT_EQ(missing.status, 2) << missing.err;
+  EXPECT_NE(missing.err.find("no_such.db: no such results store to merge"), std::string::npos) << missing.err;
+}
+
+}  // namespace
+}  // namespace imufit
