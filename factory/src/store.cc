@@ -71,7 +71,8 @@ class SqliteConnection : public SqlConnection {
     struct stat status;
     const bool exists = ::stat(path.c_str(), &status) == 0;
     if (!exists && access == StoreAccess::kRead) {
-      throw InputError(path, "no such results store (imufit fit --store and imufit batch --store create one)");
+      throw InputError(path,
+                       "no such results store (imufit fit --store and imufit batch --store create one)");
     }
     // As for outputs (output_file.h): a file without write permission is not written, even by root.
     const bool writable = exists && (status.st_mode & 0222) != 0 && ::access(path.c_str(), W_OK) == 0;

@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/SVD>
 #include <glog/logging.h>
+#include <Eigen/SVD>
 
 #include "imufit/fit/window_cost.h"
 #include "imufit/model/check.h"
@@ -190,7 +190,8 @@ bool CheckConvergence(const ceres::Solver::Summary& last_pass, FitSummary* summa
   summary->termination = last_pass.message;
   if (last_pass.termination_type == ceres::CONVERGENCE) return true;
   summary->status = FitStatus::kNotConverged;
-  if (!std::isfinite(last_pass.final_cost) || last_pass.message.find("evaluation failed") != std::string::npos) {
+  if (!std::isfinite(last_pass.final_cost) ||
+      last_pass.message.find("evaluation failed") != std::string::npos) {
     summary->termination =
         "the model's residuals are not finite numbers: a raw channel that never changes (dead, stuck or at "
         "its rail) or a non-finite reading leaves a scale factor at zero";
