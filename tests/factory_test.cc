@@ -209,6 +209,7 @@ TEST_F(FactoryTest, StoreRecordsAndAnswers) {
       fit.serial = i == 2 ? "SN2" : "SN1";
       fit.unit = "u" + std::to_string(i);
       fit.lot = i == 0 ? "lot-a" : "lot-b";
+      fit.samples_sha256 = std::string(64, static_cast<char>('a' + i));  // three runs: three logs
       fit.time_utc = "2026-11-22T07:0" + std::to_string(i) + ":00Z";
       fit.software = "imufit test";
       fit.status = "fitted";

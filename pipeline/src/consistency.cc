@@ -43,6 +43,15 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
   std::map<int, std::map<size_t, Count>> counts;  // segment -> temperature cluster -> counts
   std::map<int, double> gyro_sum;                 // squared residuals, for the finding
   std::map<int, double> accel_sum;
+  std::map<int, double> normalised_sum;  // squared residuals over the noise of the window means
+  // |residual / sigma|^2 per axis, over the axes that carry a weight.
+  const auto normalised = [](const Eigen::Vector3d& residual, const Eigen::Vector3d& sigma) {
+    double sum = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (sigma(axis) > 0.0) sum += (residual(axis) / sigma(axis)) * (residual(axis) / sigma(axis));
+    }
+    return sum;
+  };
   for (const WindowResidual& r : fit.residuals) {
     const Window& w = windows[static_cast<size_t>(r.window)];
     Count& count =
@@ -51,6 +60,8 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
     count.downweighted += r.downweighted ? 1 : 0;
     gyro_sum[w.segment] += r.gyro_radps.squaredNorm() / 3.0;
     accel_sum[w.segment] += r.accel_mps2.squaredNorm() / 3.0;
+    normalised_sum[w.segment] +=
+        (normalised(r.gyro_radps, r.gyro_sigma_radps) + normalised(r.accel_mps2, r.accel_sigma_mps2)) / 6.0;
   }
   std::string text;
   for (const auto& [segment, by_temp] : counts) {
@@ -63,7 +74,10 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
       if (!fit.distinct_temps_c.empty())
         temps += (temps.empty() ? "" : ", ") + Format("%.0f", fit.distinct_temps_c[cluster]);
     }
-    if (!everywhere) continue;
+    if (!everywhere ||
+        normalised_sum[segment] / windows_seen <= kModelErrorAllowance * kModelErrorAllowance) {
+      continue;
+    }
     text += (text.empty() ? "" : "; ") + std::string("segment ") + std::to_string(segment) +
             " down-weighted at every temperature (" + temps + " degC), residual RMS gyro " +
             Format("%.3g", std::sqrt(gyro_sum[segment] / windows_seen) * kRadToDeg) + " deg/s, accel " +

@@ -13,8 +13,10 @@
 //    fit has absorbed something the plan does not describe (a wrong position, a wrong rate, a
 //    disturbed window): exchanged faces give about 1e6, a rate typo 1e5;
 //  - a segment that the robust loss down-weighted at every temperature where it has windows
-//    (more than half of its windows there): not an outlier, but a segment whose truth is not what
-//    the plan says.
+//    (more than half of its windows there) and whose residuals exceed kModelErrorAllowance times
+//    the noise of its window means: not an outlier, but a segment whose truth is not what the plan
+//    says. (A segment down-weighted by a little, e.g. a turn on a noiseless one-temperature run, is
+//    model error, as for the chi-square.)
 #ifndef IMUFIT_PIPELINE_CONSISTENCY_H_
 #define IMUFIT_PIPELINE_CONSISTENCY_H_
 
