@@ -252,6 +252,16 @@ class FactoryCliTest : public testing::TempDirTest {
     return pages;
   }
 
+  // Expects docs/troubleshooting.md to quote `said`, a line the program printed (its final newline
+  // and this test's folder left out, as the page shortens paths), between backquotes.
+  void ExpectTroubleshootingQuotes(std::string said) const {
+    for (size_t at; (at = said.find(dir_.string() + "/")) != std::string::npos;)
+      said.erase(at, dir_.string().size() + 1);
+    if (!said.empty() && said.back() == '\n') said.pop_back();
+    EXPECT_NE(ReadBytes(kFixtures + "/../docs/troubleshooting.md").find("`" + said + "`"), std::string::npos)
+        << "docs/troubleshooting.md does not quote: " << said;
+  }
+
   std::map<std::string, std::map<std::string, std::string>> Summary(const std::string& out) const {
     std::map<std::string, std::map<std::string, std::string>> by_unit;
     for (const auto& row : ReadCsv(ReadBytes(dir_ / out / "lot_summary.csv"))) by_unit[row.at("unit")] = row;
@@ -267,6 +277,12 @@ void ExecuteSql(const std::string& path, const std::string& sql) {
   EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
   sqlite3_free(error);
   sqlite3_close(db);
+}
+
+// The line of `text` from where `start` is found to its end ("" when it is not found).
+std::string LineWith(const std::string& text, const std::string& start) {
+  const size_t at = text.find(start);
+  return at == std::string::npos ? "" : text.substr(at, text.find('\n', at) - at);
 }
 
 // The files in `folder` whose names contain ".tmp-" (an output never committed).
@@ -297,6 +313,7 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   // ... which is said, on stderr and on its certificate; a unit with a serial gets no such warning.
   const std::string not_stated = "serial not stated: the unit folder's name is used";
   EXPECT_NE(r.err.find("imufit: warning: unit-03: " + not_stated), std::string::npos) << r.err;
+  ExpectTroubleshootingQuotes(LineWith(r.err, "imufit: warning: unit-03: "));
   EXPECT_EQ(r.err.find("unit-01: " + not_stated), std::string::npos) << r.err;
   EXPECT_NE(ReadBytes(dir_ / "out" / "unit-03" / "report.html").find(not_stated), std::string::npos);
   EXPECT_EQ(ReadBytes(dir_ / "out" / "unit-01" / "report.html").find(not_stated), std::string::npos);
@@ -516,6 +533,9 @@ TEST_F(FactoryCliTest, InterruptedBatchSaysSoAndLeavesNoHalfUnit) {
   EXPECT_TRUE(std::regex_search(err, std::regex("imufit: interrupted: [1-5] of 5 units done; run the same "
                                                 "command again to finish\n")))
       << err;
+  // The page quotes it for a lot of 8 with 3 done.
+  ExpectTroubleshootingQuotes(std::regex_replace(err.substr(err.find("imufit: interrupted")),
+                                                 std::regex("[0-9]+ of [0-9]+ units"), "3 of 8 units"));
   for (const auto& unit : fs::directory_iterator(dir_ / "out")) {
     if (!unit.is_directory()) continue;
     if (fs::exists(unit.path() / "calibration.yaml")) {
@@ -602,6 +622,8 @@ TEST_F(FactoryCliTest, BatchFindsSamplesByGlobAndSaysWhatAFolderHolds) {
                        ": --samples-glob \"*_imu.csv.gz\" matches no file (it has: notes.txt)\n"),
             std::string::npos)
       << r.out;
+  ExpectTroubleshootingQuotes(LineWith(r.out, Path("logger/u2") + ": "));
+  ExpectTroubleshootingQuotes(LineWith(r.out, Path("logger/u3") + ": "));
   // Without the pattern, the folder's files are named.
   r = Run({"batch", Path("logger"), "-o", Path("out2"), "--plan", kFixtures + "/plan_6pos.yaml", "-q"});
   EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
@@ -609,6 +631,7 @@ TEST_F(FactoryCliTest, BatchFindsSamplesByGlobAndSaysWhatAFolderHolds) {
             Path("logger/u1") +
                 ": no samples.csv or samples.csv.gz (it has: 2026-11-24_imu.csv.gz, notes.txt, plan.yaml; "
                 "--samples-glob names the logger's samples file)");
+  ExpectTroubleshootingQuotes(Summary("out2")["u1"]["message"]);
   // A pattern with a units list is refused before any unit.
   Write("list.csv", "SN-1, logger/u1/2026-11-24_imu.csv.gz\n");
   r = Run({"batch", "--units-list", Path("list.csv"), "--samples-glob", "*.gz", "-o", Path("out3")});
@@ -647,10 +670,11 @@ TEST_F(FactoryCliTest, BatchFitsTheUnitsOfAUnitList) {
   EXPECT_EQ(r.status, kExitFailedLimits);
   EXPECT_EQ(Summary("out2")["SN-77"]["message"],
             Path("missing.csv.gz") + ": no such file (" + Path("units.txt") + " line 1)");
+  ExpectTroubleshootingQuotes(Summary("out2")["SN-77"]["message"]);
 
   // Bad lines: one line each, exit 2, nothing written.
   const std::pair<std::string, std::string> bad[] = {
-      {"SN-1\n", ":1:1: a unit is \"serial, samples file[, plan]\"; this line has 1 fields"},
+      {"SN-1\n", ":1:1: a unit is \"serial, samples file[, plan]\"; this line has 1 field"},
       {"SN-1 a.csv\nSN-1 b.csv\n", ":2:1: serial \"SN-1\" is listed twice (lines 1 and 2)"},
       {"../x a.csv\n", ":1:1: serial \"../x\" cannot name the unit's output folder"}};
   for (const auto& [text, said] : bad) {
@@ -659,6 +683,7 @@ TEST_F(FactoryCliTest, BatchFitsTheUnitsOfAUnitList) {
              kFixtures + "/plan_6pos.yaml"});
     EXPECT_EQ(r.status, kExitBadInput) << text;
     EXPECT_EQ(r.err, "imufit: " + Path("bad.txt") + said + "\n") << text;
+    ExpectTroubleshootingQuotes(r.err);
     EXPECT_FALSE(fs::exists(Path("out_bad/lot_summary.csv")));
   }
 }
@@ -752,6 +777,7 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
     EXPECT_EQ(r.err.rfind("imufit: " + store + ": ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    ExpectTroubleshootingQuotes(r.err);
     EXPECT_EQ(ReadBytes(previous), "# the calibration flashed last week\n") << store;
     EXPECT_FALSE(fs::exists(Path("cal.html"))) << store;
   }
@@ -766,6 +792,7 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
   EXPECT_EQ(r.status, kExitBadInput);
   EXPECT_EQ(r.err, "imufit: " + Path("missing.db") +
                        ": no such results store (imufit fit --store and imufit batch --store create one)\n");
+  ExpectTroubleshootingQuotes(r.err);
   EXPECT_FALSE(fs::exists(Path("missing.db")));
 }
 

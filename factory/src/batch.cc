@@ -515,7 +515,7 @@ std::vector<UnitInput> ReadUnitsList(const std::string& list, const Shard& shard
     if (f.size() < 2 || f.size() > 3 || f[1].empty())
       throw InputError(list, number, 1,
                        "a unit is \"serial, samples file[, plan]\"; this line has " +
-                           std::to_string(f.size()) + " fields");
+                           std::to_string(f.size()) + (f.size() == 1 ? " field" : " fields"));
     if (f[0] == "." || f[0] == ".." || f[0][0] == '.' || f[0].find('/') != std::string::npos)
       throw InputError(list, number, 1,
                        "serial " + QuoteForMessage(f[0]) + " cannot name the unit's output folder");
