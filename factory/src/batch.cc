@@ -538,11 +538,13 @@ std::vector<UnitInput> ReadUnitsList(const std::string& list, const Shard& shard
 }
 
 // Everything shared by the units, each input checked: a bad one is the lot's error, before any unit.
-void Prepare(const BatchOptions& options, Shared* shared) {
+void Prepare(const BatchOptions& options, Shared* shared, std::vector<UnitInput>* units) {
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit batch", problem);
   if (options.units_list.empty() && !fs::is_directory(options.units_dir))
     throw InputError(options.units_dir, "not a folder");
+  *units = options.units_list.empty() ? ListUnits(options.units_dir, options.shard)
+                                      : ReadUnitsList(options.units_list, options.shard);
   shared->options = &options;
   shared->fit_options = options.fit.Describe();
   shared->certify.software = options.fit.software;
@@ -651,7 +653,8 @@ std::string BatchOptions::Validate() const {
 
 BatchResult RunBatch(const BatchOptions& options) {
   Shared shared;
-  Prepare(options, &shared);
+  std::vector<UnitInput> units;
+  Prepare(options, &shared, &units);
   const FolderLock lock(options.output_dir, options.shard);
   shared.certify.lot = LotName(options);
   if (!options.store_path.empty()) {
@@ -659,9 +662,6 @@ BatchResult RunBatch(const BatchOptions& options) {
     shared.certify.store = shared.store.get();
   }
   SetInterruptNote(InterruptNote);
-  const std::vector<UnitInput> units = options.units_list.empty()
-                                           ? ListUnits(options.units_dir, options.shard)
-                                           : ReadUnitsList(options.units_list, options.shard);
   BatchResult result = Tally(ProcessUnits(shared, units));
   SetInterruptNote(nullptr);
   if (result.complete && options.shard.count == 1) WriteLotOutputs(shared, result);
