@@ -799,7 +799,7 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
 // `imufit fit ... | head -3`: the program stops of SIGPIPE, silently, and leaves no temporary.
 TEST_F(FactoryCliTest, FitIntoAClosedPipeLeavesNoTemporaries) {
   for (int attempt = 0; attempt < 3; ++attempt) {
-    const RunResult r = testing::RunProgram(
+    const RunResult r = RunProgram(
         "/bin/sh", {"-c", std::string("'") + IMUFIT_EXE + "' fit -p '" + Path("units/unit-01/plan.yaml") +
                               "' -s '" + Path("units/unit-01/samples.csv.gz") + "' -o '" + Path("cal.yaml") +
                               "' --report '" + Path("cal.html") + "' --validate | head -3"});
