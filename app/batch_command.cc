@@ -100,7 +100,15 @@ CommandRunner AddBatchCommand(CLI::App* root) {
       "a re-run skips units whose inputs, fit options and software are unchanged. Exit 0 every "
       "unit "
       "passed, 3 some unit failed its limits or could not be fitted, 1 stopped early, 2 bad invocation.");
-  command->add_option("units_dir", b.units_dir, "folder of unit folders")->required();
+  command->add_option("units_dir", b.units_dir, "folder of unit folders (or --units-list)");
+  command->add_option(
+      "--units-list", b.units_list,
+      "file listing the units instead of UNITS_DIR: a line per unit, \"serial, samples file[, "
+      "plan]\" (CSV or blank-separated; paths relative to the list; a unit's outputs go to "
+      "OUT_DIR/<serial>)");
+  command->add_option("--samples-glob", b.samples_glob,
+                      "each unit folder's samples file as the logger names it: the one file matching this "
+                      "pattern (e.g. '*_imu.csv.gz'; default samples.csv.gz, else samples.csv)");
   command->add_option("--output,-o", b.output_dir, "output folder")->required();
   command->add_option("--limits,-l", b.limits_path, "acceptance limits YAML (format imufit-limits)");
   command->add_option("--plan,-p", b.shared_plan, "plan for units without their own plan.yaml");

@@ -56,7 +56,13 @@ void PrintCoefficients(const FitSummary& fit, const FitOptions& options) {
     return out;
   };
   const char* axes = "xyz";
-  std::printf("  at 25 degC (+- 1 sigma):\n");
+  // A run that did not reach 25 degC (a hot-only run): the cubics extrapolated, as the certificate
+  // and the limits say too (acceptance.h Figure::extrapolated).
+  const double low = fit.temp_range_c[0], high = fit.temp_range_c[1];
+  char range[96] = "";
+  if (high > low && (kFigureTempC < low || kFigureTempC > high))
+    std::snprintf(range, sizeof range, " (extrapolated: fitted %.4g..%.4g degC)", low, high);
+  std::printf("  at 25 degC (+- 1 sigma)%s:\n", range);
   for (int i = 0; i < 3; ++i) {
     std::printf("    gyro %c   bias %s deg/s   scale %s raw/(deg/s)\n", axes[i],
                 text("%+.5f +- %.5f", at25(Sensor::kGyro, kBiasCoefficient + i)).c_str(),

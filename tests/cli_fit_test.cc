@@ -60,6 +60,26 @@ TEST_F(CliTest, FitWritesACalibrationThatCorrectsAnotherRun) {
   EXPECT_LT(worst_accel, kAccelToleranceMps2);
 }
 
+// A hot-only run never reached 25 degC: the summary's 25 degC figures say they are extrapolated;
+// a run through 25 degC says nothing of the kind.
+TEST_F(CliTest, FitSummaryMarksFiguresOutsideTheFittedRangeAsExtrapolated) {
+  const std::string hot = Path("hot.csv");
+  std::vector<std::string> hot_run = SmallRunArgs(hot, {"--seed=7"});
+  *std::find(hot_run.begin(), hot_run.end(), "--temps=-20,5,30,60") = "--temps=40,55,70,85";
+  ASSERT_EQ(Run(hot_run).status, 0);
+  RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", hot, "-o", Path("hot.yaml")});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("  at 25 degC (+- 1 sigma) (extrapolated: fitted 40..85 degC):\n"),
+            std::string::npos)
+      << fit.out;
+  const std::string through = Path("through.csv");
+  ASSERT_EQ(Run(SmallRunArgs(through, {"--seed=7"})).status, 0);
+  fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", through, "-o", Path("through.yaml")});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("  at 25 degC (+- 1 sigma):\n"), std::string::npos) << fit.out;
+  EXPECT_EQ(fit.out.find("extrapolated"), std::string::npos) << fit.out;
+}
+
 TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
   const std::string samples = Path("one_temperature.csv");
   ASSERT_EQ(Run({"simulate", "-p", Fixture("plan_6pos.yaml"), "-c", Fixture("mems_truth.yaml"), "-o", samples,

@@ -252,6 +252,16 @@ class FactoryCliTest : public testing::TempDirTest {
     return pages;
   }
 
+  // Expects docs/troubleshooting.md to quote `said`, a line the program printed (its final newline
+  // and this test's folder left out, as the page shortens paths), between backquotes.
+  void ExpectTroubleshootingQuotes(std::string said) const {
+    for (size_t at; (at = said.find(dir_.string() + "/")) != std::string::npos;)
+      said.erase(at, dir_.string().size() + 1);
+    if (!said.empty() && said.back() == '\n') said.pop_back();
+    EXPECT_NE(ReadBytes(kFixtures + "/../docs/troubleshooting.md").find("`" + said + "`"), std::string::npos)
+        << "docs/troubleshooting.md does not quote: " << said;
+  }
+
   std::map<std::string, std::map<std::string, std::string>> Summary(const std::string& out) const {
     std::map<std::string, std::map<std::string, std::string>> by_unit;
     for (const auto& row : ReadCsv(ReadBytes(dir_ / out / "lot_summary.csv"))) by_unit[row.at("unit")] = row;
@@ -267,6 +277,12 @@ void ExecuteSql(const std::string& path, const std::string& sql) {
   EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
   sqlite3_free(error);
   sqlite3_close(db);
+}
+
+// The line of `text` from where `start` is found to its end ("" when it is not found).
+std::string LineWith(const std::string& text, const std::string& start) {
+  const size_t at = text.find(start);
+  return at == std::string::npos ? "" : text.substr(at, text.find('\n', at) - at);
 }
 
 // The files in `folder` whose names contain ".tmp-" (an output never committed).
@@ -294,6 +310,14 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   EXPECT_EQ(summary["unit-01"]["verdict"], "PASS");
   EXPECT_EQ(summary["unit-03"]["serial"], "unit-03");  // shared plan without a serial: the folder name
   EXPECT_EQ(summary["unit-03"]["verdict"], "PASS");
+  // ... which is said, on stderr and on its certificate; a unit with a serial gets no such warning.
+  const std::string not_stated = "serial not stated: the unit folder's name is used";
+  EXPECT_NE(r.err.find("imufit: warning: unit-03: " + not_stated), std::string::npos) << r.err;
+  ExpectTroubleshootingQuotes(LineWith(r.err, "imufit: warning: unit-03: "));
+  EXPECT_EQ(r.err.find("unit-01: " + not_stated), std::string::npos) << r.err;
+  const std::string on_page = "serial not stated: the unit folder&#39;s name is used";  // HTML-escaped
+  EXPECT_NE(ReadBytes(dir_ / "out" / "unit-03" / "report.html").find(on_page), std::string::npos);
+  EXPECT_EQ(ReadBytes(dir_ / "out" / "unit-01" / "report.html").find(on_page), std::string::npos);
   EXPECT_EQ(summary["unit-04"]["status"], "fitted");
   EXPECT_EQ(summary["unit-04"]["verdict"], "FAIL");
   EXPECT_NE(summary["unit-04"]["message"].find("|gyro_g_sensitivity_dpsg.xx|"), std::string::npos);
@@ -510,6 +534,9 @@ TEST_F(FactoryCliTest, InterruptedBatchSaysSoAndLeavesNoHalfUnit) {
   EXPECT_TRUE(std::regex_search(err, std::regex("imufit: interrupted: [1-5] of 5 units done; run the same "
                                                 "command again to finish\n")))
       << err;
+  // The page quotes it for a lot of 8 with 3 done.
+  ExpectTroubleshootingQuotes(std::regex_replace(err.substr(err.find("imufit: interrupted")),
+                                                 std::regex("[0-9]+ of [0-9]+ units"), "3 of 8 units"));
   for (const auto& unit : fs::directory_iterator(dir_ / "out")) {
     if (!unit.is_directory()) continue;
     if (fs::exists(unit.path() / "calibration.yaml")) {
@@ -567,6 +594,99 @@ TEST_F(FactoryCliTest, BatchesShareANewStoreAndRecordSkippedUnits) {
   EXPECT_NE(ReadBytes(Path("out_c/lot.html")).find("data-key=\"yield\">not judged"), std::string::npos);
   r = Run({"history", Path("c.db"), "--lot"});
   EXPECT_NE(r.out.find("not judged"), std::string::npos) << r.out;
+}
+
+// A unit folder's samples named as the logger names them (--samples-glob): exactly one match, else
+// the unit's error names what the folder holds.
+TEST_F(FactoryCliTest, BatchFindsSamplesByGlobAndSaysWhatAFolderHolds) {
+  const std::string samples = ReadBytes(Path("units/unit-01/samples.csv.gz"));
+  for (const char* unit : {"u1", "u2", "u3"}) fs::create_directories(dir_ / "logger" / unit);
+  Write("logger/u1/plan.yaml", ReadBytes(Path("units/unit-01/plan.yaml")));
+  Write("logger/u1/2026-11-24_imu.csv.gz", samples);
+  Write("logger/u1/notes.txt", "chamber 2\n");
+  Write("logger/u2/a_imu.csv.gz", samples);
+  Write("logger/u2/b_imu.csv.gz", samples);
+  Write("logger/u3/notes.txt", "no log\n");
+  RunResult r = Run({"batch", Path("logger"), "--samples-glob", "*_imu.csv.gz", "-o", Path("out"), "--plan",
+                     kFixtures + "/plan_6pos.yaml", "--jobs", "2"});
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  auto summary = Summary("out");
+  EXPECT_EQ(summary["u1"]["status"], "fitted") << summary["u1"]["message"];
+  EXPECT_EQ(summary["u1"]["serial"], "SN-01");
+  // (from stdout: the summary's CSV quotes the quotes)
+  EXPECT_NE(r.out.find("  u2 (u2): error: " + Path("logger/u2") +
+                       ": --samples-glob \"*_imu.csv.gz\" matches 2 files, one unit's samples are one file: "
+                       "a_imu.csv.gz, b_imu.csv.gz\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("  u3 (u3): error: " + Path("logger/u3") +
+                       ": --samples-glob \"*_imu.csv.gz\" matches no file (it has: notes.txt)\n"),
+            std::string::npos)
+      << r.out;
+  ExpectTroubleshootingQuotes(LineWith(r.out, Path("logger/u2") + ": "));
+  ExpectTroubleshootingQuotes(LineWith(r.out, Path("logger/u3") + ": "));
+  // Without the pattern, the folder's files are named.
+  r = Run({"batch", Path("logger"), "-o", Path("out2"), "--plan", kFixtures + "/plan_6pos.yaml", "-q"});
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_EQ(Summary("out2")["u1"]["message"],
+            Path("logger/u1") +
+                ": no samples.csv or samples.csv.gz (it has: 2026-11-24_imu.csv.gz, notes.txt, plan.yaml; "
+                "--samples-glob names the logger's samples file)");
+  ExpectTroubleshootingQuotes(Summary("out2")["u1"]["message"]);
+  // A pattern with a units list is refused before any unit.
+  Write("list.csv", "SN-1, logger/u1/2026-11-24_imu.csv.gz\n");
+  r = Run({"batch", "--units-list", Path("list.csv"), "--samples-glob", "*.gz", "-o", Path("out3")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_EQ(r.err,
+            "imufit: imufit batch: --samples-glob names the samples file in unit folders; a --units-list "
+            "names each itself\n");
+}
+
+// A unit list names each unit's serial, samples and plan (CSV or blank-separated): the serial names
+// the unit and its output folder; a bad line is one error before any unit.
+TEST_F(FactoryCliTest, BatchFitsTheUnitsOfAUnitList) {
+  fs::create_directories(dir_ / "lists");
+  Write("lists/units.csv",
+        "serial, samples, plan\n"
+        "SN-31, ../units/unit-03/samples.csv.gz\n"
+        "# a comment\n"
+        "SN-01,../units/unit-01/samples.csv.gz,../units/unit-01/plan.yaml\n");
+  RunResult r =
+      Run({"batch", "--units-list", Path("lists/units.csv"), "-o", Path("out"), "--plan",
+           kFixtures + "/plan_6pos.yaml", "--limits", Path("limits.yaml"), "--store", Path("l.db")});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  auto summary = Summary("out");
+  ASSERT_EQ(summary.size(), 2u);
+  EXPECT_EQ(summary["SN-31"]["serial"], "SN-31");
+  EXPECT_EQ(summary["SN-01"]["verdict"], "PASS");
+  EXPECT_EQ(YAML::LoadFile(Path("out/SN-31/calibration.yaml"))["serial"].as<std::string>(), "SN-31");
+  r = Run({"history", Path("l.db"), "--lot", "--csv"});
+  EXPECT_EQ(ReadCsv(r.out).at(0)["lot"], "units");  // the list's name
+
+  // Blank-separated; a listed file that is not there is that unit's error, naming the list's line.
+  Write("units.txt", "SN-77   missing.csv.gz\n");
+  r = Run({"batch", "--units-list", Path("units.txt"), "-o", Path("out2"), "--plan",
+           kFixtures + "/plan_6pos.yaml", "-q"});
+  EXPECT_EQ(r.status, kExitFailedLimits);
+  EXPECT_EQ(Summary("out2")["SN-77"]["message"],
+            Path("missing.csv.gz") + ": no such file (" + Path("units.txt") + " line 1)");
+  ExpectTroubleshootingQuotes(Summary("out2")["SN-77"]["message"]);
+
+  // Bad lines: one line each, exit 2, nothing written.
+  const std::pair<std::string, std::string> bad[] = {
+      {"SN-1\n", ":1:1: a unit is \"serial, samples file[, plan]\"; this line has 1 field"},
+      {"SN-1 a.csv\nSN-1 b.csv\n", ":2:1: serial \"SN-1\" is listed twice (lines 1 and 2)"},
+      {"../x a.csv\n", ":1:1: serial \"../x\" cannot name the unit's output folder"}};
+  for (const auto& [text, said] : bad) {
+    Write("bad.txt", text);
+    r = Run({"batch", "--units-list", Path("bad.txt"), "-o", Path("out_bad"), "--plan",
+             kFixtures + "/plan_6pos.yaml"});
+    EXPECT_EQ(r.status, kExitBadInput) << text;
+    EXPECT_EQ(r.err, "imufit: " + Path("bad.txt") + said + "\n") << text;
+    ExpectTroubleshootingQuotes(r.err);
+    EXPECT_FALSE(fs::exists(Path("out_bad/lot_summary.csv")));
+  }
 }
 
 TEST_F(FactoryCliTest, FitWithLimitsReportAndStore) {
@@ -658,6 +778,7 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
     EXPECT_EQ(r.err.rfind("imufit: " + store + ": ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    ExpectTroubleshootingQuotes(r.err);
     EXPECT_EQ(ReadBytes(previous), "# the calibration flashed last week\n") << store;
     EXPECT_FALSE(fs::exists(Path("cal.html"))) << store;
   }
@@ -672,6 +793,7 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
   EXPECT_EQ(r.status, kExitBadInput);
   EXPECT_EQ(r.err, "imufit: " + Path("missing.db") +
                        ": no such results store (imufit fit --store and imufit batch --store create one)\n");
+  ExpectTroubleshootingQuotes(r.err);
   EXPECT_FALSE(fs::exists(Path("missing.db")));
 }
 

@@ -1,6 +1,7 @@
 #include "imufit/factory/batch.h"
 
 #include <fcntl.h>
+#include <fnmatch.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -9,8 +10,11 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #include <yaml-cpp/yaml.h>
@@ -167,6 +171,16 @@ UnitPaths PathsOf(const BatchOptions& options, const std::string& unit) {
   return paths;
 }
 
+// One unit to fit: a folder of UNITS_DIR, or a line of --units-list.
+struct UnitInput {
+  std::string name;  // OUT_DIR/<name>/: the folder's name, or the list's serial
+  fs::path dir;      // the unit folder (a folder unit)
+  bool listed = false;
+  // A listed unit: its serial, where the list states it ("units.csv line 3"), its samples and plan
+  // (empty: the shared --plan).
+  std::string serial, serial_source, samples, plan;
+};
+
 // The serial in UNIT/serial.txt (its first line, trimmed), or "" without that file.
 std::string SerialFile(const fs::path& unit_dir) {
   std::ifstream stream(unit_dir / "serial.txt");
@@ -177,15 +191,64 @@ std::string SerialFile(const fs::path& unit_dir) {
   return first == std::string::npos ? "" : line.substr(first, last - first + 1);
 }
 
-// The unit's plan (its plan.yaml, else the shared plan) and samples (samples.csv.gz, else
-// samples.csv), and their hashes.
-void FindInputs(const BatchOptions& options, const fs::path& unit_dir, UnitOutcome* unit) {
-  std::string samples = (unit_dir / "samples.csv.gz").string();
-  if (!fs::exists(samples)) samples = (unit_dir / "samples.csv").string();
-  if (!fs::exists(samples)) throw InputError(unit_dir.string(), "no samples.csv or samples.csv.gz");
-  std::string plan = (unit_dir / "plan.yaml").string();
-  if (!fs::exists(plan)) {
-    if (options.shared_plan.empty()) throw InputError(unit_dir.string(), "no plan.yaml and no shared --plan");
+// What a unit folder holds, for a message: "it has: a.csv, plan.yaml" or "it is empty".
+std::string FolderContents(const fs::path& dir) {
+  constexpr size_t kMostNamesShown = 8;
+  std::set<std::string> names;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error))
+    names.insert(entry.path().filename().string() + (entry.is_directory() ? "/" : ""));
+  if (names.empty()) return "it is empty";
+  std::vector<std::string> shown(names.begin(), names.end());
+  const size_t more = shown.size() > kMostNamesShown ? shown.size() - kMostNamesShown : 0;
+  shown.resize(shown.size() - more);
+  return "it has: " + Join(shown, ", ") + (more > 0 ? " and " + std::to_string(more) + " more" : "");
+}
+
+// The unit folder's samples file: the one file matching --samples-glob, else samples.csv.gz, else
+// samples.csv.
+std::string FindSamples(const BatchOptions& options, const fs::path& unit_dir) {
+  if (options.samples_glob.empty()) {
+    for (const char* name : {"samples.csv.gz", "samples.csv"}) {
+      if (fs::exists(unit_dir / name)) return (unit_dir / name).string();
+    }
+    throw InputError(unit_dir.string(), "no samples.csv or samples.csv.gz (" + FolderContents(unit_dir) +
+                                            "; --samples-glob names the logger's samples file)");
+  }
+  std::vector<std::string> matches;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(unit_dir, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_directory() && fnmatch(options.samples_glob.c_str(), name.c_str(), FNM_PERIOD) == 0)
+      matches.push_back(name);
+  }
+  std::sort(matches.begin(), matches.end());
+  if (matches.size() == 1) return (unit_dir / matches[0]).string();
+  const std::string glob = "--samples-glob \"" + options.samples_glob + "\"";
+  if (matches.empty())
+    throw InputError(unit_dir.string(), glob + " matches no file (" + FolderContents(unit_dir) + ")");
+  throw InputError(unit_dir.string(), glob + " matches " + std::to_string(matches.size()) +
+                                          " files, one unit's samples are one file: " + Join(matches, ", "));
+}
+
+// The unit's plan (the list's, its plan.yaml, else the shared plan) and samples (the list's, or
+// FindSamples'), and their hashes.
+void FindInputs(const BatchOptions& options, const UnitInput& input, UnitOutcome* unit) {
+  std::string samples = input.samples, plan = input.plan;
+  if (input.listed) {
+    if (!fs::exists(samples)) throw InputError(samples, "no such file (" + input.serial_source + ")");
+    if (!plan.empty() && !fs::exists(plan))
+      throw InputError(plan, "no such file (" + input.serial_source + ")");
+  } else {
+    samples = FindSamples(options, input.dir);
+    plan = (input.dir / "plan.yaml").string();
+    if (!fs::exists(plan)) plan.clear();
+  }
+  if (plan.empty()) {
+    if (options.shared_plan.empty())
+      throw InputError(
+          input.listed ? input.serial_source : input.dir.string(),
+          input.listed ? "no plan in the list and no shared --plan" : "no plan.yaml and no shared --plan");
     plan = options.shared_plan;
   }
   unit->plan_path = plan;
@@ -244,20 +307,26 @@ void RecordSkippedUnit(const Shared& shared, const UnitPaths& paths, UnitOutcome
   unit->calibration_yaml.clear();
 }
 
-// Fits the unit, whose serial.txt states its serial. A unit not fitted says why; a fitted one's
-// calibration carries the unit's serial (the folder name when nothing else names the unit).
-void FitUnit(const Shared& shared, const fs::path& unit_dir, const UnitPaths& paths, UnitOutcome* unit) {
+// The warning, on stderr and the certificate, for a unit that nothing names.
+constexpr const char* kSerialNotStated =
+    "serial not stated: the unit folder's name is used (no serial.txt, no \"# serial:\" line in the samples "
+    "header, no serial in the plan)";
+
+// Fits the unit, whose serial.txt (or list line) states its serial. A unit not fitted says why; a fitted
+// one's calibration carries the unit's serial (the folder name when nothing else names the unit).
+void FitUnit(const Shared& shared, const UnitInput& input, const UnitPaths& paths, UnitOutcome* unit) {
   fs::create_directories(paths.folder);
   RemoveLeftovers(paths.folder);
   FitRunOptions options = shared.options->fit;
-  options.serial = SerialFile(unit_dir);
-  options.serial_source = (unit_dir / "serial.txt").string();
+  options.serial = input.listed ? input.serial : SerialFile(input.dir);
+  options.serial_source = input.listed ? input.serial_source : (input.dir / "serial.txt").string();
   options.plan_sha256 = unit->plan_sha256;
   options.keep_static_stretch = shared.options->write_reports;  // the certificate's noise section
   unit->fit = FitRun(unit->plan_path, unit->samples_path, options);
   FitRunResult& result = *unit->fit;
   if (!result.serial.empty()) unit->serial = result.serial;  // serial.txt, the samples', the plan's
   unit->warnings = result.serial_warnings;
+  if (result.serial.empty()) unit->warnings.push_back(kSerialNotStated);
   if (result.fit.status == FitStatus::kUndetermined) {
     unit->status = "not-fitted";
     unit->message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");
@@ -319,10 +388,10 @@ void InterruptNote() {
   [[maybe_unused]] const ssize_t written = ::write(2, line, static_cast<size_t>(out - line));
 }
 
-UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
+UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
   const auto start = std::chrono::steady_clock::now();
   UnitOutcome unit;
-  unit.unit = unit_dir.filename().string();
+  unit.unit = input.name;
   unit.serial = unit.unit;
   unit.status = "error";
   const UnitPaths paths = PathsOf(*shared.options, unit.unit);
@@ -330,13 +399,13 @@ UnitOutcome ProcessUnit(const Shared& shared, const fs::path& unit_dir) {
   bool done = false;     // certified: outputs, manifest and store row committed together
   bool outside = false;  // failed for a reason outside the unit: not marked done
   try {
-    FindInputs(*shared.options, unit_dir, &unit);
+    FindInputs(*shared.options, input, &unit);
     manifest = InputsManifest(shared, unit);
     if (TakeUnchanged(shared, manifest, paths, &unit)) {
       RecordSkippedUnit(shared, paths, &unit);
       return unit;
     }
-    FitUnit(shared, unit_dir, paths, &unit);
+    FitUnit(shared, input, paths, &unit);
   } catch (const InputError& e) {
     unit.status = "error";
     unit.message = e.what();
@@ -382,32 +451,100 @@ void WriteLotSummary(const std::string& path, const BatchResult& result) {
   out.Commit();
 }
 
-// The lot's name in the store: --lot, else the units folder's name.
+// The lot's name in the store: --lot, else the units folder's name (the list's, without its
+// extension).
 std::string LotName(const BatchOptions& options) {
   if (!options.lot.empty()) return options.lot;
+  if (!options.units_list.empty()) return fs::path(options.units_list).stem().string();
   const fs::path units = fs::path(options.units_dir).lexically_normal();
   const std::string name = units.filename().string();
   return name.empty() ? units.parent_path().filename().string() : name;  // "units/" ends in ""
 }
 
 // The unit folders of `shard`, in name order (not .git and the like).
-std::vector<fs::path> ListUnits(const std::string& units_dir, const Shard& shard) {
-  std::vector<fs::path> units;
+std::vector<UnitInput> ListUnits(const std::string& units_dir, const Shard& shard) {
+  std::vector<UnitInput> units;
   for (const fs::directory_entry& entry : fs::directory_iterator(units_dir)) {
     const std::string name = entry.path().filename().string();
     if (entry.is_directory() && name[0] != '.' && ShardOf(name, shard.count) == shard.index) {
-      units.push_back(entry.path());
+      UnitInput unit;
+      unit.name = name;
+      unit.dir = entry.path();
+      units.push_back(unit);
     }
   }
-  std::sort(units.begin(), units.end());
+  std::sort(units.begin(), units.end(),
+            [](const UnitInput& a, const UnitInput& b) { return a.name < b.name; });
+  return units;
+}
+
+// The fields of a unit list's line: comma-separated (trimmed) when it has a comma, else separated
+// by blanks.
+std::vector<std::string> ListFields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  if (line.find(',') != std::string::npos) {
+    std::istringstream cells(line);
+    while (std::getline(cells, field, ',')) {
+      const size_t first = field.find_first_not_of(" \t"), last = field.find_last_not_of(" \t");
+      fields.push_back(first == std::string::npos ? "" : field.substr(first, last - first + 1));
+    }
+    if (line.back() == ',') fields.push_back("");
+  } else {
+    std::istringstream words(line);
+    while (words >> field) fields.push_back(field);
+  }
+  return fields;
+}
+
+// The units of --units-list in `shard`: one a line, "serial, samples[, plan]" (paths relative to
+// the list's folder), an optional header line starting "serial", blank lines and # comments.
+std::vector<UnitInput> ReadUnitsList(const std::string& list, const Shard& shard) {
+  std::ifstream stream(list);
+  if (!stream) throw InputError(list, "cannot open the unit list");
+  const fs::path base = fs::path(list).parent_path();
+  std::vector<UnitInput> units;
+  std::map<std::string, long> lines_of;
+  std::string line;
+  for (long number = 1; std::getline(stream, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::vector<std::string> f = ListFields(line);
+    if (f.empty() || f[0].empty() || f[0][0] == '#' ||
+        (units.empty() && lines_of.empty() && f[0] == "serial"))
+      continue;
+    if (f.size() < 2 || f.size() > 3 || f[1].empty())
+      throw InputError(list, number, 1,
+                       "a unit is \"serial, samples file[, plan]\"; this line has " +
+                           std::to_string(f.size()) + (f.size() == 1 ? " field" : " fields"));
+    if (f[0] == "." || f[0] == ".." || f[0][0] == '.' || f[0].find('/') != std::string::npos)
+      throw InputError(list, number, 1,
+                       "serial " + QuoteForMessage(f[0]) + " cannot name the unit's output folder");
+    if (const auto [at, added] = lines_of.emplace(f[0], number); !added)
+      throw InputError(list, number, 1,
+                       "serial " + QuoteForMessage(f[0]) + " is listed twice (lines " +
+                           std::to_string(at->second) + " and " + std::to_string(number) + ")");
+    if (ShardOf(f[0], shard.count) != shard.index) continue;
+    UnitInput unit;
+    unit.name = unit.serial = f[0];
+    unit.listed = true;
+    unit.serial_source = list + " line " + std::to_string(number);
+    unit.samples = (base / f[1]).string();
+    if (f.size() == 3 && !f[2].empty()) unit.plan = (base / f[2]).string();
+    units.push_back(unit);
+  }
+  std::sort(units.begin(), units.end(),
+            [](const UnitInput& a, const UnitInput& b) { return a.name < b.name; });
   return units;
 }
 
 // Everything shared by the units, each input checked: a bad one is the lot's error, before any unit.
-void Prepare(const BatchOptions& options, Shared* shared) {
+void Prepare(const BatchOptions& options, Shared* shared, std::vector<UnitInput>* units) {
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit batch", problem);
-  if (!fs::is_directory(options.units_dir)) throw InputError(options.units_dir, "not a folder");
+  if (options.units_list.empty() && !fs::is_directory(options.units_dir))
+    throw InputError(options.units_dir, "not a folder");
+  *units = options.units_list.empty() ? ListUnits(options.units_dir, options.shard)
+                                      : ReadUnitsList(options.units_list, options.shard);
   shared->options = &options;
   shared->fit_options = options.fit.Describe();
   shared->certify.software = options.fit.software;
@@ -424,7 +561,7 @@ void Prepare(const BatchOptions& options, Shared* shared) {
 // The units processed by a pool of threads; a unit is nullopt when max_units stopped the batch
 // before it.
 std::vector<std::optional<UnitOutcome>> ProcessUnits(const Shared& shared,
-                                                     const std::vector<fs::path>& units) {
+                                                     const std::vector<UnitInput>& units) {
   const BatchOptions& options = *shared.options;
   std::vector<std::optional<UnitOutcome>> outcomes(units.size());
   std::atomic<size_t> next{0};
@@ -502,7 +639,10 @@ void WriteLotOutputs(const Shared& shared, const BatchResult& result) {
 }  // namespace
 
 std::string BatchOptions::Validate() const {
-  if (units_dir.empty()) return "no units folder";
+  if (units_dir.empty() && units_list.empty()) return "no units folder and no --units-list";
+  if (!units_dir.empty() && !units_list.empty()) return "give a units folder or --units-list, not both";
+  if (!units_list.empty() && !samples_glob.empty())
+    return "--samples-glob names the samples file in unit folders; a --units-list names each itself";
   if (output_dir.empty()) return "no output folder";
   if (jobs < 0) return "jobs must be >= 0";
   if (max_units < 0) return "max_units must be >= 0";
@@ -513,7 +653,8 @@ std::string BatchOptions::Validate() const {
 
 BatchResult RunBatch(const BatchOptions& options) {
   Shared shared;
-  Prepare(options, &shared);
+  std::vector<UnitInput> units;
+  Prepare(options, &shared, &units);
   const FolderLock lock(options.output_dir, options.shard);
   shared.certify.lot = LotName(options);
   if (!options.store_path.empty()) {
@@ -521,7 +662,7 @@ BatchResult RunBatch(const BatchOptions& options) {
     shared.certify.store = shared.store.get();
   }
   SetInterruptNote(InterruptNote);
-  BatchResult result = Tally(ProcessUnits(shared, ListUnits(options.units_dir, options.shard)));
+  BatchResult result = Tally(ProcessUnits(shared, units));
   SetInterruptNote(nullptr);
   if (result.complete && options.shard.count == 1) WriteLotOutputs(shared, result);
   return result;

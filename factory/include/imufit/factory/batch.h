@@ -1,7 +1,10 @@
 // imufit — a batch: every unit of a lot fitted, judged and recorded (`imufit batch`).
 //
-// UNITS_DIR holds one folder per unit: plan.yaml + samples.csv (or samples.csv.gz), or samples
-// only when a shared plan is given. Units are fitted in parallel (a pool of `jobs` threads, one
+// UNITS_DIR holds one folder per unit: plan.yaml + samples.csv (or samples.csv.gz, or the one file
+// matching samples_glob, as the logger names it), or samples only when a shared plan is given; a
+// unit's serial is its serial.txt, its samples header's or its plan's, else (a warning, shown on
+// the certificate) the folder's name. Or a unit list (units_list) names each unit: its serial, its
+// samples file and optionally its plan. Units are fitted in parallel (a pool of `jobs` threads, one
 // unit each, one solver thread per unit); a unit's failure never stops the others. Each fitted
 // unit is certified as `imufit fit` certifies one (certify.h). For each unit OUT_DIR/<unit>/
 // receives calibration.yaml (when fitted) and report.html (with write_reports) together, then
@@ -34,7 +37,11 @@ struct BatchProgress {
 };
 
 struct BatchOptions {
-  std::string units_dir;
+  std::string units_dir;   // a folder of unit folders; or:
+  std::string units_list;  // a file listing the units: "serial, samples[, plan]" a line (CSV or blanks)
+  // The samples file in each unit folder: the one file whose name matches this shell pattern
+  // (fnmatch, e.g. "*_imu.csv.gz"); empty: samples.csv.gz, else samples.csv.
+  std::string samples_glob;
   std::string output_dir;
   std::string limits_path;   // empty: no verdicts
   std::string shared_plan;   // used by units without their own plan.yaml
