@@ -390,8 +390,7 @@ TEST_F(CliTest, NoCommandWritesANonFiniteNumber) {
   const std::string samples = Write("hot.csv", header + "0,25,1,2,3,4,5,6\n0.1,1e300,1,2,3,4,5,6\n");
   RunResult r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", samples, "-o", Path("out.csv"), "-q"});
   EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("hot.csv:3:2: temp_c: 1e+300 degC is outside -100..200 degC"),
-            std::string::npos)
+  EXPECT_NE(r.err.find("hot.csv:3:2: temp_c: 1e+300 degC is outside -100..200 degC"), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(Path("out.csv")));
   // apply: a calibration whose scale crosses zero inside its fit range is refused on read.

@@ -44,8 +44,9 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitNotDone = 1;
 constexpr int kExitFailedLimits = 3;
 constexpr int kUnits = 5;
-// A passing unit's certificate prints on at most about 4 pages.
-constexpr int kMostPagesOfAPassingCertificate = 4;
+// A passing unit's certificate prints on at most this many pages (five since it states its
+// uncertainty budget and decision rule).
+constexpr int kMostPagesOfAPassingCertificate = 5;
 
 constexpr const char* kLimits = R"(format: imufit-limits
 version: 1
@@ -222,8 +223,9 @@ class FactoryCliTest : public testing::TempDirTest {
           Path(name + "-page-" + (pages >= 10 && page < 10 ? "0" : "") + std::to_string(page) + ".png");
       const std::string image = ReadBytes(png);
       EXPECT_EQ(image.substr(1, 3), "PNG") << png;
-      // A page with text and plots compresses to far more than a blank one (about 1 kB at 30 dpi).
-      constexpr size_t kMinimumPrintedPagePngBytes = 4000;
+      // A page with text compresses to far more than a blank one (about 1 kB at 30 dpi); the last
+      // page may hold one table.
+      constexpr size_t kMinimumPrintedPagePngBytes = 2500;
       EXPECT_GT(image.size(), kMinimumPrintedPagePngBytes) << png;
       const RunResult words = RunProgram("/usr/bin/pdftotext", {"-f", std::to_string(page), "-l",
                                                                 std::to_string(page), pdf, Path("page.txt")});
@@ -966,7 +968,7 @@ TEST_F(FactoryCliTest, PdfOptionPrintsTheCertificateAndTheLotPage) {
 // The standard simulated 6-position soak (fixtures/mems_6pos_soak.csv.gz: 18 segments at five
 // temperatures), fitted with validation and certified with limits and a station file: a passing
 // unit on at most kMostPagesOfAPassingCertificate pages of A4 and of Letter.
-TEST_F(FactoryCliTest, StandardSoakCertificatePrintsOnFourPages) {
+TEST_F(FactoryCliTest, StandardSoakCertificatePrintsOnFivePages) {
   if (!fs::exists("/usr/bin/chromium") || !fs::exists("/usr/bin/pdftoppm")) {
     GTEST_SKIP() << "no chromium or pdftoppm (Debian: chromium poppler-utils)";
   }
