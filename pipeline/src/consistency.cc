@@ -18,8 +18,8 @@ std::string Format(const char* format, double value) {
 }
 
 // A sensor held whole (SensorFit::kNone) was not fitted: its chi-square measures the held values.
-std::string Chi2Finding(const char* sensor, SensorFit fitted, double reduced_chi2, int dof) {
-  if (fitted == SensorFit::kNone || dof <= 0 || !(reduced_chi2 > ReducedChi2Limit(dof))) return "";
+std::string Chi2Finding(const char* sensor, bool judged, double reduced_chi2, int dof) {
+  if (!judged || dof <= 0 || !(reduced_chi2 > ReducedChi2Limit(dof))) return "";
   return std::string(sensor) + " reduced chi-square " + Format("%.3g", reduced_chi2) + " (at most " +
          Format("%.3g", ReducedChi2Limit(dof)) + " for the noise and model error of " + std::to_string(dof) +
          " degrees of freedom)";
@@ -35,7 +35,8 @@ size_t Cluster(const std::vector<double>& centres, double temp_c) {
 }
 
 // Segments down-weighted (more than half of their windows) at every temperature they were seen at.
-std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window>& windows) {
+std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window>& windows, bool gyro_judged,
+                                 bool accel_judged) {
   struct Count {
     int windows = 0;
     int downweighted = 0;
@@ -60,8 +61,9 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
     count.downweighted += r.downweighted ? 1 : 0;
     gyro_sum[w.segment] += r.gyro_radps.squaredNorm() / 3.0;
     accel_sum[w.segment] += r.accel_mps2.squaredNorm() / 3.0;
-    normalised_sum[w.segment] +=
-        (normalised(r.gyro_radps, r.gyro_sigma_radps) + normalised(r.accel_mps2, r.accel_sigma_mps2)) / 6.0;
+    normalised_sum[w.segment] += ((gyro_judged ? normalised(r.gyro_radps, r.gyro_sigma_radps) : 0.0) +
+                                  (accel_judged ? normalised(r.accel_mps2, r.accel_sigma_mps2) : 0.0)) /
+                                 (3.0 * (gyro_judged + accel_judged));
   }
   std::string text;
   for (const auto& [segment, by_temp] : counts) {
@@ -94,12 +96,23 @@ double ReducedChi2Limit(int dof) {
          (1.0 + kChi2Sigmas * std::sqrt(2.0 / std::max(dof, 1)));
 }
 
-std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows) {
+bool JudgedByTheGate(const FitOptions& options, bool gyro) {
+  const int default_order = FitOptions().gyro_temp_order;
+  if (gyro) {
+    return options.gyro_fit == SensorFit::kAll && options.fit_g_sensitivity &&
+           options.gyro_temp_order >= default_order;
+  }
+  return options.accel_fit == SensorFit::kAll && options.accel_temp_order >= default_order;
+}
+
+std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows,
+                          const FitOptions& options) {
+  const bool gyro = JudgedByTheGate(options, true), accel = JudgedByTheGate(options, false);
+  if (!gyro && !accel) return "";
   std::string text;
-  for (const std::string& finding :
-       {Chi2Finding("gyro", fit.gyro_fit, fit.gyro_reduced_chi2, fit.gyro_dof),
-        Chi2Finding("accel", fit.accel_fit, fit.accel_reduced_chi2, fit.accel_dof),
-        DownweightedSegments(fit, windows)}) {
+  for (const std::string& finding : {Chi2Finding("gyro", gyro, fit.gyro_reduced_chi2, fit.gyro_dof),
+                                     Chi2Finding("accel", accel, fit.accel_reduced_chi2, fit.accel_dof),
+                                     DownweightedSegments(fit, windows, gyro, accel)}) {
     if (!finding.empty()) text += (text.empty() ? "" : "; ") + finding;
   }
   if (text.empty()) return text;

@@ -126,7 +126,7 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
   if (!result.fit.IsSolutionUsable()) return result;
-  result.inconsistency = Inconsistency(result.fit, result.run.windows);
+  result.inconsistency = Inconsistency(result.fit, result.run.windows, options.fit);
   if (!result.inconsistency.empty()) {
     if (!options.write_inconsistent) {
       throw PlanMismatchError(samples_path + ": the fit is inconsistent with the run's noise: " +

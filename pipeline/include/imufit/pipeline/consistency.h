@@ -36,8 +36,15 @@ inline constexpr double kChi2Sigmas = 5.0;
 // The largest reduced chi-square of a consistent fit with `dof` degrees of freedom.
 double ReducedChi2Limit(int dof);
 
-// Why the fit of `windows` is inconsistent, on one line ("" when it is not).
-std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows);
+// Whether the gate judges the gyro (`gyro`) or the accelerometer: only a sensor fitted with the whole
+// model (every group, the g-sensitivity, the default temperature order or more). A reduced model
+// chosen by the user (a held group, a lower order) leaves in its residuals what it does not model;
+// its sigmas are inflated by the reduced chi-square instead.
+bool JudgedByTheGate(const FitOptions& options, bool gyro);
+
+// Why the fit of `windows` with `options` is inconsistent, on one line ("" when it is not).
+std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows,
+                          const FitOptions& options);
 
 }  // namespace imufit
 
