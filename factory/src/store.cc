@@ -17,6 +17,12 @@
 namespace imufit {
 namespace {
 
+InputError UnsupportedVersion(const std::string& name, int64_t found) {
+  return InputError(name, "results store schema version " + std::to_string(found) +
+                              " is not supported (this imufit reads and writes version " +
+                              std::to_string(kStoreSchemaVersion) + "; use the imufit that wrote it)");
+}
+
 // A prepared statement, finalized on scope exit.
 class Statement {
  public:
@@ -213,12 +219,6 @@ CREATE INDEX fits_time ON fits (time_utc);
 CREATE INDEX figures_name ON figures (name, fit_id);
 CREATE INDEX figures_coefficient ON figures (coefficient, fit_id);
 )sql";
-
-InputError UnsupportedVersion(const std::string& name, int64_t found) {
-  return InputError(name, "results store schema version " + std::to_string(found) +
-                              " is not supported (this imufit reads and writes version " +
-                              std::to_string(kStoreSchemaVersion) + "; use the imufit that wrote it)");
-}
 
 std::string SchemaFor(const SqlConnection& db) {
   std::string sql = kSchema;
