@@ -25,6 +25,9 @@ const std::map<std::string, std::string> kOtherTexts = {
     {"prior", Fixture("mems_truth.yaml")},
     {"check_samples", "another_run.csv"},
     {"check_plan", "another_plan.yaml"},
+    {"time_unit", "ms"},
+    {"delimiter", ";"},
+    {"column", "time_s=Zeit"},
 };
 
 // Changes the option of `entry` in `options` to another valid value.
