@@ -148,6 +148,7 @@ class CliOptions {
             if (!shown.empty()) b.option->default_str(shown);
           } else {
             b.option = command->add_option(entry.flag, b.text, entry.help);
+            if (entry.repeatable) b.option->multi_option_policy(CLI::MultiOptionPolicy::Join);
             if (const std::string shown = kind.Get(defaults); !shown.empty()) b.option->default_str(shown);
           }
         },

@@ -45,7 +45,7 @@ struct SamplesInputArguments {
     return input;
   }
 };
-// --temp-c and --time-unit.
+// --temp-c, --time-unit, --delimiter, --decimal-comma and --column: how a file is read.
 void AddTempOption(CLI::App* command, SamplesInputArguments* args);
 // The segmentation options: --segment-window, --min-steady, --direction-tolerance, ...
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);

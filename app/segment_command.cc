@@ -1,6 +1,8 @@
 // imufit segment — finds a plan's segments in an unlabelled log and writes it with a segment column.
 #include <cstdio>
 #include <memory>
+#include <set>
+#include <string>
 
 #include "commands.h"
 #include "imufit/io/error.h"
@@ -46,13 +48,17 @@ int RunSegment(const SegmentArguments& args) {
 
 }  // namespace
 
+// The options that say how a file is read, as opposed to how its segments are found.
+const std::set<std::string> kFileReadingKeys = {"temp_c", "time_unit", "delimiter", "decimal_comma",
+                                                "column"};
+
 void AddTempOption(CLI::App* command, SamplesInputArguments* args) {
-  args->options.AddOne(command, SamplesInputOptionTable(), "temp_c");
-  args->options.AddOne(command, SamplesInputOptionTable(), "time_unit");
+  for (const std::string& key : kFileReadingKeys)
+    args->options.AddOne(command, SamplesInputOptionTable(), key);
 }
 
 void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args) {
-  args->options.Add(command, SamplesInputOptionTable(), {"temp_c", "time_unit"});
+  args->options.Add(command, SamplesInputOptionTable(), kFileReadingKeys);
 }
 
 CommandRunner AddSegmentCommand(CLI::App* root) {

@@ -80,6 +80,16 @@ class CliInputTest : public CliTest {
     args.insert(args.end(), extra.begin(), extra.end());
     return Run(args);
   }
+
+  // docs/troubleshooting.md quotes the line `r` printed (the test's folder left out).
+  void ExpectInTroubleshooting(const RunResult& r) const {
+    std::string said = r.err.substr(0, r.err.size() - 1);
+    const std::string folder = Path("x").substr(0, Path("x").size() - 1);
+    for (size_t at = said.find(folder); at != std::string::npos; at = said.find(folder))
+      said.erase(at, folder.size());
+    EXPECT_NE(ReadBytes(Fixture("../docs/troubleshooting.md")).find("`" + said + "`"), std::string::npos)
+        << said;
+  }
 };
 
 // Time stamps in milliseconds or nanoseconds read as seconds give a sample rate no calibration
@@ -263,10 +273,111 @@ TEST_F(CliInputTest, HeadersAsSpreadsheetsAndLoggersWriteThem) {
         "2100\r\n");
   r = Run({"apply", "-c", cal, "-s", Path("de.csv"), "-o", Path("out2.csv")});
   EXPECT_EQ(r.status, 2);
-  ExpectOneLine(r,
-                "de.csv:1: the header is separated by ';', not commas (a spreadsheet's export in a locale "
-                "with a decimal comma?)");
+  ExpectOneLine(r, "de.csv:1: the header is separated by ';', not ',': give --delimiter ';'");
+  ExpectInTroubleshooting(r);
   EXPECT_FALSE(fs::exists(Path("out2.csv")));
+}
+
+// `text`, a plain samples CSV, as a spreadsheet in a German locale saves it: ';' between fields,
+// decimal commas, CRLF line ends (comments kept as they are).
+std::string GermanLocale(const std::string& text) {
+  std::istringstream lines(text);
+  std::string out;
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty() && line[0] != '#') {
+      std::replace(line.begin(), line.end(), ',', ';');
+      std::replace(line.begin(), line.end(), '.', ',');
+    }
+    out += line + "\r\n";
+  }
+  return out;
+}
+
+// The calibration's lines that hold numbers of the fit (not the input's path, hash or date).
+std::vector<std::string> FittedLines(const std::string& path) {
+  std::istringstream lines(ReadBytes(path));
+  std::vector<std::string> kept;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("samples") == std::string::npos && line.find("sha256") == std::string::npos &&
+        line.find("date") == std::string::npos && line.find("created") == std::string::npos &&
+        line.find("options") == std::string::npos) {
+      kept.push_back(line);
+    }
+  }
+  return kept;
+}
+
+// A German-locale export fits with --delimiter ';' --decimal-comma to the numbers of the plain file
+// (the labelled file is parsed in parallel blocks: the dialect travels with them); without the
+// options each mistake is named with the option to give.
+TEST_F(CliInputTest, GermanLocaleExportFitsWithItsDialectToTheSameNumbers) {
+  const std::string raw = RawRun();
+  ASSERT_EQ(Fit(raw).status, 0);
+  const std::vector<std::string> plain = FittedLines(Path("cal.yaml"));
+  fs::remove(Path("cal.yaml"));
+  const std::string de = Write("de.csv", GermanLocale(ReadBytes(raw)));
+  const RunResult fitted = Fit(de, {"--delimiter", ";", "--decimal-comma"});
+  ASSERT_EQ(fitted.status, 0) << fitted.err;
+  EXPECT_EQ(FittedLines(Path("cal.yaml")), plain);
+  fs::remove(Path("cal.yaml"));
+  // The same through segment, which reads the file twice without its segment column.
+  EXPECT_EQ(Run({"segment", "-p", Fixture("plan_6pos.yaml"), "-s", de, "-o", Path("seg.csv"), "-q",
+                 "--delimiter", ";", "--decimal-comma"})
+                .status,
+            0);
+  for (const auto& [options, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{}, "the header is separated by ';', not ',': give --delimiter ';' (and --decimal-comma"},
+           {{"--delimiter", ";"}, "is not a number (a decimal comma? give --decimal-comma)"},
+           {{"--decimal-comma"}, "--decimal-comma needs --delimiter ';' or tab"},
+           {{"--delimiter", "|"}, "delimiter \"|\" is not one of: ,, ;, tab"}}) {
+    const RunResult r = Fit(de, options);
+    EXPECT_EQ(r.status, 2) << message;
+    ExpectOneLine(r, message);
+    if (options.size() == 2 && options[1] == ";") ExpectInTroubleshooting(r);
+    EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  }
+  // A tab-separated file the same way.
+  std::string tabs = ReadBytes(raw);
+  std::replace(tabs.begin(), tabs.end(), ',', '\t');
+  ASSERT_EQ(Fit(Write("tabs.tsv", tabs), {"--delimiter", "tab"}).status, 0);
+  EXPECT_EQ(FittedLines(Path("cal.yaml")), plain);
+}
+
+// A logger that names its columns its own way: --column NAME=COLUMN (repeated, or pairs joined by
+// ','), and the fit is the plain file's.
+TEST_F(CliInputTest, ColumnMapReadsALoggersOwnNames) {
+  const std::string raw = RawRun();
+  ASSERT_EQ(Fit(raw).status, 0);
+  const std::vector<std::string> plain = FittedLines(Path("cal.yaml"));
+  fs::remove(Path("cal.yaml"));
+  std::string text = ReadBytes(raw);
+  const size_t header = text.find("time_s,temp_c,");
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"time_s,", "Zeit,"}, {"temp_c,", "T (degC),"}, {"gyro_y,", "rate y,"}}) {
+    const size_t at = text.find(from, header);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  }
+  const std::string logger = Write("logger.csv", text);
+  RunResult r = Fit(logger, {"--column", "time_s=Zeit", "--column", "temp_c=T (degC),gyro_y=rate y"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(FittedLines(Path("cal.yaml")), plain);
+  fs::remove(Path("cal.yaml"));
+  // A name imufit does not read, a pair without '=', a column read twice.
+  for (const auto& [map, message] : std::vector<std::pair<std::string, std::string>>{
+           {"speed=Zeit", "column \"speed\" is not one imufit reads: time_s, temp_c, segment"},
+           {"time_s", "column \"time_s\" is not NAME=COLUMN (e.g. time_s=Time)"},
+           {"time_s=Zeit,temp_c=T (degC),gyro_y=rate y,gyro_x=rate y",
+            "column \"rate y\" is read as two columns"}}) {
+    r = Fit(logger, {"--column", map});
+    EXPECT_EQ(r.status, 2) << map;
+    ExpectOneLine(r, message);
+    EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  }
+  // Without the map, the file's names are said, with a near name where one is.
+  r = Fit(logger);
+  EXPECT_EQ(r.status, 2);
+  ExpectOneLine(r, "no columns \"time_s\", \"gyro_y\" and \"temp_c\" in the header");
 }
 
 }  // namespace

@@ -26,6 +26,8 @@ const std::map<std::string, std::string> kOtherTexts = {
     {"check_samples", "another_run.csv"},
     {"check_plan", "another_plan.yaml"},
     {"time_unit", "ms"},
+    {"delimiter", ";"},
+    {"column", "time_s=Zeit"},
 };
 
 // Changes the option of `entry` in `options` to another valid value.

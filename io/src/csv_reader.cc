@@ -22,6 +22,15 @@ constexpr size_t kBlockBytes = IMUFIT_CSV_BLOCK_BYTES;
 constexpr size_t kBlockBytes = 4 << 20;
 #endif
 
+// The delimiters a file may use (CsvDialect), with their names in messages and on the command line.
+constexpr char kDelimiters[] = {',', ';', '\t'};
+std::string DelimiterName(char delimiter) {
+  return delimiter == '\t' ? "tabs" : std::string("'") + delimiter + "'";
+}
+std::string DelimiterOption(char delimiter) {
+  return delimiter == '\t' ? "tab" : std::string("'") + delimiter + "'";
+}
+
 std::string_view Trim(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
   while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
@@ -96,7 +105,13 @@ class CsvReader::Source : public ByteSource {
   using ByteSource::ByteSource;
 };
 
-CsvReader::CsvReader(std::string path, Sha256* raw_digest) : path_(std::move(path)) {
+CsvReader::CsvReader(std::string path, Sha256* raw_digest, const CsvDialect& dialect)
+    : path_(std::move(path)), dialect_(dialect) {
+  if (dialect_.decimal_comma && dialect_.delimiter == ',') {
+    throw InputError(path_,
+                     "--decimal-comma needs --delimiter ';' or tab (a decimal comma and a ',' between "
+                     "fields cannot be told apart)");
+  }
   errno = 0;
   source_ = std::make_unique<Source>(path_, raw_digest);
   buffer_.resize(kBlockBytes);
@@ -135,6 +150,7 @@ CsvReader::CsvReader(std::string path, Sha256* raw_digest) : path_(std::move(pat
 
 CsvReader::CsvReader(const CsvReader& header_of, std::string_view rows, long line_before)
     : path_(header_of.path_),
+      dialect_(header_of.dialect_),
       buffer_(rows.begin(), rows.end()),
       end_(rows.size()),
       eof_(true),
@@ -186,18 +202,17 @@ std::vector<int> CsvReader::RequireColumns(const std::vector<std::string>& names
     }
   }
   if (missing.empty()) return columns;
-  // One field holding the other delimiter: the columns were never split.
-  std::string delimiter;
+  // One field holding another delimiter: the columns were never split.
   if (header_.size() == 1) {
-    if (header_[0].find(';') != std::string::npos) delimiter = "';'";
-    if (header_[0].find('\t') != std::string::npos) delimiter = "tabs";
-  }
-  if (!delimiter.empty()) {
-    throw InputError(path_, header_line_, 0,
-                     "the header is separated by " + delimiter +
-                         ", not commas (a spreadsheet's export in a locale with a decimal comma?): "
-                         "save it as CSV with ',' between fields and '.' in numbers (header: " +
-                         EscapeForMessage(header_[0], 80) + ")");
+    for (const char delimiter : kDelimiters) {
+      if (delimiter == dialect_.delimiter || header_[0].find(delimiter) == std::string::npos) continue;
+      std::string message = "the header is separated by " + DelimiterName(delimiter) + ", not " +
+                            DelimiterName(dialect_.delimiter) + ": give --delimiter " +
+                            DelimiterOption(delimiter);
+      if (delimiter != ',') message += " (and --decimal-comma when its numbers are written 1,5)";
+      throw InputError(path_, header_line_, 0,
+                       message + " (header: " + EscapeForMessage(header_[0], 80) + ")");
+    }
   }
   constexpr size_t kShown = 12;
   std::string have;
@@ -303,12 +318,12 @@ bool CsvReader::NextBlock(std::string_view* rows, long* line_before) {
 void CsvReader::SplitLine(std::string_view line) {
   field_count_ = 0;
   if (std::memchr(line.data(), '"', line.size()) == nullptr) {
-    // Fast path: no quotes, so every comma separates two fields.
+    // Fast path: no quotes, so every delimiter separates two fields.
     const char* data = line.data();
     const char* end = data + line.size();
     const char* start = data;
     for (;;) {
-      const char* comma = static_cast<const char*>(std::memchr(start, ',', end - start));
+      const char* comma = static_cast<const char*>(std::memchr(start, dialect_.delimiter, end - start));
       if (comma == nullptr) break;
       AddField(std::string_view(start, comma - start));
       start = comma + 1;
@@ -345,14 +360,14 @@ void CsvReader::SplitLine(std::string_view line) {
         field += line[i++];
       }
       while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-      if (i < line.size() && line[i] != ',') {
+      if (i < line.size() && line[i] != dialect_.delimiter) {
         throw InputError(path_, line_number_, column,
                          "text after the closing quote of a field: " + QuoteForMessage(line.substr(start)));
       }
       unquoted_.push_back(std::move(field));
       AddField(unquoted_.back());
     } else {
-      const size_t comma = std::min(line.find(',', i), line.size());
+      const size_t comma = std::min(line.find(dialect_.delimiter, i), line.size());
       const std::string_view field = line.substr(i, comma - i);
       if (field.find('"') != std::string_view::npos) {
         throw InputError(path_, line_number_, column,
@@ -363,7 +378,7 @@ void CsvReader::SplitLine(std::string_view line) {
       i = comma;
     }
     if (i >= line.size()) return;
-    ++i;  // the comma
+    ++i;  // the delimiter
     if (i == line.size()) {
       AddField(std::string_view());
       return;
@@ -402,18 +417,31 @@ double CsvReader::Number(int column) const {
   if (ParseSmallInteger(text, &value)) return value;
   text = Trim(text);
   if (text.empty()) Fail(column, "empty value, a number is needed");
+  const std::string_view as_written = text;
+  // A decimal comma becomes a point (a point in such a file is a thousands separator: refused).
+  constexpr size_t kMaxNumberBytes = 64;
+  char with_point[kMaxNumberBytes];
+  if (dialect_.decimal_comma && text.size() <= kMaxNumberBytes) {
+    if (text.find('.') != std::string_view::npos) {
+      Fail(column, QuoteForMessage(text) + " has a '.' in a file with decimal commas (--decimal-comma)");
+    }
+    std::replace_copy(text.begin(), text.end(), with_point, ',', '.');
+    text = std::string_view(with_point, text.size());
+  } else if (dialect_.delimiter != ',' && text.find(',') != std::string_view::npos) {
+    Fail(column, QuoteForMessage(text) + " is not a number (a decimal comma? give --decimal-comma)");
+  }
   const char* first = text.data();
   const char* last = text.data() + text.size();
   if (*first == '+') {
     ++first;
     if (first != last && (*first == '-' || *first == '+'))
-      Fail(column, QuoteForMessage(text) + " is not a number");
+      Fail(column, QuoteForMessage(as_written) + " is not a number");
   }
   const auto result = std::from_chars(first, last, value);
   if (result.ec != std::errc() || result.ptr != last) {
-    Fail(column, QuoteForMessage(text) + " is not a number");
+    Fail(column, QuoteForMessage(as_written) + " is not a number");
   }
-  if (!std::isfinite(value)) Fail(column, QuoteForMessage(text) + " is not a finite number");
+  if (!std::isfinite(value)) Fail(column, QuoteForMessage(as_written) + " is not a finite number");
   return value;
 }
 

@@ -29,7 +29,8 @@ constexpr size_t kMinRowBytes = 24;
 
 SamplesReader::SamplesReader(const SamplesReader& header_of, std::string_view rows, long line_before,
                              std::optional<double> last_time_s, bool probe_interval)
-    : csv_(header_of.csv_, rows, line_before),
+    : format_(header_of.format_),
+      csv_(header_of.csv_, rows, line_before),
       seconds_per_time_unit_(header_of.seconds_per_time_unit_),
       time_column_(header_of.time_column_),
       temp_column_(header_of.temp_column_),
@@ -119,7 +120,7 @@ bool ParallelSamplesReader::Next(Sample* sample) {
 
 void ParallelSamplesReader::Fail(const std::string& column, const std::string& message) const {
   const CsvReader& csv = header_->csv_;
-  const std::optional<int> index = csv.FindColumn(column);
+  const std::optional<int> index = header_->FindColumn(column);
   if (!index) throw InputError(csv.path(), line_, 0, message);
   csv.FailAt(line_, *index, message);
 }

@@ -41,8 +41,10 @@ const TableSegment* Plan::Find(int id) const {
   return nullptr;
 }
 
-Plan ReadPlan(const std::string& path) {
-  const YAML::Node root_node = yaml::LoadFile(path);
+namespace {
+
+// A plan from its parsed YAML, named `path`.
+Plan ReadPlanNode(const YAML::Node& root_node, const std::string& path) {
   const yaml::Located root{&path, root_node, ""};
   if (!root_node.IsMap()) throw InputError(path, "not an imufit plan (expected a YAML mapping)");
   root.RejectUnknownKeys({"format", "version", "gravity_mps2", "latitude_deg", "serial", "segments"});
@@ -117,6 +119,14 @@ Plan ReadPlan(const std::string& path) {
     plan.segments.push_back(segment);
   }
   return plan;
+}
+
+}  // namespace
+
+Plan ReadPlan(const std::string& path) { return ReadPlanNode(yaml::LoadFile(path), path); }
+
+Plan ReadPlanText(const std::string& text, const std::string& name) {
+  return ReadPlanNode(yaml::LoadText(text, name), name);
 }
 
 }  // namespace imufit

@@ -58,7 +58,8 @@ std::string ShortNumber(double value) {
 
 SamplesReader::SamplesReader(std::string path, bool require_segment, const SamplesFormat& format,
                              Sha256* raw_digest)
-    : csv_(std::move(path), raw_digest),
+    : format_(format),
+      csv_(std::move(path), raw_digest, format.dialect),
       seconds_per_time_unit_(format.seconds_per_time_unit),
       serial_(SerialInHeader(csv_)) {
   const std::optional<double>& temp_c = format.temp_c;
@@ -68,9 +69,11 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, const Sampl
   names.insert(names.end(), std::begin(kAccelNames), std::end(kAccelNames));
   if (!temp_c) names.push_back("temp_c");
   if (require_segment) names.push_back("segment");
-  const bool has_temp = csv_.FindColumn("temp_c").has_value();
+  for (std::string& name : names) name = format.InFile(name);
+  const bool has_temp = FindColumn("temp_c").has_value();
   const std::vector<int> columns = csv_.RequireColumns(
       names, temp_c || has_temp ? "" : "; for a run without a thermometer give its temperature (--temp-c)");
+  CheckDistinct(columns);
   time_column_ = columns[0];
   for (int axis = 0; axis < 3; ++axis) {
     gyro_columns_[axis] = columns[1 + axis];
@@ -87,7 +90,7 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, const Sampl
   }
   if (require_segment) {
     segment_column_ = columns.back();
-  } else if (const auto column = csv_.FindColumn("segment")) {
+  } else if (const auto column = FindColumn("segment")) {
     segment_column_ = *column;
   }
 }
@@ -129,46 +132,76 @@ bool SamplesReader::Next(Sample* sample) {
 }
 
 void SamplesReader::CheckTemperature(double temp_c) const {
-  if (temp_c >= kMinPlausibleTempC && temp_c <= kMaxPlausibleTempC) return;
+  if (const std::string problem = TemperatureProblem(temp_c, rows_ == 1); !problem.empty())
+    csv_.Fail(temp_column_, problem);
+}
+
+std::string TemperatureProblem(double temp_c, bool first) {
+  if (temp_c >= kMinPlausibleTempC && temp_c <= kMaxPlausibleTempC) return "";
   std::string message = FormatDouble(temp_c) + " degC is outside " + FormatDouble(kMinPlausibleTempC) + ".." +
                         FormatDouble(kMaxPlausibleTempC) + " degC, what an IMU can report: ";
   const double as_kelvin_c = temp_c - kZeroCelsiusK;
   if (as_kelvin_c >= kMinPlausibleTempC && as_kelvin_c <= kMaxPlausibleTempC) {
-    message += std::string(rows_ == 1 ? "the column is in kelvin?" : "kelvin?") + " (" +
-               FormatDouble(temp_c) + " K is " + FormatDouble(as_kelvin_c) + " degC; temp_c must be degC)";
+    message += std::string(first ? "the column is in kelvin?" : "kelvin?") + " (" + FormatDouble(temp_c) +
+               " K is " + FormatDouble(as_kelvin_c) + " degC; temp_c must be degC)";
   } else if (temp_c == -kZeroCelsiusK) {
     message += "absolute zero, a logger's fill value for a missing reading? (kelvin? temp_c must be degC)";
   } else {
     message += "a fill value or a broken reading? (kelvin? temp_c must be degC)";
   }
-  csv_.Fail(temp_column_, message);
+  return message;
 }
 
 void SamplesReader::CheckInterval() const {
   const long long intervals = rows_ - 1;
   const double interval_s = (last_time_s_ - first_time_s_) / static_cast<double>(intervals);
-  if (interval_s < kMaxSampleIntervalS && interval_s >= kMinSampleIntervalS) return;
+  if (const std::string problem = IntervalProblem(interval_s, intervals, seconds_per_time_unit_);
+      !problem.empty()) {
+    csv_.Fail(time_column_, problem);
+  }
+}
+
+std::string IntervalProblem(double interval_s, long long intervals, double seconds_per_time_unit) {
+  if (interval_s < kMaxSampleIntervalS && interval_s >= kMinSampleIntervalS) return "";
   // The first other unit that makes the interval plausible.
   constexpr const char* kLongNames[] = {"seconds", "milliseconds", "microseconds", "nanoseconds"};
   std::string hint = " (is --time-unit right?)";
-  const double as_written = interval_s / seconds_per_time_unit_;
+  const double as_written = interval_s / seconds_per_time_unit;
   for (size_t i = 0; i < std::size(kTimeUnitNames); ++i) {
     const double candidate = as_written * kTimeUnitNames[i].value;
-    if (kTimeUnitNames[i].value == seconds_per_time_unit_ || candidate >= kMaxSampleIntervalS ||
+    if (kTimeUnitNames[i].value == seconds_per_time_unit || candidate >= kMaxSampleIntervalS ||
         candidate < kMinSampleIntervalS) {
       continue;
     }
     hint = std::string(": time in ") + kLongNames[i] + "? use --time-unit " + kTimeUnitNames[i].name;
     break;
   }
-  csv_.Fail(time_column_, "the time steps by " + ShortNumber(interval_s) + " s per sample over the first " +
-                              std::to_string(intervals) + " intervals (" + ShortNumber(1.0 / interval_s) +
-                              " Hz), too " + (interval_s >= kMaxSampleIntervalS ? "slow" : "fast") +
-                              " for an IMU run whose dwells and turns last seconds" + hint);
+  return "the time steps by " + ShortNumber(interval_s) + " s per sample over the first " +
+         std::to_string(intervals) + " intervals (" + ShortNumber(1.0 / interval_s) + " Hz), too " +
+         (interval_s >= kMaxSampleIntervalS ? "slow" : "fast") +
+         " for an IMU run whose dwells and turns last seconds" + hint;
+}
+
+void SamplesReader::CheckDistinct(const std::vector<int>& columns) const {
+  for (size_t i = 0; i < columns.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (columns[i] != columns[j]) continue;
+      throw InputError(csv_.path(), csv_.header_line(), columns[i] + 1,
+                       "column " + QuoteForMessage(csv_.header()[columns[i]]) +
+                           " is read as two columns (a --column map names a column that has its own name?)");
+    }
+  }
+}
+
+std::string SamplesFormat::InFile(const std::string& name) const {
+  for (const ColumnName& column : column_names) {
+    if (column.name == name) return column.in_file;
+  }
+  return name;
 }
 
 void SamplesReader::Fail(const std::string& column, const std::string& message) const {
-  const std::optional<int> index = csv_.FindColumn(column);
+  const std::optional<int> index = FindColumn(column);
   if (!index) csv_.FailRow(message);
   csv_.Fail(*index, message);
 }

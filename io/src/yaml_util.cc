@@ -85,6 +85,10 @@ YAML::Node LoadFile(const std::string& path) {
     text.append(block, static_cast<size_t>(n));
   }
   ::close(fd);
+  return LoadText(text, path);
+}
+
+YAML::Node LoadText(const std::string& text, const std::string& path) {
   YAML::Node root;
   try {
     root = YAML::Load(text);  // the first document

@@ -18,6 +18,8 @@ inline constexpr int kMaxYamlDepth = 64;
 // file over kMaxYamlBytes, more than one document, a key repeated in one mapping, nesting
 // deeper than kMaxYamlDepth.
 YAML::Node LoadFile(const std::string& path);
+// The same of `text`, which messages name `path`.
+YAML::Node LoadText(const std::string& text, const std::string& path);
 
 // A node with the file and the dotted key path it was reached by, for error messages.
 struct Located {

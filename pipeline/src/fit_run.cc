@@ -1,5 +1,7 @@
 #include "imufit/pipeline/fit_run.h"
 
+#include <functional>
+#include <memory>
 #include <set>
 
 #include "imufit/io/output_file.h"
@@ -59,7 +61,7 @@ FitRecord RecordOf(const FitRunResult& result, const std::string& plan_path, con
 // The unit's serial: the most specific source first (the caller's, the unit's own log, then the
 // possibly shared plan).
 UnitSerial ResolveUnitSerial(const FitRunOptions& options, const std::string& plan_path, const Plan& plan,
-                             const SamplesReader& samples) {
+                             const RunReader& samples) {
   SerialSource stated;
   stated.kind = SerialSource::Kind::kStated;
   stated.name = options.serial_source;
@@ -67,7 +69,8 @@ UnitSerial ResolveUnitSerial(const FitRunOptions& options, const std::string& pl
   SerialSource planned;
   planned.name = "the plan " + plan_path;
   planned.serial = plan.serial;
-  return ResolveSerial({stated, SamplesHeaderSerial(samples), planned}, options.allow_serial_mismatch);
+  return ResolveSerial({stated, SamplesHeaderSerial(samples.name(), samples.located_serial()), planned},
+                       options.allow_serial_mismatch);
 }
 
 // The calibration of a usable fit, with its `fit:` record.
@@ -102,24 +105,26 @@ void CheckBeforeFit(const std::string& plan_path, const std::string& samples_pat
   if (!dead.empty()) throw PlanMismatchError(samples_path + ": " + dead);
 }
 
-}  // namespace
-
-FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
-                    const FitRunOptions& options) {
+// The fit of `plan` (named by its path) and the samples `open` opens for it.
+FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
+                      const std::function<std::unique_ptr<RunReader>(const Plan&)>& open,
+                      const FitRunOptions& options) {
   FitRunResult result;
-  result.plan = ReadPlan(plan_path);
-  result.plan_sha256 = options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256;
-  RunReader samples(result.plan, samples_path, options.input);
-  UnitSerial serial = ResolveUnitSerial(options, plan_path, result.plan, samples.header());
+  result.plan = std::move(plan);
+  result.plan_sha256 = std::move(plan_sha256);
+  const std::string plan_path = result.plan.path;
+  const std::unique_ptr<RunReader> samples = open(result.plan);
+  const std::string samples_path = samples->name();
+  UnitSerial serial = ResolveUnitSerial(options, plan_path, result.plan, *samples);
   result.serial = std::move(serial.serial);
   result.serial_warnings = std::move(serial.warnings);
-  result.run = samples.Read(options.windows, options.keep_static_stretch);
+  result.run = samples->Read(options.windows, options.keep_static_stretch);
   CheckBeforeFit(plan_path, samples_path, options, result);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   Plan check_plan;
   std::vector<Window> check_windows;
   if (!options.check_samples.empty()) {
-    check_plan = ReadPlan(options.check_plan.empty() ? plan_path : options.check_plan);
+    check_plan = options.check_plan.empty() ? result.plan : ReadPlan(options.check_plan);
     check_windows = ReadRunWindows(check_plan, options.check_samples, options.windows, options.input).windows;
   }
 
@@ -154,6 +159,30 @@ FitRunResult FitRun(const std::string& plan_path, const std::string& samples_pat
   }
   result.calibration = std::move(calibration);
   return result;
+}
+
+}  // namespace
+
+FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
+                    const FitRunOptions& options) {
+  return FitRun(ReadPlan(plan_path),
+                options.plan_sha256.empty() ? Sha256OfFile(plan_path) : options.plan_sha256, samples_path,
+                options);
+}
+
+FitRunResult FitRun(Plan plan, std::string plan_sha256, const std::string& samples_path,
+                    const FitRunOptions& options) {
+  return FitRunOf(
+      std::move(plan), std::move(plan_sha256),
+      [&](const Plan& read) { return std::make_unique<RunReader>(read, samples_path, options.input); },
+      options);
+}
+
+FitRunResult FitRun(Plan plan, std::string plan_sha256, const SamplesInMemory& samples,
+                    const FitRunOptions& options) {
+  return FitRunOf(
+      std::move(plan), std::move(plan_sha256),
+      [&](const Plan& read) { return std::make_unique<RunReader>(read, samples, options.input); }, options);
 }
 
 }  // namespace imufit

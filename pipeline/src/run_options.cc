@@ -1,5 +1,7 @@
 // The option tables of a run (SamplesInput, FitRunOptions), FitRunOptions::Validate() and its
 // fingerprint, Describe(): all derived from the tables (model/option_table.h).
+#include <algorithm>
+#include <iterator>
 #include <type_traits>
 
 #include "imufit/io/calibration.h"
@@ -11,6 +13,71 @@
 
 namespace imufit {
 namespace {
+
+// The delimiters --delimiter takes, by the name it is typed with.
+struct DelimiterName {
+  char value;
+  const char* name;
+};
+constexpr DelimiterName kDelimiterNames[] = {{',', ","}, {';', ";"}, {'\t', "tab"}};
+
+// How the fields and numbers of a file are written. Not in the fingerprint: a file reads in one
+// dialect only, and to the same samples in it.
+OptionTable<CsvDialect> MakeCsvDialectOptionTable() {
+  OptionTable<CsvDialect> t;
+  OptionEntry<CsvDialect>& delimiter = t.Text(
+      "delimiter", "--delimiter",
+      "what separates the fields: ',' (default), ';' or tab (a spreadsheet's export in a German or French "
+      "locale has ';')",
+      [](const CsvDialect& d) { return std::string(NameOf(kDelimiterNames, d.delimiter)); },
+      [](const std::string& text, CsvDialect* d) {
+        if (text == "\t") d->delimiter = '\t';  // a tab typed as itself
+        if (text == "\t" || ValueOf(kDelimiterNames, text, &d->delimiter)) return std::string();
+        return "delimiter " + QuoteForMessage(text) + " is not one of: " + AllNames(kDelimiterNames);
+      });
+  delimiter.fingerprint = Fingerprint::kNone;
+  t.Flag("decimal_comma", "--decimal-comma",
+         "numbers are written with a decimal comma (1,5); needs --delimiter ';' or tab",
+         &CsvDialect::decimal_comma)
+      .fingerprint = Fingerprint::kNone;
+  return t;
+}
+
+// "time_s=Time,temp_c=T" (or one pair a line: --column given several times) as ColumnNames.
+std::string SetColumnNames(const std::string& text, SamplesInput* in) {
+  in->column_names.clear();
+  std::string pair;
+  for (size_t start = 0; start <= text.size();) {
+    const size_t end = std::min(text.find_first_of(",\n", start), text.size());
+    pair = text.substr(start, end - start);
+    start = end + 1;
+    if (pair.empty()) continue;
+    const size_t equals = pair.find('=');
+    const std::string name = pair.substr(0, std::min(equals, pair.size()));
+    if (equals == std::string::npos || equals + 1 == pair.size()) {
+      return "column " + QuoteForMessage(pair) + " is not NAME=COLUMN (e.g. time_s=Time)";
+    }
+    if (std::find(std::begin(kSamplesColumnNames), std::end(kSamplesColumnNames), name) ==
+        std::end(kSamplesColumnNames)) {
+      std::string names;
+      for (const char* known : kSamplesColumnNames) names += (names.empty() ? "" : ", ") + std::string(known);
+      return "column " + QuoteForMessage(name) + " is not one imufit reads: " + names;
+    }
+    for (const ColumnName& given : in->column_names) {
+      if (given.name == name) return "column " + QuoteForMessage(name) + " is mapped twice";
+    }
+    in->column_names.push_back({name, pair.substr(equals + 1)});
+  }
+  return "";
+}
+
+std::string ColumnNamesText(const SamplesInput& in) {
+  std::string text;
+  for (const ColumnName& column : in.column_names) {
+    text += (text.empty() ? "" : ",") + column.name + "=" + column.in_file;
+  }
+  return text;
+}
 
 OptionTable<SamplesInput> MakeSamplesInputOptionTable() {
   OptionTable<SamplesInput> t;
@@ -34,6 +101,18 @@ OptionTable<SamplesInput> MakeSamplesInputOptionTable() {
     return in.seconds_per_time_unit == 1.0
                ? ""
                : "time_unit=" + std::string(NameOf(kTimeUnitNames, in.seconds_per_time_unit));
+  };
+  t.Include(MakeCsvDialectOptionTable(), &SamplesInput::dialect);
+  OptionEntry<SamplesInput>& columns =
+      t.Text("column", "--column",
+             "a column the file names its own way, NAME=COLUMN (time_s=Time); repeat it, or separate pairs "
+             "with ','",
+             ColumnNamesText, SetColumnNames);
+  columns.repeatable = true;
+  // Another map reads other numbers as the same column: in the fingerprint, when given.
+  columns.fingerprint = Fingerprint::kCustom;
+  columns.describe = [](const SamplesInput& in) {
+    return in.column_names.empty() ? "" : "column=" + ColumnNamesText(in);
   };
   t.Include(SegmentationOptionTable(), &SamplesInput::segmentation);
   return t;

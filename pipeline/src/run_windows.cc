@@ -38,33 +38,63 @@ void ReadSamples(const Plan& plan, Reader* reader, Labeller* labeller, WindowBui
 RunReader::RunReader(const Plan& plan, std::string samples_path, const SamplesInput& input)
     : plan_(plan),
       input_(input),
-      first_pass_(std::move(samples_path), /*require_segment=*/false, input.Format(), &digest_) {}
+      first_pass_(std::in_place, std::move(samples_path), /*require_segment=*/false, input.Format(),
+                  &digest_) {}
+
+RunReader::RunReader(const Plan& plan, const SamplesInMemory& samples, const SamplesInput& input)
+    : plan_(plan),
+      input_(input),
+      memory_(std::in_place, samples, input.seconds_per_time_unit),
+      in_memory_(&samples) {}
+
+RunWindows RunReader::ReadMemory(WindowBuilder* builder, LongestStaticStretch* stretch) {
+  RunWindows run;
+  std::optional<Labeller> labeller;
+  if (!memory_->has_segment()) {
+    run.segmentation = SegmentSamples(plan_, &*memory_, input_);
+    labeller.emplace(*run.segmentation);
+    memory_->Rewind();
+  }
+  ReadSamples(plan_, &*memory_, labeller ? &*labeller : nullptr, builder, stretch);
+  run.samples_sha256 = in_memory_->Sha256();
+  return run;
+}
 
 RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretch) {
   IMUFIT_CHECK(!read_, "RunReader::Read() reads the file once");
   read_ = true;
+  WindowBuilder builder(options, plan_.segments);
+  std::optional<LongestStaticStretch> stretch;
+  if (keep_static_stretch) stretch.emplace(plan_);
+  RunWindows run;
+  if (memory_) {
+    run = ReadMemory(&builder, stretch ? &*stretch : nullptr);
+  } else {
+    run = ReadFile(&builder, stretch ? &*stretch : nullptr);
+  }
+  run.windows = builder.Finish();
+  run.stats = builder.stats();
+  if (stretch) run.static_stretch = stretch->Finish();
+  return run;
+}
+
+RunWindows RunReader::ReadFile(WindowBuilder* builder, LongestStaticStretch* stretch) {
   RunWindows run;
   // Without a segment column the first pass finds the segments and the second labels the samples.
   std::optional<SamplesReader> second_pass;
   std::optional<Labeller> labeller;
-  if (!first_pass_.has_segment()) {
-    run.segmentation = SegmentSamples(plan_, &first_pass_, input_);
+  if (!first_pass_->has_segment()) {
+    run.segmentation = SegmentSamples(plan_, &*first_pass_, input_);
     labeller.emplace(*run.segmentation);
-    second_pass.emplace(first_pass_.path(), /*require_segment=*/false, input_.Format());
+    second_pass.emplace(first_pass_->path(), /*require_segment=*/false, input_.Format());
   }
-  WindowBuilder builder(options, plan_.segments);
-  std::optional<LongestStaticStretch> stretch;
-  if (keep_static_stretch) stretch.emplace(plan_);
   if (second_pass) {
-    ReadSamples(plan_, &*second_pass, &*labeller, &builder, stretch ? &*stretch : nullptr);
+    ReadSamples(plan_, &*second_pass, &*labeller, builder, stretch);
   } else {
-    ParallelSamplesReader samples(&first_pass_);  // a labelled file: parsed on every core
-    ReadSamples(plan_, &samples, nullptr, &builder, stretch ? &*stretch : nullptr);
+    ParallelSamplesReader samples(&*first_pass_);  // a labelled file: parsed on every core
+    ReadSamples(plan_, &samples, nullptr, builder, stretch);
   }
-  run.windows = builder.Finish();
-  run.stats = builder.stats();
   run.samples_sha256 = digest_.HexDigest();  // the first pass has read the whole file
-  if (stretch) run.static_stretch = stretch->Finish();
   return run;
 }
 

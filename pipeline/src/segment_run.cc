@@ -10,22 +10,26 @@ namespace {
 
 // Finding segments needs no temperature: a file without temp_c (and no fixed temperature) is read
 // with NaN in its place, and written without the column.
-std::optional<double> TempToRead(const std::string& samples_path, const SamplesInput& input) {
-  if (input.temp_c) return input.temp_c;
-  if (CsvReader(samples_path).FindColumn("temp_c")) return std::nullopt;
-  return std::nan("");
+SamplesFormat FormatToRead(const std::string& samples_path, const SamplesInput& input) {
+  SamplesFormat format = input.Format();
+  if (input.temp_c) return format;
+  if (CsvReader(samples_path, nullptr, format.dialect).FindColumn(format.InFile("temp_c"))) return format;
+  format.temp_c = std::nan("");
+  return format;
 }
 
 }  // namespace
 
 Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path,
                                 const SamplesInput& input) {
-  SamplesReader reader(samples_path, /*require_segment=*/false,
-                       SamplesFormat{TempToRead(samples_path, input), input.seconds_per_time_unit});
+  SamplesReader reader(samples_path, /*require_segment=*/false, FormatToRead(samples_path, input));
   return SegmentSamples(plan, &reader, input);
 }
 
-Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const SamplesInput& input) {
+namespace {
+
+template <typename Reader>
+Segmentation SegmentAll(const Plan& plan, Reader* reader, const SamplesInput& input) {
   MotionDetector detector(input.segmentation);
   Sample sample;
   while (reader->Next(&sample)) detector.Add(sample);
@@ -37,10 +41,19 @@ Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const Sampl
   }
 }
 
+}  // namespace
+
+Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const SamplesInput& input) {
+  return SegmentAll(plan, reader, input);
+}
+
+Segmentation SegmentSamples(const Plan& plan, MemorySamplesReader* reader, const SamplesInput& input) {
+  return SegmentAll(plan, reader, input);
+}
+
 LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
                                         const std::string& output_path, const SamplesInput& input) {
-  SamplesReader reader(samples_path, /*require_segment=*/false,
-                       SamplesFormat{TempToRead(samples_path, input), input.seconds_per_time_unit});
+  SamplesReader reader(samples_path, /*require_segment=*/false, FormatToRead(samples_path, input));
   SamplesWriter writer(output_path, SampleColumns{true, reader.has_temp() || input.temp_c.has_value()},
                        SerialComment(reader.serial(), samples_path));
   LabelledFileReport report;

@@ -24,6 +24,10 @@ SerialSource SamplesHeaderSerial(const std::string& samples_path) {
   return HeaderSource(samples_path, LocateSamplesSerial(samples_path));
 }
 
+SerialSource SamplesHeaderSerial(const std::string& samples_name, const SamplesSerial& found) {
+  return HeaderSource(samples_name, found);
+}
+
 SerialSource SamplesHeaderSerial(const SamplesReader& reader) {
   return HeaderSource(reader.path(), reader.located_serial());
 }

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import tempfile
 from collections.abc import Mapping
 from typing import Any
 
@@ -69,20 +68,20 @@ class FitResult:
     diagnostics: dict[str, Any]
 
 
-def fit(plan: str | os.PathLike[str], samples: str | os.PathLike[str] | Mapping[str, Any], **options: Any) -> FitResult:
+def fit(plan: str | os.PathLike[str] | Mapping[str, Any], samples: str | os.PathLike[str] | Mapping[str, Any], **options: Any) -> FitResult:
     """Fits the thermal model to a rate-table run, as ``imufit fit`` does (the same library call).
 
-    ``plan`` is a plan YAML path; ``samples`` a samples CSV path or arrays
-    ({time_s, temp_c, segment, gyro, accel}, as simulate() and read_samples() return), which are
-    written to a temporary CSV (shortest round-trip numbers, so the fit sees the same doubles).
-    ``options``: see fit_options(). Raises InputError (a ValueError) on bad input,
+    ``plan`` is a plan YAML path or the plan as a dict (its YAML as a mapping); ``samples`` a
+    samples CSV path or arrays ({time_s, temp_c, gyro, accel; segment and serial optional}, as
+    simulate() and read_samples() return), fitted as they are, through the same reader as a file
+    (its checks, windows and labelling) with nothing written; the serial in ``samples["serial"]``
+    is the unit's, as a file's ``# serial:`` line. ``options``: see fit_options(). Raises InputError (a ValueError) on bad input,
     UndeterminedError naming what is missing when the run does not determine the model,
     PlanMismatchError when a run without a segment column does not match the plan, and FitError
     when the solver does not converge.
     """
+    if isinstance(plan, Mapping):
+        plan = dict(plan)
     if isinstance(samples, Mapping):
-        with tempfile.TemporaryDirectory(prefix="imufit_fit_") as folder:
-            path = os.path.join(folder, "samples.csv")
-            write_samples(path, dict(samples))
-            return FitResult(**_fit(plan, path, options))
+        samples = dict(samples)
     return FitResult(**_fit(plan, samples, options))

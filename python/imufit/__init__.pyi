@@ -136,10 +136,12 @@ class Calibration:
 
 def read_samples(path: PathLike) -> dict[str, FloatArray | IntArray]:
     """A samples file (CSV or .csv.gz) as {time_s (N,) s, temp_c (N,) degC, segment (N,) int64 if
-    present, gyro (N, 3), accel (N, 3)}. Raises InputError on bad input."""
+    present, gyro (N, 3), accel (N, 3), serial (str) if its header states one}. Raises InputError on
+    bad input."""
 
 def write_samples(path: PathLike, samples: Mapping[str, ArrayLike], comment: str = "") -> None:
-    """Writes {time_s, temp_c, [segment], gyro, accel} atomically, shortest round-trip numbers."""
+    """Writes {time_s, temp_c, [segment], gyro, accel, [serial]} atomically, shortest round-trip
+    numbers (the serial as a `# serial:` line)."""
 
 @dataclasses.dataclass
 class FitResult:
@@ -188,6 +190,9 @@ class _FitOptions(TypedDict, total=False):
     accel_full_scale_raw: float  # raw
     temp_c: float | None  # degC, for a run without a temp_c column
     time_unit: str  # the unit of the time_s column: "s" (default), "ms", "us" or "ns"
+    delimiter: str  # what separates a file's fields: "," (default), ";" or "tab"
+    decimal_comma: bool  # a file's numbers are written 1,5 (with delimiter ";" or "tab")
+    column: str  # columns a file names its own way: "time_s=Time,temp_c=T"
     segment_window_s: float  # s; this and the next six: finding the segments of a run without a segment column
     segment_noise_quantile: float
     segment_threshold_factor: float
@@ -201,9 +206,10 @@ class _FitOptions(TypedDict, total=False):
     write_inconsistent: bool
     allow_serial_mismatch: bool
 
-def fit(plan: PathLike, samples: PathLike | Mapping[str, ArrayLike], **options: Unpack[_FitOptions]) -> FitResult:
-    """Fits the thermal model to a run, as `imufit fit` does. plan: plan YAML path; samples: a path
-    or arrays as simulate() returns. Options: _FitOptions (SI; defaults and descriptions from
+def fit(plan: PathLike | Mapping[str, Any], samples: PathLike | Mapping[str, Any], **options: Unpack[_FitOptions]) -> FitResult:
+    """Fits the thermal model to a run, as `imufit fit` does. plan: plan YAML path or the plan as a
+    dict; samples: a path or arrays as simulate() and read_samples() return (with "serial"), fitted
+    in memory (no file written). Options: _FitOptions (SI; defaults and descriptions from
     fit_options()). Raises InputError, UndeterminedError (what is missing), PlanMismatchError,
     FitError (not converged)."""
 

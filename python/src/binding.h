@@ -23,6 +23,7 @@
 #include <pybind11/stl.h>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/memory_samples.h"
 
 namespace imufit::python {
 
@@ -58,6 +59,11 @@ py::array_t<double> ToArray(const std::vector<double>& values);
 py::dict CoefficientArrays(const double* params, int coefficients);
 // {"gyro": ..., "accel": ...} of CoefficientArrays.
 py::dict ModelArrays(const SensorModel& model);
+
+// The run of `samples` ({time_s, temp_c, gyro, accel; segment and serial optional}, as
+// read_samples() and simulate() return it), its shapes checked; errors and its name say `where`,
+// the public function called ("imufit.fit").
+SamplesInMemory SamplesFromArrays(const py::dict& samples, const std::string& where);
 
 void BindCalibration(py::module_& m);
 void BindFit(py::module_& m);

@@ -193,11 +193,13 @@ py::dict ReadSamples(const py::object& path) {
   std::copy(accel.begin(), accel.end(), accels.mutable_data());
   samples["gyro"] = gyros;
   samples["accel"] = accels;
+  if (!reader.serial().empty()) samples["serial"] = reader.serial();
   return samples;
 }
 
-void WriteSamples(const py::object& path, const py::dict& samples, const std::string& comment) {
-  const std::string where = "imufit.write_samples";
+}  // namespace
+
+SamplesInMemory SamplesFromArrays(const py::dict& samples, const std::string& where) {
   const auto column = [&](const char* name) {
     if (!samples.contains(name)) ThrowBadArgument(where, std::string("samples has no \"") + name + "\"");
     DoubleArray array = DoubleArray::ensure(samples[name]);
@@ -219,23 +221,39 @@ void WriteSamples(const py::object& path, const py::dict& samples, const std::st
   check("temp_c", temp_c, 0);
   check("gyro", gyro, 3);
   check("accel", accel, 3);
-  const bool with_segment = samples.contains("segment");
+  SamplesInMemory run;
+  run.name = where + " samples";
+  run.has_segment = samples.contains("segment");
   py::array_t<int64_t, py::array::c_style | py::array::forcecast> segment;
-  if (with_segment) {
+  if (run.has_segment) {
     segment = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(samples["segment"]);
     if (!segment) throw py::error_already_set();
     check("segment", segment, 0);
   }
-  SamplesWriter writer(PathString(path), with_segment, comment);
-  Sample sample;
+  if (samples.contains("serial") && !samples["serial"].is_none()) {
+    run.serial.serial = py::str(samples["serial"]);
+    SerialComment(run.serial.serial, where);  // refuses a control character
+  }
+  run.samples.resize(static_cast<size_t>(n));
   for (py::ssize_t i = 0; i < n; ++i) {
+    Sample& sample = run.samples[static_cast<size_t>(i)];
     sample.time_s = time_s.data()[i];
     sample.temp_c = temp_c.data()[i];
-    sample.segment = with_segment ? static_cast<int>(segment.data()[i]) : kTransitionSegment;
+    sample.segment = run.has_segment ? static_cast<int>(segment.data()[i]) : kTransitionSegment;
     sample.gyro = Eigen::Vector3d(gyro.data() + 3 * i);
     sample.accel = Eigen::Vector3d(accel.data() + 3 * i);
-    writer.Write(sample);
   }
+  return run;
+}
+
+namespace {
+
+void WriteSamples(const py::object& path, const py::dict& samples, const std::string& comment) {
+  const SamplesInMemory run = SamplesFromArrays(samples, "imufit.write_samples");
+  std::string header = SerialComment(run.serial.serial, "imufit.write_samples");
+  if (!comment.empty()) header += (header.empty() ? "" : "\n") + comment;
+  SamplesWriter writer(PathString(path), run.has_segment, header);
+  for (const Sample& sample : run.samples) writer.Write(sample);
   writer.Commit();
 }
 

@@ -7,6 +7,7 @@
 
 #include "binding.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/sha256.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/sim/simulator.h"
 #include "keyword_options.h"
@@ -150,19 +151,39 @@ py::dict Diagnostics(const FitRunResult& result) {
   throw py::error_already_set();
 }
 
-// imufit._fit(plan, samples, options) -> {calibration, sigma, diagnostics}.
+// imufit.fit(plan, samples, **options) -> {calibration, sigma, diagnostics}. `plan` is a path or
+// a dict (the plan's YAML as a mapping); `samples` a path or arrays (SamplesFromArrays), fitted as
+// they are, through the reader of files (RunReader), with no file written.
 py::dict Fit(const py::object& plan, const py::object& samples, const py::dict& kwargs) {
+  const std::string where = "imufit.fit";
   FitRunOptions options;
   options.software = std::string("imufit ") + IMUFIT_VERSION;
-  ApplyKeywords(FitRunOptionTable(), "imufit.fit", kwargs, &options);
-  if (const std::string problem = options.Validate(); !problem.empty())
-    ThrowBadArgument("imufit.fit", problem);
-  const std::string plan_path = PathString(plan);
-  const std::string samples_path = PathString(samples);
+  ApplyKeywords(FitRunOptionTable(), where, kwargs, &options);
+  if (const std::string problem = options.Validate(); !problem.empty()) ThrowBadArgument(where, problem);
+  std::optional<SamplesInMemory> arrays;
+  if (py::isinstance<py::dict>(samples)) {
+    arrays = SamplesFromArrays(samples.cast<py::dict>(), where);
+    if (options.input.temp_c) ThrowBadArgument(where, "temp_c is for a samples file without a temp_c column");
+  }
+  std::optional<Plan> plan_read;
+  std::string plan_sha256;
+  if (py::isinstance<py::dict>(plan)) {
+    // JSON is YAML: the dict is read by the plan reader, with its checks and messages.
+    const std::string text = py::str(py::module_::import("json").attr("dumps")(plan));
+    plan_read = ReadPlanText(text, where + " plan");
+    plan_sha256 = Sha256Hex(text);
+  }
+  const std::string plan_path = plan_read ? plan_read->path : PathString(plan);
+  const std::string samples_path = arrays ? arrays->name : PathString(samples);
   std::optional<FitRunResult> result;
   {
     py::gil_scoped_release release;
-    result = FitRun(plan_path, samples_path, options);
+    if (!plan_read) {
+      plan_read = ReadPlan(plan_path);
+      plan_sha256 = Sha256OfFile(plan_path);
+    }
+    result = arrays ? FitRun(std::move(*plan_read), plan_sha256, *arrays, options)
+                    : FitRun(std::move(*plan_read), plan_sha256, samples_path, options);
   }
   const FitSummary& fit = result->fit;
   py::dict diagnostics = Diagnostics(*result);
@@ -246,8 +267,9 @@ py::dict Simulate(const py::object& plan_path, const py::object& truth, const py
 }  // namespace
 
 void BindFit(py::module_& m) {
-  m.def("_fit", &Fit, py::arg("plan"), py::arg("samples"), py::arg("options"),
-        "imufit.fit() without the conversion of in-memory samples: paths only.");
+  m.def(
+      "_fit", &Fit, py::arg("plan"), py::arg("samples"), py::arg("options"),
+      "imufit.fit() with the options as a dict: plan a path or a dict, samples a path or a dict of arrays.");
   m.def(
       "fit_options", [] { return DescribeKeywords(FitRunOptionTable()); },
       "{name: (default, description)} of every keyword option of imufit.fit().");

@@ -25,6 +25,13 @@ namespace imufit {
 
 class Sha256;
 
+// How a CSV file separates its fields and writes its numbers: ',' and '.' by default; a spreadsheet
+// in a German (or French, ...) locale exports ';' between fields and a decimal comma.
+struct CsvDialect {
+  char delimiter = ',';        // ',', ';' or '\t'
+  bool decimal_comma = false;  // numbers as "1,5" (only with a delimiter other than ',')
+};
+
 class CsvReader {
  public:
   // Input limits (docs/conventions.md): a longer line or more fields is an InputError, so a
@@ -40,9 +47,10 @@ class CsvReader {
   // `raw_digest` is not null, every byte of the file as it is on disk (compressed, for .gz) is fed
   // to it as it is read: once NextRow() has returned false, it has seen the whole file. It must
   // outlive the reader.
-  explicit CsvReader(std::string path, Sha256* raw_digest = nullptr);
+  // `dialect` says how its fields are separated and its numbers written.
+  explicit CsvReader(std::string path, Sha256* raw_digest = nullptr, const CsvDialect& dialect = {});
   // Reads `rows`, lines of the file of `header_of` after its line `line_before`, with its header
-  // (parallel_samples.h parses the blocks of one file in several of these at once).
+  // and dialect (parallel_samples.h parses the blocks of one file in several of these at once).
   CsvReader(const CsvReader& header_of, std::string_view rows, long line_before);
   ~CsvReader();
   CsvReader(const CsvReader&) = delete;
@@ -66,7 +74,8 @@ class CsvReader {
   int RequireColumn(std::string_view name) const;
   // The indices of the columns called `names`, in order; when any is absent, throws one InputError
   // at the header line naming every absent one, with a "did you mean" for a near name, and the
-  // delimiter when the header is not separated by commas (a spreadsheet's ';' export). `hint`, when
+  // delimiter when the header is not separated by the reader's delimiter (a spreadsheet's ';'
+  // export read with ','), with the options to give. `hint`, when
   // not empty, is added to the message.
   std::vector<int> RequireColumns(const std::vector<std::string>& names, const std::string& hint = "") const;
 
@@ -94,6 +103,7 @@ class CsvReader {
   [[noreturn]] void FailRow(const std::string& message) const;
 
   const std::string& path() const { return path_; }
+  long header_line() const { return header_line_; }
   long line_number() const { return line_number_; }
   // Bytes of (decompressed) input consumed so far.
   long long bytes_read() const { return bytes_read_; }
@@ -109,6 +119,7 @@ class CsvReader {
   [[noreturn]] void TooManyFields() const;
 
   std::string path_;
+  CsvDialect dialect_;
   std::unique_ptr<Source> source_;
   std::vector<char> buffer_;
   size_t begin_ = 0;  // start of unconsumed bytes in buffer_

@@ -30,6 +30,8 @@ struct Plan {
 };
 
 Plan ReadPlan(const std::string& path);
+// A plan from its YAML (or JSON) `text`, which messages and Plan::path name `name`.
+Plan ReadPlanText(const std::string& text, const std::string& name);
 
 }  // namespace imufit
 

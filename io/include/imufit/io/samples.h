@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/output_file.h"
@@ -39,6 +40,16 @@ inline constexpr double kMinPlausibleTempC = -100.0;
 inline constexpr double kMaxPlausibleTempC = 200.0;
 inline constexpr double kZeroCelsiusK = 273.15;
 
+// A column the file names its own way (--column time_s=Time): the name imufit reads, the file's.
+struct ColumnName {
+  std::string name;
+  std::string in_file;
+};
+
+// The names a samples file's columns are read by (time_s, temp_c, segment, gyro_x..accel_z).
+inline constexpr const char* kSamplesColumnNames[] = {"time_s", "temp_c",  "segment", "gyro_x", "gyro_y",
+                                                      "gyro_z", "accel_x", "accel_y", "accel_z"};
+
 // How a samples file is read beyond its column names: what a command's options say about it.
 struct SamplesFormat {
   // The temperature of every sample of a file without a temp_c column (a file with one is then
@@ -46,6 +57,13 @@ struct SamplesFormat {
   std::optional<double> temp_c;
   // Seconds per unit of the time_s column (kTimeUnitNames): times are read as seconds times this.
   double seconds_per_time_unit = 1.0;
+  // Its delimiter and decimal mark (--delimiter, --decimal-comma).
+  CsvDialect dialect;
+  // Columns under the file's own names (--column); the others are found by their names.
+  std::vector<ColumnName> column_names;
+
+  // The name of column `name` in the file.
+  std::string InFile(const std::string& name) const;
 };
 
 // The serial of a samples header and where it is stated (its first `# serial:` line, at the text
@@ -59,7 +77,8 @@ struct SamplesSerial {
 class SamplesReader {
  public:
   // Opens a samples file; `require_segment` makes the segment column mandatory (imufit fit).
-  // `format` says how it is read (SamplesFormat). Throws InputError naming the missing column.
+  // `format` says how it is read (SamplesFormat). Throws InputError naming every missing column,
+  // or a column read under two names.
   // `raw_digest`, when not null, hashes the file as it is read (CsvReader).
   SamplesReader(std::string path, bool require_segment, const SamplesFormat& format = {},
                 Sha256* raw_digest = nullptr);
@@ -94,7 +113,14 @@ class SamplesReader {
   friend class ParallelSamplesReader;  // reads the file's blocks (parallel_samples.h)
   void CheckTemperature(double temp_c) const;
   void CheckInterval() const;
+  // Throws when two of `columns` (RequireColumns' answer) are one column of the file.
+  void CheckDistinct(const std::vector<int>& columns) const;
+  // The index of column `name` (a kSamplesColumnNames name), if the file has it.
+  std::optional<int> FindColumn(const std::string& name) const {
+    return csv_.FindColumn(format_.InFile(name));
+  }
 
+  SamplesFormat format_;  // before csv_, which reads with its dialect
   CsvReader csv_;
   double seconds_per_time_unit_ = 1.0;
   int time_column_;
@@ -108,6 +134,13 @@ class SamplesReader {
   double first_time_s_ = 0.0;
   double last_time_s_ = 0.0;
 };
+
+// What is wrong with a temp_c reading outside kMin..kMaxPlausibleTempC, with its likely cause
+// (kelvin, a fill value), or "" when it is plausible; `first`: the first row's.
+std::string TemperatureProblem(double temp_c, bool first);
+// What is wrong with a mean sample interval of `interval_s` over the first `intervals` intervals,
+// with the --time-unit to give (the column read in `seconds_per_time_unit`), or "" when plausible.
+std::string IntervalProblem(double interval_s, long long intervals, double seconds_per_time_unit);
 
 // The unit's serial as a samples file's header states it: a comment line `# serial: SN0001`
 // before the column names (what `imufit simulate --serial` writes, and a logger can). Returns the

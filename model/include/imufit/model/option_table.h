@@ -187,6 +187,7 @@ struct OptionEntry {
   Value value;
   Fingerprint fingerprint = Fingerprint::kValue;
   std::function<std::string(const Options&)> describe;  // with Fingerprint::kCustom
+  bool repeatable = false;  // a text option given several times on the command line: its values, a line each
 
   // The help with the unit: "seconds dropped ..., s".
   std::string HelpWithUnit(const std::string& shown_unit) const {
@@ -267,6 +268,7 @@ class OptionTable {
       lifted.value =
           std::visit([&part](const auto& kind) -> typename Entry::Value { return kind.Lift(part); }, e.value);
       lifted.fingerprint = e.fingerprint;
+      lifted.repeatable = e.repeatable;
       if (e.describe) {
         lifted.describe = [d = e.describe, part](const Options& o) {
           return d(part(const_cast<Options&>(o)));

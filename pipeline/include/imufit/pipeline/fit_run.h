@@ -96,6 +96,14 @@ struct FitRunResult {
 
 FitRunResult FitRun(const std::string& plan_path, const std::string& samples_path,
                     const FitRunOptions& options);
+// The same of a plan already read (plan.path names it; `plan_sha256` is that of the text it was
+// read from) and samples held in memory (Python's imufit.fit on arrays): what the files of the
+// same plan and samples give, without writing them.
+FitRunResult FitRun(Plan plan, std::string plan_sha256, const SamplesInMemory& samples,
+                    const FitRunOptions& options);
+// A plan already read, and a samples file.
+FitRunResult FitRun(Plan plan, std::string plan_sha256, const std::string& samples_path,
+                    const FitRunOptions& options);
 
 }  // namespace imufit
 

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "imufit/io/memory_samples.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
@@ -42,11 +43,17 @@ class RunReader {
   // Opens `samples_path` (CSV or .csv.gz) for a run of `plan` (which must outlive the reader), read
   // as `input` says. Throws InputError for a bad file or header.
   RunReader(const Plan& plan, std::string samples_path, const SamplesInput& input);
+  // A run held in memory (which must outlive the reader), read as its file would be: the same
+  // checks, windows and labelling; its hash is SamplesInMemory::Sha256().
+  RunReader(const Plan& plan, const SamplesInMemory& samples, const SamplesInput& input);
   RunReader(const RunReader&) = delete;
   RunReader& operator=(const RunReader&) = delete;
 
-  // The samples file's header, read.
-  const SamplesReader& header() const { return first_pass_; }
+  // The samples' name (the file's path) and the serial its header states.
+  const std::string& name() const { return memory_ ? memory_->path() : first_pass_->path(); }
+  const SamplesSerial& located_serial() const {
+    return memory_ ? memory_->located_serial() : first_pass_->located_serial();
+  }
 
   // Streams the samples through a WindowBuilder (once only). Throws InputError for bad input,
   // including a sample whose segment id the plan does not have (located at its line). A file
@@ -55,10 +62,16 @@ class RunReader {
   RunWindows Read(const WindowOptions& options, bool keep_static_stretch = false);
 
  private:
+  // The samples into `builder` (and `stretch` when not null): the run's segmentation and hash.
+  RunWindows ReadFile(WindowBuilder* builder, LongestStaticStretch* stretch);
+  RunWindows ReadMemory(WindowBuilder* builder, LongestStaticStretch* stretch);
+
   const Plan& plan_;
   SamplesInput input_;
   Sha256 digest_;
-  SamplesReader first_pass_;  // hashes into digest_
+  std::optional<SamplesReader> first_pass_;  // a file: hashes into digest_
+  std::optional<MemorySamplesReader> memory_;
+  const SamplesInMemory* in_memory_ = nullptr;
   bool read_ = false;
 };
 

@@ -6,7 +6,9 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "imufit/io/memory_samples.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/run/segmentation.h"
@@ -20,13 +22,17 @@ struct SamplesInput {
   std::optional<double> temp_c;
   // Seconds per unit of the time_s column (--time-unit: kTimeUnitNames).
   double seconds_per_time_unit = 1.0;
+  // Its delimiter and decimal mark (--delimiter, --decimal-comma).
+  CsvDialect dialect;
+  // Columns under the file's own names (--column time_s=Time).
+  std::vector<ColumnName> column_names;
   // How the segments are found in a file without a segment column.
   SegmentationOptions segmentation;
 
   // An empty string when usable, else what is wrong (naming the option and its value).
   std::string Validate() const;
   // How SamplesReader reads the file.
-  SamplesFormat Format() const { return {temp_c, seconds_per_time_unit}; }
+  SamplesFormat Format() const { return {temp_c, seconds_per_time_unit, dialect, column_names}; }
 };
 
 // Every option of SamplesInput, described once (model/option_table.h; run_options.cc).
@@ -37,6 +43,8 @@ const OptionTable<SamplesInput>& SamplesInputOptionTable();
 Segmentation SegmentSamplesFile(const Plan& plan, const std::string& samples_path, const SamplesInput& input);
 // The same over a reader that has read nothing but the header yet; reads it to its end.
 Segmentation SegmentSamples(const Plan& plan, SamplesReader* reader, const SamplesInput& input);
+// The same over samples in memory.
+Segmentation SegmentSamples(const Plan& plan, MemorySamplesReader* reader, const SamplesInput& input);
 
 struct LabelledFileReport {
   long long samples = 0;

@@ -41,6 +41,8 @@ struct SerialSource {
 SerialSource SamplesHeaderSerial(const std::string& samples_path);
 // The same from a reader of the file, which has read the header already.
 SerialSource SamplesHeaderSerial(const SamplesReader& reader);
+// The same of samples named `samples_name` whose header states `found`.
+SerialSource SamplesHeaderSerial(const std::string& samples_name, const SamplesSerial& found);
 
 struct UnitSerial {
   std::string serial;  // "" when no source names one
