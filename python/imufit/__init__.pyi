@@ -78,6 +78,7 @@ class FitRecord:
     bias_correlation_s: float | None  # correlation time of that bias wander, s
     segments_without_windows: list[int] | None  # plan segments without a single usable window
     missing_segments: int | None  # how many segments that is
+    inconsistent: str | None  # written with --write-inconsistent: why the fit is inconsistent
 
 class CheckRecord:
     """The errors on a held-out run (`imufit fit --check-samples`): the `check:` block."""
