@@ -293,7 +293,8 @@ TEST_F(BudgetTest, LimitsFileChoosesTheRule) {
 TEST_F(BudgetTest, LimitsAsSpecificationsAreWritten) {
   ASSERT_TRUE(fit_->calibration.has_value());
   Calibration cal = *fit_->calibration;
-  const Figure* bias = FindFigure(KeyFigures(cal), "accel_bias_mg.x");
+  const std::vector<Figure> figures = KeyFigures(cal);  // FindFigure points into it
+  const Figure* bias = FindFigure(figures, "accel_bias_mg.x");
   ASSERT_NE(bias, nullptr);
   const double u = 2.0 * bias->sigma;
   const auto judge = [&](const std::string& criteria) {
@@ -330,7 +331,8 @@ TEST_F(BudgetTest, LimitsAsSpecificationsAreWritten) {
 
   // A hot-only run: its 25 degC figures are extrapolated, and the criterion says so.
   cal.fit_temp_range_c = {40.0, 85.0};
-  const Figure* hot = FindFigure(KeyFigures(cal), "gyro_bias_dps.x");
+  const std::vector<Figure> hot_figures = KeyFigures(cal);
+  const Figure* hot = FindFigure(hot_figures, "gyro_bias_dps.x");
   ASSERT_NE(hot, nullptr);
   EXPECT_TRUE(hot->extrapolated);
   verdict = judge("  - {quantity: gyro_bias_dps, axes: [x], max_abs: 100}\n");
