@@ -1,26 +1,18 @@
 // The frame, cells and plots every document of factory shares (page.h), and FormatNumber().
 #include "page.h"
 
-#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
 #include "imufit/factory/report.h"
+#include "imufit/model/number_text.h"
 
 namespace imufit {
-namespace {
-
-std::string Printf(const char* format, double value) {
-  char text[96];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::string FormatNumber(const char* format, double value) {
-  const std::string text = Printf(format, value);
-  if (text != Printf(format, -0.0) && text != Printf(format, 0.0)) return text;
+  const std::string text = NumberText(format, value);
+  if (text != NumberText(format, -0.0) && text != NumberText(format, 0.0)) return text;
   std::string unsigned_format = format;  // the '+' flag dropped from the conversion
   for (size_t at = unsigned_format.find('%'); at != std::string::npos;
        at = unsigned_format.find('%', at + 2)) {
@@ -34,7 +26,7 @@ std::string FormatNumber(const char* format, double value) {
       }
     }
   }
-  return Printf(unsigned_format.c_str(), 0.0);
+  return NumberText(unsigned_format.c_str(), 0.0);
 }
 
 namespace internal {

@@ -2,27 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <set>
 
 #include "imufit/model/constants.h"
+#include "imufit/model/number_text.h"
 
 namespace imufit {
 namespace {
 
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 // A sensor held whole (SensorFit::kNone) was not fitted: its chi-square measures the held values.
 std::string Chi2Finding(const char* sensor, bool judged, double reduced_chi2, int dof) {
   if (!judged || dof <= 0 || !(reduced_chi2 > ReducedChi2Limit(dof))) return "";
-  return std::string(sensor) + " reduced chi-square " + Format("%.3g", reduced_chi2) + " (at most " +
-         Format("%.3g", ReducedChi2Limit(dof)) + " for the noise and model error of " + std::to_string(dof) +
-         " degrees of freedom)";
+  return std::string(sensor) + " reduced chi-square " + NumberText("%.3g", reduced_chi2) + " (at most " +
+         NumberText("%.3g", ReducedChi2Limit(dof)) + " for the noise and model error of " +
+         std::to_string(dof) + " degrees of freedom)";
 }
 
 // The temperature cluster (index into distinct_temps_c) nearest to `temp_c`.
@@ -74,7 +68,7 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
       everywhere = everywhere && 2 * count.downweighted > count.windows;
       windows_seen += count.windows;
       if (!fit.distinct_temps_c.empty())
-        temps += (temps.empty() ? "" : ", ") + Format("%.0f", fit.distinct_temps_c[cluster]);
+        temps += (temps.empty() ? "" : ", ") + NumberText("%.0f", fit.distinct_temps_c[cluster]);
     }
     if (!everywhere ||
         normalised_sum[segment] / windows_seen <= kModelErrorAllowance * kModelErrorAllowance) {
@@ -82,8 +76,8 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
     }
     text += (text.empty() ? "" : "; ") + std::string("segment ") + std::to_string(segment) +
             " down-weighted at every temperature (" + temps + " degC), residual RMS gyro " +
-            Format("%.3g", std::sqrt(gyro_sum[segment] / windows_seen) * kRadToDeg) + " deg/s, accel " +
-            Format("%.3g", std::sqrt(accel_sum[segment] / windows_seen) / (1e-3 * kStandardGravityMps2)) +
+            NumberText("%.3g", std::sqrt(gyro_sum[segment] / windows_seen) * kRadToDeg) + " deg/s, accel " +
+            NumberText("%.3g", std::sqrt(accel_sum[segment] / windows_seen) / (1e-3 * kStandardGravityMps2)) +
             " mg";
   }
   return text;

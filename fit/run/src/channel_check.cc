@@ -2,20 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <set>
 
 #include "imufit/model/constants.h"
+#include "imufit/model/number_text.h"
 
 namespace imufit {
 namespace {
-
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
 
 // A gyro axis is judged only when the plan turns the table about it at least this fast, rad/s.
 constexpr double kMinDrivingRateRadps = 0.1;
@@ -37,7 +31,7 @@ bool ConverterLimit(double value) {
 std::string Stuck(int channel, double value, const WindowOptions& options) {
   const double full_scale = channel < 3 ? options.gyro_full_scale_raw : options.accel_full_scale_raw;
   const std::string reads =
-      std::string(ChannelName(channel)) + " reads " + Format("%.10g", value) + " in every sample";
+      std::string(ChannelName(channel)) + " reads " + NumberText("%.10g", value) + " in every sample";
   if ((full_scale > 0.0 && std::abs(value) >= full_scale) || ConverterLimit(value)) {
     return reads + ": at its rail (saturated, or a fault holds it there)?";
   }
@@ -104,11 +98,11 @@ std::string Unresponsive(int channel, const std::vector<Window>& windows, const 
   if (response > kResponseSigmas * (plus.Scatter() + minus.Scatter())) return "";
   std::set<int> ids = plus.segments;
   ids.insert(minus.segments.begin(), minus.segments.end());
-  const std::string size = gyro ? Format("%.4g", largest * kRadToDeg) + " deg/s about "
-                                : Format("%.3g", largest / kStandardGravityMps2) + " g along ";
-  return std::string(ChannelName(channel)) + " does not respond: raw spread " + Format("%.3g", response) +
+  const std::string size = gyro ? NumberText("%.4g", largest * kRadToDeg) + " deg/s about "
+                                : NumberText("%.3g", largest / kStandardGravityMps2) + " g along ";
+  return std::string(ChannelName(channel)) + " does not respond: raw spread " + NumberText("%.3g", response) +
          " between the +-" + size + "xyz"[axis] + " (segments " + Ids(ids) + "), raw mean " +
-         Format("%.6g", plus.Mean()) + ": dead or disconnected?";
+         NumberText("%.6g", plus.Mean()) + ": dead or disconnected?";
 }
 
 }  // namespace

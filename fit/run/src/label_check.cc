@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
@@ -10,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "imufit/model/constants.h"
+#include "imufit/model/number_text.h"
 
 namespace imufit {
 namespace {
@@ -72,14 +72,9 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
 }
 
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 std::string Vec(const Eigen::Vector3d& v, const char* format = "%+.2f") {
-  return "(" + Format(format, v(0)) + ", " + Format(format, v(1)) + ", " + Format(format, v(2)) + ")";
+  return "(" + NumberText(format, v(0)) + ", " + NumberText(format, v(1)) + ", " + NumberText(format, v(2)) +
+         ")";
 }
 
 Sensor Rows(const std::vector<Window>& windows, const TableSite& site,
@@ -239,22 +234,22 @@ std::string Describe(const Finding& f) {
   const std::string id = "segment " + std::to_string(s.id);
   if (!f.gyro) {
     return id + " (up " + Vec(s.up, "%+.0f") + ") measures gravity along " + Vec(f.measured.normalized()) +
-           ", " + Format("%.0f", AngleDeg(f.measured, f.planned)) + " deg from its up";
+           ", " + NumberText("%.0f", AngleDeg(f.measured, f.planned)) + " deg from its up";
   }
   const Eigen::Vector3d axis = s.RotationAxis();
   if (s.IsTurn()) {
     const double measured_deg = f.measured.dot(axis) * f.duration_s * kRadToDeg;
-    return id + " (turn " + Format("%+.1f", *s.angle_rad * kRadToDeg) + " deg about " + Vec(axis, "%+.0f") +
-           ") measures a turn of " + Format("%.1f", f.measured.norm() * f.duration_s * kRadToDeg) +
-           " deg about " + Vec(f.measured.normalized()) + " (" + Format("%+.1f", measured_deg) +
-           " deg about its axis)";
+    return id + " (turn " + NumberText("%+.1f", *s.angle_rad * kRadToDeg) + " deg about " +
+           Vec(axis, "%+.0f") + ") measures a turn of " +
+           NumberText("%.1f", f.measured.norm() * f.duration_s * kRadToDeg) + " deg about " +
+           Vec(f.measured.normalized()) + " (" + NumberText("%+.1f", measured_deg) + " deg about its axis)";
   }
   const std::string planned = s.IsStatic() ? "static"
-                                           : "rate " + Format("%+.4g", s.rate_radps * kRadToDeg) +
+                                           : "rate " + NumberText("%+.4g", s.rate_radps * kRadToDeg) +
                                                  " deg/s about " + Vec(axis, "%+.0f");
-  return id + " (" + planned + ") measures " + Format("%.4g", f.measured.norm() * kRadToDeg) +
+  return id + " (" + planned + ") measures " + NumberText("%.4g", f.measured.norm() * kRadToDeg) +
          " deg/s about " + Vec(f.measured.normalized()) + " (" +
-         Format("%+.4g", f.measured.dot(axis) * kRadToDeg) + " deg/s about its axis)";
+         NumberText("%+.4g", f.measured.dot(axis) * kRadToDeg) + " deg/s about its axis)";
 }
 
 std::string Temperatures(const Finding& f) {
