@@ -11,6 +11,7 @@
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/error.h"
 #include "imufit/io/units.h"
+#include "imufit/model/text.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
@@ -140,25 +141,21 @@ void PrintRunNotes(const FitRunOptions& options, const FitRunResult& result) {
   }
 }
 
-// A run that does not determine the model: what is missing, and what the run held. Returns 1.
+// A run that does not determine the model, as one line: what is missing, then what the run held.
+// Returns 1.
 int ReportUndetermined(const FitArguments& args, const FitRunOptions& options, const FitRunResult& result) {
   const FitSummary& fit = result.fit;
   const WindowStats& stats = result.run.stats;
-  std::fprintf(stderr, "imufit: %s: the run does not determine the model; nothing written:\n",
-               args.samples.c_str());
-  for (const std::string& finding : fit.undetermined) std::fprintf(stderr, "  - %s\n", finding.c_str());
+  std::string held = std::to_string(stats.samples) + " samples, " + std::to_string(stats.transition_samples) +
+                     " in transitions, " + std::to_string(stats.trimmed_samples) + " trimmed after moves, " +
+                     std::to_string(fit.windows_used) + " windows used, " +
+                     std::to_string(stats.short_windows) + " windows shorter than " +
+                     std::to_string(options.windows.min_samples) + " samples dropped";
+  if (const std::string note = TimeStampNote(stats); !note.empty()) held += "; time stamps: " + note;
+  if (const std::string note = SaturationNote(stats); !note.empty()) held += "; saturation: " + note;
   std::fprintf(stderr,
-               "  (the run: %lld samples, %lld in transitions, %lld trimmed after moves, %d windows used, "
-               "%lld windows "
-               "shorter than %d samples dropped)\n",
-               stats.samples, stats.transition_samples, stats.trimmed_samples, fit.windows_used,
-               stats.short_windows, options.windows.min_samples);
-  if (const std::string note = TimeStampNote(stats); !note.empty()) {
-    std::fprintf(stderr, "  (time stamps: %s)\n", note.c_str());
-  }
-  if (const std::string note = SaturationNote(stats); !note.empty()) {
-    std::fprintf(stderr, "  (saturation: %s)\n", note.c_str());
-  }
+               "imufit: %s: the run does not determine the model, nothing written: %s (the run: %s)\n",
+               args.samples.c_str(), Join(fit.undetermined, "; ").c_str(), held.c_str());
   return 1;
 }
 

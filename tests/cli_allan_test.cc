@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -137,6 +138,56 @@ TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
     EXPECT_EQ(r.status, 2) << bad[0] << " " << bad[1] << ": " << r.err;
     EXPECT_FALSE(fs::exists(Path("x.csv"))) << bad[0];
   }
+}
+
+// A static log too short to resolve the slow terms: the noise file holds no `nan` or `inf`, every
+// number in it is finite, and the terms the log cannot resolve are marked `<key>_resolved: false`.
+TEST_F(CliTest, AllanNoiseYamlOfAShortStaticLogHoldsOnlyFiniteNumbers) {
+  const std::string plan = Write("static.yaml",
+                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+                                 "  - {id: 1, up: [0, 0, 1]}\n");
+  RunResult r = Run({"simulate",
+                     "-p",
+                     plan,
+                     "-c",
+                     Fixture("mems_truth.yaml"),
+                     "-o",
+                     Path("short.csv"),
+                     "--rate",
+                     "100",
+                     "--dwell",
+                     "20",
+                     "--temps",
+                     "25",
+                     "--gyro-noise-density",
+                     "8.7e-5",
+                     "--accel-noise-density",
+                     "1.5e-3",
+                     "--seed",
+                     "5",
+                     "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Run({"allan", "-s", Path("short.csv"), "--calibration", Fixture("mems_truth.yaml"), "-o",
+           Path("short_adev.csv"), "--noise-yaml", Path("short_noise.yaml"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string text = ReadBytes(Path("short_noise.yaml"));
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+  EXPECT_EQ(text.find("inf"), std::string::npos) << text;
+  EXPECT_NE(text.find("_resolved: false"), std::string::npos) << text;
+  int numbers = 0;
+  const std::function<void(const YAML::Node&)> visit = [&](const YAML::Node& node) {
+    if (node.IsMap() || node.IsSequence()) {
+      for (const auto& child : node) visit(node.IsMap() ? child.second : child);
+      return;
+    }
+    double value = 0.0;
+    if (node.IsScalar() && YAML::convert<double>::decode(node, value)) {
+      EXPECT_TRUE(std::isfinite(value)) << node.Scalar();
+      ++numbers;
+    }
+  };
+  visit(YAML::Load(text));
+  EXPECT_GT(numbers, 10) << text;
 }
 
 }  // namespace

@@ -90,6 +90,7 @@ TEST_F(CliTest, FitRefusesARunThatCannotDetermineTheModel) {
   const RunResult fit = Run({"fit", "-p", Fixture("plan_6pos.yaml"), "-s", samples, "-o", output});
   EXPECT_EQ(fit.status, 1);
   EXPECT_NE(fit.err.find("does not determine the model"), std::string::npos) << fit.err;
+  EXPECT_EQ(std::count(fit.err.begin(), fit.err.end(), '\n'), 1) << "one line: " << fit.err;
   EXPECT_NE(
       fit.err.find("too few temperatures for a cubic temperature model: 1 distinct temperature (25.0 degC), "
                    "at least 4 needed"),

@@ -141,6 +141,19 @@ TEST_F(CliInputTest, TimeInMillisecondsOrNanosecondsIsRefusedWithTheUnitToGive) 
     }
     fs::remove(Path("a.csv"));
   }
+  // Seconds declared as milliseconds: at 10 Hz the rate (10 kHz) is one an IMU could have, but the
+  // run lasts 0.36 s, too short for the plan's 18 segments each to outlast the 0.5 s trim.
+  const RunResult seconds_as_ms = Fit(Path("raw.csv"), {"--time-unit", "ms"});
+  EXPECT_EQ(seconds_as_ms.status, 2) << seconds_as_ms.err;
+  ExpectOneLine(seconds_as_ms,
+                "shorter than the plan's segments can last (9 s): time in seconds? use --time-unit s");
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  // The same without a segment column: the segmentation fails, and the time unit is named as why.
+  ASSERT_EQ(Run(SmallRunArgs(Path("unlabelled.csv"), {"--no-segment-column"})).status, 0);
+  const RunResult unlabelled = Fit(Path("unlabelled.csv"), {"--time-unit", "ms"});
+  EXPECT_EQ(unlabelled.status, 2) << unlabelled.err;
+  ExpectOneLine(unlabelled, "time in seconds? use --time-unit s");
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
   const RunResult bad = Fit(Path("raw.csv"), {"--time-unit", "min"});
   EXPECT_EQ(bad.status, 2) << bad.err;
   EXPECT_NE(bad.err.find("is not one of: s, ms, us, ns"), std::string::npos) << bad.err;

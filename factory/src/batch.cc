@@ -28,6 +28,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 
@@ -140,12 +141,6 @@ class FolderLock {
  private:
   int fd_ = -1;
 };
-
-std::string Join(const std::vector<std::string>& parts, const char* separator) {
-  std::string text;
-  for (const std::string& p : parts) text += (text.empty() ? "" : separator) + p;
-  return text;
-}
 
 // Everything a worker needs that is shared by all units.
 struct Shared {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "imufit/factory/report.h"
-#include "imufit/model/number_text.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {}  // namespace

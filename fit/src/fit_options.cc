@@ -3,6 +3,7 @@
 
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/model/enum_names.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {
@@ -31,12 +32,6 @@ std::string NameOfGroups(SensorFit gyro, SensorFit accel) {
   return "";
 }
 
-std::string Joined(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& name : names) text += (text.empty() ? "" : ",") + name;
-  return text;
-}
-
 OptionTable<FitOptions> MakeFitOptionTable() {
   using O = FitOptions;
   OptionTable<O> t;
@@ -50,7 +45,7 @@ OptionTable<FitOptions> MakeFitOptionTable() {
         return ParseFitGroups(text, o, &error) ? "" : error;
       });
   fit.fingerprint = Fingerprint::kCustom;
-  fit.describe = [](const O& o) { return "fitted=" + Joined(o.Groups(true)); };
+  fit.describe = [](const O& o) { return "fitted=" + Join(o.Groups(true), ","); };
   t.Number(
       "gyro_temp_order", "--gyro-temp-order",
       "order of the gyro temperature polynomials (0 when temp_c gives one temperature for the whole run)", "",

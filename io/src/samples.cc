@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <iterator>
 #include <sstream>
 #include <string_view>
@@ -161,25 +162,45 @@ void SamplesReader::CheckInterval() const {
   }
 }
 
-std::string IntervalProblem(double interval_s, long long intervals, double seconds_per_time_unit) {
-  if (interval_s < kMaxSampleIntervalS && interval_s >= kMinSampleIntervalS) return "";
-  // The first other unit that makes the interval plausible.
+namespace {
+
+bool PlausibleInterval(double interval_s) {
+  return interval_s < kMaxSampleIntervalS && interval_s >= kMinSampleIntervalS;
+}
+
+// The hint naming the first other --time-unit under which `plausible(factor)` holds, `factor` being
+// what times read in the declared unit are multiplied by; a plain question when none does.
+std::string TimeUnitHint(double seconds_per_time_unit, const std::function<bool(double)>& plausible) {
   constexpr const char* kLongNames[] = {"seconds", "milliseconds", "microseconds", "nanoseconds"};
-  std::string hint = " (is --time-unit right?)";
-  const double as_written = interval_s / seconds_per_time_unit;
   for (size_t i = 0; i < std::size(kTimeUnitNames); ++i) {
-    const double candidate = as_written * kTimeUnitNames[i].value;
-    if (kTimeUnitNames[i].value == seconds_per_time_unit || candidate >= kMaxSampleIntervalS ||
-        candidate < kMinSampleIntervalS) {
-      continue;
-    }
-    hint = std::string(": time in ") + kLongNames[i] + "? use --time-unit " + kTimeUnitNames[i].name;
-    break;
+    if (kTimeUnitNames[i].value == seconds_per_time_unit) continue;
+    if (!plausible(kTimeUnitNames[i].value / seconds_per_time_unit)) continue;
+    return std::string(": time in ") + kLongNames[i] + "? use --time-unit " + kTimeUnitNames[i].name;
   }
+  return " (is --time-unit right?)";
+}
+
+}  // namespace
+
+std::string IntervalProblem(double interval_s, long long intervals, double seconds_per_time_unit) {
+  if (PlausibleInterval(interval_s)) return "";
+  const std::string hint = TimeUnitHint(
+      seconds_per_time_unit, [interval_s](double factor) { return PlausibleInterval(interval_s * factor); });
   return "the time steps by " + ShortNumber(interval_s) + " s per sample over the first " +
          std::to_string(intervals) + " intervals (" + ShortNumber(1.0 / interval_s) + " Hz), too " +
          (interval_s >= kMaxSampleIntervalS ? "slow" : "fast") +
          " for an IMU run whose dwells and turns last seconds" + hint;
+}
+
+std::string SpanProblem(double span_s, long long intervals, double needed_s, double seconds_per_time_unit) {
+  if (span_s >= needed_s || intervals <= 0) return "";
+  const double interval_s = span_s / static_cast<double>(intervals);
+  const std::string hint = TimeUnitHint(seconds_per_time_unit, [&](double factor) {
+    return span_s * factor >= needed_s && PlausibleInterval(interval_s * factor);
+  });
+  return "the run lasts " + ShortNumber(span_s) + " s (" + std::to_string(intervals + 1) + " samples at " +
+         ShortNumber(1.0 / interval_s) + " Hz), shorter than the plan's segments can last (" +
+         ShortNumber(needed_s) + " s)" + hint;
 }
 
 void SamplesReader::CheckDistinct(const std::vector<int>& columns) const {

@@ -6,7 +6,7 @@
 #include <set>
 
 #include "imufit/model/constants.h"
-#include "imufit/model/number_text.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {

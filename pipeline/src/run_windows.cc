@@ -3,6 +3,7 @@
 #include <set>
 #include <utility>
 
+#include "imufit/io/error.h"
 #include "imufit/io/parallel_samples.h"
 #include "imufit/model/check.h"
 
@@ -67,15 +68,32 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
   std::optional<LongestStaticStretch> stretch;
   if (keep_static_stretch) stretch.emplace(plan_);
   RunWindows run;
-  if (memory_) {
-    run = ReadMemory(&builder, stretch ? &*stretch : nullptr);
-  } else {
-    run = ReadFile(&builder, stretch ? &*stretch : nullptr);
+  try {
+    if (memory_) {
+      run = ReadMemory(&builder, stretch ? &*stretch : nullptr);
+    } else {
+      run = ReadFile(&builder, stretch ? &*stretch : nullptr);
+    }
+  } catch (const PlanMismatchError&) {
+    // A log that is not the plan's, or one in another time unit than the one read.
+    CheckSpan(options, memory_ ? memory_->time_span_s() : first_pass_->time_span_s(),
+              (memory_ ? memory_->rows() : first_pass_->rows()) - 1);
+    throw;
   }
   run.windows = builder.Finish();
   run.stats = builder.stats();
+  if (run.windows.empty()) {
+    CheckSpan(options, run.stats.last_time_s - run.stats.first_time_s, run.stats.samples - 1);
+  }
   if (stretch) run.static_stretch = stretch->Finish();
   return run;
+}
+
+void RunReader::CheckSpan(const WindowOptions& options, double span_s, long long intervals) const {
+  // Every segment of the plan outlasts the trim after a move in a run that can calibrate.
+  const double needed_s = static_cast<double>(plan_.segments.size()) * options.trim_s;
+  const std::string problem = SpanProblem(span_s, intervals, needed_s, input_.seconds_per_time_unit);
+  if (!problem.empty()) throw InputError(name(), "time_s: " + problem);
 }
 
 RunWindows RunReader::ReadFile(WindowBuilder* builder, LongestStaticStretch* stretch) {

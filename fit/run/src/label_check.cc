@@ -9,7 +9,7 @@
 #include <Eigen/Dense>
 
 #include "imufit/model/constants.h"
-#include "imufit/model/number_text.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {

@@ -42,6 +42,11 @@ class MemorySamplesReader {
   bool has_segment() const { return run_.has_segment; }
   const std::string& path() const { return run_.name; }
   const SamplesSerial& located_serial() const { return run_.serial; }
+  // The samples and the time from the first to the last, s.
+  long long rows() const { return static_cast<long long>(run_.samples.size()); }
+  double time_span_s() const {
+    return run_.samples.empty() ? 0.0 : TimeS(run_.samples.size() - 1) - TimeS(0);
+  }
 
  private:
   double TimeS(size_t i) const { return run_.samples[i].time_s * seconds_per_time_unit_; }

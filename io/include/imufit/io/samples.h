@@ -30,9 +30,10 @@ inline constexpr TimeUnitName kTimeUnitNames[] = {{1.0, "s"}, {1e-3, "ms"}, {1e-
 
 // What an IMU log can plausibly hold (docs/conventions.md). A calibration plan dwells and turns
 // for seconds, so its samples come faster than one a second: a slower time column is one in
-// milliseconds or finer read as seconds. Faster than a megahertz is the opposite mistake.
-inline constexpr double kMaxSampleIntervalS = 1.0;  // refused from here on (1 Hz or slower)
-inline constexpr double kMinSampleIntervalS = 1e-6;
+// milliseconds or finer read as seconds. Faster than 50 kHz (no IMU samples so fast) is the opposite
+// mistake: seconds read as a finer unit.
+inline constexpr double kMaxSampleIntervalS = 1.0;   // refused from here on (1 Hz or slower)
+inline constexpr double kMinSampleIntervalS = 2e-5;  // refused below (50 kHz or faster: no IMU's rate)
 // The rows whose mean interval is judged (fewer in a shorter file).
 inline constexpr int kIntervalProbeRows = 16;
 // A temperature an IMU can report, degC (a kelvin column, 233..358, or a fill value lies outside).
@@ -108,6 +109,9 @@ class SamplesReader {
   const std::string& path() const { return csv_.path(); }
   long line_number() const { return csv_.line_number(); }
   long long bytes_read() const { return csv_.bytes_read(); }
+  // The rows read so far and the time from the first to the last, s.
+  long long rows() const { return rows_; }
+  double time_span_s() const { return rows_ > 0 ? last_time_s_ - first_time_s_ : 0.0; }
 
  private:
   friend class ParallelSamplesReader;  // reads the file's blocks (parallel_samples.h)
@@ -141,6 +145,10 @@ std::string TemperatureProblem(double temp_c, bool first);
 // What is wrong with a mean sample interval of `interval_s` over the first `intervals` intervals,
 // with the --time-unit to give (the column read in `seconds_per_time_unit`), or "" when plausible.
 std::string IntervalProblem(double interval_s, long long intervals, double seconds_per_time_unit);
+// What is wrong with a run lasting `span_s` over `intervals` sample intervals when the plan needs
+// at least `needed_s` (the column read in `seconds_per_time_unit`), with the --time-unit that makes
+// it long enough at a plausible rate, or "" when it lasts long enough.
+std::string SpanProblem(double span_s, long long intervals, double needed_s, double seconds_per_time_unit);
 
 // The unit's serial as a samples file's header states it: a comment line `# serial: SN0001`
 // before the column names (what `imufit simulate --serial` writes, and a logger can). Returns the

@@ -65,6 +65,9 @@ class RunReader {
   // The samples into `builder` (and `stretch` when not null): the run's segmentation and hash.
   RunWindows ReadFile(WindowBuilder* builder, LongestStaticStretch* stretch);
   RunWindows ReadMemory(WindowBuilder* builder, LongestStaticStretch* stretch);
+  // Throws InputError when a run of `span_s` over `intervals` sample intervals is too short for
+  // every segment of the plan to outlast the trim (SpanProblem: time in another unit?).
+  void CheckSpan(const WindowOptions& options, double span_s, long long intervals) const;
 
   const Plan& plan_;
   SamplesInput input_;

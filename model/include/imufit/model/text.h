@@ -1,0 +1,28 @@
+// imufit — small text helpers for messages: one double through a printf format, a list joined.
+#ifndef IMUFIT_MODEL_TEXT_H_
+#define IMUFIT_MODEL_TEXT_H_
+
+#include <cstddef>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace imufit {
+
+// `value` through `format`, a printf format of one double ("%.3g", "%+.1f").
+inline std::string NumberText(const char* format, double value) {
+  char text[96];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+// `parts` with `separator` between each two ("a; b; c"); "" for none.
+inline std::string Join(const std::vector<std::string>& parts, const char* separator) {
+  std::string text;
+  for (std::size_t i = 0; i < parts.size(); ++i) text += (i == 0 ? "" : separator) + parts[i];
+  return text;
+}
+
+}  // namespace imufit
+
+#endif  // IMUFIT_MODEL_TEXT_H_
