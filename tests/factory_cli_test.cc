@@ -802,6 +802,39 @@ TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreCannotRecordIt) {
   EXPECT_FALSE(fs::exists(Path("missing.db")));
 }
 
+// A store on a read-only mount (a station's share mounted read-only): exit 2 in one line, and the
+// calibration flashed last week stays as it was. Mounting needs CAP_SYS_ADMIN: without it the test
+// says so and is skipped.
+TEST_F(FactoryCliTest, FitWritesNothingWhenTheStoreIsOnAReadOnlyMount) {
+  ASSERT_EQ(Run({"fit", "-p", Path("units/unit-01/plan.yaml"), "-s", Path("units/unit-01/samples.csv.gz"),
+                 "-o", Path("cal.yaml"), "-q", "--store", Path("good.db")})
+                .status,
+            0);
+  const std::string mount_point = Path("share");
+  fs::create_directories(mount_point);
+  const RunResult mounted = RunProgram("/bin/mount", {"-t", "tmpfs", "-o", "size=64m", "tmpfs", mount_point});
+  if (mounted.status != 0) {
+    GTEST_SKIP() << "cannot mount a file system here (mount needs CAP_SYS_ADMIN): " << mounted.err;
+  }
+  fs::copy_file(Path("good.db"), mount_point + "/results.db");
+  const RunResult read_only = RunProgram("/bin/mount", {"-o", "remount,ro", mount_point});
+  const std::string previous = Write("cal.yaml", "# the calibration flashed last week\n");
+  RunResult r;
+  if (read_only.status == 0) {
+    r = Run({"fit", "-p", Path("units/unit-01/plan.yaml"), "-s", Path("units/unit-01/samples.csv.gz"), "-o",
+             Path("cal.yaml"), "--report", Path("cal.html"), "-q", "--store", mount_point + "/results.db"});
+  }
+  RunProgram("/bin/umount", {mount_point});
+  ASSERT_EQ(read_only.status, 0) << read_only.err;
+  EXPECT_EQ(r.status, kExitBadInput) << r.err;
+  EXPECT_EQ(r.err, "imufit: " + mount_point +
+                       "/results.db: the results store is read-only: imufit records every fit in it (make it "
+                       "writable, or give another --store)\n");
+  EXPECT_EQ(ReadBytes(previous), "# the calibration flashed last week\n");
+  EXPECT_FALSE(fs::exists(Path("cal.html")));
+  EXPECT_EQ(Temporaries(dir_), std::vector<std::string>{});
+}
+
 // `imufit fit ... | head -3`: the program stops of SIGPIPE, silently, and leaves no temporary.
 TEST_F(FactoryCliTest, FitIntoAClosedPipeLeavesNoTemporaries) {
   for (int attempt = 0; attempt < 3; ++attempt) {
