@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string>
@@ -13,7 +12,6 @@
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
-#include "imufit/model/constants.h"
 #include "imufit/pipeline/plan_check.h"
 
 namespace imufit {
@@ -22,11 +20,9 @@ namespace {
 struct PlanCheckArguments {
   std::string plan;
   std::string limits;
-  std::vector<std::string> tolerances;  // GROUP=VALUE, display units
-  std::vector<double> spec_range_c;
-  double latitude_deg = 1000.0;  // not given
+  std::string noise_yaml;
   std::string format = "text";
-  PlanCheckOptions check;
+  CliOptions<PlanCheckOptions> check;     // PlanCheckOptionTable()
   CliOptions<SimulationOptions> options;  // SimulationOptionTable(): the schedule and the noise
 };
 
@@ -57,48 +53,29 @@ void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* t
   }
 }
 
-std::map<std::string, double> ParseTolerances(const std::vector<std::string>& texts) {
-  static const std::vector<std::string> kGroups = {"gyro.bias",          "gyro.scale", "gyro.misalignment",
-                                                   "gyro.g_sensitivity", "accel.bias", "accel.scale",
-                                                   "accel.misalignment"};
-  std::map<std::string, double> tolerances;
-  for (const std::string& text : texts) {
-    const size_t equals = text.find('=');
-    const std::string group = text.substr(0, equals);
-    std::string allowed;
-    for (const std::string& g : kGroups) allowed += (allowed.empty() ? "" : ", ") + g;
-    if (equals == std::string::npos || std::find(kGroups.begin(), kGroups.end(), group) == kGroups.end()) {
-      throw InputError("--tolerance", "\"" + text + "\": give GROUP=VALUE with GROUP one of " + allowed);
-    }
-    char* end = nullptr;
-    const std::string number = text.substr(equals + 1);
-    const double value = std::strtod(number.c_str(), &end);
-    if (number.empty() || *end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
-      throw InputError("--tolerance", "\"" + text + "\": the tolerance must be a positive number in " +
-                                          PlanGroupUnit(group));
-    }
-    tolerances[group] = value;
-  }
-  return tolerances;
-}
-
-int RunPlanCheck(PlanCheckArguments args) {
+int RunPlanCheck(const PlanCheckArguments& args) {
   SimulationOptions schedule;
-  args.options.Apply(&schedule);
+  if (!args.noise_yaml.empty()) ApplyNoiseYaml(args.noise_yaml, &schedule);
+  args.options.Apply(&schedule);  // what the command line gives overrides the noise YAML
   if (const std::string problem = schedule.Validate(); !problem.empty()) {
     throw InputError("imufit plan check", problem);
   }
   if (!(schedule.gyro_noise_density > 0.0) || !(schedule.accel_noise_density > 0.0)) {
     throw InputError("imufit plan check",
-                     "give the unit's white noise: --gyro-noise-density and --accel-noise-density (> 0)");
+                     "give the unit's white noise: --noise-yaml, or --gyro-noise-density and "
+                     "--accel-noise-density (> 0)");
   }
-  Plan plan = ReadPlan(args.plan);
-  if (args.latitude_deg != 1000.0) plan.site.latitude_rad = args.latitude_deg * kDegToRad;
-  args.check.tolerances = ParseTolerances(args.tolerances);
-  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &args.check.tolerances);
-  if (args.spec_range_c.size() == 2) args.check.spec_range_c = {{args.spec_range_c[0], args.spec_range_c[1]}};
-  const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, FitOptions(), args.check);
-  const std::string text = args.format == "yaml" ? PlanCheckYaml(check) : PlanCheckText(check, args.check);
+  PlanCheckOptions check_options;
+  args.check.Apply(&check_options);
+  if (const std::string problem = ValidateOptions(PlanCheckOptionTable(), check_options); !problem.empty()) {
+    throw InputError("imufit plan check", problem);
+  }
+  const Plan plan = ReadPlan(args.plan);
+  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &check_options.tolerances);
+  const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, FitOptions(), check_options);
+  const std::string text = args.format == "yaml"   ? PlanCheckYaml(check)
+                           : args.format == "json" ? PlanCheckJson(check)
+                                                   : PlanCheckText(check, check_options);
   std::fputs(text.c_str(), stdout);
   if (!check.undetermined.empty()) {
     std::fprintf(stderr, "imufit: the plan does not determine the model (%zu finding%s)\n",
@@ -125,19 +102,14 @@ CommandRunner AddPlanCommand(CLI::App* root) {
       {"start_time_s", "temp_noise_c", "quantize", "time_jitter_s", "drop_probability", "drop_burst",
        "gyro_full_scale_raw", "accel_full_scale_raw", "seed", "gyro_random_walk", "accel_random_walk"});
   args->options.Find("ramp_c")->excludes(args->options.Find("soak_temps_c"));
-  command->add_option(
-      "--tolerance", args->tolerances,
-      "GROUP=VALUE: tolerance of a coefficient group (gyro.bias deg/s, accel.bias mg, *.scale "
-      "ppm, *.misalignment mrad, gyro.g_sensitivity deg/s/g); repeatable");
+  args->check.Add(command, PlanCheckOptionTable());
   command->add_option("--limits", args->limits,
                       "acceptance limits YAML: its coefficient limits as tolerances");
-  command->add_option("--spec-range", args->spec_range_c, "the range the unit is specified over, degC: LO HI")
-      ->expected(2);
-  command->add_option("--latitude", args->latitude_deg, "the table's latitude, deg (default: the plan's)");
-  command->add_option("--z", args->check.z, "coverage factor: a tolerance is met when z sigma <= it")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--format", args->format, "text (a table) or yaml")
-      ->check(CLI::IsMember({"text", "yaml"}));
+  command->add_option("--noise-yaml", args->noise_yaml,
+                      "the unit's noise from `imufit allan --noise-yaml` (the worst axis of each sensor); "
+                      "--*-noise-density and --*-bias-instability given as well override it");
+  command->add_option("--format", args->format, "text (a table), yaml or json")
+      ->check(CLI::IsMember({"text", "yaml", "json"}));
   return [args, command]() -> int {
     if (!command->parsed()) return 2;
     return RunPlanCheck(*args);

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <string>
 
+#include <yaml-cpp/yaml.h>
+
 #include "cli_util.h"
 #include "test_util.h"
 
@@ -76,6 +78,124 @@ TEST_F(CliPlanTest, UndeterminedPlanExitsOneNamingWhatIsMissing) {
                            "--accel-noise-density", "1e-3", "--temps", "25", "--dwell", "20"});
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("undetermined: "), std::string::npos) << r.out;
+}
+
+// A node's content whatever its style (flow or block): scalars, [lists], {maps}.
+std::string Canonical(const YAML::Node& node) {
+  std::string out;
+  if (node.IsScalar()) return node.Scalar();
+  if (node.IsSequence()) {
+    for (const YAML::Node& e : node) out += Canonical(e) + ",";
+    return "[" + out + "]";
+  }
+  for (const auto& e : node) out += e.first.Scalar() + ":" + Canonical(e.second) + ",";
+  return "{" + out + "}";
+}
+
+// JSON says what the YAML says: the same keys, the same numbers (both read by one YAML reader:
+// JSON is YAML).
+TEST_F(CliPlanTest, JsonHoldsTheYamlsContent) {
+  const RunResult yaml = Run(Args({"--format", "yaml", "--tolerance", "gyro.bias=0.01,accel.bias=0.5"}));
+  const RunResult json = Run(Args({"--format", "json", "--tolerance", "gyro.bias=0.01,accel.bias=0.5"}));
+  ASSERT_EQ(yaml.status, 0) << yaml.err;
+  ASSERT_EQ(json.status, 0) << json.err;
+  EXPECT_EQ(json.out.front(), '{');
+  EXPECT_NE(json.out.find("\"rows\": ["), std::string::npos) << json.out;
+  const YAML::Node from_yaml = YAML::Load(yaml.out);
+  const YAML::Node from_json = YAML::Load(json.out);
+  ASSERT_EQ(from_yaml.size(), from_json.size());
+  for (const auto& entry : from_yaml) {
+    const std::string key = entry.first.as<std::string>();
+    EXPECT_EQ(Canonical(entry.second), Canonical(from_json[key])) << key;
+  }
+  EXPECT_GT(from_json["rows"].size(), 40u);
+  EXPECT_EQ(from_json["rows"][0]["name"].as<std::string>().rfind("gyro bias", 0), 0u);
+}
+
+// The latitude given overrides the plan's: the Earth rate the gyro sees changes, the sigmas hardly do.
+TEST_F(CliPlanTest, LatitudeIsOptional) {
+  const RunResult plans = Run(Args({"--format", "yaml"}));
+  const RunResult equator = Run(Args({"--format", "yaml", "--latitude", "0"}));
+  ASSERT_EQ(plans.status, 0) << plans.err;
+  ASSERT_EQ(equator.status, 0) << equator.err;
+  EXPECT_NE(plans.out, equator.out);
+  EXPECT_EQ(Run(Args({"--latitude", "91"})).status, 2);
+}
+
+// The unit's noise from `imufit allan --noise-yaml`: the same prediction as the densities it holds
+// typed by hand, and close to that of the densities the record was simulated with.
+TEST_F(CliPlanTest, NoiseFromAllanNoiseYaml) {
+  constexpr double kGyroDensity = 8.7e-5;           // rad/s/sqrt(Hz)
+  constexpr double kAccelDensity = 1.5e-3;          // m/s^2/sqrt(Hz)
+  constexpr double kFittedDensityTolerance = 0.08;  // relative: 300 s at 100 Hz, worst of three axes
+  const std::string plan = Write("static.yaml",
+                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+                                 "  - {id: 1, up: [0, 0, 1]}\n");
+  const std::string truth = Fixture("mems_truth.yaml");
+  RunResult r = Run({"simulate",
+                     "-p",
+                     plan,
+                     "-c",
+                     truth,
+                     "-o",
+                     Path("raw.csv.gz"),
+                     "--rate",
+                     "100",
+                     "--dwell",
+                     "300",
+                     "--temps",
+                     "40",
+                     "--gyro-noise-density",
+                     "8.7e-5",
+                     "--accel-noise-density",
+                     "1.5e-3",
+                     "--seed",
+                     "11",
+                     "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Run({"allan", "-s", Path("raw.csv.gz"), "--calibration", truth, "-o", Path("allan.csv"), "--noise-yaml",
+           Path("noise.yaml"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const YAML::Node kalibr = YAML::LoadFile(Path("noise.yaml"))["noise"]["kalibr"];
+  const std::string gyro = kalibr["gyroscope_noise_density"].Scalar();
+  const std::string accel = kalibr["accelerometer_noise_density"].Scalar();
+  EXPECT_NEAR(std::stod(gyro), kGyroDensity, kFittedDensityTolerance * kGyroDensity);
+  EXPECT_NEAR(std::stod(accel), kAccelDensity, kFittedDensityTolerance * kAccelDensity);
+
+  const std::vector<std::string> schedule = {
+      "--temps=-20,10,50,85", "--dwell", "20", "--rate", "100", "--format", "yaml"};
+  std::vector<std::string> from_file = {"plan", "check", Fixture("plan_24pos.yaml"), "--noise-yaml",
+                                        Path("noise.yaml")};
+  std::vector<std::string> by_hand = {
+      "plan", "check", Fixture("plan_24pos.yaml"), "--gyro-noise-density", gyro, "--accel-noise-density",
+      accel};
+  // The bias instability the file resolved (worst axis) goes with the densities.
+  const YAML::Node columns = YAML::LoadFile(Path("noise.yaml"))["noise"]["columns"];
+  for (const std::string sensor : {"gyro", "accel"}) {
+    const std::string key = sensor == "gyro" ? "bias_instability_radps" : "bias_instability_mps2";
+    double worst = 0.0;
+    for (const std::string axis : {"_x", "_y", "_z"}) {
+      const YAML::Node figure = columns[sensor + axis][key];
+      if (figure) worst = std::max(worst, figure[0].as<double>());
+    }
+    if (worst > 0.0) {
+      by_hand.push_back("--" + sensor + "-bias-instability");
+      by_hand.push_back(columns[sensor + "_x"] ? YAML::Dump(YAML::Node(worst)) : "0");
+    }
+  }
+  from_file.insert(from_file.end(), schedule.begin(), schedule.end());
+  by_hand.insert(by_hand.end(), schedule.begin(), schedule.end());
+  const RunResult file_check = Run(from_file);
+  const RunResult hand_check = Run(by_hand);
+  ASSERT_EQ(file_check.status, 0) << file_check.err;
+  ASSERT_EQ(hand_check.status, 0) << hand_check.err;
+  for (const std::string name : {"gyro bias x", "accel scale y"}) {
+    EXPECT_DOUBLE_EQ(YamlSigma(file_check.out, name), YamlSigma(hand_check.out, name)) << name;
+  }
+  // Not a noise file: exit 2 naming it.
+  r = Run({"plan", "check", Fixture("plan_24pos.yaml"), "--noise-yaml", Fixture("plan_6pos.yaml")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("plan_6pos.yaml"), std::string::npos) << r.err;
 }
 
 TEST_F(CliPlanTest, BadInputExitsTwo) {
