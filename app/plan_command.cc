@@ -5,25 +5,42 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "commands.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
+#include "imufit/model/constants.h"
+#include "imufit/model/number_text.h"
 #include "imufit/pipeline/plan_check.h"
+#include "imufit/pipeline/plan_design.h"
 
 namespace imufit {
 namespace {
 
-struct PlanCheckArguments {
-  std::string plan;
+// What `plan check` and `plan design` share: the schedule and the unit's noise, the limits.
+struct ScheduleArguments {
   std::string limits;
   std::string noise_yaml;
-  std::string format = "text";
-  CliOptions<PlanCheckOptions> check;     // PlanCheckOptionTable()
   CliOptions<SimulationOptions> options;  // SimulationOptionTable(): the schedule and the noise
+};
+
+struct PlanCheckArguments {
+  std::string plan;
+  std::string format = "text";
+  CliOptions<PlanCheckOptions> check;  // PlanCheckOptionTable()
+  ScheduleArguments schedule;
+};
+
+struct PlanDesignArguments {
+  std::string candidates;  // a plan whose segments are the candidates ("": DesignCandidates())
+  std::string output;
+  CliOptions<PlanDesignOptions> design;  // PlanDesignOptionTable()
+  ScheduleArguments schedule;
 };
 
 // The limits file's coefficient criteria as tolerances of their groups (a limit on the value or
@@ -53,25 +70,39 @@ void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* t
   }
 }
 
-int RunPlanCheck(const PlanCheckArguments& args) {
+SimulationOptions ScheduleOf(const ScheduleArguments& args, const char* command) {
   SimulationOptions schedule;
   if (!args.noise_yaml.empty()) ApplyNoiseYaml(args.noise_yaml, &schedule);
   args.options.Apply(&schedule);  // what the command line gives overrides the noise YAML
-  if (const std::string problem = schedule.Validate(); !problem.empty()) {
-    throw InputError("imufit plan check", problem);
-  }
+  if (const std::string problem = schedule.Validate(); !problem.empty()) throw InputError(command, problem);
   if (!(schedule.gyro_noise_density > 0.0) || !(schedule.accel_noise_density > 0.0)) {
-    throw InputError("imufit plan check",
+    throw InputError(command,
                      "give the unit's white noise: --noise-yaml, or --gyro-noise-density and "
                      "--accel-noise-density (> 0)");
   }
-  PlanCheckOptions check_options;
-  args.check.Apply(&check_options);
-  if (const std::string problem = ValidateOptions(PlanCheckOptionTable(), check_options); !problem.empty()) {
-    throw InputError("imufit plan check", problem);
+  return schedule;
+}
+
+// The options of `table` given on the command line, validated.
+template <typename Options>
+Options OptionsOf(const CliOptions<Options>& given, const OptionTable<Options>& table, const char* command) {
+  Options options;
+  given.Apply(&options);
+  if (const std::string problem = ValidateOptions(table, options); !problem.empty()) {
+    throw InputError(command, problem);
   }
+  return options;
+}
+
+void AddLimitTolerances(const ScheduleArguments& args, PlanCheckOptions* check) {
+  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &check->tolerances);
+}
+
+int RunPlanCheck(const PlanCheckArguments& args) {
+  const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan check");
+  PlanCheckOptions check_options = OptionsOf(args.check, PlanCheckOptionTable(), "imufit plan check");
+  AddLimitTolerances(args.schedule, &check_options);
   const Plan plan = ReadPlan(args.plan);
-  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &check_options.tolerances);
   const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, FitOptions(), check_options);
   const std::string text = args.format == "yaml"   ? PlanCheckYaml(check)
                            : args.format == "json" ? PlanCheckJson(check)
@@ -85,34 +116,90 @@ int RunPlanCheck(const PlanCheckArguments& args) {
   return check.tolerance_unmet ? 3 : 0;
 }
 
+int RunPlanDesign(const PlanDesignArguments& args) {
+  const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan design");
+  PlanDesignOptions options = OptionsOf(args.design, PlanDesignOptionTable(), "imufit plan design");
+  AddLimitTolerances(args.schedule, &options.check);
+  Plan candidates;
+  if (!args.candidates.empty()) {
+    RefuseToOverwriteInputs(args.output, {args.candidates});
+    candidates = ReadPlan(args.candidates);
+  }
+  PlanDesign design;
+  try {
+    design = DesignPlan(candidates.segments, candidates.site, schedule, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("imufit plan design", e.what());
+  }
+  std::fputs(PlanDesignText(design, options).c_str(), stdout);
+  if (!design.undetermined.empty()) {
+    std::fprintf(stderr, "imufit: even every candidate cannot determine the model\n");
+    return 1;
+  }
+  if (!design.met) return 3;
+  Plan plan;
+  plan.site = candidates.site;
+  if (options.check.latitude_deg) plan.site.latitude_rad = *options.check.latitude_deg * kDegToRad;
+  plan.segments = design.segments;
+  std::string temps;
+  for (double t : design.soaks_c) temps += (temps.empty() ? "" : ",") + FormatDouble(t);
+  const std::string comment =
+      "Designed by imufit plan design (docs/plan.md): " + std::to_string(design.segments.size()) +
+      " segments at " + std::to_string(design.soaks_c.size()) + " soaks, " +
+      NumberText("%.2f", design.hours) + " h.\nRun it with --temps=" + temps + " --dwell " +
+      FormatDouble(schedule.dwell_s) + " --transition " + FormatDouble(schedule.transition_s) + ".";
+  WriteFileAtomically(args.output, PlanYaml(plan, comment));
+  return 0;
+}
+
 }  // namespace
 
-CommandRunner AddPlanCommand(CLI::App* root) {
-  auto args = std::make_shared<PlanCheckArguments>();
-  CLI::App* plan = root->add_subcommand("plan", "Judge a calibration plan before the run (docs/plan.md).");
-  plan->require_subcommand(1);
-  CLI::App* command = plan->add_subcommand(
-      "check",
-      "Predict the 1-sigma of every coefficient a run of PLAN will give the fit (its own Jacobians and "
-      "weights, no noise simulated), against tolerances; name what limits the plan. Exit 3 when a "
-      "tolerance cannot be met.");
-  command->add_option("plan", args->plan, "plan YAML")->required();
+// The schedule's options, the noise YAML and the limits, on `command`.
+void AddScheduleOptions(CLI::App* command, ScheduleArguments* args) {
   args->options.Add(
       command, SimulationOptionTable(),
       {"start_time_s", "temp_noise_c", "quantize", "time_jitter_s", "drop_probability", "drop_burst",
        "gyro_full_scale_raw", "accel_full_scale_raw", "seed", "gyro_random_walk", "accel_random_walk"});
-  args->options.Find("ramp_c")->excludes(args->options.Find("soak_temps_c"));
-  args->check.Add(command, PlanCheckOptionTable());
   command->add_option("--limits", args->limits,
                       "acceptance limits YAML: its coefficient limits as tolerances");
   command->add_option("--noise-yaml", args->noise_yaml,
                       "the unit's noise from `imufit allan --noise-yaml` (the worst axis of each sensor); "
                       "--*-noise-density and --*-bias-instability given as well override it");
-  command->add_option("--format", args->format, "text (a table), yaml or json")
+}
+
+CommandRunner AddPlanCommand(CLI::App* root) {
+  auto check_args = std::make_shared<PlanCheckArguments>();
+  auto design_args = std::make_shared<PlanDesignArguments>();
+  CLI::App* plan =
+      root->add_subcommand("plan", "Judge or design a calibration plan before the run (docs/plan.md).");
+  plan->require_subcommand(1);
+  CLI::App* check = plan->add_subcommand(
+      "check",
+      "Predict the 1-sigma of every coefficient a run of PLAN will give the fit (its own Jacobians and "
+      "weights, no noise simulated), against tolerances; name what limits the plan. Exit 3 when a "
+      "tolerance cannot be met.");
+  check->add_option("plan", check_args->plan, "plan YAML")->required();
+  AddScheduleOptions(check, &check_args->schedule);
+  check_args->schedule.options.Find("ramp_c")->excludes(check_args->schedule.options.Find("soak_temps_c"));
+  check_args->check.Add(check, PlanCheckOptionTable());
+  check->add_option("--format", check_args->format, "text (a table), yaml or json")
       ->check(CLI::IsMember({"text", "yaml", "json"}));
-  return [args, command]() -> int {
-    if (!command->parsed()) return 2;
-    return RunPlanCheck(*args);
+
+  CLI::App* design = plan->add_subcommand(
+      "design",
+      "Choose, from candidate positions, rates and temperature set-points, the plan that meets the "
+      "tolerances in the fewest hours (greedy by information per second, then exchange); write it to -o "
+      "and print the predicted table before and after the exchange. Exit 3 when no plan of the "
+      "candidates meets them.");
+  design->add_option("-o,--output", design_args->output, "the plan YAML to write")->required();
+  design->add_option("--candidates", design_args->candidates,
+                     "a plan whose segments are the candidates (and whose site is the run's)");
+  AddScheduleOptions(design, &design_args->schedule);
+  design_args->design.Add(design, PlanDesignOptionTable());
+  return [check_args, design_args, check, design]() -> int {
+    if (check->parsed()) return RunPlanCheck(*check_args);
+    if (design->parsed()) return RunPlanDesign(*design_args);
+    return 2;
   };
 }
 

@@ -2,6 +2,8 @@
 // scaling laws (sigma falls as 1/sqrt(dwell) for white noise).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -196,6 +198,88 @@ TEST_F(CliPlanTest, NoiseFromAllanNoiseYaml) {
   r = Run({"plan", "check", Fixture("plan_24pos.yaml"), "--noise-yaml", Fixture("plan_6pos.yaml")});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("plan_6pos.yaml"), std::string::npos) << r.err;
+}
+
+// A number printed after `label` in `text` (nan when absent).
+double NumberAfter(const std::string& text, const std::string& label) {
+  const size_t at = text.find(label);
+  return at == std::string::npos ? std::nan("") : std::strtod(text.c_str() + at + label.size(), nullptr);
+}
+
+// `plan design` gives a plan that meets the tolerances (plan check says so) in no more chamber hours
+// than the hand-made 24-position plan that meets them too, at its D-optimal soaks.
+TEST_F(CliPlanTest, DesignMeetsTheTolerancesInNoMoreHoursThanAHandPlan) {
+  constexpr double kSoakSettleS = 1800.0;
+  const std::vector<std::string> schedule = {"--gyro-noise-density",
+                                             "1e-4",
+                                             "--accel-noise-density",
+                                             "1e-3",
+                                             "--dwell",
+                                             "20",
+                                             "--transition",
+                                             "10",
+                                             "--rate",
+                                             "100",
+                                             "--tolerance",
+                                             "gyro.bias=0.0012,accel.bias=0.1,gyro.scale=60"};
+  const std::string hand_soaks = "--temps=-40,-5.45,50.45,85";  // ends and +-1/sqrt(5) of the half-range
+  std::vector<std::string> hand = {"plan",     "check",    Fixture("plan_24pos.yaml"),
+                                   hand_soaks, "--format", "yaml"};
+  hand.insert(hand.end(), schedule.begin(), schedule.end());
+  const RunResult hand_check = Run(hand);
+  ASSERT_EQ(hand_check.status, 0) << hand_check.out << hand_check.err;  // the hand plan meets them
+  const double hand_hours = NumberAfter(hand_check.out, "plan_hours: ") + 4 * kSoakSettleS / 3600.0;
+
+  std::vector<std::string> design = {"plan",
+                                     "design",
+                                     "-o",
+                                     Path("designed.yaml"),
+                                     "--positions",
+                                     "faces,edges,corners",
+                                     "--rates",
+                                     "100,300",
+                                     "--latitude",
+                                     "52.27",
+                                     "--set-points=-40,-15,-5.45,10,35,50.45,60,85",
+                                     "--soak-settle",
+                                     "1800"};
+  design.insert(design.end(), schedule.begin(), schedule.end());
+  const RunResult designed = Run(design);
+  ASSERT_EQ(designed.status, 0) << designed.out << designed.err;
+  EXPECT_NE(designed.out.find("predicted before the exchange:"), std::string::npos) << designed.out;
+  EXPECT_NE(designed.out.find("predicted after the exchange:"), std::string::npos) << designed.out;
+  const size_t temps_at = designed.out.find("--temps=", designed.out.find("after exchange:"));
+  ASSERT_NE(temps_at, std::string::npos) << designed.out;
+  const std::string soaks = designed.out.substr(temps_at, designed.out.find(')', temps_at) - temps_at);
+
+  std::vector<std::string> check = {"plan", "check", Path("designed.yaml"), soaks, "--format", "yaml"};
+  check.insert(check.end(), schedule.begin(), schedule.end());
+  const RunResult design_check = Run(check);
+  EXPECT_EQ(design_check.status, 0) << design_check.out << design_check.err;
+  const double soak_count = static_cast<double>(std::count(soaks.begin(), soaks.end(), ',') + 1);
+  const double design_hours =
+      NumberAfter(design_check.out, "plan_hours: ") + soak_count * kSoakSettleS / 3600.0;
+  EXPECT_LE(design_hours, hand_hours) << designed.out;
+  EXPECT_NEAR(NumberAfter(designed.out.substr(designed.out.find("after exchange:")), "): "), design_hours,
+              0.01);
+  std::printf("design: %.2f h (%s), hand plan: %.2f h\n", design_hours, soaks.c_str(), hand_hours);
+}
+
+TEST_F(CliPlanTest, DesignExitsThreeWhenNoPlanMeetsTheTolerancesAndTwoWithoutOne) {
+  const std::vector<std::string> noise = {"--gyro-noise-density", "1e-4", "--accel-noise-density", "1e-3"};
+  std::vector<std::string> args = {"plan", "design", "-o", Path("x.yaml"), "--tolerance", "accel.bias=1e-7"};
+  args.insert(args.end(), noise.begin(), noise.end());
+  const RunResult unmet = Run(args);
+  EXPECT_EQ(unmet.status, 3) << unmet.out << unmet.err;
+  EXPECT_NE(unmet.out.find("verdict: no plan of these candidates meets the tolerances"), std::string::npos);
+  EXPECT_EQ(Listing().count("x.yaml"), 0u);  // nothing written
+  args = {"plan", "design", "-o", Path("x.yaml")};
+  args.insert(args.end(), noise.begin(), noise.end());
+  const RunResult none = Run(args);
+  EXPECT_EQ(none.status, 2);
+  EXPECT_NE(none.err.find("give at least one tolerance"), std::string::npos) << none.err;
+  args.insert(args.end(), {"--tolerance", "gyro.bias=0.01", "--rates", "2000"});
+  EXPECT_EQ(Run(args).status, 2);  // beyond the table's limit
 }
 
 TEST_F(CliPlanTest, BadInputExitsTwo) {

@@ -3,25 +3,25 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "imufit/io/noise_file.h"
 #include "imufit/pipeline/plan_check.h"
+#include "imufit/pipeline/plan_design.h"
 
 namespace imufit {
-namespace {
 
-std::string TolerancesText(const PlanCheckOptions& options) {
+std::string GroupValuesText(const std::map<std::string, double>& values) {
   std::string text;
-  for (const auto& [group, value] : options.tolerances) {
+  for (const auto& [group, value] : values) {
     text += (text.empty() ? "" : ",") + group + "=" + OptionNumberText(value);
   }
   return text;
 }
 
-// "GROUP=VALUE" pairs, one a line (the option given several times) or separated by ','.
-std::string SetTolerances(const std::string& text, PlanCheckOptions* options) {
+std::string ParseGroupValues(const std::string& text, std::map<std::string, double>* values) {
   std::string allowed;
   for (const std::string& g : PlanGroups()) allowed += (allowed.empty() ? "" : ", ") + g;
   size_t start = 0;
@@ -40,19 +40,26 @@ std::string SetTolerances(const std::string& text, PlanCheckOptions* options) {
     char* parsed_end = nullptr;
     const double value = std::strtod(number.c_str(), &parsed_end);
     if (number.empty() || *parsed_end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
-      return "\"" + pair + "\": the tolerance must be a positive number in " + PlanGroupUnit(group);
+      return "\"" + pair + "\": the value must be a positive number in " + PlanGroupUnit(group);
     }
-    options->tolerances[group] = value;
+    (*values)[group] = value;
   }
   return "";
 }
 
+namespace {
+
+std::string SetTolerances(const std::string& text, PlanCheckOptions* options) {
+  return ParseGroupValues(text, &options->tolerances);
+}
+
 OptionTable<PlanCheckOptions> MakePlanCheckOptionTable() {
   OptionTable<PlanCheckOptions> t;
-  t.Text("tolerance", "--tolerance",
-         "GROUP=VALUE: tolerance of a coefficient group's value (gyro.bias deg/s, accel.bias mg, *.scale "
-         "ppm, *.misalignment mrad, gyro.g_sensitivity deg/s/g); repeat it, or separate pairs with ','",
-         TolerancesText, SetTolerances)
+  t.Text(
+       "tolerance", "--tolerance",
+       "GROUP=VALUE: tolerance of a coefficient group's value (gyro.bias deg/s, accel.bias mg, *.scale "
+       "ppm, *.misalignment mrad, gyro.g_sensitivity deg/s/g); repeat it, or separate pairs with ','",
+       [](const PlanCheckOptions& o) { return GroupValuesText(o.tolerances); }, SetTolerances)
       .repeatable = true;
   t.Number("z", "--z", "coverage factor: a tolerance is met when z sigma <= it", "", &PlanCheckOptions::z,
            PositiveFinite());
@@ -79,7 +86,60 @@ OptionTable<PlanCheckOptions> MakePlanCheckOptionTable() {
   return t;
 }
 
+std::string SetPositions(const std::string& text, PlanDesignOptions* options) {
+  size_t start = 0;
+  std::string kept;
+  while (start <= text.size()) {
+    const size_t end = std::min(text.find(',', start), text.size());
+    const std::string name = text.substr(start, end - start);
+    start = end + 1;
+    if (name != "faces" && name != "edges" && name != "corners") {
+      return "\"" + name + "\" is not a set of positions: give faces, edges or corners, ',' separated";
+    }
+    kept += (kept.empty() ? "" : ",") + name;
+  }
+  options->positions = kept;
+  return "";
+}
+
+OptionTable<PlanDesignOptions> MakePlanDesignOptionTable() {
+  using O = PlanDesignOptions;
+  OptionTable<O> t;
+  t.Include(PlanCheckOptionTable(), &O::check);
+  t.Text(
+      "positions", "--positions", "candidate positions: faces (6), edges (12), corners (8), ',' separated",
+      [](const O& o) { return o.positions; }, SetPositions);
+  t.Numbers(
+      "rates_dps", "--rates", "candidate rate magnitudes, each run as a +- pair", "deg/s",
+      [](const O& o) { return o.rates_dps; }, [](const std::vector<double>& v, O* o) { o->rates_dps = v; });
+  t.Number("max_rate_dps", "--max-rate", "the table's rate limit", "deg/s", &O::max_rate_dps,
+           PositiveFinite());
+  t.Flag("two_axis", "--two-axis",
+         "a two-axis table: rates about every candidate direction, not only the faces'", &O::two_axis);
+  t.Numbers(
+      "set_points_c", "--set-points", "the temperature set-points a soak may be at", "degC",
+      [](const O& o) { return o.set_points_c; },
+      [](const std::vector<double>& v, O* o) { o->set_points_c = v; });
+  t.Number("soak_settle_s", "--soak-settle", "thermal settling of a soak, its cost before the first segment",
+           "s", &O::soak_settle_s, NonNegativeFinite());
+  t.Text(
+       "prior", "--prior",
+       "GROUP=VALUE: the data-sheet 1-sigma of a group's value over the range (units as --tolerance; "
+       "the prior that makes the first step well posed); repeat it, or separate pairs with ','",
+       [](const O& o) { return GroupValuesText(o.prior); },
+       [](const std::string& text, O* o) { return ParseGroupValues(text, &o->prior); })
+      .repeatable = true;
+  t.Number("max_exchange_rounds", "--exchange-rounds", "exchange rounds at most", "", &O::max_exchange_rounds,
+           AtLeast(0));
+  return t;
+}
+
 }  // namespace
+
+const OptionTable<PlanDesignOptions>& PlanDesignOptionTable() {
+  static const OptionTable<PlanDesignOptions> table = MakePlanDesignOptionTable();
+  return table;
+}
 
 const OptionTable<PlanCheckOptions>& PlanCheckOptionTable() {
   static const OptionTable<PlanCheckOptions> table = MakePlanCheckOptionTable();

@@ -8,6 +8,7 @@
 
 #include "imufit/model/check.h"
 #include "imufit/pipeline/plan_check.h"
+#include "imufit/pipeline/plan_design.h"
 
 namespace imufit {
 namespace {
@@ -239,6 +240,29 @@ std::string PlanCheckText(const PlanCheck& check, const PlanCheckOptions& option
   }
   if (check.tolerance_unmet)
     out += "verdict: the plan cannot meet " + check.rows.front().name + "'s tolerance\n";
+  return out;
+}
+
+std::string PlanDesignText(const PlanDesign& design, const PlanDesignOptions& options) {
+  std::string out = Format("candidates: %d segments x %d set-points\n", design.candidate_segments,
+                           design.candidate_set_points);
+  if (!design.undetermined.empty()) {
+    for (const std::string& f : design.undetermined) out += "undetermined: " + f + "\n";
+    return out;
+  }
+  const auto soaks = [](const std::vector<double>& temps) {
+    std::string text;
+    for (double t : temps) text += (text.empty() ? "" : ",") + Format("%.6g", t);
+    return text;
+  };
+  out += Format("greedy: %zu segments x %zu soaks (--temps=%s): %.2f h\n", design.greedy.size(),
+                design.greedy_soaks_c.size(), soaks(design.greedy_soaks_c).c_str(), design.greedy_hours);
+  out += Format("after exchange: %zu segments x %zu soaks (--temps=%s): %.2f h\n", design.segments.size(),
+                design.soaks_c.size(), soaks(design.soaks_c).c_str(), design.hours);
+  out += "\npredicted before the exchange:\n" + PlanCheckText(design.greedy_check, options.check);
+  out += "\npredicted after the exchange:\n" + PlanCheckText(design.check, options.check);
+  out += design.met ? "verdict: the design meets every tolerance\n"
+                    : "verdict: no plan of these candidates meets the tolerances\n";
   return out;
 }
 

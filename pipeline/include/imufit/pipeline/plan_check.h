@@ -52,6 +52,12 @@ const OptionTable<PlanCheckOptions>& PlanCheckOptionTable();
 // The coefficient groups a tolerance may be given for: "gyro.bias", ..., "accel.misalignment".
 const std::vector<std::string>& PlanGroups();
 
+// Reads "GROUP=VALUE" pairs (one a line, or separated by ',') into `values`, GROUP one of PlanGroups()
+// and VALUE > 0 in its display unit: "" or what is wrong.
+std::string ParseGroupValues(const std::string& text, std::map<std::string, double>* values);
+// The same pairs written back, separated by ','.
+std::string GroupValuesText(const std::map<std::string, double>& values);
+
 // Sets the schedule's white noise and bias instability from a noise YAML (`imufit allan
 // --noise-yaml`): the worst axis of each sensor. Throws InputError naming the file.
 void ApplyNoiseYaml(const std::string& path, SimulationOptions* schedule);
