@@ -242,7 +242,11 @@ SensorTerms TermsOf(const SensorInformation& info, const std::vector<Window>& wi
   std::map<std::string, double> prior = DefaultPlanPrior();
   for (const auto& [group, value] : options.prior) prior[group] = value;
   terms.prior = PriorOf(info, prior, 0.5 * (range[1] - range[0]));
-  terms.rows = ToleranceRows(info, options.check, range);
+  // A group without a tolerance must still beat its data-sheet value: the fit refuses a plan that
+  // leaves a direction to the prior (a scale seen through the Earth rate alone, say).
+  PlanCheckOptions check = options.check;
+  for (const auto& [group, value] : prior) check.tolerances.emplace(group, value);
+  terms.rows = ToleranceRows(info, check, range);
   return terms;
 }
 

@@ -9,7 +9,8 @@
 // values, so that F is invertible from the first step) the design
 //
 //   1. greedily adds the segment or soak with the largest fall of phi(F) = sum_r (z sigma_r / tol_r)^2
-//      (the toleranced values over the range) per second of cost: a segment costs (transition +
+//      (the values over the range; a group without a tolerance must beat its data-sheet value) per
+//      second of cost: a segment costs (transition +
 //      dwell) at every chosen soak, a soak its thermal settling plus every chosen segment;
 //   2. then exchanges (Fedorov): drops what the tolerances can spare, the dearest first, and swaps
 //      a chosen element for an unchosen one of no higher cost when phi falls;
