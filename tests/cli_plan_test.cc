@@ -282,6 +282,23 @@ TEST_F(CliPlanTest, DesignExitsThreeWhenNoPlanMeetsTheTolerancesAndTwoWithoutOne
   EXPECT_EQ(Run(args).status, 2);  // beyond the table's limit
 }
 
+// docs/troubleshooting.md quotes what the program prints for the common mistakes.
+TEST_F(CliPlanTest, TroubleshootingQuotesTheMessages) {
+  const std::string page = ReadBytes(Fixture("../docs/troubleshooting.md"));
+  const std::vector<std::vector<std::string>> mistakes = {
+      {"plan", "check", Fixture("plan_24pos.yaml")},
+      {"plan", "design", "-o", Path("x.yaml"), "--gyro-noise-density", "1e-4", "--accel-noise-density",
+       "1e-3"},
+      {"plan", "check", Fixture("plan_24pos.yaml"), "--gyro-noise-density", "1e-4", "--accel-noise-density",
+       "1e-3", "--tolerance", "gyro.bias=1deg"}};
+  for (const std::vector<std::string>& args : mistakes) {
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 2);
+    const std::string said = r.err.substr(0, r.err.find('\n'));
+    EXPECT_NE(page.find("`" + said + "`"), std::string::npos) << said;
+  }
+}
+
 TEST_F(CliPlanTest, BadInputExitsTwo) {
   EXPECT_EQ(Run(Args({"--tolerance", "gyro.bogus=1"})).status, 2);
   EXPECT_EQ(Run(Args({"--tolerance", "gyro.bias=-1"})).status, 2);
