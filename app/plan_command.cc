@@ -3,31 +3,44 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "commands.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
+#include "imufit/model/number_text.h"
 #include "imufit/pipeline/plan_check.h"
+#include "imufit/pipeline/plan_design.h"
 
 namespace imufit {
 namespace {
 
+// What `plan check` and `plan design` share: the schedule and the unit's noise, the limits.
+struct ScheduleArguments {
+  std::string limits;
+  std::string noise_yaml;
+  CliOptions<SimulationOptions> options;  // SimulationOptionTable(): the schedule and the noise
+};
+
 struct PlanCheckArguments {
   std::string plan;
-  std::string limits;
-  std::vector<std::string> tolerances;  // GROUP=VALUE, display units
-  std::vector<double> spec_range_c;
-  double latitude_deg = 1000.0;  // not given
   std::string format = "text";
-  PlanCheckOptions check;
-  CliOptions<SimulationOptions> options;  // SimulationOptionTable(): the schedule and the noise
+  CliOptions<PlanCheckOptions> check;  // PlanCheckOptionTable()
+  ScheduleArguments schedule;
+};
+
+struct PlanDesignArguments {
+  std::string candidates;  // a plan whose segments are the candidates ("": DesignCandidates())
+  std::string output;
+  CliOptions<PlanDesignOptions> design;  // PlanDesignOptionTable()
+  ScheduleArguments schedule;
 };
 
 // The limits file's coefficient criteria as tolerances of their groups (a limit on the value or
@@ -57,48 +70,43 @@ void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* t
   }
 }
 
-std::map<std::string, double> ParseTolerances(const std::vector<std::string>& texts) {
-  static const std::vector<std::string> kGroups = {"gyro.bias",          "gyro.scale", "gyro.misalignment",
-                                                   "gyro.g_sensitivity", "accel.bias", "accel.scale",
-                                                   "accel.misalignment"};
-  std::map<std::string, double> tolerances;
-  for (const std::string& text : texts) {
-    const size_t equals = text.find('=');
-    const std::string group = text.substr(0, equals);
-    std::string allowed;
-    for (const std::string& g : kGroups) allowed += (allowed.empty() ? "" : ", ") + g;
-    if (equals == std::string::npos || std::find(kGroups.begin(), kGroups.end(), group) == kGroups.end()) {
-      throw InputError("--tolerance", "\"" + text + "\": give GROUP=VALUE with GROUP one of " + allowed);
-    }
-    char* end = nullptr;
-    const std::string number = text.substr(equals + 1);
-    const double value = std::strtod(number.c_str(), &end);
-    if (number.empty() || *end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
-      throw InputError("--tolerance", "\"" + text + "\": the tolerance must be a positive number in " +
-                                          PlanGroupUnit(group));
-    }
-    tolerances[group] = value;
+SimulationOptions ScheduleOf(const ScheduleArguments& args, const char* command) {
+  SimulationOptions schedule;
+  if (!args.noise_yaml.empty()) ApplyNoiseYaml(args.noise_yaml, &schedule);
+  args.options.Apply(&schedule);  // what the command line gives overrides the noise YAML
+  if (const std::string problem = schedule.Validate(); !problem.empty()) throw InputError(command, problem);
+  if (!(schedule.gyro_noise_density > 0.0) || !(schedule.accel_noise_density > 0.0)) {
+    throw InputError(command,
+                     "give the unit's white noise: --noise-yaml, or --gyro-noise-density and "
+                     "--accel-noise-density (> 0)");
   }
-  return tolerances;
+  return schedule;
 }
 
-int RunPlanCheck(PlanCheckArguments args) {
-  SimulationOptions schedule;
-  args.options.Apply(&schedule);
-  if (const std::string problem = schedule.Validate(); !problem.empty()) {
-    throw InputError("imufit plan check", problem);
+// The options of `table` given on the command line, validated.
+template <typename Options>
+Options OptionsOf(const CliOptions<Options>& given, const OptionTable<Options>& table, const char* command) {
+  Options options;
+  given.Apply(&options);
+  if (const std::string problem = ValidateOptions(table, options); !problem.empty()) {
+    throw InputError(command, problem);
   }
-  if (!(schedule.gyro_noise_density > 0.0) || !(schedule.accel_noise_density > 0.0)) {
-    throw InputError("imufit plan check",
-                     "give the unit's white noise: --gyro-noise-density and --accel-noise-density (> 0)");
-  }
-  Plan plan = ReadPlan(args.plan);
-  if (args.latitude_deg != 1000.0) plan.site.latitude_rad = args.latitude_deg * kDegToRad;
-  args.check.tolerances = ParseTolerances(args.tolerances);
-  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &args.check.tolerances);
-  if (args.spec_range_c.size() == 2) args.check.spec_range_c = {{args.spec_range_c[0], args.spec_range_c[1]}};
-  const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, FitOptions(), args.check);
-  const std::string text = args.format == "yaml" ? PlanCheckYaml(check) : PlanCheckText(check, args.check);
+  return options;
+}
+
+void AddLimitTolerances(const ScheduleArguments& args, PlanCheckOptions* check) {
+  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &check->tolerances);
+}
+
+int RunPlanCheck(const PlanCheckArguments& args) {
+  const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan check");
+  PlanCheckOptions check_options = OptionsOf(args.check, PlanCheckOptionTable(), "imufit plan check");
+  AddLimitTolerances(args.schedule, &check_options);
+  const Plan plan = ReadPlan(args.plan);
+  const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, FitOptions(), check_options);
+  const std::string text = args.format == "yaml"   ? PlanCheckYaml(check)
+                           : args.format == "json" ? PlanCheckJson(check)
+                                                   : PlanCheckText(check, check_options);
   std::fputs(text.c_str(), stdout);
   if (!check.undetermined.empty()) {
     std::fprintf(stderr, "imufit: the plan does not determine the model (%zu finding%s)\n",
@@ -108,39 +116,90 @@ int RunPlanCheck(PlanCheckArguments args) {
   return check.tolerance_unmet ? 3 : 0;
 }
 
+int RunPlanDesign(const PlanDesignArguments& args) {
+  const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan design");
+  PlanDesignOptions options = OptionsOf(args.design, PlanDesignOptionTable(), "imufit plan design");
+  AddLimitTolerances(args.schedule, &options.check);
+  Plan candidates;
+  if (!args.candidates.empty()) {
+    RefuseToOverwriteInputs(args.output, {args.candidates});
+    candidates = ReadPlan(args.candidates);
+  }
+  PlanDesign design;
+  try {
+    design = DesignPlan(candidates.segments, candidates.site, schedule, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("imufit plan design", e.what());
+  }
+  std::fputs(PlanDesignText(design, options).c_str(), stdout);
+  if (!design.undetermined.empty()) {
+    std::fprintf(stderr, "imufit: even every candidate cannot determine the model\n");
+    return 1;
+  }
+  if (!design.met) return 3;
+  Plan plan;
+  plan.site = candidates.site;
+  if (options.check.latitude_deg) plan.site.latitude_rad = *options.check.latitude_deg * kDegToRad;
+  plan.segments = design.segments;
+  std::string temps;
+  for (double t : design.soaks_c) temps += (temps.empty() ? "" : ",") + FormatDouble(t);
+  const std::string comment =
+      "Designed by imufit plan design (docs/plan.md): " + std::to_string(design.segments.size()) +
+      " segments at " + std::to_string(design.soaks_c.size()) + " soaks, " +
+      NumberText("%.2f", design.hours) + " h.\nRun it with --temps=" + temps + " --dwell " +
+      FormatDouble(schedule.dwell_s) + " --transition " + FormatDouble(schedule.transition_s) + ".";
+  WriteFileAtomically(args.output, PlanYaml(plan, comment));
+  return 0;
+}
+
 }  // namespace
 
-CommandRunner AddPlanCommand(CLI::App* root) {
-  auto args = std::make_shared<PlanCheckArguments>();
-  CLI::App* plan = root->add_subcommand("plan", "Judge a calibration plan before the run (docs/plan.md).");
-  plan->require_subcommand(1);
-  CLI::App* command = plan->add_subcommand(
-      "check",
-      "Predict the 1-sigma of every coefficient a run of PLAN will give the fit (its own Jacobians and "
-      "weights, no noise simulated), against tolerances; name what limits the plan. Exit 3 when a "
-      "tolerance cannot be met.");
-  command->add_option("plan", args->plan, "plan YAML")->required();
+// The schedule's options, the noise YAML and the limits, on `command`.
+void AddScheduleOptions(CLI::App* command, ScheduleArguments* args) {
   args->options.Add(
       command, SimulationOptionTable(),
       {"start_time_s", "temp_noise_c", "quantize", "time_jitter_s", "drop_probability", "drop_burst",
        "gyro_full_scale_raw", "accel_full_scale_raw", "seed", "gyro_random_walk", "accel_random_walk"});
-  args->options.Find("ramp_c")->excludes(args->options.Find("soak_temps_c"));
-  command->add_option(
-      "--tolerance", args->tolerances,
-      "GROUP=VALUE: tolerance of a coefficient group (gyro.bias deg/s, accel.bias mg, *.scale "
-      "ppm, *.misalignment mrad, gyro.g_sensitivity deg/s/g); repeatable");
   command->add_option("--limits", args->limits,
                       "acceptance limits YAML: its coefficient limits as tolerances");
-  command->add_option("--spec-range", args->spec_range_c, "the range the unit is specified over, degC: LO HI")
-      ->expected(2);
-  command->add_option("--latitude", args->latitude_deg, "the table's latitude, deg (default: the plan's)");
-  command->add_option("--z", args->check.z, "coverage factor: a tolerance is met when z sigma <= it")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--format", args->format, "text (a table) or yaml")
-      ->check(CLI::IsMember({"text", "yaml"}));
-  return [args, command]() -> int {
-    if (!command->parsed()) return 2;
-    return RunPlanCheck(*args);
+  command->add_option("--noise-yaml", args->noise_yaml,
+                      "the unit's noise from `imufit allan --noise-yaml` (the worst axis of each sensor); "
+                      "--*-noise-density and --*-bias-instability given as well override it");
+}
+
+CommandRunner AddPlanCommand(CLI::App* root) {
+  auto check_args = std::make_shared<PlanCheckArguments>();
+  auto design_args = std::make_shared<PlanDesignArguments>();
+  CLI::App* plan =
+      root->add_subcommand("plan", "Judge or design a calibration plan before the run (docs/plan.md).");
+  plan->require_subcommand(1);
+  CLI::App* check = plan->add_subcommand(
+      "check",
+      "Predict the 1-sigma of every coefficient a run of PLAN will give the fit (its own Jacobians and "
+      "weights, no noise simulated), against tolerances; name what limits the plan. Exit 3 when a "
+      "tolerance cannot be met.");
+  check->add_option("plan", check_args->plan, "plan YAML")->required();
+  AddScheduleOptions(check, &check_args->schedule);
+  check_args->schedule.options.Find("ramp_c")->excludes(check_args->schedule.options.Find("soak_temps_c"));
+  check_args->check.Add(check, PlanCheckOptionTable());
+  check->add_option("--format", check_args->format, "text (a table), yaml or json")
+      ->check(CLI::IsMember({"text", "yaml", "json"}));
+
+  CLI::App* design = plan->add_subcommand(
+      "design",
+      "Choose, from candidate positions, rates and temperature set-points, the plan that meets the "
+      "tolerances in the fewest hours (greedy by information per second, then exchange); write it to -o "
+      "and print the predicted table before and after the exchange. Exit 3 when no plan of the "
+      "candidates meets them.");
+  design->add_option("-o,--output", design_args->output, "the plan YAML to write")->required();
+  design->add_option("--candidates", design_args->candidates,
+                     "a plan whose segments are the candidates (and whose site is the run's)");
+  AddScheduleOptions(design, &design_args->schedule);
+  design_args->design.Add(design, PlanDesignOptionTable());
+  return [check_args, design_args, check, design]() -> int {
+    if (check->parsed()) return RunPlanCheck(*check_args);
+    if (design->parsed()) return RunPlanDesign(*design_args);
+    return 2;
   };
 }
 

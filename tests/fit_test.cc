@@ -18,6 +18,8 @@
 namespace imufit {
 namespace {
 
+using testing::SixPositionPlan;
+
 // Recovery: every 25 degC coefficient within this many of its reported sigmas (worst case).
 constexpr double kRecoverySigmas = 3.0;
 // Monte-Carlo: the RMS of (estimate - truth) / reported sigma over seeds and coefficients must lie
@@ -35,33 +37,6 @@ TableSite Site() {
   site.gravity_mps2 = 9.79285;
   site.latitude_rad = 30.27 * kDegToRad;
   return site;
-}
-
-// Six static faces (with north) and +-100, +-300 deg/s about each axis (with a lever arm).
-std::vector<TableSegment> SixPositionPlan(bool with_rates = true) {
-  std::vector<TableSegment> segments;
-  int id = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (double sign : {1.0, -1.0}) {
-      TableSegment s;
-      s.id = id++;
-      s.up = sign * Eigen::Vector3d::Unit(axis);
-      s.north = Eigen::Vector3d::Unit((axis + 1) % 3);
-      segments.push_back(s);
-    }
-  }
-  if (!with_rates) return segments;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (double rate_dps : {100.0, -100.0, 300.0, -300.0}) {
-      TableSegment s;
-      s.id = id++;
-      s.up = Eigen::Vector3d::Unit(axis);
-      s.rate_radps = rate_dps * kDegToRad;
-      s.lever_arm_m = Eigen::Vector3d(0.01, 0.02, 0.005);
-      segments.push_back(s);
-    }
-  }
-  return segments;
 }
 
 SimulationOptions MemsNoise(std::uint64_t seed) {

@@ -5,6 +5,10 @@
 #include <cmath>
 #include <random>
 
+#include <vector>
+
+#include "imufit/model/constants.h"
+#include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 
 namespace imufit::testing {
@@ -44,6 +48,33 @@ inline SensorModel RandomMemsModel(std::uint64_t seed) {
     fill(&model.gyro[(kGSensitivityCoefficient + h) * 4], gsens * u(engine), 0.2 * gsens);
   }
   return model;
+}
+
+// Six static faces (with north) and +-100, +-300 deg/s about each axis (with a lever arm).
+inline std::vector<TableSegment> SixPositionPlan(bool with_rates = true) {
+  std::vector<TableSegment> segments;
+  int id = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double sign : {1.0, -1.0}) {
+      TableSegment s;
+      s.id = id++;
+      s.up = sign * Eigen::Vector3d::Unit(axis);
+      s.north = Eigen::Vector3d::Unit((axis + 1) % 3);
+      segments.push_back(s);
+    }
+  }
+  if (!with_rates) return segments;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double rate_dps : {100.0, -100.0, 300.0, -300.0}) {
+      TableSegment s;
+      s.id = id++;
+      s.up = Eigen::Vector3d::Unit(axis);
+      s.rate_radps = rate_dps * kDegToRad;
+      s.lever_arm_m = Eigen::Vector3d(0.01, 0.02, 0.005);
+      segments.push_back(s);
+    }
+  }
+  return segments;
 }
 
 }  // namespace imufit::testing

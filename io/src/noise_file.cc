@@ -4,9 +4,11 @@
 #include <cmath>
 #include <sstream>
 
+#include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/units.h"
 #include "imufit/model/check.h"
+#include "yaml_util.h"
 
 namespace imufit {
 namespace {
@@ -208,6 +210,39 @@ std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& extra, co
   } catch (const YAML::Exception&) {
     return std::nullopt;
   }
+}
+
+SensorNoiseFigures ReadSensorNoise(const std::string& path) {
+  const YAML::Node root = yaml::LoadFile(path);
+  const YAML::Node columns = root.IsMap() && root["noise"] ? root["noise"]["columns"] : YAML::Node();
+  if (!columns || !columns.IsMap()) {
+    throw InputError(path, "no noise.columns: give the noise YAML of `imufit allan --noise-yaml`");
+  }
+  SensorNoiseFigures figures;
+  for (const auto& entry : columns) {
+    const YAML::Node kind = entry.second["kind"];
+    if (!kind || !kind.IsScalar()) continue;
+    const bool gyro = kind.Scalar() == ToString(ColumnKind::kGyro);
+    if (!gyro && kind.Scalar() != ToString(ColumnKind::kAccel)) continue;
+    const ColumnKind column_kind = gyro ? ColumnKind::kGyro : ColumnKind::kAccel;
+    const std::string column = entry.first.Scalar();
+    double& density = gyro ? figures.gyro_noise_density : figures.accel_noise_density;
+    double& instability = gyro ? figures.gyro_bias_instability : figures.accel_bias_instability;
+    if (const auto white = ReadNoiseFigure(root, column, UnitsOf(column_kind, kRandomWalk).si_key);
+        white && std::isfinite((*white)[0])) {
+      density = std::max(density, (*white)[0]);
+    }
+    if (const auto flicker = ReadNoiseFigure(root, column, UnitsOf(column_kind, kBiasInstability).si_key);
+        flicker && std::isfinite((*flicker)[0])) {
+      instability = std::max(instability, (*flicker)[0]);
+    }
+  }
+  if (!(figures.gyro_noise_density > 0.0) || !(figures.accel_noise_density > 0.0)) {
+    throw InputError(path, std::string("no fitted white noise of the ") +
+                               (figures.gyro_noise_density > 0.0 ? "accelerometer" : "gyro") +
+                               " columns: analyse a record with gyro_x..z and accel_x..z");
+  }
+  return figures;
 }
 
 }  // namespace imufit

@@ -1,10 +1,13 @@
 #include "imufit/io/plan.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <string>
 
 #include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
 #include "imufit/model/constants.h"
 #include "yaml_util.h"
 
@@ -127,6 +130,40 @@ Plan ReadPlan(const std::string& path) { return ReadPlanNode(yaml::LoadFile(path
 
 Plan ReadPlanText(const std::string& text, const std::string& name) {
   return ReadPlanNode(yaml::LoadText(text, name), name);
+}
+
+namespace {
+
+std::string VectorYaml(const Eigen::Vector3d& v) {
+  return "[" + FormatDouble(v.x()) + ", " + FormatDouble(v.y()) + ", " + FormatDouble(v.z()) + "]";
+}
+
+}  // namespace
+
+std::string PlanYaml(const Plan& plan, const std::string& comment) {
+  std::string out;
+  size_t start = 0;
+  while (!comment.empty() && start < comment.size()) {
+    const size_t end = std::min(comment.find('\n', start), comment.size());
+    out += "# " + comment.substr(start, end - start) + "\n";
+    start = end + 1;
+  }
+  out += "format: imufit-plan\nversion: " + std::to_string(kPlanFormatVersion) + "\n";
+  out += "gravity_mps2: " + FormatDouble(plan.site.gravity_mps2) + "\n";
+  if (plan.site.latitude_rad)
+    out += "latitude_deg: " + FormatDouble(*plan.site.latitude_rad / kDegToRad) + "\n";
+  if (!plan.serial.empty()) out += "serial: \"" + plan.serial + "\"\n";
+  out += "segments:\n";
+  for (const TableSegment& s : plan.segments) {
+    out += "  - {id: " + std::to_string(s.id) + ", up: " + VectorYaml(s.up);
+    if (s.rate_radps != 0.0) out += ", rate_dps: " + FormatDouble(s.rate_radps / kDegToRad);
+    if (s.angle_rad) out += ", angle_deg: " + FormatDouble(*s.angle_rad / kDegToRad);
+    if (s.axis) out += ", axis: " + VectorYaml(*s.axis);
+    if (s.north) out += ", north: " + VectorYaml(*s.north);
+    if (s.lever_arm_m) out += ", lever_arm_m: " + VectorYaml(*s.lever_arm_m);
+    out += "}\n";
+  }
+  return out;
 }
 
 }  // namespace imufit

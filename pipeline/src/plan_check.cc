@@ -208,7 +208,28 @@ void Hours(const SimulationOptions& schedule, size_t segment_count, const FitOpt
   }
 }
 
+// The mean information of a cubic in x at `xs`.
+Eigen::Matrix4d CubicInformation(const std::vector<double>& xs) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  for (double x : xs) {
+    const Eigen::Vector4d f(1.0, x, x * x, x * x * x);
+    m += f * f.transpose();
+  }
+  return m / static_cast<double>(xs.size());
+}
+
 }  // namespace
+
+double CubicDEfficiency(const std::vector<double>& temps_c, std::array<double, 2> range_c) {
+  if (temps_c.empty() || !(range_c[1] > range_c[0])) return 0.0;
+  const double centre = 0.5 * (range_c[0] + range_c[1]);
+  const double half = 0.5 * (range_c[1] - range_c[0]);
+  std::vector<double> xs;
+  for (double t : temps_c) xs.push_back((t - centre) / half);
+  const double a = 1.0 / std::sqrt(5.0);
+  const double optimal = CubicInformation({-1.0, -a, a, 1.0}).determinant();
+  return std::pow(std::max(0.0, CubicInformation(xs).determinant() / optimal), 0.25);
+}
 
 std::string PlanGroupUnit(const std::string& group) {
   if (group == "gyro.bias") return "deg/s";
@@ -275,8 +296,11 @@ PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& 
   if (schedule.gyro_bias_instability > 0.0) fit.gyro_bias_stability_radps = schedule.gyro_bias_instability;
   if (schedule.accel_bias_instability > 0.0) fit.accel_bias_stability_mps2 = schedule.accel_bias_instability;
   fit.bias_correlation_s = schedule.bias_correlation_s;
-  const std::vector<Window> windows = PlannedWindows(segments, site, schedule, WindowOptions());
-  const PlanInformation info = ComputePlanInformation(windows, site, segments, fit, options.weak_tolerance);
+  TableSite planned_site = site;
+  if (options.latitude_deg) planned_site.latitude_rad = *options.latitude_deg * kDegToRad;
+  const std::vector<Window> windows = PlannedWindows(segments, planned_site, schedule, WindowOptions());
+  const PlanInformation info =
+      ComputePlanInformation(windows, planned_site, segments, fit, options.weak_tolerance);
   PlanCheck check;
   check.undetermined = info.undetermined;
   if (!check.undetermined.empty()) return check;
@@ -312,6 +336,9 @@ PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& 
   const double centre = 0.5 * (spec[0] + spec[1]);
   const double half = 0.5 * (spec[1] - spec[0]);
   check.best_soaks_c = {spec[0], centre - half / std::sqrt(5.0), centre + half / std::sqrt(5.0), spec[1]};
+  std::vector<double> temps;
+  for (const Window& w : windows) temps.push_back(w.temp_c);
+  check.temperature_efficiency = CubicDEfficiency(temps, spec);
   if (!refs.empty()) {
     SegmentEffects(segments, windows, info, refs[order.front()], options, &check);
   }

@@ -254,6 +254,83 @@ def simulate(
 def simulate_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of simulate()."""
 
+class _PlanCheckOptions(TypedDict, total=False):
+    """plan_check()'s own keywords: the keys of plan_check_options() (tests/test_plan.py checks that
+    the two agree). The schedule and the noise are simulate()'s keywords; noise_yaml a path."""
+
+    tolerance: str | Mapping[str, float]  # {"gyro.bias": 0.01} or "gyro.bias=0.01,accel.bias=0.5"
+    z: float
+    spec_range_c: tuple[float, float] | None  # degC
+    latitude_deg: float | None  # deg; None: the plan's
+    weak_tolerance: float
+    cut_loss: float
+
+class _PlanDesignOptions(_PlanCheckOptions, total=False):
+    """plan_design()'s own keywords: the keys of plan_design_options()."""
+
+    positions: str  # "faces,edges,corners"
+    rates_dps: Sequence[float]  # deg/s, each as a +- pair
+    max_rate_dps: float  # deg/s
+    two_axis: bool
+    set_points_c: Sequence[float]  # degC
+    soak_settle_s: float  # s
+    prior: str | Mapping[str, float]  # data-sheet 1-sigma per group
+    max_exchange_rounds: int
+
+class _PlanRows(TypedDict):
+    name: list[str]  # "gyro bias x (linear term)", the limiting one first
+    unit: list[str]
+    sigma: npt.NDArray[np.float64]
+    sigma_range: npt.NDArray[np.float64]
+    sigma_spec: npt.NDArray[np.float64]
+    tolerance: npt.NDArray[np.float64]  # 0: none
+    ratio: npt.NDArray[np.float64]  # z sigma / tolerance; 0: none
+    white_share: npt.NDArray[np.float64]
+
+class PlanCheckResult(TypedDict):
+    undetermined: list[str]
+    weak: list[str]
+    rows: _PlanRows
+    limiting: str | None
+    segments: dict[str, npt.NDArray[np.float64]]  # id, limiting_loss, worst_loss (inf: essential)
+    correlated: list[tuple[str, str, float]]
+    carriers: list[int]
+    cuttable: list[int]
+    plan_hours: float
+    needed_hours: float
+    plan_range_c: tuple[float, float]
+    best_soaks_c: npt.NDArray[np.float64]
+    temperature_efficiency: float
+    extrapolation_factor: float
+    tolerance_unmet: bool
+    warnings: list[str]
+
+class PlanDesignResult(TypedDict):
+    undetermined: list[str]
+    met: bool
+    soaks_c: npt.NDArray[np.float64]
+    hours: float
+    greedy_soaks_c: npt.NDArray[np.float64]
+    greedy_hours: float
+    plan_yaml: str
+    segment_count: int
+    check: PlanCheckResult
+    greedy_check: PlanCheckResult
+
+def plan_check(plan: PathLike | Mapping[str, Any], **options: Any) -> PlanCheckResult:
+    """What `imufit plan check` prints, as arrays (docs/plan.md). Keywords: _PlanCheckOptions, the
+    schedule and noise of simulate() (_SimulateOptions), noise_yaml. Raises InputError."""
+
+def plan_check_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of plan_check()'s own keywords."""
+
+def plan_design(candidates: PathLike | Mapping[str, Any] | None = None, **options: Any) -> PlanDesignResult:
+    """What `imufit plan design` finds, as arrays (docs/plan.md). Keywords: _PlanDesignOptions, the
+    schedule and noise of simulate(), noise_yaml. Raises InputError."""
+
+def plan_design_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of plan_design()'s own keywords."""
+
 class AllanResult:
     """An Allan-family deviation at several taus with confidence intervals (NIST SP 1065)."""
 

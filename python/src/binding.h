@@ -68,6 +68,7 @@ SamplesInMemory SamplesFromArrays(const py::dict& samples, const std::string& wh
 void BindCalibration(py::module_& m);
 void BindFit(py::module_& m);
 void BindNoise(py::module_& m);
+void BindPlan(py::module_& m);
 
 }  // namespace imufit::python
 

@@ -117,4 +117,5 @@ PYBIND11_MODULE(_imufit, m) {
   BindCalibration(m);
   BindFit(m);
   BindNoise(m);
+  BindPlan(m);
 }

@@ -101,6 +101,18 @@ void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
 std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& calibration_extra,
                                                      const std::string& column, const std::string& key);
 
+// What a noise file says about each sensor, for a plan judged with the unit's measured noise
+// (`imufit plan check --noise-yaml`): the worst axis of the fitted columns of each kind, SI.
+struct SensorNoiseFigures {
+  double gyro_noise_density = 0.0;      // rad/s/sqrt(Hz): the white (random walk) term
+  double gyro_bias_instability = 0.0;   // rad/s (0 when no gyro column resolved it)
+  double accel_noise_density = 0.0;     // m/s^2/sqrt(Hz)
+  double accel_bias_instability = 0.0;  // m/s^2
+};
+// Reads the noise block written by `imufit allan --noise-yaml` (alone or appended to a calibration).
+// Throws InputError naming the file when it is not one, or when a sensor has no fitted white noise.
+SensorNoiseFigures ReadSensorNoise(const std::string& path);
+
 }  // namespace imufit
 
 #endif  // IMUFIT_IO_NOISE_FILE_H_

@@ -32,6 +32,9 @@ struct Plan {
 Plan ReadPlan(const std::string& path);
 // A plan from its YAML (or JSON) `text`, which messages and Plan::path name `name`.
 Plan ReadPlanText(const std::string& text, const std::string& name);
+// The YAML of `plan` (its path is not written; `comment`, when not empty, opens the file as '#'
+// lines): ReadPlanText reads it back to the same site and segments (shortest round-trip numbers).
+std::string PlanYaml(const Plan& plan, const std::string& comment);
 
 }  // namespace imufit
 

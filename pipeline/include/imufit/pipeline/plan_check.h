@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "imufit/fit/plan_information.h"
+#include "imufit/model/option_table.h"
 #include "imufit/run/windows.h"
 #include "imufit/sim/simulator.h"
 
@@ -37,11 +38,29 @@ struct PlanCheckOptions {
   std::map<std::string, double> tolerances;
   // The range the unit is specified over, degC (absent: the plan's own).
   std::optional<std::array<double, 2>> spec_range_c;
+  // The table's latitude, deg (absent: the plan's own).
+  std::optional<double> latitude_deg;
   // A direction weaker than this fraction of the strongest (column-normalised Jacobian) is named.
   double weak_tolerance = 1e-4;
   // A segment whose removal changes every sigma by less than this fraction could be cut.
   double cut_loss = 0.01;
 };
+
+// Every option of PlanCheckOptions, described once (model/option_table.h; plan_options.cc).
+const OptionTable<PlanCheckOptions>& PlanCheckOptionTable();
+
+// The coefficient groups a tolerance may be given for: "gyro.bias", ..., "accel.misalignment".
+const std::vector<std::string>& PlanGroups();
+
+// Reads "GROUP=VALUE" pairs (one a line, or separated by ',') into `values`, GROUP one of PlanGroups()
+// and VALUE > 0 in its display unit: "" or what is wrong.
+std::string ParseGroupValues(const std::string& text, std::map<std::string, double>* values);
+// The same pairs written back, separated by ','.
+std::string GroupValuesText(const std::map<std::string, double>& values);
+
+// Sets the schedule's white noise and bias instability from a noise YAML (`imufit allan
+// --noise-yaml`): the worst axis of each sensor. Throws InputError naming the file.
+void ApplyNoiseYaml(const std::string& path, SimulationOptions* schedule);
 
 // "deg/s", "mg", "ppm", "mrad", "deg/s/g" for a group "gyro.bias", ...; the factor SI -> display.
 std::string PlanGroupUnit(const std::string& group);
@@ -85,8 +104,16 @@ struct PlanCheck {
   std::array<double, 4> best_soaks_c{};     // D-optimal soaks of a cubic over the plan's range
   std::array<double, 2> plan_range_c{};     // the planned temperatures
   double extrapolation_factor = 1.0;        // sigma at the spec ends / the largest over the plan
+  double temperature_efficiency = 1.0;      // CubicDEfficiency of the windows' temperatures, spec range
   bool tolerance_unmet = false;             // some row's ratio above 1
 };
+
+// The D-efficiency for a cubic in temperature over `range_c` of a run whose windows (equal weights)
+// lie at `temps_c`: (det M / det M*)^(1/4), M = mean of f f^T with f = (1, x, x^2, x^3), x the
+// temperature scaled to [-1, 1], and M* that of the D-optimal soaks {-1, -1/sqrt(5), +1/sqrt(5), +1}
+// (Hoel 1958; Kiefer-Wolfowitz: their variance function f^T M*^-1 f peaks at 4 exactly there).
+// 1 for those soaks, 0.959 for four equally spaced, 0.605 for a uniform ramp; 0 when M is singular.
+double CubicDEfficiency(const std::vector<double>& temps_c, std::array<double, 2> range_c);
 
 // Checks `segments` under `schedule` for the fit of `fit_options` (its bias stability from the
 // schedule's bias instability and correlation time when those are given).
@@ -97,6 +124,8 @@ PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& 
 // The people's table and the machines' YAML.
 std::string PlanCheckText(const PlanCheck& check, const PlanCheckOptions& options);
 std::string PlanCheckYaml(const PlanCheck& check);
+// The same content as the YAML, in JSON (every number finite).
+std::string PlanCheckJson(const PlanCheck& check);
 
 }  // namespace imufit
 
