@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <optional>
@@ -480,6 +481,17 @@ std::vector<StoredFit> ResultsStore::Fits(const std::string& where,
 std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
   const std::lock_guard<std::mutex> lock(mutex_);
   return Fits("r.serial = ?1", {serial});
+}
+
+std::vector<StoredFit> ResultsStore::LatestOfLot(const std::string& lot) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<StoredFit> fits = Fits(
+      "r.lot = ?1 AND NOT EXISTS (SELECT 1 FROM fits f2 JOIN runs r2 ON r2.run_key = f2.run_key WHERE "
+      "r2.lot = r.lot AND r2.unit = r.unit AND (f2.time_utc > f.time_utc OR (f2.time_utc = f.time_utc AND "
+      "f2.id > f.id)))",
+      {lot});
+  std::sort(fits.begin(), fits.end(), [](const StoredFit& a, const StoredFit& b) { return a.unit < b.unit; });
+  return fits;
 }
 
 std::vector<StoredFit> ResultsStore::All() {

@@ -120,6 +120,43 @@ std::vector<MonthlyMean> MonthlyMeans(const std::vector<TrendPoint>& points) {
   return means;
 }
 
+BatchResult StoredLot(ResultsStore* store, const std::string& lot) {
+  BatchResult result;
+  for (StoredFit& f : store->LatestOfLot(lot)) {
+    UnitOutcome u;
+    u.unit = f.unit;
+    u.serial = f.serial;
+    u.status = f.status;
+    u.verdict = f.verdict;
+    u.message = f.message;
+    u.plan_sha256 = f.plan_sha256;
+    u.samples_sha256 = f.samples_sha256;
+    if (f.status == "fitted") u.calibrated_utc = f.time_utc;  // a batch's: the calibration's created_utc
+    u.calibration_yaml = std::move(f.calibration_yaml);
+    for (const StoredFigure& g : f.figures) {
+      u.figures.push_back(g);
+      if (g.outcome.empty()) continue;
+      CriterionResult c;
+      c.name = "|" + g.name + "|";
+      c.unit = g.unit;
+      c.measured = std::abs(g.value);
+      c.limit = g.limit_abs;
+      c.margin = g.limit_abs - c.measured;
+      c.expanded = g.expanded_u;
+      c.pass = g.outcome == "pass";
+      c.outcome = c.pass ? Outcome::kPass : Outcome::kFail;
+      u.verdict_detail.criteria.push_back(c);
+    }
+    u.verdict_detail.pass = u.verdict == "PASS";
+    if (u.status == "error") ++result.errors;
+    if (u.status == "not-fitted") ++result.not_fitted;
+    if (u.verdict == "PASS") ++result.passed;
+    if (u.verdict == "FAIL") ++result.failed;
+    result.units.push_back(std::move(u));
+  }
+  return result;
+}
+
 std::string YieldPageHtml(const std::string& store, YieldGroup by, const std::vector<GroupYield>& yields) {
   const std::string group = NameOf(kYieldGroupNames, by);
   return Page("Yield by " + group, store, {YieldBars(by, yields)},

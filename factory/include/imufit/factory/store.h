@@ -160,6 +160,9 @@ class ResultsStore {
 
   // Whether any fit of `unit` in `lot` is recorded.
   bool HasUnit(const std::string& lot, const std::string& unit);
+  // Each unit of `lot` by its latest fit in the lot (the fit Yield() counts), with figures and
+  // attachments, by unit name.
+  std::vector<StoredFit> LatestOfLot(const std::string& lot);
   // Every fit of a serial, oldest first, with figures.
   std::vector<StoredFit> BySerial(const std::string& serial);
   // Yield per lot (one lot when `lot` is not empty), by each unit's latest fit in the lot.

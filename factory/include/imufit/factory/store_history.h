@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "imufit/factory/batch.h"
 #include "imufit/factory/store.h"
 
 namespace imufit {
@@ -38,6 +39,13 @@ std::string TrendPageHtml(const std::string& store, const std::string& figure,
 // `imufit history DB --serial S --html`: every calibration of the serial, oldest first.
 std::string SerialPageHtml(const std::string& store, const std::string& serial,
                            const std::vector<StoredFit>& fits);
+
+// A lot as its batch found it, from the store (`imufit lot --store`, after a sharded batch): each
+// unit by its latest fit in the lot, in unit order, with its status, verdict, message, key figures
+// and calibration time, and the criteria its figures were judged on (pass or fail; whether a
+// judgement was conditional is not stored). MakeLotSummary() and LotSummaryCsv() take it as they
+// take a batch's own result.
+BatchResult StoredLot(ResultsStore* store, const std::string& lot);
 
 }  // namespace imufit
 
