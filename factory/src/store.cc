@@ -546,15 +546,27 @@ std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std
 }
 
 std::vector<LotValue> ResultsStore::LotValues(const std::string& figure) {
+  return LotValues(std::vector<std::string>{figure});
+}
+
+std::vector<LotValue> ResultsStore::LotValues(const std::vector<std::string>& figures) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  std::string list;  // ?1, ?2, ...: one pass over the units' latest fits for every figure
+  for (size_t i = 0; i < figures.size(); ++i) list += (i ? ", ?" : "?") + std::to_string(i + 1);
   std::vector<LotValue> values;
+  if (figures.empty()) return values;
   db_->Query(
       std::string(kLatestPerUnit) +
-          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit FROM latest l JOIN figures g ON g.fit_id = l.id "
-          "WHERE l.n = 1 AND l.lot <> '' AND l.status = 'fitted' AND (g.name = ?1 OR g.coefficient = ?1) "
-          "ORDER BY l.lot, l.unit",
-      {figure}, [&](const SqlRow& row) {
-        values.push_back({row.Text(0), row.Text(1), row.Double(2), row.Double(3), row.Text(4)});
+          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest l JOIN figures "
+          "g "
+          "ON g.fit_id = l.id WHERE l.n = 1 AND l.lot <> '' AND l.status = 'fitted' AND (g.name IN (" +
+          list + ") OR g.coefficient IN (" + list + ")) ORDER BY l.lot, l.unit",
+      std::vector<SqlValue>(figures.begin(), figures.end()), [&](const SqlRow& row) {
+        const std::string name = row.Text(5), coefficient = row.Text(6);
+        for (const std::string& figure : figures) {
+          if (figure != name && figure != coefficient) continue;
+          values.push_back({row.Text(0), row.Text(1), row.Double(2), row.Double(3), row.Text(4), figure});
+        }
       });
   return values;
 }

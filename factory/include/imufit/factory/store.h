@@ -131,6 +131,7 @@ struct LotValue {
   double value = 0.0;
   double sigma = -1.0;
   std::string figure_unit;  // "deg/s", ...
+  std::string figure;       // the figure as asked for (LotValues())
 };
 
 class ResultsStore {
@@ -178,6 +179,8 @@ class ResultsStore {
   // One key figure (name or coefficient path, as Trend) of every unit of every lot, each unit by
   // its latest fit in the lot (the fit Yield() counts), fitted units only; by lot, then unit.
   std::vector<LotValue> LotValues(const std::string& figure);
+  // The same for several figures in one pass (the lot page's trends), by lot, then unit.
+  std::vector<LotValue> LotValues(const std::vector<std::string>& figures);
 
  private:
   void Open();  // schema, version check, migration
