@@ -172,12 +172,18 @@ TEST(HistoryTest, TheCommandAnswersAsTableCsvAndHtml) {
     ++rows;
   EXPECT_EQ(rows, 2u);
 
-  r = History({target, "--by", "week"});
-  EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--by: \"week\" is not one of lot, station, month"), std::string::npos) << r.err;
-  r = History({target, "--station", "station-1", "--by", "lot"});
-  EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--station gives a station's drift"), std::string::npos) << r.err;
+  // Mistakes: one line each, as docs/troubleshooting.md quotes it.
+  const std::string troubleshooting =
+      testing::ReadBytes(std::string(IMUFIT_FIXTURES_DIR) + "/../docs/troubleshooting.md");
+  for (const std::vector<std::string>& mistake : {std::vector<std::string>{target, "--by", "week"},
+                                                  {target, "--station", "station-1", "--by", "lot"}}) {
+    r = History(mistake);
+    EXPECT_EQ(r.status, 2) << r.err;
+    ASSERT_FALSE(r.err.empty());
+    const std::string said = r.err.substr(0, r.err.size() - 1);  // less its newline
+    EXPECT_EQ(said.find('\n'), std::string::npos) << r.err;
+    EXPECT_NE(troubleshooting.find("`" + said + "`"), std::string::npos) << said;
+  }
 }
 
 }  // namespace
