@@ -27,6 +27,7 @@ CommandRunner AddSimulateCommand(CLI::App* root);
 CommandRunner AddAllanCommand(CLI::App* root);
 CommandRunner AddBatchCommand(CLI::App* root);
 CommandRunner AddHistoryCommand(CLI::App* root);
+CommandRunner AddLotCommand(CLI::App* root);
 CommandRunner AddStoreCommand(CLI::App* root);
 CommandRunner AddReportCommand(CLI::App* root);
 CommandRunner AddSegmentCommand(CLI::App* root);

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   add(imufit::AddAllanCommand(&app));
   add(imufit::AddBatchCommand(&app));
   add(imufit::AddHistoryCommand(&app));
+  add(imufit::AddLotCommand(&app));
   add(imufit::AddStoreCommand(&app));
   add(imufit::AddReportCommand(&app));
   add(imufit::AddSegmentCommand(&app));

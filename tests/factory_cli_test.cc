@@ -408,7 +408,7 @@ TEST_F(FactoryCliTest, BatchJudgesRecordsReportsAndSkipsUnchangedUnits) {
   EXPECT_FALSE(fs::exists(dir_ / "lots_z.html"));
   r = Run({"history", Path("store.db"), "--html", Path("lots_z.html")});
   EXPECT_EQ(r.status, kExitBadInput);
-  EXPECT_NE(r.err.find("give them with --lot"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("give one of --serial S, --lot [NAME], --by"), std::string::npos) << r.err;
 
   // Again: nothing changed, nothing redone, same summary, no new rows.
   const std::string first_summary = ReadBytes(dir_ / "out" / "lot_summary.csv");

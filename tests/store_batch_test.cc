@@ -1,6 +1,15 @@
 // `imufit batch --shard` into one store on the backend under test: four shards writing at once
-// give every unit exactly once and the lot the yield and figures of one unsharded batch; a shard
-// stopped part way and run again completes.
+// give every unit exactly once and, through `imufit lot --store`, the lot summary and page of one
+// unsharded batch; a shard stopped part way, or killed (SIGKILL) mid-batch, and run again completes
+// with every unit once and every output whole.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -12,6 +21,7 @@
 
 #include "imufit/factory/shard.h"
 #include "imufit/factory/store.h"
+#include "imufit/io/calibration.h"
 #include "store_test_util.h"
 #include "test_util.h"
 
@@ -43,6 +53,25 @@ testing::RunResult Imufit(const fs::path& folder, const std::vector<std::string>
 void WriteText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());
   std::ofstream(path) << text;
+}
+
+// `text` (CSV) without its column `drop` (cells split at commas outside quotes).
+std::string WithoutColumn(const std::string& text, int drop) {
+  std::string out, cell;
+  int column = 0;
+  bool quoted = false;
+  for (char c : text) {
+    if (c == '"') quoted = !quoted;
+    if (quoted || (c != ',' && c != '\n')) {
+      cell += c;
+      continue;
+    }
+    if (column != drop) out += (column > 0 && !(drop == 0 && column == 1) ? "," : "") + cell;
+    cell.clear();
+    column = c == '\n' ? 0 : column + 1;
+    if (c == '\n') out += '\n';
+  }
+  return out;
 }
 
 // A lot of kUnits units, each its own serial; every fifth unit's gyro g-sensitivity fails the
@@ -144,6 +173,38 @@ TEST_F(ShardTest, FourShardsAtOnceGiveEveryUnitOnceAndTheUnshardedLot) {
     EXPECT_NEAR(vb[i].value, va[i].value, kSameFigure) << va[i].unit;
   }
   EXPECT_FALSE(fs::exists(folder_ / "out_shards" / "lot_summary.csv"));  // the lot page comes from the store
+
+  // `imufit lot --store` gives the unsharded batch's own summary from its store, byte for byte,
+  // and the same from the shards' store but for the time each unit was calibrated.
+  const std::string batch_summary = testing::ReadBytes((folder_ / "out_whole" / "lot_summary.csv").string());
+  const testing::RunResult from_whole =
+      Imufit(folder_, {"lot", "--store", whole, "--lot", "LOT-S", "--csv", (folder_ / "whole.csv").string()},
+             "lot_whole");
+  ASSERT_EQ(from_whole.status, 0) << from_whole.err;
+  EXPECT_EQ(testing::ReadBytes((folder_ / "whole.csv").string()), batch_summary);
+  const testing::RunResult from_shards =
+      Imufit(folder_,
+             {"lot", "--store", sharded, "--lot", "LOT-S", "--csv", (folder_ / "shards.csv").string(),
+              "--html", (folder_ / "lot.html").string(), "--limits", (folder_ / "limits.yaml").string()},
+             "lot_shards");
+  ASSERT_EQ(from_shards.status, 0) << from_shards.err;
+  const std::string shards_summary = testing::ReadBytes((folder_ / "shards.csv").string());
+  constexpr int kCalibratedColumn = 5;  // unit,serial,status,verdict,message,calibrated_utc,...
+  EXPECT_EQ(WithoutColumn(shards_summary, kCalibratedColumn),
+            WithoutColumn(batch_summary, kCalibratedColumn));
+  EXPECT_EQ(std::count(shards_summary.begin(), shards_summary.end(), '\n'), kUnits + 1);
+  for (int i = 0; i < kUnits; ++i) {
+    const std::string row = "\nunit-" + std::to_string(100 + i) + ",";
+    EXPECT_NE(shards_summary.find(row), std::string::npos) << row;
+  }
+  const std::string page = testing::ReadBytes((folder_ / "lot.html").string());
+  EXPECT_NE(page.find("<tr data-history-lot=\"LOT-S\" class=\"current\">"), std::string::npos);
+  EXPECT_NE(page.find("MEMS-A acceptance"), std::string::npos);
+  const testing::RunResult missing = Imufit(
+      folder_, {"lot", "--store", sharded, "--lot", "LOT-X", "--csv", (folder_ / "x.csv").string()}, "lot_x");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("no lot named \"LOT-X\""), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(folder_ / "x.csv"));
 }
 
 TEST_F(ShardTest, AShardStoppedPartWayAndRunAgainCompletes) {
@@ -163,6 +224,70 @@ TEST_F(ShardTest, AShardStoppedPartWayAndRunAgainCompletes) {
   ResultsStore resumed(store);
   EXPECT_EQ(resumed.CountFits(), expected);
   EXPECT_EQ(resumed.Yield("LOT-S")[0].units, expected);
+}
+
+// The units of shard `index` of kShards.
+int UnitsOfShard(int index) {
+  int units = 0;
+  for (int i = 0; i < kUnits; ++i)
+    units += ShardOf("unit-" + std::to_string(100 + i), kShards) == index ? 1 : 0;
+  return units;
+}
+
+// Starts `args` as a process of its own, its output into `log`; its process id.
+pid_t Start(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> all = {IMUFIT_EXE};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&files, 1, 2);
+  pid_t pid = -1;
+  const int status = posix_spawn(&pid, IMUFIT_EXE, &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  return status == 0 ? pid : -1;
+}
+
+TEST_F(ShardTest, AShardKilledMidBatchAndRunAgainCompletesWithEveryUnitOnce) {
+  constexpr auto kPatience = std::chrono::seconds(120);  // for the first unit to be recorded
+  const std::string store = FreshStore("shard_killed");
+  { ResultsStore create(store); }
+  std::vector<std::string> args = Batch("out_killed", store);
+  args.insert(args.end(), {"--jobs", "1", "--shard", "2/4"});
+  const int expected = UnitsOfShard(2);
+  ASSERT_GT(expected, 2);
+  const pid_t batch = Start(args, folder_ / "killed.log");
+  ASSERT_GT(batch, 0);
+  const auto give_up = std::chrono::steady_clock::now() + kPatience;
+  int64_t recorded = 0;
+  while (recorded == 0 && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    recorded = ResultsStore(store, StoreAccess::kRead).CountFits();
+  }
+  ASSERT_EQ(kill(batch, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(batch, &status, 0), batch);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the batch ended before it was killed";
+  const int64_t at_kill = ResultsStore(store, StoreAccess::kRead).CountFits();
+  EXPECT_GE(at_kill, 1);
+  EXPECT_LT(at_kill, expected);  // killed mid-batch
+
+  const testing::RunResult again = Imufit(folder_, args, "after_kill");
+  EXPECT_TRUE(again.status == 0 || again.status == 3) << again.status << again.err;
+  ResultsStore done(store, StoreAccess::kRead);
+  EXPECT_EQ(done.CountFits(), expected);
+  const std::vector<StoredFit> units = done.LatestOfLot("LOT-S");
+  ASSERT_EQ(units.size(), static_cast<size_t>(expected));
+  for (const StoredFit& unit : units) {
+    // Every unit's calibration is whole: the file the store holds, and it reads.
+    const fs::path calibration = folder_ / "out_killed" / unit.unit / "calibration.yaml";
+    ASSERT_TRUE(fs::exists(calibration)) << calibration;
+    EXPECT_EQ(testing::ReadBytes(calibration.string()), unit.calibration_yaml) << unit.unit;
+    EXPECT_NO_THROW(ReadCalibration(calibration.string())) << unit.unit;
+  }
 }
 
 }  // namespace

@@ -81,6 +81,25 @@ TEST(StoreTest, TheSameFitRecordedTwiceIsOneRowAndARefitOfTheSameRunSharesItsRun
   EXPECT_EQ(store.Yield("lot-a")[0].failed, 1);  // the latest fit counts
 }
 
+TEST(StoreTest, ARunKeepsTheLotItWasFirstRecordedIn) {
+  ResultsStore store(FreshStore("first_lot"));
+  const StoredFit fit = MakeFit("SN1", "lot-a", "2026-01-01T00:00:00Z", 1.5, "PASS");
+  const int64_t id = store.Record(fit);
+  StoredFit again = fit;  // the same run re-imported under another lot
+  again.lot = "lot-z";
+  EXPECT_EQ(store.Record(again), id);
+  StoredFit refit = again;  // a refit of the same run, recorded under another lot
+  refit.time_utc = "2026-01-02T00:00:00Z";
+  store.Record(refit);
+  const std::vector<StoredFit> fits = store.BySerial("SN1");
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(fits[0].lot, "lot-a");
+  EXPECT_EQ(fits[1].lot, "lot-a");
+  EXPECT_TRUE(store.Yield("lot-z").empty());
+  EXPECT_EQ(store.LatestOfLot("lot-a").size(), 1u);
+  EXPECT_EQ(store.LatestOfLot("lot-a")[0].time_utc, "2026-01-02T00:00:00Z");
+}
+
 TEST(StoreTest, RunKeysAreVersion5Uuids) {
   const std::string key = RunKey(MakeFit("SN1", "lot-a", "2026-01-01T00:00:00Z", 1.5, "PASS"));
   ASSERT_EQ(key.size(), 36u);

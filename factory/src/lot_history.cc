@@ -123,11 +123,13 @@ LotHistory MakeLotHistory(ResultsStore* store, const std::string& current_lot, c
     h.yield_pct.push_back(y.units > 0 ? 100.0 * y.passed / y.units : 0.0);
     if (y.lot == current_lot) h.current = static_cast<int>(i);
   }
+  const std::vector<LotValue> all = store->LotValues(figures);
   for (const std::string& name : figures) {
     std::vector<std::vector<double>> per_lot(h.lots.size());
     LotTrend trend;
     trend.name = name;
-    for (const LotValue& v : store->LotValues(name)) {
+    for (const LotValue& v : all) {
+      if (v.figure != name) continue;
       const auto lot = index.find(v.lot);
       if (lot == index.end()) continue;
       per_lot[lot->second].push_back(v.value);

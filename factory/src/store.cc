@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <optional>
@@ -247,12 +248,19 @@ std::vector<std::string*> TextFields(StoredFit* f) {
           &f->calibration_yaml};
 }
 
-// Each unit of a lot by its latest fit (a unit refitted after a fix counts as fixed): n = 1.
+// Each unit by its latest fit (a unit refitted after a fix counts as fixed): n = 1. A unit is a
+// lot's unit, or (lot "") a single fit's samples file.
 constexpr const char* kLatestPerUnit =
-    "WITH latest AS (SELECT f.id AS id, r.lot AS lot, r.unit AS unit, f.time_utc AS time_utc, "
-    "f.status AS status, f.verdict AS verdict, ROW_NUMBER() OVER (PARTITION BY r.lot, r.unit "
-    "ORDER BY f.time_utc DESC, f.id DESC) AS n FROM fits f JOIN runs r ON r.run_key = f.run_key "
-    "WHERE r.lot <> '') ";
+    "WITH latest AS (SELECT f.id AS id, r.lot AS lot, r.unit AS unit, r.station AS station, "
+    "substr(f.time_utc, 1, 7) AS month, f.time_utc AS time_utc, f.status AS status, f.verdict AS verdict, "
+    "ROW_NUMBER() OVER (PARTITION BY r.lot, r.unit ORDER BY f.time_utc DESC, f.id DESC) AS n "
+    "FROM fits f JOIN runs r ON r.run_key = f.run_key) ";
+
+// The counts of Yield() and YieldBy() over the units of `latest`, after the group's column.
+constexpr const char* kYieldCounts =
+    ", count(*), sum(CASE WHEN verdict = 'PASS' THEN 1 ELSE 0 END), "
+    "sum(CASE WHEN verdict = 'FAIL' THEN 1 ELSE 0 END), "
+    "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest WHERE n = 1 ";
 
 class Transaction {
  public:
@@ -475,6 +483,17 @@ std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
   return Fits("r.serial = ?1", {serial});
 }
 
+std::vector<StoredFit> ResultsStore::LatestOfLot(const std::string& lot) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<StoredFit> fits = Fits(
+      "r.lot = ?1 AND NOT EXISTS (SELECT 1 FROM fits f2 JOIN runs r2 ON r2.run_key = f2.run_key WHERE "
+      "r2.lot = r.lot AND r2.unit = r.unit AND (f2.time_utc > f.time_utc OR (f2.time_utc = f.time_utc AND "
+      "f2.id > f.id)))",
+      {lot});
+  std::sort(fits.begin(), fits.end(), [](const StoredFit& a, const StoredFit& b) { return a.unit < b.unit; });
+  return fits;
+}
+
 std::vector<StoredFit> ResultsStore::All() {
   const std::lock_guard<std::mutex> lock(mutex_);
   return Fits("1 = 1", {});
@@ -488,45 +507,66 @@ int64_t ResultsStore::CountFits() {
 }
 
 std::vector<LotYield> ResultsStore::Yield(const std::string& lot) {
-  const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<LotYield> yields;
-  db_->Query(
-      std::string(kLatestPerUnit) +
-          "SELECT lot, count(*), sum(CASE WHEN verdict = 'PASS' THEN 1 ELSE 0 END), "
-          "sum(CASE WHEN verdict = 'FAIL' THEN 1 ELSE 0 END), "
-          "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest "
-          "WHERE n = 1 AND (?1 = '' OR lot = ?1) GROUP BY lot ORDER BY min(time_utc), lot",
-      {lot}, [&](const SqlRow& row) {
-        yields.push_back({row.Text(0), static_cast<int>(row.Integer(1)), static_cast<int>(row.Integer(2)),
-                          static_cast<int>(row.Integer(3)), static_cast<int>(row.Integer(4))});
-      });
+  for (const GroupYield& y : YieldBy(YieldGroup::kLot)) {
+    if (lot.empty() || y.group == lot) yields.push_back({y.group, y.units, y.passed, y.failed, y.not_fitted});
+  }
   return yields;
 }
 
-std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std::string& serial) {
+std::vector<GroupYield> ResultsStore::YieldBy(YieldGroup by) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const char* column = NameOf(kYieldGroupNames, by);
+  const std::string sql =
+      std::string(kLatestPerUnit) + "SELECT " + column + kYieldCounts +
+      (by == YieldGroup::kLot ? "AND lot <> '' GROUP BY lot ORDER BY min(time_utc), lot"
+                              : std::string("GROUP BY ") + column + " ORDER BY " + column);
+  std::vector<GroupYield> yields;
+  db_->Query(sql, {}, [&](const SqlRow& row) {
+    yields.push_back({row.Text(0), static_cast<int>(row.Integer(1)), static_cast<int>(row.Integer(2)),
+                      static_cast<int>(row.Integer(3)), static_cast<int>(row.Integer(4))});
+  });
+  return yields;
+}
+
+std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std::string& serial,
+                                            const std::string& station) {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<TrendPoint> points;
   db_->Query(
-      "SELECT f.time_utc, r.serial, r.lot, g.value, g.sigma, g.unit FROM figures g JOIN fits f ON f.id = "
-      "g.fit_id "
-      "JOIN runs r ON r.run_key = f.run_key WHERE (g.name = ?1 OR g.coefficient = ?1) "
-      "AND (?2 = '' OR r.serial = ?2) ORDER BY f.time_utc, f.id",
-      {figure, serial}, [&](const SqlRow& row) {
-        points.push_back({row.Text(0), row.Text(1), row.Text(2), row.Double(3), row.Double(4), row.Text(5)});
+      "SELECT f.time_utc, r.serial, r.lot, r.station, g.value, g.sigma, g.unit FROM figures g "
+      "JOIN fits f ON f.id = g.fit_id JOIN runs r ON r.run_key = f.run_key "
+      "WHERE (g.name = ?1 OR g.coefficient = ?1) AND (?2 = '' OR r.serial = ?2) "
+      "AND (?3 = '' OR r.station = ?3) ORDER BY f.time_utc, f.id",
+      {figure, serial, station}, [&](const SqlRow& row) {
+        points.push_back(
+            {row.Text(0), row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5), row.Text(6)});
       });
   return points;
 }
 
 std::vector<LotValue> ResultsStore::LotValues(const std::string& figure) {
+  return LotValues(std::vector<std::string>{figure});
+}
+
+std::vector<LotValue> ResultsStore::LotValues(const std::vector<std::string>& figures) {
   const std::lock_guard<std::mutex> lock(mutex_);
+  std::string list;  // ?1, ?2, ...: one pass over the units' latest fits for every figure
+  for (size_t i = 0; i < figures.size(); ++i) list += (i ? ", ?" : "?") + std::to_string(i + 1);
   std::vector<LotValue> values;
+  if (figures.empty()) return values;
   db_->Query(
       std::string(kLatestPerUnit) +
-          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit FROM latest l JOIN figures g ON g.fit_id = l.id "
-          "WHERE l.n = 1 AND l.status = 'fitted' AND (g.name = ?1 OR g.coefficient = ?1) "
-          "ORDER BY l.lot, l.unit",
-      {figure}, [&](const SqlRow& row) {
-        values.push_back({row.Text(0), row.Text(1), row.Double(2), row.Double(3), row.Text(4)});
+          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest l JOIN figures "
+          "g "
+          "ON g.fit_id = l.id WHERE l.n = 1 AND l.lot <> '' AND l.status = 'fitted' AND (g.name IN (" +
+          list + ") OR g.coefficient IN (" + list + ")) ORDER BY l.lot, l.unit",
+      std::vector<SqlValue>(figures.begin(), figures.end()), [&](const SqlRow& row) {
+        const std::string name = row.Text(5), coefficient = row.Text(6);
+        for (const std::string& figure : figures) {
+          if (figure != name && figure != coefficient) continue;
+          values.push_back({row.Text(0), row.Text(1), row.Double(2), row.Double(3), row.Text(4), figure});
+        }
       });
   return values;
 }

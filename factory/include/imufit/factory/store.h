@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/model/enum_names.h"
 
 namespace imufit {
 
@@ -103,9 +104,24 @@ struct TrendPoint {
   std::string time_utc;
   std::string serial;
   std::string lot;
+  std::string station;  // "" when not given
   double value = 0.0;
   double sigma = -1.0;
   std::string unit;
+};
+
+// What yield is grouped by: the lot of a batch, the station a unit was calibrated at, or the month
+// (YYYY-MM, UTC) it was calibrated in.
+enum class YieldGroup { kLot, kStation, kMonth };
+inline constexpr EnumName<YieldGroup> kYieldGroupNames[] = {
+    {YieldGroup::kLot, "lot"}, {YieldGroup::kStation, "station"}, {YieldGroup::kMonth, "month"}};
+
+struct GroupYield {
+  std::string group;  // the lot, the station ("" not given) or the month
+  int units = 0;      // distinct units, each counted by its latest fit (in the group of that fit)
+  int passed = 0;
+  int failed = 0;
+  int not_fitted = 0;  // not-fitted or error
 };
 
 // One key figure of one unit of a lot.
@@ -115,6 +131,7 @@ struct LotValue {
   double value = 0.0;
   double sigma = -1.0;
   std::string figure_unit;  // "deg/s", ...
+  std::string figure;       // the figure as asked for (LotValues())
 };
 
 class ResultsStore {
@@ -144,16 +161,26 @@ class ResultsStore {
 
   // Whether any fit of `unit` in `lot` is recorded.
   bool HasUnit(const std::string& lot, const std::string& unit);
+  // Each unit of `lot` by its latest fit in the lot (the fit Yield() counts), with figures and
+  // attachments, by unit name.
+  std::vector<StoredFit> LatestOfLot(const std::string& lot);
   // Every fit of a serial, oldest first, with figures.
   std::vector<StoredFit> BySerial(const std::string& serial);
   // Yield per lot (one lot when `lot` is not empty), by each unit's latest fit in the lot.
   std::vector<LotYield> Yield(const std::string& lot);
+  // Yield by lot (lots in the order of their first fit), station or month (in name order): every
+  // unit (a lot's unit, or a single fit's samples file) counted once, by its latest fit, in the
+  // group of that fit; lots leave out single fits (no lot).
+  std::vector<GroupYield> YieldBy(YieldGroup by);
   // One key figure (a Figure name such as "gyro_bias_dps.x" or coefficient path "gyro.bias.x")
-  // over time, oldest first; optionally of one serial.
-  std::vector<TrendPoint> Trend(const std::string& figure, const std::string& serial);
+  // over time, oldest first; optionally of one serial, of one station (its drift).
+  std::vector<TrendPoint> Trend(const std::string& figure, const std::string& serial,
+                                const std::string& station = "");
   // One key figure (name or coefficient path, as Trend) of every unit of every lot, each unit by
   // its latest fit in the lot (the fit Yield() counts), fitted units only; by lot, then unit.
   std::vector<LotValue> LotValues(const std::string& figure);
+  // The same for several figures in one pass (the lot page's trends), by lot, then unit.
+  std::vector<LotValue> LotValues(const std::vector<std::string>& figures);
 
  private:
   void Open();  // schema, version check, migration
