@@ -11,7 +11,10 @@
 //   read + parse of the .csv.gz   >= 1 x the single-core parse of the plain .csv (MB/s of CSV)
 //   imufit fit peak memory        < 100 MB
 //
-// Usage: fit_bench [--keep DIR]   (the run is simulated into DIR, default a temp dir)
+// Usage: fit_bench [--keep DIR] [--parse-only THREADS]
+//   --keep DIR            the run is simulated into DIR (default a temp dir), kept for the next
+//   --parse-only THREADS  only parses DIR's run once (0: one reader; N: blocks on N threads), for
+//                         a profiler (perf record fit_bench --keep DIR --parse-only 1)
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -19,6 +22,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -123,8 +127,10 @@ void Row(const char* what, double seconds, double ratio, const char* of, const c
 
 int main(int argc, char** argv) {
   fs::path dir;
+  int parse_only = -1;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--keep") == 0 && i + 1 < argc) dir = argv[++i];
+    if (std::strcmp(argv[i], "--parse-only") == 0 && i + 1 < argc) parse_only = std::atoi(argv[++i]);
   }
   const bool temporary = dir.empty();
   if (temporary) dir = fs::temp_directory_path() / ("imufit_fit_bench_" + std::to_string(getpid()));
@@ -154,6 +160,12 @@ int main(int argc, char** argv) {
     std::printf("simulated %s in %.2f s\n", samples_path.c_str(), Seconds(start));
   }
   if (!fs::exists(gzip_path)) Compress(samples_path, gzip_path);
+  if (parse_only >= 0) {
+    const auto start = std::chrono::steady_clock::now();
+    Parse(samples_path, parse_only);
+    std::printf("parsed on %d threads in %.3f s\n", parse_only, Seconds(start));
+    return 0;
+  }
   long rss = 0;
 
   // Yardsticks: a plain read pass, coreutils' sha256sum.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <unordered_set>
+#include <utility>
 
 #include "byte_source.h"
 #include "imufit/io/error.h"
@@ -115,6 +116,7 @@ CsvReader::CsvReader(std::string path, Sha256* raw_digest, const CsvDialect& dia
   errno = 0;
   source_ = std::make_unique<Source>(path_, raw_digest);
   buffer_.resize(kBlockBytes);
+  text_ = buffer_.data();
   std::string_view line;
   while (NextLine(&line)) {
     if (line_number_ == 1) SkipByteOrderMark(&line);
@@ -151,7 +153,7 @@ CsvReader::CsvReader(std::string path, Sha256* raw_digest, const CsvDialect& dia
 CsvReader::CsvReader(const CsvReader& header_of, std::string_view rows, long line_before)
     : path_(header_of.path_),
       dialect_(header_of.dialect_),
-      buffer_(rows.begin(), rows.end()),
+      text_(rows.data()),
       end_(rows.size()),
       eof_(true),
       line_number_(line_before),
@@ -253,7 +255,7 @@ void CsvReader::TooManyFields() const {
 
 bool CsvReader::NextLine(std::string_view* line) {
   for (;;) {
-    const char* start = buffer_.data() + begin_;
+    const char* start = text_ + begin_;
     const void* newline = std::memchr(start, '\n', end_ - begin_);
     if (newline != nullptr) {
       const char* stop = static_cast<const char*>(newline);
@@ -261,7 +263,7 @@ bool CsvReader::NextLine(std::string_view* line) {
       *line = std::string_view(start, stop - start);
       if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
       bytes_read_ += (stop - start) + 1;
-      begin_ = (stop - buffer_.data()) + 1;
+      begin_ = (stop - text_) + 1;
       ++line_number_;
       return true;
     }
@@ -288,31 +290,56 @@ void CsvReader::Refill() {
   begin_ = 0;
   end_ = partial;
   if (end_ == buffer_.size()) buffer_.resize(std::min(buffer_.size() * 2, kMaxLineBytes + 2));
+  text_ = buffer_.data();
   const size_t got = source_->Read(buffer_.data() + end_, buffer_.size() - end_);
   if (got == 0) eof_ = true;
   end_ += got;
 }
 
-bool CsvReader::NextBlock(std::string_view* rows, long* line_before) {
-  *line_before = line_number_;
+bool CsvReader::NextBlock(std::string* rows, size_t bytes) {
+  if (read_error_) std::rethrow_exception(std::exchange(read_error_, nullptr));
+  // The partial line the last block left (or what reading the header left), then the file's bytes.
+  rows->assign(text_ + begin_, end_ - begin_);
+  begin_ = end_ = 0;
+  // After the last newline in rows (0 when there is none).
+  const auto end_of_lines = [rows] {
+    const void* newline = rows->empty() ? nullptr : ::memrchr(rows->data(), '\n', rows->size());
+    return newline == nullptr ? 0 : static_cast<size_t>(static_cast<const char*>(newline) - rows->data() + 1);
+  };
+  size_t last_line_end = 0;
   for (;;) {
-    const char* start = buffer_.data() + begin_;
-    const size_t size = end_ - begin_;
-    const void* last_newline = size > 0 ? ::memrchr(start, '\n', size) : nullptr;
-    const size_t take = last_newline != nullptr ? static_cast<const char*>(last_newline) - start + 1
-                        : eof_                  ? size
-                                                : 0;
-    if (take > 0) {
-      *rows = std::string_view(start, take);
-      begin_ += take;
-      bytes_read_ += static_cast<long long>(take);
-      line_number_ +=
-          static_cast<long>(std::count(rows->begin(), rows->end(), '\n')) + (rows->back() != '\n');
+    last_line_end = end_of_lines();
+    // Full enough, or one line longer than any may be: it goes on as it is, to fail at its place.
+    if (eof_ || (last_line_end > 0 && rows->size() >= bytes) || rows->size() > kMaxLineBytes) break;
+    const size_t have = rows->size();
+    rows->resize(std::max(bytes, have + have / 2));
+    try {
+      size_t got = 0;
+      while (have + got < rows->size() && !eof_) {
+        const size_t n = source_->Read(rows->data() + have + got, rows->size() - have - got);
+        eof_ = n == 0;
+        got += n;
+      }
+      rows->resize(have + got);
+    } catch (...) {
+      // A read error comes after the whole lines read before it, as NextRow() reads them.
+      read_error_ = std::current_exception();
+      rows->resize(have);
+      eof_ = true;
+      rows->resize(end_of_lines());
+      if (rows->empty()) std::rethrow_exception(std::exchange(read_error_, nullptr));
+      bytes_read_ += static_cast<long long>(rows->size());
       return true;
     }
-    if (eof_) return false;
-    Refill();
   }
+  if (!eof_ && last_line_end > 0) {  // the partial last line waits for the next block
+    buffer_.assign(rows->begin() + last_line_end, rows->end());
+    text_ = buffer_.data();
+    end_ = buffer_.size();
+    rows->resize(last_line_end);
+  }
+  bytes_read_ += static_cast<long long>(rows->size());
+  return !rows->empty();
 }
 
 void CsvReader::SplitLine(std::string_view line) {
