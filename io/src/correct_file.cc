@@ -4,12 +4,16 @@
 #include <stdexcept>
 
 #include "imufit/io/output_file.h"
+#include "imufit/io/parallel_samples.h"
 
 namespace imufit {
 
-CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
-                                 const std::function<void(const Sample& corrected)>& sink) {
-  RefuseCorrectedSamples(*reader);
+namespace {
+
+// CorrectSamples over `reader`, a SamplesReader or a ParallelSamplesReader.
+template <typename Reader>
+CorrectFileReport CorrectEach(const Calibration& calibration, Reader* reader,
+                              const std::function<void(const Sample& corrected)>& sink) {
   CorrectFileReport report;
   Sample raw;
   Sample corrected;
@@ -36,6 +40,14 @@ CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* 
     ++report.samples;
   }
   return report;
+}
+
+}  // namespace
+
+CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
+                                 const std::function<void(const Sample& corrected)>& sink) {
+  RefuseCorrectedSamples(*reader);
+  return CorrectEach(calibration, reader, sink);
 }
 
 std::string CorrectedByComment(const Calibration& calibration, const std::string& calibration_sha256,
@@ -65,8 +77,10 @@ CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::
   std::string comment = SerialComment(reader.serial(), samples_path);
   if (!corrected_by.empty()) comment += (comment.empty() ? "" : "\n") + corrected_by;
   SamplesWriter writer(output_path, reader.has_segment(), comment);
+  RefuseCorrectedSamples(reader);
+  ParallelSamplesReader parallel(&reader);  // parsed on the other core while this one corrects
   const CorrectFileReport report =
-      CorrectSamples(calibration, &reader, [&writer](const Sample& corrected) { writer.Write(corrected); });
+      CorrectEach(calibration, &parallel, [&writer](const Sample& corrected) { writer.Write(corrected); });
   writer.Commit();
   return report;
 }

@@ -1,29 +1,36 @@
 #include "imufit/io/parallel_samples.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <exception>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 #include "imufit/io/error.h"
+#include "imufit/model/check.h"
 
 namespace imufit {
 
-// A block of the file: its text, where it starts, and what its parse gave (the samples with their
-// lines, then the error that stopped it, if one did).
+// A block of the file: its text, and what its parse gave: the samples with their lines (counted
+// from the block's start: the lines before it are known only when it is handed on), the number of
+// lines it holds, whether a row stopped it, and the read error after its rows, if one came.
+// Blocks are reused, so that their memory is allocated (and paged in) once.
 struct ParallelSamplesReader::Block {
   std::string rows;
-  long line_before = 0;
+  bool first = false;  // the file's first block
   std::vector<Sample> samples;
-  std::vector<long> lines;
-  std::exception_ptr error;
+  std::vector<uint32_t> lines;
+  long line_count = 0;
+  bool row_error = false;  // the parse stopped at a row: parsed again, located, when handed on
+  std::exception_ptr read_error;
 };
 
 namespace {
 
-// The bytes of a CSV row of samples, at least: to reserve for a block's samples.
-constexpr size_t kMinRowBytes = 24;
+// The CSV text of a block: small enough to stay in cache with its samples, large enough that
+// handing blocks between threads costs nothing.
+constexpr size_t kBlockBytes = 1 << 20;
 
 }  // namespace
 
@@ -45,42 +52,55 @@ SamplesReader::SamplesReader(const SamplesReader& header_of, std::string_view ro
 }
 
 ParallelSamplesReader::ParallelSamplesReader(SamplesReader* header, int threads)
-    : header_(header), threads_(std::max(threads, 1)) {}
+    : header_(header), threads_(std::max(threads, 1)), line_before_(header->line_number()) {}
 
 ParallelSamplesReader::~ParallelSamplesReader() = default;  // waits for the blocks in flight
 
+void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
+  block->samples.clear();
+  block->lines.clear();
+  block->row_error = false;
+  try {
+    SamplesReader reader(header, block->rows, 0, std::nullopt, block->first);
+    Sample sample;
+    while (reader.Next(&sample)) {
+      block->samples.push_back(sample);
+      block->lines.push_back(static_cast<uint32_t>(reader.line_number()));
+    }
+    block->line_count = reader.line_number();
+  } catch (const InputError&) {
+    block->row_error = true;
+  }
+}
+
 bool ParallelSamplesReader::Launch() {
   if (end_of_file_) return false;
-  auto block = std::make_unique<Block>();
+  std::unique_ptr<Block> block;
+  if (free_.empty()) {
+    block = std::make_unique<Block>();
+  } else {
+    block = std::move(free_.back());
+    free_.pop_back();
+  }
+  block->read_error = nullptr;
+  block->rows.clear();
   try {
-    std::string_view rows;
-    if (!header_->csv_.NextBlock(&rows, &block->line_before)) {
+    if (!header_->csv_.NextBlock(&block->rows, kBlockBytes)) {
       end_of_file_ = true;
+      free_.push_back(std::move(block));
       return false;
     }
-    block->rows.assign(rows);
   } catch (...) {
     // A read error comes after the rows before it: it waits in line with their blocks.
-    block->error = std::current_exception();
+    block->read_error = std::current_exception();
+    block->rows.clear();
     end_of_file_ = true;
   }
-  const SamplesReader* header = header_;
-  const bool first_block = !launched_;
+  block->first = !launched_;
   launched_ = true;
-  auto parse = [header, first_block, block = std::move(block)]() mutable {
-    if (block->error) return std::move(block);
-    try {
-      SamplesReader reader(*header, block->rows, block->line_before, std::nullopt, first_block);
-      block->samples.reserve(block->rows.size() / kMinRowBytes);
-      block->lines.reserve(block->rows.size() / kMinRowBytes);
-      Sample sample;
-      while (reader.Next(&sample)) {
-        block->samples.push_back(sample);
-        block->lines.push_back(reader.line_number());
-      }
-    } catch (...) {
-      block->error = std::current_exception();
-    }
+  const SamplesReader* header = header_;
+  auto parse = [header, block = std::move(block)]() mutable {
+    if (!block->rows.empty()) Parse(*header, block.get());
     return std::move(block);
   };
   in_flight_.push_back(
@@ -89,6 +109,10 @@ bool ParallelSamplesReader::Launch() {
 }
 
 bool ParallelSamplesReader::Advance() {
+  if (current_ != nullptr) {
+    line_before_ += current_->line_count;
+    free_.push_back(std::move(current_));
+  }
   while (static_cast<int>(in_flight_.size()) < threads_ && Launch()) {
   }
   if (in_flight_.empty()) return false;
@@ -96,23 +120,36 @@ bool ParallelSamplesReader::Advance() {
   in_flight_.pop_front();
   next_ = 0;
   Launch();  // the next block parses while this one is handed on
+  if (current_->rows.empty()) std::rethrow_exception(current_->read_error);
   // The block's first row against the last row before it: when its time does not increase (or
   // the row has an error of its own), parse it again after that row, as one reader would have.
   if (last_time_s_ && (current_->samples.empty() || !(current_->samples.front().time_s > *last_time_s_))) {
-    SamplesReader first_row(*header_, current_->rows, current_->line_before, last_time_s_);
+    SamplesReader first_row(*header_, current_->rows, line_before_, last_time_s_);
     Sample sample;
     first_row.Next(&sample);
   }
   return true;
 }
 
+void ParallelSamplesReader::EndOfBlock() const {
+  if (current_->row_error) {
+    // Parsed again where its lines are known, it throws its error at its place.
+    SamplesReader reader(*header_, current_->rows, line_before_, std::nullopt, current_->first);
+    Sample sample;
+    while (reader.Next(&sample)) {
+    }
+    IMUFIT_CHECK(false, "a block's row error is not found again");
+  }
+  if (current_->read_error) std::rethrow_exception(current_->read_error);
+}
+
 bool ParallelSamplesReader::Next(Sample* sample) {
   while (current_ == nullptr || next_ == current_->samples.size()) {
-    if (current_ != nullptr && current_->error) std::rethrow_exception(current_->error);
+    if (current_ != nullptr) EndOfBlock();
     if (!Advance()) return false;
   }
   *sample = current_->samples[next_];
-  line_ = current_->lines[next_];
+  line_ = line_before_ + current_->lines[next_];
   ++next_;
   last_time_s_ = sample->time_s;
   return true;

@@ -1,6 +1,8 @@
 #include "imufit/io/samples.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <iterator>
@@ -133,6 +135,7 @@ bool SamplesReader::Next(Sample* sample) {
 }
 
 void SamplesReader::CheckTemperature(double temp_c) const {
+  if (temp_c >= kMinPlausibleTempC && temp_c <= kMaxPlausibleTempC) return;  // without a call, per row
   if (const std::string problem = TemperatureProblem(temp_c, rows_ == 1); !problem.empty())
     csv_.Fail(temp_column_, problem);
 }
@@ -253,24 +256,29 @@ SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std:
 }
 
 void SamplesWriter::Write(const Sample& sample) {
-  file_.WriteNumber(sample.time_s);
-  if (columns_.temp) {
-    file_.Write(",");
-    file_.WriteNumber(sample.temp_c);
-  }
+  // The row is formatted in one buffer and written at once: a write per field costs more than the
+  // numbers' formatting. Non-finite numbers are spelled as WriteNumber spells them.
+  char row[kMaxRowBytes];
+  char* end = row;
+  const auto number = [&end, &row](double value) {
+    if (!std::isfinite(value)) {
+      const std::string text = FormatDouble(value);
+      end = std::copy(text.begin(), text.end(), end);
+    } else {
+      end = std::to_chars(end, row + kMaxRowBytes, value).ptr;
+    }
+    *end++ = ',';
+  };
+  number(sample.time_s);
+  if (columns_.temp) number(sample.temp_c);
   if (columns_.segment) {
-    file_.Write(",");
-    file_.Write(std::to_string(sample.segment));
+    end = std::to_chars(end, row + kMaxRowBytes, sample.segment).ptr;
+    *end++ = ',';
   }
-  for (int axis = 0; axis < 3; ++axis) {
-    file_.Write(",");
-    file_.WriteNumber(sample.gyro(axis));
-  }
-  for (int axis = 0; axis < 3; ++axis) {
-    file_.Write(",");
-    file_.WriteNumber(sample.accel(axis));
-  }
-  file_.Write("\n");
+  for (int axis = 0; axis < 3; ++axis) number(sample.gyro(axis));
+  for (int axis = 0; axis < 3; ++axis) number(sample.accel(axis));
+  end[-1] = '\n';
+  file_.Write(std::string_view(row, end - row));
 }
 
 }  // namespace imufit

@@ -106,12 +106,9 @@ RunWindows RunReader::ReadFile(WindowBuilder* builder, LongestStaticStretch* str
     labeller.emplace(*run.segmentation);
     second_pass.emplace(first_pass_->path(), /*require_segment=*/false, input_.Format());
   }
-  if (second_pass) {
-    ReadSamples(plan_, &*second_pass, &*labeller, builder, stretch);
-  } else {
-    ParallelSamplesReader samples(&*first_pass_);  // a labelled file: parsed on every core
-    ReadSamples(plan_, &samples, nullptr, builder, stretch);
-  }
+  // Parsed on every core.
+  ParallelSamplesReader samples(second_pass ? &*second_pass : &*first_pass_);
+  ReadSamples(plan_, &samples, labeller ? &*labeller : nullptr, builder, stretch);
   run.samples_sha256 = digest_.HexDigest();  // the first pass has read the whole file
   return run;
 }

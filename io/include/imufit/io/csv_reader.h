@@ -15,6 +15,7 @@
 #define IMUFIT_IO_CSV_READER_H_
 
 #include <algorithm>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,6 +52,7 @@ class CsvReader {
   explicit CsvReader(std::string path, Sha256* raw_digest = nullptr, const CsvDialect& dialect = {});
   // Reads `rows`, lines of the file of `header_of` after its line `line_before`, with its header
   // and dialect (parallel_samples.h parses the blocks of one file in several of these at once).
+  // `rows` is read where it is, not copied: it must outlive the reader.
   CsvReader(const CsvReader& header_of, std::string_view rows, long line_before);
   ~CsvReader();
   CsvReader(const CsvReader&) = delete;
@@ -89,10 +91,13 @@ class CsvReader {
   // Field `column` as an integer; an empty field gives `if_empty`.
   long Integer(int column, long if_empty) const;
 
-  // The next block of whole lines, at least one and at most a read block's worth, in `rows` (the
-  // file's text, newlines and all; valid until the next call); `line_before` gets the number of
-  // the line before its first. False at the end. Read either blocks or rows after the header.
-  bool NextBlock(std::string_view* rows, long* line_before);
+  // Replaces `rows` with the next block of whole lines of the file's text (newlines and all): at
+  // least `bytes` when the file has them, more to end at a line's end (a line longer than
+  // kMaxLineBytes goes as it is, for its reader to refuse at its place). False at the end. A read
+  // error is thrown after the whole lines read before it have been returned. Lines are not counted
+  // (line_number() stays at the header): a block's reader counts its own. Read either blocks or
+  // rows after the header.
+  bool NextBlock(std::string* rows, size_t bytes);
 
   // Throws an InputError located at the current row and `column` (1-based field = column + 1).
   [[noreturn]] void Fail(int column, const std::string& message) const {
@@ -122,8 +127,9 @@ class CsvReader {
   CsvDialect dialect_;
   std::unique_ptr<Source> source_;
   std::vector<char> buffer_;
-  size_t begin_ = 0;  // start of unconsumed bytes in buffer_
-  size_t end_ = 0;    // end of valid bytes in buffer_
+  const char* text_ = nullptr;  // the text read: buffer_'s, or a block's (the constructor for rows)
+  size_t begin_ = 0;            // start of unconsumed bytes in text_
+  size_t end_ = 0;              // end of valid bytes in text_
   bool eof_ = false;
   long line_number_ = 0;
   long header_line_ = 0;  // line number of the header, for errors about columns
@@ -140,6 +146,7 @@ class CsvReader {
   std::vector<std::string_view> fields_;  // the first field_count_ are the current row's
   size_t field_count_ = 0;
   std::vector<std::string> unquoted_;  // storage for fields that had quotes
+  std::exception_ptr read_error_;      // NextBlock's, thrown at its next call
 };
 
 }  // namespace imufit

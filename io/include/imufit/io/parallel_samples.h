@@ -1,12 +1,14 @@
 // imufit — a samples file parsed on several cores, its samples handed on in the file's order.
 //
-// The file is read in blocks of whole lines (a few MiB each, CsvReader::NextBlock); each block is
-// parsed on a thread of its own by a SamplesReader over the block's text, which knows the line
-// number the block starts at. At most `threads` blocks are in flight ahead of the reader's user,
-// so memory stays bounded whatever the file's length. Every error is the one a single SamplesReader
-// gives, at the same line and column, and comes after the samples before it: a block's error is
-// raised when its samples have been handed on, and the first row of each block is checked against
-// the last row of the one before (a time that does not increase).
+// The file is read in blocks of whole lines (1 MiB each, CsvReader::NextBlock) by the calling
+// thread, which also decompresses and hashes; each block is parsed on a thread of its own by a
+// SamplesReader over the block's text, counting its lines from the block's start. At most `threads`
+// blocks are in flight ahead of the reader's user, and their memory is reused, so memory stays
+// bounded whatever the file's length. Every error is the one a single SamplesReader gives, at the
+// same line and column, and comes after the samples before it: a block that stops at a row error is
+// parsed again when its samples have been handed on, knowing its first line, to throw that error
+// at its place; a read error comes after the block before it; and the first row of each block is
+// checked against the last row of the one before (a time that does not increase).
 #ifndef IMUFIT_IO_PARALLEL_SAMPLES_H_
 #define IMUFIT_IO_PARALLEL_SAMPLES_H_
 
@@ -15,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "imufit/io/samples.h"
 
@@ -40,16 +43,22 @@ class ParallelSamplesReader {
 
  private:
   struct Block;
+  // Parses `block` (on a thread of its own): its samples, until a row error.
+  static void Parse(const SamplesReader& header, Block* block);
   // Reads the next block and starts its parse; false at the end of the file.
   bool Launch();
   // Takes the oldest block in flight as the current one; false when there is none.
   bool Advance();
+  // At the end of the current block's samples: throws its error (a row's, located, or a read's).
+  void EndOfBlock() const;
 
   SamplesReader* header_;
   int threads_;
   std::deque<std::future<std::unique_ptr<Block>>> in_flight_;
+  std::vector<std::unique_ptr<Block>> free_;  // blocks handed on, to read the next into
   std::unique_ptr<Block> current_;
-  size_t next_ = 0;  // the next sample of current_
+  long line_before_;  // the line before the current block's first
+  size_t next_ = 0;   // the next sample of current_
   bool end_of_file_ = false;
   bool launched_ = false;  // a block was launched: the next is not the file's first
   std::optional<double> last_time_s_;

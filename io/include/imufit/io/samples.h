@@ -184,6 +184,8 @@ class SamplesWriter {
   void Commit() { file_.Commit(); }
 
  private:
+  // A row's bytes at most: 8 numbers of at most 24 characters and a segment id, with delimiters.
+  static constexpr size_t kMaxRowBytes = 256;
   OutputFile file_;
   SampleColumns columns_;
 };
