@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "imufit/factory/git_revision.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/run/segmentation.h"
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
       "1 the job could not be done, 2 bad invocation or bad input, 3 done but acceptance limits failed.",
       "imufit"};
   app.set_version_flag("--version",
-                       std::string(imufit::SoftwareVersion()) + " (git " + IMUFIT_GIT_REVISION + ")");
+                       std::string(imufit::SoftwareVersion()) + " (git " + imufit::GitRevision() + ")");
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, imufit::CommandRunner>> commands;
   // The subcommand an Add*Command just registered is the last one defined. (get_subcommands()

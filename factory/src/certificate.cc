@@ -7,6 +7,7 @@
 
 #include "certificate_sections.h"
 #include "imufit/factory/engineering_units.h"
+#include "imufit/factory/git_revision.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/sha256.h"
 #include "imufit/model/check.h"
@@ -105,7 +106,7 @@ void Identify(const CertificateSources& sources, Certificate* c) {
   c->written_utc = UtcNow();
   c->calibration_software = cal.software;
   c->report_software = sources.software;
-  c->git_revision = IMUFIT_GIT_REVISION;
+  c->git_revision = GitRevision();
   c->reference_temp_c = cal.model.basis.center_c;
   for (const ReportInput& input : sources.inputs) {
     if (input.path.empty()) continue;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/git_revision.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/output_file.h"
 
@@ -170,7 +171,7 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
   s.lot = lot;
   s.written_utc = UtcNow();
   s.software = software;
-  s.git_revision = IMUFIT_GIT_REVISION;
+  s.git_revision = GitRevision();
   if (limits) s.limits_name = limits->name.empty() ? limits->path : limits->name;
   s.units = static_cast<int>(batch.units.size());
   s.passed = batch.passed;
