@@ -66,6 +66,7 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
   WindowBuilder builder(options, plan_.segments);
   std::optional<LongestStaticStretch> stretch;
   if (keep_static_stretch) stretch.emplace(plan_);
+  const RunHeader header = run_header();
   RunWindows run;
   if (memory_) {
     run = ReadMemory(&builder, stretch ? &*stretch : nullptr);
@@ -73,6 +74,7 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
     run = ReadFile(&builder, stretch ? &*stretch : nullptr);
   }
   run.windows = builder.Finish();
+  run.header = header;
   run.stats = builder.stats();
   if (stretch) run.static_stretch = stretch->Finish();
   return run;
