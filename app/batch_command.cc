@@ -19,6 +19,7 @@ struct BatchArguments {
   FitRunArguments run;  // every unit is fitted with these, as imufit fit would fit it
   bool no_report = false;
   PdfArguments pdf;
+  CustomerArguments customer;
   bool quiet = false;
   std::string shard;  // --shard I/N, auto, auto/N
 };
@@ -54,6 +55,9 @@ int RunBatchCommand(BatchArguments args) {
   if (args.pdf.pdf && args.no_report)
     throw InputError("--pdf", "prints the certificates: leave out --no-report");
   options.paper = args.pdf.Resolve();
+  args.customer.Check();
+  options.customer = args.customer.customer;
+  options.order = args.customer.order;
   options.write_pdf = args.pdf.pdf;
   if (!args.shard.empty())
     options.shard = ParseShard(args.shard, [](const char* name) { return std::getenv(name); });
@@ -132,6 +136,7 @@ CommandRunner AddBatchCommand(CLI::App* root) {
       ->capture_default_str();
   command->add_flag("--no-report", args->no_report, "write no report.html per unit");
   AddPdfOptions(command, &args->pdf);
+  AddCustomerOptions(command, &args->customer);
   // Not --threads (units run in parallel instead) nor a check run (a lot has no held-out runs).
   AddFitRunOptions(command, &args->run, {"threads", "check_samples", "check_plan"});
   command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");

@@ -107,6 +107,15 @@ struct PdfArguments {
 };
 void AddPdfOptions(CLI::App* command, PdfArguments* args);
 
+// --customer and --order: whom a certificate is issued to (report_command.cc; fit --report, report
+// and batch share them).
+struct CustomerArguments {
+  std::string customer, order;
+  // Throws InputError naming the option for a value that is not one line of printable text.
+  void Check() const;
+};
+void AddCustomerOptions(CLI::App* command, CustomerArguments* args);
+
 // Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
 // failed its acceptance limits (or, in a batch, could not be fitted).
 inline constexpr int kExitFailedLimits = 3;

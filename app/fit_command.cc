@@ -22,13 +22,14 @@ struct FitArguments {
   std::string samples;
   std::string output;
   bool quiet = false;
-  std::string limits;   // acceptance limits: verdict table, exit 3 when they fail
-  std::string report;   // certificate HTML to write
-  std::string store;    // results store to record the fit in
-  std::string serial;   // the unit's serial; empty: the samples header's, else the plan's
-  std::string station;  // station file shown on the certificate (with --report)
-  PdfArguments pdf;     // the certificate printed too (with --report)
-  FitRunArguments run;  // the fit options, shared with imufit batch
+  std::string limits;          // acceptance limits: verdict table, exit 3 when they fail
+  std::string report;          // certificate HTML to write
+  std::string store;           // results store to record the fit in
+  std::string serial;          // the unit's serial; empty: the samples header's, else the plan's
+  std::string station;         // station file shown on the certificate (with --report)
+  PdfArguments pdf;            // the certificate printed too (with --report)
+  CustomerArguments customer;  // printed on the certificate (with --report)
+  FitRunArguments run;         // the fit options, shared with imufit batch
 };
 
 // A value and its 1-sigma: the sigma goes through the same unit conversion as the value, whose
@@ -119,6 +120,8 @@ CertifySettings ReadFactoryInputs(const FitArguments& args, const FitRunOptions&
   settings.windows = options.windows;
   settings.samples_input = options.input;
   ReadLimitsAndStation(args.limits, args.station, &settings);
+  settings.customer = args.customer.customer;
+  settings.order = args.customer.order;
   if (!args.store.empty()) {
     *store = std::make_unique<ResultsStore>(args.store);
     settings.store = store->get();
@@ -254,6 +257,10 @@ int RunFit(const FitArguments& args) {
   }
   if (args.pdf.pdf && args.report.empty())
     throw InputError("--pdf", "prints the certificate: give --report too");
+  if ((!args.customer.customer.empty() || !args.customer.order.empty()) && args.report.empty())
+    throw InputError(args.customer.customer.empty() ? "--order" : "--customer",
+                     "is shown on the certificate: give --report too");
+  args.customer.Check();
   const Paper paper = args.pdf.Resolve();
   const std::string pdf = args.pdf.pdf ? PdfPathFor(args.report) : "";
   if (!pdf.empty()) {
@@ -325,6 +332,7 @@ CommandRunner AddFitCommand(CLI::App* root) {
   command->add_option("--report", args->report,
                       "write the unit's calibration certificate (self-contained HTML)");
   AddPdfOptions(command, &args->pdf);
+  AddCustomerOptions(command, &args->customer);
   command->add_option(
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");

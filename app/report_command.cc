@@ -1,8 +1,10 @@
 // imufit report — the certificate of a unit from an existing calibration and the run it was
 // fitted to.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include "commands.h"
 #include "imufit/factory/certificate.h"
@@ -28,6 +30,7 @@ struct ReportArguments {
   std::string station;  // station file: where and by whom
   bool allow_mismatch = false;
   PdfArguments pdf;
+  CustomerArguments customer;
   RunReadingArguments run;  // the run is read as imufit fit read it
 };
 
@@ -35,6 +38,7 @@ int RunReport(const ReportArguments& args) {
   RefuseToOverwriteInputs(args.output,
                           {args.calibration, args.plan, args.samples, args.limits, args.station});
   const Paper paper = args.pdf.Resolve();
+  args.customer.Check();
   const std::string pdf = args.pdf.pdf ? PdfPathFor(args.output) : "";
   if (!pdf.empty())
     RefuseToOverwriteInputs(pdf, {args.calibration, args.plan, args.samples, args.limits, args.station});
@@ -75,8 +79,12 @@ int RunReport(const ReportArguments& args) {
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
   sources.samples_input = input;
+  sources.customer = args.customer.customer;
+  sources.order = args.customer.order;
   // Read once for the windows, the hash and the noise section's static stretch.
-  sources.run = RunReader(sources.plan, args.samples, input).Read(windows, /*keep_static_stretch=*/true);
+  RunReader reader(sources.plan, args.samples, input);
+  sources.header = reader.run_header();  // where the calibration's record does not say it
+  sources.run = reader.Read(windows, /*keep_static_stretch=*/true);
   sources.windows = windows;
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},
@@ -109,6 +117,27 @@ Paper PdfArguments::Resolve() const {
       throw std::runtime_error("--pdf: " + problem);
   }
   return value;
+}
+
+void CustomerArguments::Check() const {
+  for (const auto& [name, value] : {std::pair<const char*, const std::string&>{"--customer", customer},
+                                    std::pair<const char*, const std::string&>{"--order", order}}) {
+    if (std::any_of(value.begin(), value.end(),
+                    [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; })) {
+      throw InputError(name, "must be one line of text without control characters");
+    }
+    if (value.size() > kMaxStationTextBytes) {
+      throw InputError(name, "is " + std::to_string(value.size()) + " bytes long; at most " +
+                                 std::to_string(kMaxStationTextBytes) + " fit on a certificate");
+    }
+  }
+}
+
+void AddCustomerOptions(CLI::App* command, CustomerArguments* args) {
+  command->add_option("--customer", args->customer,
+                      "the customer the certificate is issued to (printed on it)");
+  command->add_option("--order", args->order,
+                      "the customer's order or job number (printed on the certificate)");
 }
 
 void AddPdfOptions(CLI::App* command, PdfArguments* args) {
@@ -145,6 +174,7 @@ CommandRunner AddReportCommand(CLI::App* root) {
       "--station", args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
   AddPdfOptions(command, &args->pdf);
+  AddCustomerOptions(command, &args->customer);
   command->add_flag("--allow-mismatch", args->allow_mismatch,
                     "certify even when the calibration records other plan/samples hashes than these files', "
                     "or --serial names another unit than the samples header (the certificate says so)");

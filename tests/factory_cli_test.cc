@@ -29,6 +29,7 @@
 #include <sqlite3.h>
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/io/calibration.h"
 #include "imufit/io/sha256.h"
 #include "test_util.h"
 
@@ -1232,6 +1233,101 @@ TEST_F(FactoryCliTest, BatchFitsAStaticOnlyLotWithFitAccelAndRedoesUnitsWhenTheO
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "bare_out2"));
+}
+
+// Identity and dates: the samples header's run lines (acquired, model, firmware, ambient) are
+// recorded in the calibration apart from the fit's time and printed with the laboratory, the
+// customer and a certificate number that the same inputs reproduce; the reference equipment's due
+// date is judged against the acquisition, and against the fit's date (said so) without one.
+TEST_F(FactoryCliTest, TheCertificateNamesTheRunTheItemAndTheLaboratory) {
+  Simulate(UnitPlan("unit-01", "SN-01"), kFixtures + "/mems_truth.yaml", Path("run.csv"), 1);
+  const std::string run = ReadBytes(Path("run.csv"));
+  // A page's text with its apostrophes as written (the page escapes them).
+  const auto page = [&](const std::string& name) {
+    return std::regex_replace(ReadBytes(Path(name)), std::regex("&#39;"), "'");
+  };
+  const auto with_header = [&](const std::string& name, const std::string& lines) {
+    return Write(name, lines + run);
+  };
+  const std::string samples = with_header("acquired.csv",
+                                          "# acquired: 2026-01-10T08:15:00Z\n# model: IMU-9X rev B\n"
+                                          "# firmware: 2.4.1\n# ambient: 23.1 degC, 41 %RH\n");
+  std::string station = std::regex_replace(std::string(kStation), std::regex("2099-12-31"), "2026-01-31");
+  station +=
+      "laboratory: Acme Inertial Calibration Laboratory, 12 Dock Road, Bristol\n"
+      "accreditation: UKAS 1234 (ISO/IEC 17025)\n";
+  const std::string station_path = Write("lab.yaml", station);
+  const std::string plan = Path("units/unit-01/plan.yaml");
+  RunResult r =
+      Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal.yaml"), "--station", station_path, "--report",
+           Path("cert.html"), "--customer", "Northwind Avionics", "--order", "PO-7731", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Calibration calibration = ReadCalibration(Path("cal.yaml"));
+  ASSERT_TRUE(calibration.fit && calibration.fit->acquired_utc);
+  EXPECT_EQ(*calibration.fit->acquired_utc, "2026-01-10T08:15:00Z");
+  EXPECT_EQ(calibration.fit->unit_firmware.value_or(""), "2.4.1");
+  EXPECT_NE(calibration.created_utc.substr(0, 10), "2026-01-10");  // the fit's own time, apart
+  const std::string html = ReadBytes(Path("cert.html"));
+  const auto shows = [&](const std::string& page, const std::string& key, const std::string& value) {
+    EXPECT_NE(page.find("data-key=\"" + key + "\">" + value + "<"), std::string::npos) << key;
+  };
+  shows(html, "acquired_utc", "2026-01-10T08:15:00Z");
+  shows(html, "unit_model", "IMU-9X rev B");
+  shows(html, "unit_firmware", "2.4.1");
+  shows(html, "ambient", "23.1 degC, 41 %RH");
+  shows(html, "customer", "Northwind Avionics");
+  shows(html, "order", "PO-7731");
+  shows(html, "laboratory", "Acme Inertial Calibration Laboratory, 12 Dock Road, Bristol");
+  shows(html, "accreditation", "UKAS 1234 (ISO/IEC 17025)");
+  EXPECT_NE(html.find("apply only to the item calibrated"), std::string::npos);
+  // Due 2026-01-31, recorded on 2026-01-10 and fitted later: within its calibration.
+  EXPECT_EQ(html.find("due for calibration"), std::string::npos);
+  const std::regex number_pattern("data-key=\"certificate_number\">(SN-01-20260110-[0-9a-f]{8})<");
+  std::smatch number;
+  ASSERT_TRUE(std::regex_search(html, number, number_pattern)) << "no certificate number";
+
+  // The same inputs give the same number; another order, another number.
+  const auto report_number = [&](const std::string& order) {
+    const std::string out = Path("again_" + order + ".html");
+    const RunResult again =
+        Run({"report", "-c", Path("cal.yaml"), "-p", plan, "-s", samples, "--station", station_path, "-o",
+             out, "--customer", "Northwind Avionics", "--order", order});
+    EXPECT_EQ(again.status, 0) << again.err;
+    const std::string page = ReadBytes(out);
+    std::smatch found;
+    return std::regex_search(page, found, number_pattern) ? found[1].str() : std::string("none");
+  };
+  EXPECT_EQ(report_number("PO-7731"), number[1].str());
+  EXPECT_NE(report_number("PO-7732"), number[1].str());
+
+  // Recorded after the due date: a warning; no acquisition time: judged against the fit's date.
+  r = Run({"fit", "-p", plan, "-s", with_header("late.csv", "# acquired: 2026-02-01 09:00Z\n"), "-o",
+           Path("late.yaml"), "--station", station_path, "--report", Path("late.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string overdue =
+      "the station's reference equipment was due for calibration on 2026-01-31, before this unit's run was "
+      "recorded (2026-02-01)";
+  EXPECT_NE(page("late.html").find(overdue), std::string::npos);
+  ExpectTroubleshootingQuotes(overdue);
+  r = Run({"fit", "-p", plan, "-s", Path("run.csv"), "-o", Path("undated.yaml"), "--station", station_path,
+           "--report", Path("undated.html"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string undated = page("undated.html");
+  EXPECT_NE(undated.find("no '# acquired:' time: the fit's date"), std::string::npos);
+  EXPECT_NE(undated.find("not stated (no '# acquired:' line in the samples header)"), std::string::npos);
+
+  // A time that is not UTC ISO 8601: exit 2 at its line and column, nothing written.
+  r = Run({"fit", "-p", plan, "-s", with_header("bad.csv", "# serial: SN-01\n# acquired: 10/01/2026 08:15\n"),
+           "-o", Path("bad.yaml"), "--report", Path("bad.html")});
+  EXPECT_EQ(r.status, kExitBadInput);
+  EXPECT_NE(r.err.find("bad.csv:2:13: \"10/01/2026 08:15\" is not a UTC time written as ISO 8601"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(Path("bad.yaml")));
+  ExpectTroubleshootingQuotes(r.err);
+  r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("c2.yaml"), "--customer", "X"});
+  EXPECT_EQ(r.status, kExitBadInput);
+  ExpectTroubleshootingQuotes(r.err);
 }
 
 }  // namespace

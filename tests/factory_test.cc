@@ -20,11 +20,13 @@
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/engineering_units.h"
 #include "imufit/factory/html.h"
+#include "imufit/factory/plot.h"
 #include "imufit/factory/report.h"
 #include "imufit/factory/store.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
@@ -451,6 +453,159 @@ TEST_F(CertificateTest, HoldsEveryNumberAQualityEngineerReads) {
   EXPECT_EQ(plots[0].panels[0].series[2].style, PlotSeries::Style::kErrorBars);
   EXPECT_EQ(plots[0].panels[0].series[2].y.size(), c.curves[0].curves[0].points.size());
   EXPECT_EQ(plots[0].panels[0].series[2].error[0], c.curves[0].curves[0].points[0].sigma);
+}
+
+// Written for its reader: criteria and coefficients in words, every value rounded to its U, no
+// developer text (solver strings, file-format references, gnuplot's SVG titles), long paths
+// shortened at a folder, and time-axis tick labels that fit their panel.
+TEST_F(CertificateTest, IsWrittenForItsReader) {
+  EXPECT_EQ(FigureTitle("gyro_bias_dps.x"), "Gyro bias X");
+  EXPECT_EQ(FigureTitle("gyro_g_sensitivity_dpsg.xy"), "Gyro g-sensitivity X from Y");
+  EXPECT_EQ(FigureTitle("accel_misalignment_mrad.zx"), "Accel misalignment Z from X");
+  EXPECT_EQ(FigureTitle("fit_temp_range_c"), "Fitted temperature range");
+  EXPECT_EQ(FigureTitle("something_else.q"), "something_else.q");
+  // GUM 7.2.6: U to two significant digits, the value to the same place.
+  const RoundedValue bias = RoundToUncertainty(7.6412345, 0.00086);
+  EXPECT_EQ(bias.value, "7.64123");
+  EXPECT_EQ(bias.uncertainty, "0.00086");
+  EXPECT_EQ(RoundToUncertainty(0.0712, 0.0021, true).value, "+0.0712");
+  EXPECT_EQ(RoundToUncertainty(1234.6, 96).value, "1235");
+  const RoundedValue carried = RoundToUncertainty(12345, 996);  // U rounds up to 1000: one place fewer
+  EXPECT_EQ(carried.uncertainty, "1000");
+  EXPECT_EQ(carried.value, "12300");
+  EXPECT_EQ(RoundToUncertainty(-0.00004, 0.0021).value, "0.0000");  // no "-0.0000"
+  EXPECT_EQ(RoundToUncertainty(0.5, 0.0).uncertainty, "");
+
+  const std::string limits_path = Write("limits.yaml", kLimits);
+  Certificate c = Make(kFixtures + "/plan_6pos.yaml", ReadLimits(limits_path));
+  const std::string long_path =
+      "/srv/calibration/station-02/2026/lots/LOT-A/unit-0001/acceptance/limits_rev_b.yaml";
+  c.inputs.push_back({"limits", long_path, std::string(64, 'a')});
+  ASSERT_TRUE(c.verdict.has_value());
+  if (!GnuplotAvailable()) GTEST_SKIP() << "no gnuplot on PATH: the page's plots are not drawn";
+  const std::string html = CertificateHtml(c);
+  // What a reader sees: the text outside tags (attributes keep the machine names).
+  std::string text;
+  bool in_tag = false;
+  for (char ch : html) {
+    if (ch == '<') in_tag = true;
+    if (!in_tag) text += ch;
+    if (ch == '>') in_tag = false;
+  }
+  for (const char* developer : {"_dps", "_mg", "_mrad", "dpsg", "docs/spec.md", "tolerance reached",
+                                "Gnuplot", "GNUPLOT", "|gyro", "sigma(gyro"}) {
+    EXPECT_EQ(text.find(developer), std::string::npos) << developer;
+  }
+  EXPECT_NE(text.find("Gyro g-sensitivity X from X"), std::string::npos);
+  EXPECT_NE(text.find("g-sensitivity X from Y"), std::string::npos);
+  EXPECT_NE(text.find("converged after"), std::string::npos);
+  // The only <title> is the document's; no <desc> (tooltips over the plots).
+  EXPECT_EQ(html.find("<title>", html.find("<title>") + 1), std::string::npos);
+  EXPECT_EQ(html.find("<desc>"), std::string::npos);
+  // Each coefficient's value at the decimal place of its U.
+  for (const KeyFigureRow& f : c.figures) {
+    if (!f.is_coefficient || !(f.expanded > 0.0)) continue;
+    const RoundedValue v = RoundToUncertainty(f.value, f.expanded, true);
+    EXPECT_NE(html.find("data-value=\"" + FormatDouble(f.value) + "\">" + v.value + "<"), std::string::npos)
+        << f.name << " " << v.value;
+    EXPECT_NE(html.find(">" + v.uncertainty + "<"), std::string::npos) << f.name;
+  }
+  // The long path: whole folder names after an ellipsis, the whole path kept for tools.
+  EXPECT_NE(text.find("\xe2\x80\xa6/\xe2\x80\x8b"), std::string::npos);
+  EXPECT_NE(text.find("limits_rev_b.yaml"), std::string::npos);
+  EXPECT_EQ(text.find("/srv/"), std::string::npos);
+  EXPECT_NE(html.find("data-path=\"" + long_path + "\""), std::string::npos);
+
+  // A time axis of 0 .. 1300 s in a third of the page: the labels of 250 s steps would collide.
+  PlotFigure grid;
+  grid.rows = 3;
+  grid.cols = 3;
+  grid.width_px = 700;
+  grid.height_px = 480;
+  Plot time_panel;
+  time_panel.max_x_tics = 7;
+  PlotSeries s;
+  s.x = {0.0, 650.0, 1300.0};
+  s.y = {0.0, 1.0, 2.0};
+  time_panel.series = {s};
+  grid.panels = {time_panel};
+  const std::string script = GnuplotScript(grid, "svg", "out.svg");
+  const size_t at = script.find("set xtics ");
+  ASSERT_NE(at, std::string::npos) << script;
+  EXPECT_GE(std::stod(script.substr(at + 10)), 500.0) << script.substr(at, 20);
+}
+
+// Limits as specifications are written: the largest value and the variation over a temperature
+// range (checked against the polynomial evaluated here on a finer grid), the worst window error at
+// any temperature, and a noise term this run cannot resolve, which says what stretch it needs.
+TEST_F(CertificateTest, LimitsOverATemperatureRangeAndTermsTheRunCannotResolve) {
+  const std::string limits_path = Write("range_limits.yaml", R"(format: imufit-limits
+version: 1
+criteria:
+  - {quantity: gyro_bias_dps, statistic: largest, over: [-40, 85], max_abs: 100, axes: [x]}
+  - {quantity: gyro_bias_dps, statistic: variation, max_abs: 100, axes: [x]}
+  - {quantity: gyro_residual_max_dps, max_abs: 1}
+  - {quantity: gyro_arw_deg_per_sqrt_hr, max_abs: 1, axes: [x]}
+)");
+  const Certificate c = Make(kFixtures + "/plan_6pos.yaml", ReadLimits(limits_path));
+  ASSERT_TRUE(c.verdict.has_value());
+  ASSERT_EQ(c.verdict->criteria.size(), 4u);
+  const CriterionResult& largest = c.verdict->criteria[0];
+  const CriterionResult& variation = c.verdict->criteria[1];
+  EXPECT_EQ(largest.title, "Gyro bias X, largest over -40..85 degC");
+  // By hand: the polynomial on a grid four times finer than the evaluation's.
+  double most = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
+  const Calibration fitted =
+      FitRun(kFixtures + "/plan_6pos.yaml", kFixtures + "/mems_6pos_soak.csv.gz", FitRunOptions())
+          .calibration.value();
+  for (int i = 0; i <= 1000; ++i) {
+    const double temp_c = -40.0 + 125.0 * i / 1000.0;
+    const double v = FindFigure(KeyFigures(fitted, temp_c), "gyro_bias_dps.x")->value;
+    most = std::max(most, std::abs(v));
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  constexpr double kGridRelative = 1e-3;  // the evaluation's coarser grid misses the peak by less
+  EXPECT_NEAR(largest.measured, most, kGridRelative * most);
+  EXPECT_LE(largest.measured, most * (1.0 + 1e-12));
+  const auto& range = fitted.fit_temp_range_c;
+  EXPECT_NE(largest.reason.find(" degC"), std::string::npos) << largest.reason;  // where it binds
+  double flo = HUGE_VAL, fhi = -HUGE_VAL;
+  for (int i = 0; i <= 1000; ++i) {
+    const double v =
+        FindFigure(KeyFigures(fitted, range[0] + (range[1] - range[0]) * i / 1000.0), "gyro_bias_dps.x")
+            ->value;
+    flo = std::min(flo, v);
+    fhi = std::max(fhi, v);
+  }
+  EXPECT_NEAR(variation.measured, fhi - flo, kGridRelative * (fhi - flo));
+  EXPECT_EQ(variation.expanded, -1.0);
+  // The worst window at any temperature is the per-segment table's.
+  EXPECT_EQ(c.verdict->criteria[2].measured, c.residual_table.back().gyro_max_dps);
+  // A 6-position soak has no minute-long static stretch: the ARW is not resolved, and says why.
+  const CriterionResult& arw = c.verdict->criteria[3];
+  EXPECT_FALSE(arw.pass);
+  EXPECT_EQ(arw.measured_text, "not resolved by this run");
+  EXPECT_NE(arw.reason.find("needs a static stretch of 60 s"), std::string::npos) << arw.reason;
+  EXPECT_NE(arw.reason.find("imufit allan --noise-yaml"), std::string::npos) << arw.reason;
+
+  // The reader: a range needs a range statistic; a variation has no min/max; noise has no curve.
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"{quantity: gyro_bias_dps, over: [-40, 85], max_abs: 1}", "a range takes `statistic: largest`"},
+      {"{quantity: gyro_bias_dps, statistic: variation, min: -1, max: 1}", "a variation takes max_abs"},
+      {"{quantity: gyro_arw_deg_per_sqrt_hr, statistic: largest, max_abs: 1}",
+       "does not vary with temperature"},
+      {"{quantity: gyro_bias_dps, statistic: largest, over: [85, -40], max_abs: 1}", "lo < hi"}};
+  for (const auto& [criterion, message] : bad) {
+    const std::string path =
+        Write("bad_range.yaml", "format: imufit-limits\nversion: 1\ncriteria:\n  - " + criterion + "\n");
+    try {
+      ReadLimits(path);
+      ADD_FAILURE() << criterion;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
 }
 
 // The window estimates of every coefficient on a run with white noise only, simulated from the

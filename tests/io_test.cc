@@ -25,6 +25,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/parallel_samples.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/run_header.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
@@ -1144,6 +1145,32 @@ TEST_F(IoTest, TemporaryOutputsAreRemovedOnSigtermSigintSighup) {
     EXPECT_EQ(WTERMSIG(status), signal_number);
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 0)
         << "temporary file left behind after signal " << signal_number;
+  }
+}
+
+// The run header's times: the ISO 8601 forms a logger writes in UTC, one normal form; local times,
+// impossible dates and times are refused.
+TEST(RunHeader, AcquiredIsAUtcTimeInOneForm) {
+  EXPECT_EQ(NormalisedUtc("2026-11-20T14:03:00Z"), "2026-11-20T14:03:00Z");
+  EXPECT_EQ(NormalisedUtc("2026-11-20T14:03Z"), "2026-11-20T14:03:00Z");
+  EXPECT_EQ(NormalisedUtc("2026-11-20 14:03:07.250Z"), "2026-11-20T14:03:07Z");
+  EXPECT_EQ(NormalisedUtc("2026-11-20T14:03:07+00:00"), "2026-11-20T14:03:07Z");
+  for (const char* bad :
+       {"2026-11-20T14:03:00", "2026-11-20T14:03:00+01:00", "2026-02-30T10:00Z", "2026-11-20T24:00Z",
+        "2026-11-20T14:3Z", "20/11/2026 14:03", "2026-11-20T14:03:00.Z"}) {
+    EXPECT_EQ(NormalisedUtc(bad), "") << bad;
+  }
+  const std::string path = "run.csv";
+  const RunHeader header = RunHeaderOf(
+      path, {{1, 3, "serial: SN1"}, {2, 3, "acquired: 2026-11-20T14:03Z"}, {3, 3, "firmware: 2.4.1"}});
+  EXPECT_EQ(header.acquired_utc, "2026-11-20T14:03:00Z");
+  EXPECT_EQ(header.firmware, "2.4.1");
+  EXPECT_EQ(header.model, "");
+  try {
+    RunHeaderOf(path, {{4, 3, "model: A"}, {5, 3, "model: B"}});
+    ADD_FAILURE() << "two models";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "run.csv:5:10: a second model \"B\" after \"A\"");
   }
 }
 

@@ -49,7 +49,224 @@ void Decide(const Verdict& verdict, CriterionResult* r) {
   }
 }
 
+// What a criterion is judged with beside its figures.
+struct Context {
+  const Limits& limits;
+  const Calibration& calibration;
+  const UncertaintyBudget* budget;  // nullptr: U = 2 x 1-sigma
+};
+
+// One figure's reading for a criterion: the value judged (a scale error relative to the nominal
+// scale; the 1-sigma for a sigma criterion) and its U.
+struct Reading {
+  bool found = false;
+  double value = 0.0;
+  double expanded = -1.0;  // < 0: none
+  bool extrapolated = false;
+  std::string unresolved;  // Figure::unresolved
+};
+
+Reading Read(const Context& context, const std::string& name, bool sigma, const std::vector<Figure>& figures,
+             const UncertaintyBudget* budget) {
+  // U of a figure: the budget's, else k = 2 times its 1-sigma; < 0: none.
+  const auto expanded = [&](const Figure& f) {
+    const FigureBudget* b = budget != nullptr ? budget->Find(f.name) : nullptr;
+    return b != nullptr ? b->expanded : f.sigma >= 0.0 ? 2.0 * f.sigma : -1.0;
+  };
+  Reading reading;
+  // Scale errors are relative to the nominal scale the limits file gives.
+  if (name.find("_scale_error_") != std::string::npos) {
+    const bool gyro = name.rfind("gyro", 0) == 0;
+    const std::string axis = name.substr(name.rfind('.') + 1);
+    const Figure* scale = FindFigure(figures, std::string(gyro ? "gyro" : "accel") + ".scale." + axis);
+    const double nominal = gyro ? context.limits.nominal_gyro_scale / kRadToDeg
+                                : context.limits.nominal_accel_scale * kStandardGravityMps2;
+    const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
+    reading.value = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
+    if (!sigma && expanded(*scale) >= 0.0) reading.expanded = expanded(*scale) / nominal * factor;
+    reading.extrapolated = scale->extrapolated;
+    reading.found = !sigma || scale->sigma >= 0.0;
+    return reading;
+  }
+  // A figure this run could not resolve gives way to one of the same name that is known (a
+  // calibration's `noise:` block).
+  const Figure* figure = nullptr;
+  for (const Figure& f : figures) {
+    if (f.name != name && f.coefficient != name) continue;
+    if (f.unresolved.empty()) {
+      figure = &f;
+      break;
+    }
+    if (reading.unresolved.empty()) reading.unresolved = f.unresolved;
+  }
+  reading.found = figure != nullptr && (!sigma || figure->sigma >= 0.0);
+  if (!reading.found) return reading;
+  reading.value = sigma ? figure->sigma : figure->value;
+  if (!sigma) reading.expanded = expanded(*figure);
+  reading.extrapolated = figure->extrapolated;
+  return reading;
+}
+
+// A statistic over a temperature range (LimitStatistic::kLargest, kVariation), the polynomial
+// evaluated at kRangeStatisticPoints temperatures: the value that binds, with its U there (2 x its
+// 1-sigma: the budget is at 25 degC), and `*at_c`, where; for a variation, largest - smallest, without
+// a U (the errors of its ends are correlated).
+Reading ReadOverRange(const Context& context, const LimitCriterion& criterion, const std::string& name,
+                      double* at_c) {
+  const std::array<double, 2> range = criterion.over_c.value_or(context.calibration.fit_temp_range_c);
+  Reading lowest, highest, largest;
+  double lowest_c = range[0], highest_c = range[0], largest_c = range[0];
+  for (int i = 0; i < kRangeStatisticPoints; ++i) {
+    const double temp_c = range[0] + (range[1] - range[0]) * i / (kRangeStatisticPoints - 1);
+    const Reading r = Read(context, name, false, KeyFigures(context.calibration, temp_c), nullptr);
+    if (!r.found) return r;
+    if (i == 0 || r.value < lowest.value) lowest = r, lowest_c = temp_c;
+    if (i == 0 || r.value > highest.value) highest = r, highest_c = temp_c;
+    if (i == 0 || std::abs(r.value) > std::abs(largest.value)) largest = r, largest_c = temp_c;
+  }
+  const auto& fitted = context.calibration.fit_temp_range_c;
+  const bool beyond = range[0] < fitted[0] || range[1] > fitted[1];
+  if (criterion.statistic == LimitStatistic::kVariation) {
+    Reading variation = highest;
+    variation.value = highest.value - lowest.value;
+    variation.expanded = -1.0;
+    variation.extrapolated = beyond;
+    *at_c = highest_c;
+    return variation;
+  }
+  Reading binding = largest;
+  *at_c = largest_c;
+  if (criterion.min || criterion.max) {  // the side nearer its bound
+    const double above_min = criterion.min ? lowest.value - *criterion.min : HUGE_VAL;
+    const double below_max = criterion.max ? *criterion.max - highest.value : HUGE_VAL;
+    binding = below_max <= above_min ? highest : lowest;
+    *at_c = below_max <= above_min ? highest_c : lowest_c;
+  }
+  binding.extrapolated = beyond;
+  return binding;
+}
+
+// "largest over -40..85 degC" (the range a statistic is taken over), "" for a value at 25 degC.
+std::string RangeText(const LimitCriterion& criterion, const Calibration& calibration) {
+  if (criterion.statistic != LimitStatistic::kLargest && criterion.statistic != LimitStatistic::kVariation)
+    return "";
+  const std::array<double, 2> range = criterion.over_c.value_or(calibration.fit_temp_range_c);
+  return std::string(criterion.statistic == LimitStatistic::kLargest ? "largest" : "variation") + " over " +
+         Number(range[0]) + ".." + Number(range[1]) + " degC";
+}
+
+// The name and the words of a criterion on one figure (`name`, with its axis), and its limit.
+CriterionResult Named(const LimitCriterion& criterion, const std::string& name,
+                      const std::string& range_text) {
+  const bool sigma = criterion.statistic == LimitStatistic::kSigma;
+  const bool bounds = criterion.min || criterion.max;
+  CriterionResult r;
+  r.name = sigma                 ? "sigma(" + name + ")"
+           : !range_text.empty() ? range_text.substr(0, range_text.find(' ')) + "(" + name + ")"
+           : bounds || criterion.kind == LimitKind::kFigure ? name
+                                                            : "|" + name + "|";
+  r.title = FigureTitle(name) + (sigma ? ", 1-sigma" : range_text.empty() ? "" : ", " + range_text);
+  r.unit = criterion.unit;
+  r.limit = criterion.max_abs;
+  r.limit_text = "< " + Number(criterion.max_abs) + " " + criterion.unit;
+  if (bounds) {
+    r.limit_text = criterion.min && criterion.max
+                       ? Number(*criterion.min) + " .. " + Number(*criterion.max) + " " + criterion.unit
+                   : criterion.min ? ">= " + Number(*criterion.min) + " " + criterion.unit
+                                   : "<= " + Number(*criterion.max) + " " + criterion.unit;
+  }
+  return r;
+}
+
+// The outcome of one criterion on one figure (`name`, with its axis).
+CriterionResult Judge(const LimitCriterion& criterion, const std::string& name,
+                      const std::vector<Figure>& figures, const Context& context, const Verdict& verdict) {
+  const std::string range_text = RangeText(criterion, context.calibration);
+  CriterionResult r = Named(criterion, name, range_text);
+  double at_c = kFigureTempC;
+  const Reading reading =
+      range_text.empty()
+          ? Read(context, name, criterion.statistic == LimitStatistic::kSigma, figures, context.budget)
+          : ReadOverRange(context, criterion, name, &at_c);
+  if (!reading.found) {
+    r.measured_text = reading.unresolved.empty() ? "not in calibration" : "not resolved by this run";
+    r.reason = reading.unresolved;
+    if (reading.unresolved.empty() && name.find("_residual_max_") != std::string::npos)
+      r.reason = "measured on the certificate's windows (give --report)";
+    r.margin = -r.limit;
+    r.margin_text = "none";
+    r.pass = false;
+    return r;
+  }
+  r.measured = reading.value;
+  r.expanded = reading.expanded;
+  // A max_abs criterion judges |value|: that is what it shows (a residual RMS is >= 0 anyway);
+  // min/max judge the signed value, its margin to the nearer bound.
+  if (criterion.min || criterion.max) {
+    const double above_min = criterion.min ? r.measured - *criterion.min : HUGE_VAL;
+    const double below_max = criterion.max ? *criterion.max - r.measured : HUGE_VAL;
+    r.margin = std::min(above_min, below_max);
+    r.limit = below_max <= above_min ? *criterion.max : *criterion.min;
+  } else {
+    r.measured = std::abs(r.measured);
+    r.margin = r.limit - r.measured;
+  }
+  r.measured_text = Number(r.measured) + " " + criterion.unit;
+  // Coverage counts segments missing; its margin is segments to spare, not missing ones.
+  r.margin_text = criterion.quantity == "coverage"
+                      ? Number(r.margin) + (r.margin == 1.0 ? " segment" : " segments")
+                      : Number(r.margin) + " " + criterion.unit;
+  Decide(verdict, &r);
+  if (criterion.statistic == LimitStatistic::kLargest) {
+    r.reason += std::string(r.reason.empty() ? "" : "; ") + "at " + Number(at_c) + " degC";
+  }
+  if (reading.extrapolated) {
+    const auto& range = context.calibration.fit_temp_range_c;
+    r.reason += std::string(r.reason.empty() ? "" : "; ") +
+                (range_text.empty() ? "evaluated at 25 degC" : "evaluated") + ", outside the fitted range " +
+                Number(range[0]) + ".." + Number(range[1]) + " degC: extrapolated";
+  }
+  return r;
+}
+
 }  // namespace
+
+std::string FigureTitle(const std::string& name) {
+  struct Words {
+    const char* quantity;
+    const char* title;
+    bool pair;  // two-letter axes: "xy" reads "X from Y"
+  };
+  static constexpr Words kWords[] = {{"gyro_bias_dps", "Gyro bias", false},
+                                     {"accel_bias_mg", "Accel bias", false},
+                                     {"gyro_scale_per_dps", "Gyro scale factor", false},
+                                     {"accel_scale_per_g", "Accel scale factor", false},
+                                     {"gyro_scale_error_ppm", "Gyro scale-factor error", false},
+                                     {"gyro_scale_error_pct", "Gyro scale-factor error", false},
+                                     {"accel_scale_error_ppm", "Accel scale-factor error", false},
+                                     {"accel_scale_error_pct", "Accel scale-factor error", false},
+                                     {"gyro_misalignment_mrad", "Gyro misalignment", true},
+                                     {"accel_misalignment_mrad", "Accel misalignment", true},
+                                     {"gyro_g_sensitivity_dpsg", "Gyro g-sensitivity", true},
+                                     {"gyro_residual_rms_dps", "Gyro residual RMS", false},
+                                     {"accel_residual_rms_mg", "Accel residual RMS", false},
+                                     {"fit_temp_range_c", "Fitted temperature range", false},
+                                     {"coverage", "Plan segments without a window", false},
+                                     {"gyro_arw_deg_per_sqrt_hr", "Gyro angle random walk", false},
+                                     {"gyro_bias_instability_dph", "Gyro bias instability", false}};
+  const size_t dot = name.find('.');
+  const std::string quantity = name.substr(0, dot),
+                    axis = dot == std::string::npos ? "" : name.substr(dot + 1);
+  for (const Words& w : kWords) {
+    if (quantity != w.quantity) continue;
+    std::string title = w.title;
+    const auto upper = [](char c) { return std::string(1, static_cast<char>(c - 'a' + 'A')); };
+    if (w.pair && axis.size() == 2) return title + " " + upper(axis[0]) + " from " + upper(axis[1]);
+    if (axis.size() == 1) return title + " " + upper(axis[0]);
+    return title;
+  }
+  return name;
+}
 
 const char* OutcomeName(Outcome outcome) {
   switch (outcome) {
@@ -65,18 +282,17 @@ const char* OutcomeName(Outcome outcome) {
   return "FAIL";
 }
 
-std::vector<Figure> KeyFigures(const Calibration& calibration) {
+std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
   const SensorModel* sigma = calibration.sigma ? &*calibration.sigma : nullptr;
   std::vector<Figure> figures;
   const auto add = [&](const std::string& quantity, Sensor sensor, int coefficient) {
     const CoefficientName& n = kCoefficientNames[coefficient];
-    const EngineeringValue v =
-        EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, kFigureTempC);
+    const EngineeringValue v = EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, temp_c);
     const auto& range = calibration.fit_temp_range_c;
     figures.push_back({quantity + "." + n.axis,
                        std::string(sensor == Sensor::kGyro ? "gyro." : "accel.") + n.group + "." + n.axis,
                        EngineeringUnit(sensor, coefficient), v.value, v.sigma,
-                       range[1] > range[0] && (kFigureTempC < range[0] || kFigureTempC > range[1])});
+                       range[1] > range[0] && (temp_c < range[0] || temp_c > range[1])});
   };
   for (int i = 0; i < 3; ++i) add("gyro_bias_dps", Sensor::kGyro, kBiasCoefficient + i);
   for (int i = 0; i < 3; ++i) add("accel_bias_mg", Sensor::kAccel, kBiasCoefficient + i);
@@ -151,11 +367,12 @@ std::string Verdict::RuleText() const {
          "within U of a limit is reported as a conditional pass (inside) or a conditional fail (outside).";
 }
 
-std::string Verdict::FailedSummary() const {
+std::string Verdict::FailedSummary(bool in_words) const {
   std::string text;
   for (const CriterionResult& c : criteria) {
     if (c.pass) continue;
-    text += (text.empty() ? "" : "; ") + c.name + " " + c.measured_text + " (limit " + c.limit_text + ")";
+    text += (text.empty() ? "" : "; ") + (in_words ? c.title : c.name) + " " + c.measured_text + " (limit " +
+            c.limit_text + ")";
   }
   return text;
 }
@@ -185,18 +402,14 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
   verdict.limits_name = limits.name;
   verdict.rule = limits.decision_rule;
   verdict.guard_band_u = limits.guard_band_u;
-  // U of a figure: the budget's, else k = 2 times its 1-sigma; < 0: none.
-  const auto expanded = [&](const Figure& f) {
-    const FigureBudget* b = budget != nullptr ? budget->Find(f.name) : nullptr;
-    return b != nullptr ? b->expanded : f.sigma >= 0.0 ? 2.0 * f.sigma : -1.0;
-  };
+  const Context context{limits, calibration, budget};
   std::vector<Figure> figures = measured;  // found first: they take the place of the calibration's
   for (const Figure& f : KeyFigures(calibration)) figures.push_back(f);
   for (const LimitCriterion& criterion : limits.criteria) {
-    const bool sigma = criterion.statistic == LimitStatistic::kSigma;
     if (criterion.kind == LimitKind::kCoverage) {
       CriterionResult r;
       r.name = criterion.quantity;
+      r.title = FigureTitle(r.name);
       r.unit = criterion.unit;
       const auto& range = calibration.fit_temp_range_c;
       r.margin = std::min(criterion.covers_c[0] - range[0], range[1] - criterion.covers_c[1]);
@@ -215,74 +428,8 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
     std::vector<std::string> names;
     if (criterion.axes.empty()) names.push_back(criterion.quantity);
     for (const std::string& axis : criterion.axes) names.push_back(criterion.quantity + "." + axis);
-    for (const std::string& name : names) {
-      CriterionResult r;
-      r.name = sigma ? "sigma(" + name + ")" : criterion.kind == LimitKind::kFigure ? name : "|" + name + "|";
-      r.unit = criterion.unit;
-      const bool bounds = criterion.min || criterion.max;
-      if (bounds) r.name = name;
-      r.limit = criterion.max_abs;
-      r.limit_text = "< " + Number(criterion.max_abs) + " " + criterion.unit;
-      if (bounds) {
-        r.limit_text = criterion.min && criterion.max
-                           ? Number(*criterion.min) + " .. " + Number(*criterion.max) + " " + criterion.unit
-                       : criterion.min ? ">= " + Number(*criterion.min) + " " + criterion.unit
-                                       : "<= " + Number(*criterion.max) + " " + criterion.unit;
-      }
-      bool extrapolated = false;
-      // Scale errors are relative to the nominal scale the limits file gives.
-      const size_t error_at = name.find("_scale_error_");
-      bool found = true;
-      if (error_at != std::string::npos) {
-        const bool gyro = name.rfind("gyro", 0) == 0;
-        const std::string axis = name.substr(name.rfind('.') + 1);
-        const Figure* scale = FindFigure(figures, std::string(gyro ? "gyro" : "accel") + ".scale." + axis);
-        const double nominal =
-            gyro ? limits.nominal_gyro_scale / kRadToDeg : limits.nominal_accel_scale * kStandardGravityMps2;
-        const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
-        r.measured = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
-        if (!sigma && expanded(*scale) >= 0.0) r.expanded = expanded(*scale) / nominal * factor;
-        extrapolated = scale->extrapolated;
-        found = !sigma || scale->sigma >= 0.0;
-      } else {
-        const Figure* figure = FindFigure(figures, name);
-        found = figure != nullptr && (!sigma || figure->sigma >= 0.0);
-        if (found) r.measured = sigma ? figure->sigma : figure->value;
-        if (found && !sigma) r.expanded = expanded(*figure);
-        extrapolated = found && figure->extrapolated;
-      }
-      if (!found) {
-        r.measured_text = "not in calibration";
-        r.margin = -r.limit;
-        r.margin_text = "none";
-        r.pass = false;
-      } else {
-        // A max_abs criterion judges |value|: that is what it shows (a residual RMS is >= 0 anyway);
-        // min/max judge the signed value, its margin to the nearer bound.
-        if (bounds) {
-          const double above_min = criterion.min ? r.measured - *criterion.min : HUGE_VAL;
-          const double below_max = criterion.max ? *criterion.max - r.measured : HUGE_VAL;
-          r.margin = std::min(above_min, below_max);
-          r.limit = below_max <= above_min ? *criterion.max : *criterion.min;
-        } else {
-          r.measured = std::abs(r.measured);
-          r.margin = r.limit - r.measured;
-        }
-        r.measured_text = Number(r.measured) + " " + criterion.unit;
-        // Coverage counts segments missing; its margin is segments to spare, not missing ones.
-        r.margin_text = criterion.quantity == "coverage"
-                            ? Number(r.margin) + (r.margin == 1.0 ? " segment" : " segments")
-                            : Number(r.margin) + " " + criterion.unit;
-        Decide(verdict, &r);
-        if (extrapolated) {
-          const auto& range = calibration.fit_temp_range_c;
-          r.reason += std::string(r.reason.empty() ? "" : "; ") +
-                      "evaluated at 25 degC, outside the fitted range " + Number(range[0]) + ".." +
-                      Number(range[1]) + " degC: extrapolated";
-        }
-      }
-      verdict.criteria.push_back(r);
-    }
+    for (const std::string& name : names)
+      verdict.criteria.push_back(Judge(criterion, name, figures, context, verdict));
   }
   for (const CriterionResult& c : verdict.criteria) verdict.pass = verdict.pass && c.pass;
   return verdict;

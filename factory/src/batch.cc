@@ -60,6 +60,7 @@ struct Manifest {
   std::string calibration_sha256;  // of the calibration written (fitted units)
   std::string station_sha256;      // "" without a station file
   std::string fit_options;         // FitRunOptions::Describe(): what the unit was fitted with
+  std::string issued_to;           // --customer and --order, as the certificate prints them
 };
 
 std::optional<Manifest> ReadManifest(const std::string& path) {
@@ -79,6 +80,7 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
     // Absent in a manifest of an imufit that did not record the options: they are unknown, so the
     // unit is done again.
     if (node["fit_options"]) m.fit_options = node["fit_options"].as<std::string>();
+    if (node["issued_to"]) m.issued_to = node["issued_to"].as<std::string>();
     return m;
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the unit is done again
@@ -99,7 +101,8 @@ void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction
                                                                {"message", &m.message},
                                                                {"calibration_sha256", &m.calibration_sha256},
                                                                {"station_sha256", &m.station_sha256},
-                                                               {"fit_options", &m.fit_options}};
+                                                               {"fit_options", &m.fit_options},
+                                                               {"issued_to", &m.issued_to}};
   for (const auto& [key, value] : fields)
     out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
   out << YAML::EndMap;
@@ -261,6 +264,8 @@ Manifest InputsManifest(const Shared& shared, const UnitOutcome& unit) {
   manifest.limits_sha256 = shared.certify.limits_sha256;
   manifest.station_sha256 = shared.certify.station_sha256;
   manifest.fit_options = shared.fit_options;
+  if (!shared.certify.customer.empty() || !shared.certify.order.empty())
+    manifest.issued_to = "customer: " + shared.certify.customer + "; order: " + shared.certify.order;
   return manifest;
 }
 
@@ -272,7 +277,8 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
   if (!previous || previous->software != manifest.software || previous->plan_sha256 != manifest.plan_sha256 ||
       previous->samples_sha256 != manifest.samples_sha256 ||
       previous->limits_sha256 != manifest.limits_sha256 ||
-      previous->station_sha256 != manifest.station_sha256 || previous->fit_options != manifest.fit_options) {
+      previous->station_sha256 != manifest.station_sha256 || previous->fit_options != manifest.fit_options ||
+      previous->issued_to != manifest.issued_to) {
     return false;
   }
   if (previous->status == "fitted" &&
@@ -546,6 +552,8 @@ void Prepare(const BatchOptions& options, Shared* shared, std::vector<UnitInput>
   shared->certify.windows = options.fit.windows;
   shared->certify.samples_input = options.fit.input;
   ReadLimitsAndStation(options.limits_path, options.station_path, &shared->certify);
+  shared->certify.customer = options.customer;
+  shared->certify.order = options.order;
   if (!options.shared_plan.empty()) ReadPlan(options.shared_plan);
   std::error_code error;
   fs::create_directories(options.output_dir, error);

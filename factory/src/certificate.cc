@@ -8,6 +8,7 @@
 #include "certificate_sections.h"
 #include "imufit/factory/engineering_units.h"
 #include "imufit/factory/git_revision.h"
+#include "imufit/factory/report.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/sha256.h"
 #include "imufit/model/check.h"
@@ -84,17 +85,34 @@ void CoverageWarnings(const RunSummary& run, std::vector<std::string>* warnings)
   }
 }
 
-// The station's reference equipment must have been within its calibration when the unit was
-// calibrated (ISO dates compare as text).
-void StationWarnings(const Station& station, const std::string& calibrated_utc,
-                     const std::string& written_utc, std::vector<std::string>* warnings) {
+// The station's reference equipment must have been within its calibration when the run was
+// recorded (ISO dates compare as text); without an acquisition time, when the unit was fitted.
+void StationWarnings(const Station& station, const Certificate& c, std::vector<std::string>* warnings) {
   if (station.reference_calibration_due.empty()) return;
-  const std::string when = (calibrated_utc.size() >= 10 ? calibrated_utc : written_utc).substr(0, 10);
+  const std::string& time = !c.acquired_utc.empty()         ? c.acquired_utc
+                            : c.calibrated_utc.size() >= 10 ? c.calibrated_utc
+                                                            : c.written_utc;
+  const std::string when = time.substr(0, 10);
   if (station.reference_calibration_due < when) {
     warnings->push_back("the station's reference equipment was due for calibration on " +
-                        station.reference_calibration_due + ", before this unit was calibrated (" + when +
-                        ")");
+                        station.reference_calibration_due + ", before this unit's run was recorded (" + when +
+                        (c.acquired_utc.empty() ? "; no '# acquired:' time: the fit's date" : "") + ")");
   }
+}
+
+// What the run header says, the calibration's record first.
+void RunIdentity(const CertificateSources& sources, Certificate* c) {
+  const std::optional<FitRecord>& fit = sources.calibration.fit;
+  const RunHeader header_read = sources.header.value_or(RunHeader());
+  const auto pick = [&](const std::optional<std::string> FitRecord::*recorded, const std::string& header) {
+    return fit && (*fit.*recorded) && !(*fit.*recorded)->empty() ? *(*fit.*recorded) : header;
+  };
+  c->acquired_utc = pick(&FitRecord::acquired_utc, header_read.acquired_utc);
+  c->unit_model = pick(&FitRecord::unit_model, header_read.model);
+  c->unit_firmware = pick(&FitRecord::unit_firmware, header_read.firmware);
+  c->ambient = pick(&FitRecord::ambient, header_read.ambient);
+  c->customer = sources.customer;
+  c->order = sources.order;
 }
 
 // Who, when, by what, from which files, and what the reader must be warned of.
@@ -127,8 +145,12 @@ void Identify(const CertificateSources& sources, Certificate* c) {
         *cal.fit->inconsistent);
   }
   for (const std::string& w : sources.warnings) c->warnings.push_back(w);
+  RunIdentity(sources, c);
+  c->number = CertificateNumber(c->serial.empty() ? c->unit : c->serial,
+                                c->acquired_utc.empty() ? c->calibrated_utc : c->acquired_utc, c->inputs,
+                                c->customer, c->order);
   c->station = sources.station;
-  if (c->station) StationWarnings(*c->station, c->calibrated_utc, c->written_utc, &c->warnings);
+  if (c->station) StationWarnings(*c->station, *c, &c->warnings);
 }
 
 // The key figures at 25 degC, with their expanded uncertainty (the budget's, where it has the figure).
@@ -193,6 +215,14 @@ void ReadCertificateFiles(CertificateSources* sources) {
   for (ReportInput& input : inputs) {
     if (!input.path.empty() && input.sha256.empty()) input.sha256 = Sha256OfFile(input.path);
   }
+  const std::optional<FitRecord>& fit = sources->calibration.fit;
+  // A run read from its file (hashed on the way) brought its header along.
+  if (!sources->header && !sources->run.samples_sha256.empty()) sources->header = sources->run.header;
+  if (!sources->header && !(fit && fit->acquired_utc)) {
+    for (const ReportInput& input : inputs) {
+      if (input.role == "samples" && !input.path.empty()) sources->header = ReadRunHeader(input.path);
+    }
+  }
   if (sources->noise) return;
   // The stretch the run's reading kept (the file is not read again), else measured on the file.
   if (sources->run.static_stretch) {
@@ -233,19 +263,80 @@ Certificate MakeCertificate(const CertificateSources& sources) {
   return c;
 }
 
+std::string CertificateNumber(const std::string& serial, const std::string& date_utc,
+                              const std::vector<ReportInput>& inputs, const std::string& customer,
+                              const std::string& order) {
+  std::string content;
+  for (const ReportInput& input : inputs) content += input.role + " " + input.sha256 + "\n";
+  content += "customer " + customer + "\norder " + order + "\n";
+  // The serial as a file name would hold it: letters, digits, '.', '_' and '-'.
+  std::string name;
+  for (char ch : serial.empty() ? std::string("UNIT") : serial) {
+    const bool plain = (ch >= '0' && ch <= '9') || (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') ||
+                       ch == '.' || ch == '_' || ch == '-';
+    name += plain ? ch : '_';
+  }
+  std::string date;
+  for (char ch : date_utc.substr(0, 10)) {
+    if (ch != '-') date += ch;
+  }
+  return name + "-" + date + "-" + Sha256Hex(content).substr(0, 8);
+}
+
+namespace {
+
+// Why this run does not resolve a noise term, and how to supply it (Figure::unresolved).
+std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, bool arw) {
+  const double needed_s = arw ? kMinAllanStretchS : kBiasInstabilityStretchS;
+  std::string text =
+      "not resolved by this run (needs a static stretch of " + FormatNumber("%g", needed_s) + " s";
+  if (!noise.computed) {
+    text += "; " + noise.why_not + ")";
+  } else {
+    text += "; its longest is " + FormatNumber("%.0f", noise.duration_s) + " s";
+    if (axis != nullptr && !axis->why_not.empty()) text += ", " + axis->why_not;
+    text += ")";
+  }
+  return text +
+         ": add a static dwell of that length to the plan, or give the calibration a noise: block measured "
+         "on such a stretch (imufit allan --noise-yaml)";
+}
+
+}  // namespace
+
 std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
   std::vector<Figure> figures;
-  for (const NoiseAxis& a : certificate.noise.axes) {
-    if (!a.fitted) continue;
-    if (a.arw_resolved) {
-      figures.push_back({"gyro_arw_deg_per_sqrt_hr." + a.axis, "certificate.gyro_" + a.axis + ".arw",
-                         "deg/sqrt(h)", a.arw_deg_per_sqrt_hr, a.arw_sigma});
+  const NoiseSection& noise = certificate.noise;
+  for (const char* axis_name : {"x", "y", "z"}) {
+    const NoiseAxis* a = nullptr;
+    for (const NoiseAxis& axis : noise.axes) {
+      if (axis.axis == axis_name) a = &axis;
     }
-    if (a.bias_instability_resolved) {
-      figures.push_back({"gyro_bias_instability_dph." + a.axis,
-                         "certificate.gyro_" + a.axis + ".bias_instability", "deg/h", a.bias_instability_dph,
-                         a.bias_instability_sigma});
+    const std::string axis = axis_name;
+    Figure arw{"gyro_arw_deg_per_sqrt_hr." + axis, "certificate.gyro_" + axis + ".arw", "deg/sqrt(h)"};
+    Figure instability{"gyro_bias_instability_dph." + axis, "certificate.gyro_" + axis + ".bias_instability",
+                       "deg/h"};
+    if (a != nullptr && a->fitted && a->arw_resolved) {
+      arw.value = a->arw_deg_per_sqrt_hr;
+      arw.sigma = a->arw_sigma;
+    } else {
+      arw.unresolved = Unresolved(noise, a, true);
     }
+    if (a != nullptr && a->fitted && a->bias_instability_resolved) {
+      instability.value = a->bias_instability_dph;
+      instability.sigma = a->bias_instability_sigma;
+    } else {
+      instability.unresolved = Unresolved(noise, a, false);
+    }
+    figures.push_back(arw);
+    figures.push_back(instability);
+  }
+  // The worst window after correction, at any temperature of the run (the per-segment table's "all").
+  if (!certificate.residual_table.empty()) {
+    const ResidualRow& all = certificate.residual_table.back();
+    figures.push_back({"gyro_residual_max_dps", "certificate.gyro_residual_max", "deg/s", all.gyro_max_dps});
+    if (all.accel_windows > 0)
+      figures.push_back({"accel_residual_max_mg", "certificate.accel_residual_max", "mg", all.accel_max_mg});
   }
   return figures;
 }

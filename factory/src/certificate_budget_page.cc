@@ -5,12 +5,6 @@
 namespace imufit::internal {
 namespace {
 
-// "gyro_scale_per_dps" -> "gyro scale per dps": the class's name in words.
-std::string Words(std::string quantity) {
-  for (char& ch : quantity) ch = ch == '_' ? ' ' : ch;
-  return quantity;
-}
-
 void Sources(Html* h, const UncertaintyBudget& budget) {
   if (budget.inputs.empty()) return;
   h->Open("table", {{"data-key", "budget_sources"}}).Open("thead");
@@ -56,7 +50,7 @@ void BudgetSection(Html* h, const Certificate& c) {
     for (const BudgetClassLine& line : k.top) {
       top += (top.empty() ? "" : "; ") + line.source + " " + Fmt("%.2g", line.rms);
     }
-    h->Open("tr", {{"data-budget-class", k.quantity}}).Element("td", Words(k.quantity));
+    h->Open("tr", {{"data-budget-class", k.quantity}}).Element("td", FigureTitle(k.quantity));
     Num(h, Fmt("%.2g", k.type_a_rms));
     h->Element("td", top.empty() ? "none declared" : top).Element("td", k.unit).Close("tr");
   }

@@ -6,6 +6,7 @@
 #include "certificate_budget_page.h"
 #include "imufit/factory/allan_plot.h"
 #include "imufit/factory/html.h"
+#include "imufit/factory/report.h"
 #include "imufit/io/output_file.h"
 #include "page.h"
 
@@ -160,8 +161,8 @@ std::string EquipmentText(const StationEquipment& e) {
 void Station(Html* h, const Certificate& c) {
   h->Open("div").Open("table", {{"class", "fill"}});
   if (!c.station) {
-    for (const char* field :
-         {"station", "location", "rate table", "chamber", "reference equipment calibrated until"})
+    for (const char* field : {"laboratory", "station", "location", "rate table", "chamber",
+                              "reference equipment calibrated until"})
       Row(h, {field, ""});
     h->Close("table").Close("div");
     return;
@@ -171,6 +172,8 @@ void Station(Html* h, const Certificate& c) {
     if (value.empty()) return;
     h->Open("tr").Element("td", name).Element("td", value, {{"data-key", key}}).Close("tr");
   };
+  field("laboratory", s.laboratory, "laboratory");
+  field("accreditation", s.accreditation, "accreditation");
   field("station", s.name + (s.id.empty() ? "" : " (" + s.id + ")"), "station");
   field("location", s.location, "location");
   field("operator", s.operator_name, "operator");
@@ -210,7 +213,7 @@ void Identification(Html* h, const Certificate& c) {
     h->Close("p");
     // What failed, where the signer looks first (the table below has every criterion).
     if (!c.verdict->pass) {
-      h->Element("p", "Failed: " + c.verdict->FailedSummary() + ".",
+      h->Element("p", "Failed: " + c.verdict->FailedSummary(/*in_words=*/true) + ".",
                  {{"class", "FAIL"}, {"data-key", "failed_criteria"}});
     }
   } else {
@@ -223,9 +226,24 @@ void Identification(Html* h, const Certificate& c) {
   }
   h->Open("div", {{"class", "cols"}});
   h->Open("div").Open("table", {{"class", "fill"}});
-  Row(h, {"unit serial", serial});
+  const auto field = [&](const char* name, const std::string& value, const char* key) {
+    if (value.empty()) return;
+    h->Open("tr").Element("td", name).Element("td", value, {{"data-key", key}}).Close("tr");
+  };
+  field("certificate number", c.number, "certificate_number");
+  field("unit serial", serial, "unit_serial");
+  field("product model / part number", c.unit_model, "unit_model");
+  field("unit firmware", c.unit_firmware, "unit_firmware");
   if (!c.unit.empty()) Row(h, {"unit folder", c.unit});
-  Row(h, {"calibrated (UTC)", c.calibrated_utc});
+  field("customer", c.customer, "customer");
+  field("customer's order", c.order, "order");
+  field("run recorded (UTC)",
+        c.acquired_utc.empty() ? "not stated (no '# acquired:' line in the samples header): dates are judged "
+                                 "against the fit's"
+                               : c.acquired_utc,
+        "acquired_utc");
+  field("ambient conditions", c.ambient, "ambient");
+  Row(h, {"calibration fitted (UTC)", c.calibrated_utc});
   Row(h, {"certificate written (UTC)", c.written_utc});
   h->Open("tr")
       .Element("td", "calibration software")
@@ -237,13 +255,15 @@ void Identification(Html* h, const Certificate& c) {
   Station(h, c);
   h->Close("div");
   Signatures(h, c);
+  h->Element("p", kItemOnlyStatement, {{"class", "note"}, {"data-key", "item_only"}});
   h->Open("div", {{"class", "keep"}});
   h->Element("h2", "Input files");
   h->Open("table").Open("thead");
   Row(h, {"role", "file", "SHA-256"}, "th");
   h->Close("thead").Open("tbody");
   for (const ReportInput& in : c.inputs) {
-    h->Open("tr").Element("td", in.role).Element("td", in.path, {{"class", "path"}});
+    h->Open("tr").Element("td", in.role);
+    internal::PathCell(h, in.path);
     h->Element("td", in.sha256, {{"class", "hash"}, {"data-sha256", in.role}}).Close("tr");
   }
   h->Close("tbody").Close("table").Close("div");
@@ -257,7 +277,9 @@ void PlanAndRun(Html* h, const Certificate& c) {
     for (double v : values) text += (text.empty() ? "" : ", ") + Fmt("%g", v);
     return text;
   };
-  h->Open("tr").Element("td", "plan").Element("td", c.run.plan_path, {{"class", "path"}}).Close("tr");
+  h->Open("tr").Element("td", "plan");
+  internal::PathCell(h, c.run.plan_path);
+  h->Close("tr");
   std::string segments = Count(c.run.segments) + " (" + Count(c.run.static_segments) + " static";
   if (!c.run.rates_dps.empty()) segments += "; rates " + list(c.run.rates_dps) + " deg/s";
   if (c.run.turn_segments > 0) {
@@ -291,6 +313,15 @@ void PlanAndRun(Html* h, const Certificate& c) {
   h->Close("table").Close("div");
 }
 
+// The solver's outcome for a reader: the fit converged (its tolerances reached) or stopped.
+std::string SolverInWords(const FitSettings& s) {
+  const std::string iterations = Count(s.iterations) + (s.iterations == 1 ? " iteration" : " iterations");
+  if (s.termination.find("tolerance") != std::string::npos) return "converged after " + iterations;
+  if (s.termination.find("Maximum number of iterations") != std::string::npos)
+    return "stopped at its iteration limit, after " + iterations;
+  return "stopped after " + iterations;
+}
+
 // How the fit was made and what it says of itself.
 void FitSettingsTable(Html* h, const FitSettings& s) {
   h->Open("div").Element("h2", "Fit settings and diagnostics").Open("table");
@@ -303,8 +334,7 @@ void FitSettingsTable(Html* h, const FitSettings& s) {
             Fmt("%.3g", s.gyro_reduced_chi2) + " / " + Fmt("%.3g", s.accel_reduced_chi2)});
     Row(h, {"temperature orders gyro / accel", Count(s.gyro_temp_order) + " / " + Count(s.accel_temp_order)});
     Row(h, {"g-sensitivity", s.g_sensitivity_fitted ? "fitted" : "held at zero"});
-    Row(h, {"solver",
-            s.termination + " " + Count(s.iterations) + (s.iterations == 1 ? " iteration" : " iterations")});
+    Row(h, {"solver", SolverInWords(s)});
     Row(h, {"bias stability in the sigmas", s.gyro_bias_stability_dph > 0.0 || s.accel_bias_stability_ug > 0.0
                                                 ? Fmt("gyro %g deg/h", s.gyro_bias_stability_dph) +
                                                       Fmt(", accel %g micro-g", s.accel_bias_stability_ug)
@@ -327,15 +357,23 @@ void Acceptance(Html* h, const Verdict& verdict) {
   h->Element("h2",
              "Acceptance: " + (verdict.limits_name.empty() ? std::string("limits") : verdict.limits_name));
   h->Open("table").Open("thead");
-  Row(h, {"criterion", "measured", "limit", "margin", "verdict"}, "th");
+  Row(h, {"criterion", "measured \xc2\xb1 U", "limit", "margin", "verdict"}, "th");
   h->Close("thead").Open("tbody");
   for (const CriterionResult& cr : verdict.criteria) {
     HtmlAttributes row = {{"data-criterion", cr.name}, {"data-pass", cr.pass ? "1" : "0"}};
     if (!cr.pass) row.push_back({"class", "failed"});
-    h->Open("tr", row).Element("td", cr.name);
-    Num(h, cr.measured_text);
-    Num(h, cr.limit_text);
-    Num(h, cr.margin_text);
+    h->Open("tr", row).Element("td", cr.title);
+    // A value with its U is printed to U's decimal place, its margin too.
+    if (cr.expanded > 0.0 && cr.margin_text != "none") {
+      const RoundedValue v = RoundToUncertainty(cr.measured, cr.expanded);
+      Num(h, v.value + " \xc2\xb1 " + v.uncertainty + " " + cr.unit);
+      Num(h, cr.limit_text);
+      Num(h, AtDecimals(cr.margin, v.decimals) + " " + cr.unit);
+    } else {
+      Num(h, cr.measured_text);
+      Num(h, cr.limit_text);
+      Num(h, cr.margin_text);
+    }
     h->Element("td", OutcomeName(cr.outcome) + (cr.reason.empty() ? std::string() : ": " + cr.reason),
                {{"class", cr.pass ? "PASS" : "FAIL"}, {"data-outcome", OutcomeName(cr.outcome)}})
         .Close("tr");
@@ -353,11 +391,19 @@ void FigureTable(Html* h, const std::vector<KeyFigureRow>& figures, bool gyro) {
   h->Close("thead").Open("tbody");
   for (const KeyFigureRow& f : figures) {
     if (f.name.rfind(prefix, 0) != 0) continue;
-    h->Open("tr").Element("td", f.name.substr(prefix.size()));
-    Num(h, Fmt(f.is_coefficient ? "%+.6g" : "%.6g", f.value),
-        {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
-    Num(h, f.sigma >= 0.0 ? Fmt("%.3g", f.sigma) : "\xe2\x80\x93");
-    Num(h, f.expanded >= 0.0 ? Fmt("%.3g", f.expanded) : "\xe2\x80\x93");
+    // Under the sensor's heading: "bias X", "g-sensitivity X from Y".
+    std::string title = FigureTitle(f.name);
+    for (const char* sensor : {"Gyro ", "Accel "}) {
+      if (title.rfind(sensor, 0) == 0) title = title.substr(std::string(sensor).size());
+    }
+    h->Open("tr").Element("td", title);
+    // U to two significant digits, the value and its 1-sigma to U's decimal place (GUM 7.2.6).
+    const RoundedValue v = RoundToUncertainty(f.value, f.expanded, f.is_coefficient);
+    Num(h, v.value, {{"data-figure", f.name}, {"data-value", FormatDouble(f.value)}});
+    Num(h, f.sigma > 0.0 && f.expanded > 0.0 ? AtDecimals(f.sigma, v.decimals + 1)
+           : f.sigma >= 0.0                  ? Fmt("%.2g", f.sigma)
+                                             : "\xe2\x80\x93");
+    Num(h, f.expanded > 0.0 ? v.uncertainty : f.expanded == 0.0 ? "0" : "\xe2\x80\x93");
     h->Element("td", f.extrapolated ? f.unit + ", extrapolated" : f.unit,
                f.extrapolated ? HtmlAttributes{{"data-extrapolated", f.name}} : HtmlAttributes{})
         .Close("tr");
@@ -613,8 +659,8 @@ std::string CertificateHtml(const Certificate& c) {
   Html h;
   internal::OpenPage(
       &h, "Calibration certificate " + serial, "IMU calibration certificate " + serial,
-      c.verdict ? std::string(c.verdict->pass ? "PASS" : "FAIL") + " \xe2\x80\x94 " + c.calibrated_utc
-                : c.calibrated_utc);
+      (c.verdict ? std::string(c.verdict->pass ? "PASS" : "FAIL") + " \xe2\x80\x94 " : std::string()) +
+          "certificate " + c.number + ", " + (c.acquired_utc.empty() ? c.calibrated_utc : c.acquired_utc));
   Identification(&h, c);
   RunAndSettings(&h, c);
   if (c.verdict) Acceptance(&h, *c.verdict);
@@ -625,8 +671,9 @@ std::string CertificateHtml(const Certificate& c) {
   NoisePlot(&h, c, svgs);
   Validation(&h, c);
   h.Element("p",
-            "Units: angular rate in deg/s, specific force in mg (1 g = 9.80665 m/s\xc2\xb2); key figures at "
-            "25 degC. Coefficient model and file format: docs/spec.md; conversions: docs/factory.md.",
+            "Units: angular rate in deg/s, specific force in mg (1 g = 9.80665 m/s\xc2\xb2); coefficients at "
+            "25 degC. Each value is rounded to the decimal place of its expanded uncertainty U (two "
+            "significant digits).",
             {{"class", "note"}});
   return internal::ClosePage(&h);
 }

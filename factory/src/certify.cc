@@ -38,6 +38,9 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
                     {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
                     {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
   sources.station = settings.station;
+  sources.header = RunHeader();  // the fit recorded what the samples header says
+  sources.customer = settings.customer;
+  sources.order = settings.order;
   ReadCertificateFiles(&sources);  // only what is not known yet: the run kept its static stretch
   return MakeCertificate(sources);
 }

@@ -1,6 +1,7 @@
 // The frame, cells and plots every document of factory shares (page.h), and FormatNumber().
 #include "page.h"
 
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -29,6 +30,31 @@ std::string FormatNumber(const char* format, double value) {
   return NumberText(unsigned_format.c_str(), 0.0);
 }
 
+std::string AtDecimals(double value, int decimals, bool sign) {
+  if (decimals >= 0) {
+    const std::string format = std::string(sign ? "%+." : "%.") + std::to_string(decimals) + "f";
+    return FormatNumber(format.c_str(), value);
+  }
+  const double unit = std::pow(10.0, -decimals);
+  return FormatNumber(sign ? "%+.0f" : "%.0f", std::round(value / unit) * unit);
+}
+
+RoundedValue RoundToUncertainty(double value, double uncertainty, bool sign) {
+  RoundedValue r;
+  if (!(uncertainty > 0.0) || !std::isfinite(uncertainty)) {
+    r.value = FormatNumber(sign ? "%+.6g" : "%.6g", value);
+    r.decimals = 6;
+    return r;
+  }
+  int exponent = static_cast<int>(std::floor(std::log10(uncertainty)));
+  // Two significant digits; 0.0996 rounds to 0.10, one place fewer.
+  if (std::round(uncertainty * std::pow(10.0, 1 - exponent)) >= 100.0) ++exponent;
+  r.decimals = 1 - exponent;
+  r.value = AtDecimals(value, r.decimals, sign);
+  r.uncertainty = AtDecimals(uncertainty, r.decimals);
+  return r;
+}
+
 namespace internal {
 namespace {
 
@@ -39,7 +65,7 @@ body { font-family: "DejaVu Sans", Helvetica, Arial, sans-serif; font-size: 12px
 h1 { font-size: 20px; margin: 0 0 6px 0; } h2 { font-size: 15px; border-bottom: 1px solid #999; margin: 16px 0 6px 0; }
 h3 { font-size: 13px; margin: 10px 0 4px 0; }
 table { border-collapse: collapse; margin: 4px 0; } td, th { border: 1px solid #bbb; padding: 1px 6px; text-align: left; vertical-align: top; }
-th { background: #eee; } .path { overflow-wrap: anywhere; } td.num { text-align: right; font-variant-numeric: tabular-nums; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
+th { background: #eee; } .path { overflow-wrap: normal; } td.num { text-align: right; font-variant-numeric: tabular-nums; font-family: "DejaVu Sans Mono", monospace; white-space: nowrap; }
 thead { display: table-header-group; } td:first-child { white-space: nowrap; } tr { break-inside: avoid; page-break-inside: avoid; }
 .hash { font-family: "DejaVu Sans Mono", monospace; font-size: 10px; word-break: break-all; }
 .PASS { color: #06642a; font-weight: bold; } .FAIL { color: #b00; font-weight: bold; }
@@ -66,6 +92,27 @@ table.fill td:first-child { width: 35%; }
 std::string Fmt(const char* format, double value) { return FormatNumber(format, value); }
 
 std::string Count(long long value) { return std::to_string(value); }
+
+std::string ShortPath(const std::string& path) {
+  if (path.size() <= kMostPathChars) return path;
+  const std::string ellipsis = "\xe2\x80\xa6/";
+  size_t cut = path.find('/');
+  // The shortest cut at a '/' whose tail, after the ellipsis (one character on the page), fits.
+  while (cut != std::string::npos && path.size() - cut - 1 + 2 > kMostPathChars)
+    cut = path.find('/', cut + 1);
+  if (cut == std::string::npos) {
+    const size_t name = path.rfind('/');
+    return name == std::string::npos ? path : ellipsis + path.substr(name + 1);
+  }
+  return ellipsis + path.substr(cut + 1);
+}
+
+void PathCell(Html* h, const std::string& path) {
+  // A zero-width space after each '/': the line may break there, and nowhere inside a name.
+  std::string text;
+  for (char c : ShortPath(path)) text += c == '/' ? std::string("/\xe2\x80\x8b") : std::string(1, c);
+  h->Element("td", text, {{"class", "path"}, {"data-path", path}});
+}
 
 std::string YieldText(double pct) { return Fmt("%.1f %%", pct); }
 

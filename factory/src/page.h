@@ -31,6 +31,14 @@ std::string ClosePage(Html* h);
 
 // A table row of cells (each text escaped).
 void Row(Html* h, std::initializer_list<std::string> cells, const char* tag = "td");
+// A path as a page prints it: at most kMostPathChars characters, the leading folders replaced by
+// "\xe2\x80\xa6/" (whole folder names only: a name is never cut; a file name longer than that is
+// printed whole).
+inline constexpr size_t kMostPathChars = 56;
+std::string ShortPath(const std::string& path);
+// A table cell of a path: ShortPath(), breakable after each '/' (a zero-width space); the whole path in
+// data-path.
+void PathCell(Html* h, const std::string& path);
 // A number's cell (right-aligned, tabular figures).
 void Num(Html* h, const std::string& text, const HtmlAttributes& attributes = {});
 

@@ -28,9 +28,39 @@ double PositiveNumber(const yaml::Located& value) {
   return number;
 }
 
+// A criterion's `statistic:` and `over:`.
+void ReadStatistic(const yaml::Located& entry, LimitCriterion* criterion) {
+  if (entry.Has("statistic")) {
+    const yaml::Located statistic = entry["statistic"];
+    const std::string text = statistic.String();
+    const bool coefficient = criterion->kind == LimitKind::kCoefficient;
+    // The noise figures are measured at one temperature: they have no curve to take a range of.
+    const bool has_curve = coefficient && criterion->quantity.find("_arw_") == std::string::npos &&
+                           criterion->quantity.find("_bias_instability_") == std::string::npos;
+    if (text == "sigma") {
+      if (!coefficient) statistic.Fail(criterion->quantity + " has no 1-sigma");
+      criterion->statistic = LimitStatistic::kSigma;
+    } else if (text == "largest" || text == "variation") {
+      if (!has_curve) statistic.Fail(criterion->quantity + " does not vary with temperature in the model");
+      criterion->statistic = text == "largest" ? LimitStatistic::kLargest : LimitStatistic::kVariation;
+    } else if (text != "value") {
+      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: value, sigma, largest, variation)");
+    }
+  }
+  if (entry.Has("over")) {
+    const yaml::Located over = entry["over"];
+    if (criterion->statistic != LimitStatistic::kLargest &&
+        criterion->statistic != LimitStatistic::kVariation)
+      over.Fail("a range takes `statistic: largest` or `statistic: variation`");
+    const std::vector<double> range = over.Doubles(2);
+    if (!(range[0] < range[1])) over.Fail("expected [lo, hi] with lo < hi");
+    criterion->over_c = std::array<double, 2>{range[0], range[1]};
+  }
+}
+
 LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
   entry.RejectUnknownKeys(
-      {"quantity", "axes", "statistic", "max_abs", "min", "max", "covers", "covers_tolerance"});
+      {"quantity", "axes", "statistic", "over", "max_abs", "min", "max", "covers", "covers_tolerance"});
   LimitCriterion criterion;
   const yaml::Located quantity = entry["quantity"];
   criterion.quantity = quantity.String();
@@ -66,17 +96,7 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
     criterion.axes = all_axes;
   }
 
-  if (entry.Has("statistic")) {
-    const yaml::Located statistic = entry["statistic"];
-    const std::string text = statistic.String();
-    if (text == "sigma") {
-      if (criterion.kind != LimitKind::kCoefficient) statistic.Fail(criterion.quantity + " has no 1-sigma");
-      criterion.statistic = LimitStatistic::kSigma;
-    } else if (text != "value") {
-      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: value, sigma)");
-    }
-  }
-
+  ReadStatistic(entry, &criterion);
   if (criterion.kind == LimitKind::kCoverage) {
     if (entry.Has("max_abs"))
       entry["max_abs"].Fail(criterion.quantity + " takes `covers: [lo, hi]`, not max_abs");
@@ -98,6 +118,8 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
       criterion.max_abs = PositiveNumber(entry["max_abs"]);
     } else {
       if (criterion.statistic == LimitStatistic::kSigma) entry.Fail("a 1-sigma takes max_abs, not min/max");
+      if (criterion.statistic == LimitStatistic::kVariation)
+        entry.Fail("a variation takes max_abs, not min/max");
       if (entry.Has("min")) criterion.min = entry["min"].Double();
       if (entry.Has("max")) criterion.max = entry["max"].Double();
       if (criterion.min && criterion.max && !(*criterion.min < *criterion.max))

@@ -3,25 +3,11 @@
 #include <cmath>
 
 #include "imufit/io/error.h"
+#include "imufit/io/run_header.h"
 #include "yaml_util.h"
 
 namespace imufit {
 namespace {
-
-bool IsLeapYear(int year) { return (year % 4 == 0 && year % 100 != 0) || year % 400 == 0; }
-
-// A date written YYYY-MM-DD that exists in the Gregorian calendar.
-bool IsIsoDate(const std::string& text) {
-  if (text.size() != 10 || text[4] != '-' || text[7] != '-') return false;
-  for (size_t i : {0, 1, 2, 3, 5, 6, 8, 9}) {
-    if (text[i] < '0' || text[i] > '9') return false;
-  }
-  const int year = std::stoi(text.substr(0, 4)), month = std::stoi(text.substr(5, 2));
-  const int day = std::stoi(text.substr(8, 2));
-  constexpr int kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
-  if (month < 1 || month > 12 || day < 1) return false;
-  return day <= kDays[month - 1] + (month == 2 && IsLeapYear(year) ? 1 : 0);
-}
 
 // One line of text: not empty, no line break, at most kMaxStationTextBytes.
 std::string Line(const yaml::Located& value) {
@@ -112,13 +98,16 @@ std::vector<StationUncertainty> Uncertainties(const yaml::Located& node) {
 Station ReadStation(const std::string& path) {
   const YAML::Node root_node = yaml::LoadFile(path);
   const yaml::Located root{&path, root_node, ""};
-  root.RejectUnknownKeys({"format", "version", "station", "station_id", "location", "operator", "rate_table",
-                          "chamber", "reference_calibration_due", "notes", "uncertainty"});
+  root.RejectUnknownKeys({"format", "version", "station", "station_id", "laboratory", "accreditation",
+                          "location", "operator", "rate_table", "chamber", "reference_calibration_due",
+                          "notes", "uncertainty"});
   root.RequireFormat("imufit-station", kStationFormatVersion);
   Station station;
   station.path = path;
   station.name = Line(root["station"]);
   if (root.Has("station_id")) station.id = Line(root["station_id"]);
+  if (root.Has("laboratory")) station.laboratory = Line(root["laboratory"]);
+  if (root.Has("accreditation")) station.accreditation = Line(root["accreditation"]);
   if (root.Has("location")) station.location = Line(root["location"]);
   if (root.Has("operator")) station.operator_name = Line(root["operator"]);
   if (root.Has("rate_table")) station.rate_table = Equipment(root["rate_table"]);

@@ -58,6 +58,17 @@ FitRecord RecordOf(const FitRunResult& result, const std::string& plan_path, con
   return record;
 }
 
+// What the samples header says of the run, apart from the fit's own time (calibration created_utc).
+void RecordRunHeader(const RunHeader& header, FitRecord* record) {
+  const auto set = [](const std::string& value, std::optional<std::string>* key) {
+    if (!value.empty()) *key = value;
+  };
+  set(header.acquired_utc, &record->acquired_utc);
+  set(header.model, &record->unit_model);
+  set(header.firmware, &record->unit_firmware);
+  set(header.ambient, &record->ambient);
+}
+
 // The unit's serial: the most specific source first (the caller's, the unit's own log, then the
 // possibly shared plan).
 UnitSerial ResolveUnitSerial(const FitRunOptions& options, const std::string& plan_path, const Plan& plan,
@@ -118,6 +129,7 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
   UnitSerial serial = ResolveUnitSerial(options, plan_path, result.plan, *samples);
   result.serial = std::move(serial.serial);
   result.serial_warnings = std::move(serial.warnings);
+  const RunHeader header = samples->run_header();
   result.run = samples->Read(options.windows, options.keep_static_stretch);
   CheckBeforeFit(plan_path, samples_path, options, result);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
@@ -130,6 +142,7 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
 
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
+  RecordRunHeader(header, &result.record);
   if (!result.fit.IsSolutionUsable()) return result;
   result.inconsistency = Inconsistency(result.fit, result.run.windows, options.fit);
   if (!result.inconsistency.empty()) {

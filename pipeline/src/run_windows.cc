@@ -67,6 +67,7 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
   WindowBuilder builder(options, plan_.segments);
   std::optional<LongestStaticStretch> stretch;
   if (keep_static_stretch) stretch.emplace(plan_);
+  const RunHeader header = run_header();
   RunWindows run;
   try {
     if (memory_) {
@@ -81,6 +82,7 @@ RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretc
     throw;
   }
   run.windows = builder.Finish();
+  run.header = header;
   run.stats = builder.stats();
   if (run.windows.empty()) {
     CheckSpan(options, run.stats.last_time_s - run.stats.first_time_s, run.stats.samples - 1);

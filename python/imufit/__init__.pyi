@@ -54,6 +54,10 @@ class FitRecord:
     samples: str | None  # the samples file, as given
     plan_sha256: str | None  # SHA-256 of the plan file
     samples_sha256: str | None  # SHA-256 of the samples file
+    acquired_utc: str | None  # when the run was recorded (the samples header's '# acquired:'), UTC
+    unit_model: str | None  # the product's model or part number (the samples header's '# model:')
+    unit_firmware: str | None  # the unit's firmware (the samples header's '# firmware:')
+    ambient: str | None  # the laboratory's conditions (the samples header's '# ambient:')
     samples_read: int | None  # samples in the file
     segments_found_in_data: int | None  # a file without a segment column: the segments found in the data
     plan_passes_found: int | None  # a file without a segment column: complete passes through the plan

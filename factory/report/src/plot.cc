@@ -16,6 +16,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
 #include "imufit/model/check.h"
+#include "imufit/model/number_text.h"
 #include "temp_folder.h"
 
 extern char** environ;
@@ -155,6 +156,18 @@ double TickStep(double lo, double hi, int most) {
   return 10.0 * power;
 }
 
+// What a tick label takes at the terminal's 10-point DejaVu Sans: a digit's width, and the gap
+// kept between two labels, in characters.
+constexpr double kTickCharPx = 6.4;
+constexpr double kTickGapChars = 1.5;
+// Of a panel's width, what its y tick labels, y label and right margin take.
+constexpr double kPanelFramePx = 80.0;
+
+// The width of a panel's plotting area, px.
+double PlotWidthPx(const PlotFigure& figure) {
+  return std::max(1.0, static_cast<double>(figure.width_px) / std::max(figure.cols, 1) - kPanelFramePx);
+}
+
 // ---------------------------------------------------------------- a panel's script, by stages
 
 // Title, axis labels, log scales and tick formats.
@@ -202,8 +215,21 @@ void WriteRangesAndKey(std::ostream& gp, const Plot& plot) {
   }
 }
 
-// At most max_x_tics / max_y_tics tick labels on a linear axis; the axis ends where the data end.
-void WriteTickSteps(std::ostream& gp, const Plot& plot) {
+// The tick labels of `step` on [lo, hi] side by side, in pixels at kTickCharPx a character with
+// a gap of kTickGapChars between two.
+double TickLabelsWidthPx(double lo, double hi, double step) {
+  size_t chars = 0;
+  int labels = 0;
+  for (double t = std::ceil(lo / step) * step; t <= hi + 1e-9 * step && labels < 1000; t += step, ++labels) {
+    const double shown = std::abs(t) < 1e-9 * step ? 0.0 : t;
+    chars = std::max(chars, NumberText("%g", shown).size());
+  }
+  return labels * (chars + kTickGapChars) * kTickCharPx;
+}
+
+// At most max_x_tics / max_y_tics tick labels on a linear axis, and no more x labels than fit
+// side by side in the panel's `plot_width_px`; the axis ends where the data end.
+void WriteTickSteps(std::ostream& gp, const Plot& plot, double plot_width_px) {
   for (const bool y_axis : {false, true}) {
     const int most = y_axis ? plot.max_y_tics : plot.max_x_tics;
     const bool log = y_axis ? plot.log_y : plot.log_x;
@@ -225,7 +251,12 @@ void WriteTickSteps(std::ostream& gp, const Plot& plot) {
       lo -= half;
       hi += half;
     }
-    const double step = TickStep(lo, hi, most);
+    double step = TickStep(lo, hi, most);
+    // Fewer, wider steps until the x labels fit: "750 10001250" is not an axis.
+    for (int fewer = most - 1;
+         !y_axis && step > 0.0 && fewer >= 2 && TickLabelsWidthPx(lo, hi, step) > plot_width_px; --fewer) {
+      step = TickStep(lo, hi, fewer);
+    }
     if (!(step > 0.0)) continue;
     const char* axis = y_axis ? "y" : "x";
     gp << "set " << axis << "tics " << step << "\n";
@@ -402,13 +433,25 @@ std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal,
     const Plot& plot = figure.panels[p];
     WriteAxes(gp, plot);
     WriteRangesAndKey(gp, plot);
-    WriteTickSteps(gp, plot);
+    WriteTickSteps(gp, plot, PlotWidthPx(figure));
     WriteAnnotations(gp, plot);
     WritePlotCommand(gp, plot, p);
   }
   if (multi) gp << "unset multiplot\n";
   gp << "unset output\n";
   return gp.str();
+}
+
+std::string WithoutTooltips(std::string svg) {
+  for (const char* tag : {"title", "desc"}) {
+    const std::string open = std::string("<") + tag + ">", close = std::string("</") + tag + ">";
+    for (size_t at = svg.find(open); at != std::string::npos; at = svg.find(open, at)) {
+      const size_t end = svg.find(close, at);
+      if (end == std::string::npos) break;
+      svg.erase(at, end + close.size() - at);
+    }
+  }
+  return svg;
 }
 
 std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
@@ -425,7 +468,7 @@ std::vector<Svg> DrawSvg(const std::vector<PlotFigure>& figures) {
     const std::string svg = ReadBytes(folder.path + "/" + std::to_string(i) + ".svg");
     const size_t start = svg.find("<svg");  // drop the XML prolog and doctype: inline SVG in HTML
     if (start == std::string::npos) throw std::runtime_error("gnuplot drew no SVG");
-    svgs.push_back({svg.substr(start)});
+    svgs.push_back({WithoutTooltips(svg.substr(start))});
   }
   return svgs;
 }

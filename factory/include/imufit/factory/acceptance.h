@@ -30,10 +30,20 @@ struct Figure {
   // A coefficient evaluated at 25 degC outside the calibration's fitted temperature range: the
   // polynomial extrapolated.
   bool extrapolated = false;
+  // Not measured by this run (a noise term the run cannot resolve): why, and how to supply it; the
+  // figure is then judged as missing, with this as the reason.
+  std::string unresolved;
 };
 
+// A figure or limit quantity in words, for a reader: "gyro_bias_dps.x" -> "Gyro bias X",
+// "gyro_g_sensitivity_dpsg.xy" -> "Gyro g-sensitivity X from Y", "gyro_misalignment_mrad.xy" ->
+// "Gyro misalignment X from Y", "fit_temp_range_c" -> "Fitted temperature range"; a name it does
+// not know is returned as it is.
+std::string FigureTitle(const std::string& name);
+
 // Every coefficient at 25 degC and the residual RMS values, in a fixed order.
-std::vector<Figure> KeyFigures(const Calibration& calibration);
+// `temp_c`: the coefficients at another temperature (the statistics over a range of a limits file).
+std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c = kFigureTempC);
 // The figure called `name` (or with that `coefficient` path); nullptr when there is none.
 const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name);
 
@@ -44,7 +54,8 @@ enum class Outcome { kPass, kConditionalPass, kConditionalFail, kFail };
 const char* OutcomeName(Outcome outcome);
 
 struct CriterionResult {
-  std::string name;  // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"
+  std::string name;   // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"
+  std::string title;  // in words (FigureTitle): "Gyro bias X", "Gyro bias X, 1-sigma"
   std::string unit;
   double measured = 0.0;  // |value| for max_abs criteria; for coverage: the margin's side that binds
   double limit = 0.0;
@@ -75,7 +86,8 @@ struct Verdict {
   // The rule in words, for the certificate: "simple acceptance (ILAC-G8): ...".
   std::string RuleText() const;
   // "|gyro_g_sensitivity_dpsg.xx| 0.0712 > 0.05 deg/s/g; ..." — the failed criteria, one line.
-  std::string FailedSummary() const;
+  // `in_words`: the criteria by their titles ("Gyro g-sensitivity X from X 0.0712 deg/s/g (limit ...)").
+  std::string FailedSummary(bool in_words = false) const;
   // The table `imufit fit --limits` prints: criterion, measured, limit, margin, PASS/FAIL.
   std::string Table() const;
 };

@@ -43,11 +43,12 @@ struct BatchOptions {
   // (fnmatch, e.g. "*_imu.csv.gz"); empty: samples.csv.gz, else samples.csv.
   std::string samples_glob;
   std::string output_dir;
-  std::string limits_path;   // empty: no verdicts
-  std::string shared_plan;   // used by units without their own plan.yaml
-  std::string store_path;    // empty: no results store
-  std::string station_path;  // station file shown on every certificate; empty: none
-  std::string lot;           // the lot's name in the store; empty: the units folder's name
+  std::string limits_path;      // empty: no verdicts
+  std::string shared_plan;      // used by units without their own plan.yaml
+  std::string store_path;       // empty: no results store
+  std::string station_path;     // station file shown on every certificate; empty: none
+  std::string customer, order;  // whom the certificates are issued to; "" when not given
+  std::string lot;              // the lot's name in the store; empty: the units folder's name
   // Worker threads; 0: all cores.
   int jobs = 0;
   // Stop after this many units have been fitted in this run (0: no limit) — for tests of resuming.

@@ -27,6 +27,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/run_header.h"
 #include "imufit/io/station.h"
 #include "imufit/pipeline/run_windows.h"
 
@@ -63,12 +64,20 @@ struct CertificateSources {
   std::vector<std::string> warnings;  // from the caller (e.g. a mismatch the user allowed)
   // Where and by whom (a station file, --station); its file is among the inputs (role "station").
   std::optional<Station> station;
+  // What the samples header says of the run (acquired, model, firmware, ambient) where the
+  // calibration's fit record does not say it; nullopt: not known, ReadCertificateFiles reads the
+  // samples file's header (a calibration written before the record had them). A caller that has
+  // just fitted the run sets it empty: the record holds what the header said.
+  std::optional<RunHeader> header;
+  // The customer and their order (--customer, --order); "" when not given.
+  std::string customer, order;
   // The Allan section, measured on the static stretch the run's reading kept (GyroNoise), or on
   // the samples input (MeasureGyroNoise); nullopt only when no samples input is listed.
   std::optional<NoiseSection> noise;
 };
 
-// What MakeCertificate() takes from files, read into `sources`: the SHA-256 of every listed input
+// What MakeCertificate() takes from files, read into `sources`: the samples header's run header
+// when the calibration does not record an acquisition time, the SHA-256 of every listed input
 // that has none (the station's file added to the inputs when it is not among them), and, unless
 // `noise` is given, the noise section measured on the samples input (MeasureGyroNoise).
 void ReadCertificateFiles(CertificateSources* sources);
@@ -186,10 +195,25 @@ struct RunSummary {
   std::vector<double> time_s, window_temp_c;  // temperature against time, per window
 };
 
+// The statement every certificate carries (ISO/IEC 17025 7.8.2.1 k).
+inline constexpr const char* kItemOnlyStatement =
+    "The results in this certificate apply only to the item calibrated, as received. This certificate "
+    "shall not be reproduced except in full.";
+
 struct Certificate {
+  // Unique and reproducible: "<serial>-<YYYYMMDD of the acquisition, else of the fit>-<the first 8
+  // hex digits of the SHA-256 of the inputs' roles and hashes, the customer and the order>"
+  // (CertificateNumber); the same inputs give the same number, whenever the page is written.
+  std::string number;
   std::string serial;  // empty: none known (then a warning says so)
   std::string unit;
+  // When the run was recorded (the samples header's '# acquired:'); "" when not stated, then the
+  // fit time (calibrated_utc) stands in for it where a date is judged (the page says so).
+  std::string acquired_utc;
+  // When the fit ran (the calibration's created_utc) and when this page was written.
   std::string calibrated_utc, written_utc;
+  std::string unit_model, unit_firmware, ambient;  // the run header's; "" when not stated
+  std::string customer, order;
   std::string calibration_software, report_software, git_revision;
   double reference_temp_c = 25.0;
   std::vector<ReportInput> inputs;  // with their hashes
@@ -218,7 +242,15 @@ struct Certificate {
 // ReadCertificateFiles() first.
 Certificate MakeCertificate(const CertificateSources& sources);
 
-// The figures the certificate measured itself (ARW, bias instability per gyro axis, resolved ones).
+// The certificate number (Certificate::number) of a unit `serial` (or its folder's name),
+// recorded on `date_utc` ("YYYY-MM-DD..."), from `inputs` (with their hashes), customer and order.
+std::string CertificateNumber(const std::string& serial, const std::string& date_utc,
+                              const std::vector<ReportInput>& inputs, const std::string& customer,
+                              const std::string& order);
+
+// The figures the certificate measured itself: ARW and bias instability per gyro axis (a term the
+// run does not resolve as a Figure::unresolved, saying what stretch it needs), and the worst window
+// error after correction (gyro_residual_max_dps, accel_residual_max_mg).
 std::vector<Figure> MeasuredFigures(const Certificate& certificate);
 
 // Where a calibration says it was fitted to other files than the ones given (SHA-256 in its `fit:`

@@ -69,6 +69,8 @@ struct CertifySettings {
   // Where and by whom (none: the signers fill it in) and the SHA-256 of the station file.
   std::optional<Station> station;
   std::string station_sha256;
+  // Whom the certificates are issued to (--customer, --order); "" when not given.
+  std::string customer, order;
   // The results store units are recorded in (none: not recorded; not owned), and their lot
   // ("" for a single fit).
   ResultsStore* store = nullptr;

@@ -28,6 +28,9 @@ namespace imufit {
 
 // The Allan section needs a static stretch at least this long, s.
 inline constexpr double kMinAllanStretchS = 60.0;
+// A bias instability is read at the floor of the Allan deviation, which a MEMS gyro reaches at tens
+// to hundreds of seconds: a stretch shorter than this rarely shows it, s.
+inline constexpr double kBiasInstabilityStretchS = 1800.0;
 
 struct NoiseAxis {
   std::string axis;

@@ -18,6 +18,18 @@ namespace imufit {
 // "0.0", not "-0.0", and 0 through "%+g" is "0", not "+0" (zero is on neither side).
 std::string FormatNumber(const char* format, double value);
 
+// A value and its uncertainty as a certificate prints them (GUM 7.2.6): the uncertainty to two
+// significant digits, the value to the same decimal place (`sign`: "+" before a positive value),
+// both with FormatNumber(). An uncertainty that is not > 0 leaves the value at 6 significant
+// digits and the uncertainty "".
+struct RoundedValue {
+  std::string value, uncertainty;
+  int decimals = 0;  // places after the point (negative: rounded to tens, hundreds, ...)
+};
+RoundedValue RoundToUncertainty(double value, double uncertainty, bool sign = false);
+// `value` rounded to `decimals` places after the point (RoundedValue::decimals).
+std::string AtDecimals(double value, int decimals, bool sign = false);
+
 }  // namespace imufit
 
 #endif  // IMUFIT_FACTORY_REPORT_H_

@@ -26,6 +26,10 @@
   X(std::string, samples, "the samples file, as given")                                                 \
   X(std::string, plan_sha256, "SHA-256 of the plan file")                                               \
   X(std::string, samples_sha256, "SHA-256 of the samples file")                                         \
+  X(std::string, acquired_utc, "when the run was recorded (the samples header's '# acquired:'), UTC")   \
+  X(std::string, unit_model, "the product's model or part number (the samples header's '# model:')")    \
+  X(std::string, unit_firmware, "the unit's firmware (the samples header's '# firmware:')")             \
+  X(std::string, ambient, "the laboratory's conditions (the samples header's '# ambient:')")            \
   X(long long, samples_read, "samples in the file")                                                     \
   X(int, segments_found_in_data, "a file without a segment column: the segments found in the data")     \
   X(int, plan_passes_found, "a file without a segment column: complete passes through the plan")        \

@@ -12,6 +12,9 @@
 //     - {quantity: gyro_bias_dps, statistic: sigma, max_abs: 0.01}   # the 1-sigma, not the value
 //     - {quantity: fit_temp_range_c, covers: [-20, 60]}    # within kDefaultCoversToleranceC
 //     - {quantity: accel_bias_mg, min: -20, max: 35}      # the signed value, either side optional
+//     - {quantity: gyro_bias_dps, statistic: largest, over: [-40, 85], max_abs: 0.5}  # worst |value|
+//     - {quantity: gyro_bias_dps, statistic: variation, max_abs: 0.1}  # max - min over the fitted range
+//     - {quantity: gyro_residual_max_dps, max_abs: 0.02}  # the worst window error at any temperature
 //   decision_rule: guarded                  # simple (the default) or guarded (ILAC-G8)
 //   guard_band: 1.0                         # guarded: w as a multiple of the figure's U (default 1)
 //
@@ -63,12 +66,21 @@ inline constexpr LimitQuantity kLimitQuantities[] = {
     // Plan segments without a usable window in the run (`fit:` block): {quantity: coverage,
     // max_abs: 1} passes when every segment of the plan was measured.
     {"coverage", LimitKind::kFigure, "", "segments missing"},
+    // The largest error of any window after correction, at any temperature of the run: measured by
+    // the certificate (its per-segment table), not in the calibration.
+    {"gyro_residual_max_dps", LimitKind::kFigure, "", "deg/s"},
+    {"accel_residual_max_mg", LimitKind::kFigure, "", "mg"},
     // From a `noise:` block in the calibration (imufit allan --noise-yaml appended to it).
     {"gyro_arw_deg_per_sqrt_hr", LimitKind::kCoefficient, "x y z", "deg/sqrt(h)"},
     {"gyro_bias_instability_dph", LimitKind::kCoefficient, "x y z", "deg/h"},
 };
 
-enum class LimitStatistic { kValue, kSigma };
+// What of a coefficient is judged: its value at 25 degC, its 1-sigma there, or over a temperature
+// range (`over:`, else the calibration's fitted range) the largest |value| (with min/max: the
+// lowest and the highest value) or the variation, largest - smallest.
+enum class LimitStatistic { kValue, kSigma, kLargest, kVariation };
+// Temperatures a statistic over a range evaluates the polynomial at, ends included.
+inline constexpr int kRangeStatisticPoints = 251;
 
 enum class DecisionRule { kSimple, kGuarded };
 // "simple", "guarded".
@@ -89,6 +101,8 @@ struct LimitCriterion {
   std::optional<double> min, max;
   std::array<double, 2> covers_c{0.0, 0.0};  // kCoverage: lo < hi
   double covers_tolerance_c = kDefaultCoversToleranceC;
+  // kLargest, kVariation: the range, degC; nullopt: the calibration's fitted range.
+  std::optional<std::array<double, 2>> over_c;
 };
 
 struct Limits {

@@ -5,6 +5,8 @@
 //   version: 1
 //   station: "Rate table bench 2"            # required: the station's name
 //   station_id: "CB-02"                      # optional, like every key below
+//   laboratory: "Acme Inertial Calibration Laboratory, 12 Dock Road, Bristol"  # who issues it
+//   accreditation: "UKAS 1234 (ISO/IEC 17025)"
 //   location: "Building 4, room 112"
 //   operator: "J. Smith"
 //   rate_table: {model: "Acutronic AC1120S", serial: "RT-2291"}
@@ -87,6 +89,8 @@ struct Station {
   std::string path;
   std::string name;  // required
   std::string id, location, operator_name;
+  // The laboratory issuing the certificate (name and address) and its accreditation; "" when not given.
+  std::string laboratory, accreditation;
   StationEquipment rate_table, chamber;
   std::string reference_calibration_due;  // YYYY-MM-DD; "" when not given
   std::string notes;

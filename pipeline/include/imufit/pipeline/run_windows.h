@@ -16,6 +16,7 @@
 
 #include "imufit/io/memory_samples.h"
 #include "imufit/io/plan.h"
+#include "imufit/io/run_header.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/pipeline/segment_run.h"
@@ -34,6 +35,8 @@ struct RunWindows {
   std::string samples_sha256;
   // The longest static stretch of the run, when the reading was asked to keep it.
   std::optional<StaticStretch> static_stretch;
+  // What the samples header says of the run (run_header.h; empty for a run held in memory).
+  RunHeader header;
 };
 
 // A run's samples file, opened: its header is read (the serial in it can be checked before any
@@ -53,6 +56,12 @@ class RunReader {
   const std::string& name() const { return memory_ ? memory_->path() : first_pass_->path(); }
   const SamplesSerial& located_serial() const {
     return memory_ ? memory_->located_serial() : first_pass_->located_serial();
+  }
+
+  // What the samples header says of the run (acquired, model, firmware, ambient; run_header.h);
+  // empty for a run held in memory. Throws InputError at a bad header line.
+  RunHeader run_header() const {
+    return memory_ ? RunHeader() : RunHeaderOf(first_pass_->path(), first_pass_->header_comments());
   }
 
   // Streams the samples through a WindowBuilder (once only). Throws InputError for bad input,

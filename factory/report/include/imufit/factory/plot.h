@@ -141,6 +141,10 @@ struct Svg {
   std::string markup;
 };
 
+// `svg` without its <title> and <desc> elements: gnuplot's "Gnuplot", "Produced by GNUPLOT ..." and
+// each series' name, which browsers show as tooltips over a page's plots.
+std::string WithoutTooltips(std::string svg);
+
 // The gnuplot commands that draw `figure` into `output` with `terminal` ("svg" or "png").
 std::string GnuplotScript(const PlotFigure& figure, const std::string& terminal, const std::string& output);
 // Draws every figure in one gnuplot run.
