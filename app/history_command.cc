@@ -16,6 +16,7 @@
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {
@@ -130,7 +131,9 @@ int Serial(const HistoryArguments& args, ResultsStore* store) {
     return 0;
   }
   if (args.csv) {
-    std::printf("id,time_utc,serial,lot,unit,software,status,verdict,samples_sha256,message,station");
+    std::printf(
+        "id,time_utc,serial,lot,unit,software,status,verdict,samples_sha256,message,station,acquired_utc,"
+        "part_number");
     for (const std::string& name : kSummaryFigures) std::printf(",%s", name.c_str());
     std::printf("\n");
   } else {
@@ -140,9 +143,13 @@ int Serial(const HistoryArguments& args, ResultsStore* store) {
   }
   for (const StoredFit& f : fits) {
     if (args.csv) {
-      std::printf("%lld,%s,%s,%s,%s,%s,%s,%s,%s,\"%s\",%s", static_cast<long long>(f.id), f.time_utc.c_str(),
-                  f.serial.c_str(), f.lot.c_str(), f.unit.c_str(), f.software.c_str(), f.status.c_str(),
-                  f.verdict.c_str(), f.samples_sha256.c_str(), f.message.c_str(), f.station.c_str());
+      std::string row = std::to_string(f.id);
+      for (const std::string* text :
+           {&f.time_utc, &f.serial, &f.lot, &f.unit, &f.software, &f.status, &f.verdict, &f.samples_sha256,
+            &f.message, &f.station, &f.acquired_utc, &f.part_number}) {
+        row += "," + CsvCell(*text);
+      }
+      std::printf("%s", row.c_str());
       for (const std::string& name : kSummaryFigures) {
         const Figure* figure = FindFigure(f.figures, name);
         std::printf(",%s", figure ? FormatDouble(figure->value).c_str() : "");

@@ -15,7 +15,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
-#include "imufit/model/number_text.h"
+#include "imufit/model/text.h"
 #include "imufit/pipeline/plan_check.h"
 #include "imufit/pipeline/plan_design.h"
 

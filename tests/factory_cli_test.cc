@@ -1258,10 +1258,14 @@ TEST_F(FactoryCliTest, TheCertificateNamesTheRunTheItemAndTheLaboratory) {
       "accreditation: UKAS 1234 (ISO/IEC 17025)\n";
   const std::string station_path = Write("lab.yaml", station);
   const std::string plan = Path("units/unit-01/plan.yaml");
-  RunResult r =
-      Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal.yaml"), "--station", station_path, "--report",
-           Path("cert.html"), "--customer", "Northwind Avionics", "--order", "PO-7731", "-q"});
+  RunResult r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal.yaml"), "--station", station_path,
+                     "--report", Path("cert.html"), "--customer", "Northwind Avionics", "--order", "PO-7731",
+                     "--store", Path("acquired.db"), "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
+  // The store records the run's acquisition and the unit's model from the header, not the file's time.
+  const RunResult stored = Run({"history", Path("acquired.db"), "--serial", "SN-01", "--csv"});
+  ASSERT_EQ(stored.status, 0) << stored.err;
+  EXPECT_NE(stored.out.find(",2026-01-10T08:15:00Z,IMU-9X rev B"), std::string::npos) << stored.out;
   const Calibration calibration = ReadCalibration(Path("cal.yaml"));
   ASSERT_TRUE(calibration.fit && calibration.fit->acquired_utc);
   EXPECT_EQ(*calibration.fit->acquired_utc, "2026-01-10T08:15:00Z");

@@ -125,7 +125,11 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.calibration_yaml = unit->calibration_yaml;
   if (settings.station)
     row.station = settings.station->id.empty() ? settings.station->name : settings.station->id;
-  row.acquired_utc = FileTimeUtc(unit->samples_path);
+  // When the run was recorded and what the unit is: the samples header's, else the file's time.
+  const RunHeader* header = unit->fit ? &unit->fit->run.header : nullptr;
+  row.acquired_utc =
+      header && !header->acquired_utc.empty() ? header->acquired_utc : FileTimeUtc(unit->samples_path);
+  if (header) row.part_number = header->model;
   for (const Figure& figure : unit->figures) {
     StoredFigure g(figure);
     if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;

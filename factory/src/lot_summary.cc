@@ -8,6 +8,7 @@
 #include "imufit/factory/git_revision.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/output_file.h"
+#include "imufit/model/text.h"
 
 namespace imufit {
 
@@ -50,14 +51,6 @@ std::vector<std::string> LotFigureNames(const BatchResult& batch) {
 }
 
 namespace {
-
-// A CSV cell: quoted when it holds a comma, a quote or a line break (a line break becomes a space).
-std::string CsvCell(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return quoted + "\"";
-}
 
 // A number's cell: empty when it is not finite or (`known`) not known.
 std::string NumberCell(double value, bool known = true) {

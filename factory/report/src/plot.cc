@@ -16,7 +16,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
 #include "imufit/model/check.h"
-#include "imufit/model/number_text.h"
+#include "imufit/model/text.h"
 #include "temp_folder.h"
 
 extern char** environ;

@@ -1,4 +1,4 @@
-// imufit — small text helpers for messages: one double through a printf format, a list joined.
+// imufit — small text helpers: one double through a printf format, a list joined, a CSV cell.
 #ifndef IMUFIT_MODEL_TEXT_H_
 #define IMUFIT_MODEL_TEXT_H_
 
@@ -21,6 +21,18 @@ inline std::string Join(const std::vector<std::string>& parts, const char* separ
   std::string text;
   for (std::size_t i = 0; i < parts.size(); ++i) text += (i == 0 ? "" : separator) + parts[i];
   return text;
+}
+
+// A CSV cell (RFC 4180): quoted when it holds a comma, a quote or a line break (a line break
+// becomes a space).
+inline std::string CsvCell(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += (c == '\n' || c == '\r') ? ' ' : c;
+  }
+  return quoted + "\"";
 }
 
 }  // namespace imufit
