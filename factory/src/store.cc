@@ -587,10 +587,10 @@ std::vector<LotValue> ResultsStore::LotValues(const std::vector<std::string>& fi
   std::vector<LotValue> values;
   if (figures.empty()) return values;
   db_->Query(
-      std::string(kLatestPerUnit) +
-          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest l JOIN figures "
-          "g "
-          "ON g.fit_id = l.id WHERE l.lot <> '' AND l.status = 'fitted' AND (g.name IN (" +
+      // latest_fits in its key's order: no runs to join, nothing to sort.
+      "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest_fits l "
+      "JOIN fits f ON f.id = l.fit_id JOIN figures g ON g.fit_id = l.fit_id WHERE l.lot <> '' AND "
+      "f.status = 'fitted' AND (g.name IN (" +
           list + ") OR g.coefficient IN (" + list + ")) ORDER BY l.lot, l.unit",
       std::vector<SqlValue>(figures.begin(), figures.end()), [&](const SqlRow& row) {
         const std::string name = row.Text(5), coefficient = row.Text(6);
