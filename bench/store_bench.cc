@@ -84,6 +84,10 @@ std::vector<std::string> FillStatements(int fits) {
       "'pass' "
       "FROM fits f CROSS JOIN (" +
           figures + ") k",
+      // Every unit has one fit: its latest.
+      "INSERT INTO latest_fits (lot, unit, fit_id, time_utc) SELECT r.lot, r.unit, f.id, f.time_utc FROM "
+      "fits f "
+      "JOIN runs r ON r.run_key = f.run_key",
       "ANALYZE"};
 }
 

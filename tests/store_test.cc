@@ -6,15 +6,20 @@
 #include <libpq-fe.h>
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
+#include <random>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -173,6 +178,167 @@ TEST(StoreTest, AVersion1SqliteStoreIsMigratedKeepingEveryRow) {
   EXPECT_EQ(store.Yield("lot-a")[0].units, 2);
   ResultsStore again(path);  // opening a migrated store changes nothing
   EXPECT_EQ(again.CountFits(), 3);
+}
+
+// Runs `sql` on the store `target` directly, as an older imufit would have left it.
+void ExecuteOnStore(const std::string& target, const std::string& sql) {
+  if (StoreBackend() == "sqlite") {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(target.c_str(), &db), SQLITE_OK);
+    EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+    sqlite3_close(db);
+    return;
+  }
+  PGconn* connection = PQconnectdb(target.c_str());
+  ASSERT_EQ(PQstatus(connection), CONNECTION_OK) << PQerrorMessage(connection);
+  PGresult* result = PQexec(connection, sql.c_str());
+  EXPECT_EQ(PQresultStatus(result), PGRES_COMMAND_OK) << PQresultErrorMessage(result);
+  PQclear(result);
+  PQfinish(connection);
+}
+
+// One line per answer, in the order given: what YieldBy(), LatestOfLot() and LotValues() say.
+std::string Answers(ResultsStore* store, const std::vector<std::string>& lots) {
+  std::ostringstream out;
+  for (YieldGroup by : {YieldGroup::kLot, YieldGroup::kStation, YieldGroup::kMonth}) {
+    for (const GroupYield& y : store->YieldBy(by)) {
+      out << NameOf(kYieldGroupNames, by) << " " << y.group << ": " << y.units << " " << y.passed << " "
+          << y.failed << " " << y.not_fitted << "\n";
+    }
+  }
+  for (const std::string& lot : lots) {
+    for (const StoredFit& f : store->LatestOfLot(lot))
+      out << "latest " << lot << " " << f.unit << " " << f.id << "\n";
+  }
+  for (const LotValue& v : store->LotValues("gyro_bias_dps.x"))
+    out << "value " << v.lot << " " << v.unit << " " << v.value << "\n";
+  return out.str();
+}
+
+// The same answers recomputed from every fit: each (lot, unit) by its fit of the latest time, of
+// those the highest id.
+std::string RecomputedAnswers(ResultsStore* store, const std::vector<std::string>& lots) {
+  std::map<std::pair<std::string, std::string>, StoredFit> latest;
+  for (StoredFit& f : store->All()) {
+    const auto key = std::make_pair(f.lot, f.unit);
+    const auto it = latest.find(key);
+    if (it == latest.end() || std::tie(f.time_utc, f.id) > std::tie(it->second.time_utc, it->second.id)) {
+      latest[key] = std::move(f);
+    }
+  }
+  std::ostringstream out;
+  for (YieldGroup by : {YieldGroup::kLot, YieldGroup::kStation, YieldGroup::kMonth}) {
+    std::map<std::string, GroupYield> groups;
+    std::map<std::string, std::string> first;  // a lot's earliest latest fit: lots are listed by it
+    for (const auto& [key, f] : latest) {
+      const std::string group = by == YieldGroup::kLot       ? f.lot
+                                : by == YieldGroup::kStation ? f.station
+                                                             : f.time_utc.substr(0, 7);
+      if (by == YieldGroup::kLot && group.empty()) continue;
+      GroupYield& y = groups[group];
+      y.group = group;
+      ++y.units;
+      y.passed += f.verdict == "PASS";
+      y.failed += f.verdict == "FAIL";
+      y.not_fitted += f.status != "fitted";
+      if (first[group].empty() || f.time_utc < first[group]) first[group] = f.time_utc;
+    }
+    std::vector<GroupYield> ordered;
+    for (const auto& [group, y] : groups) ordered.push_back(y);
+    if (by == YieldGroup::kLot) {
+      std::stable_sort(ordered.begin(), ordered.end(), [&](const GroupYield& a, const GroupYield& b) {
+        return first[a.group] < first[b.group];
+      });
+    }
+    for (const GroupYield& y : ordered) {
+      out << NameOf(kYieldGroupNames, by) << " " << y.group << ": " << y.units << " " << y.passed << " "
+          << y.failed << " " << y.not_fitted << "\n";
+    }
+  }
+  for (const std::string& lot : lots) {
+    for (const auto& [key, f] : latest) {
+      if (key.first == lot) out << "latest " << lot << " " << f.unit << " " << f.id << "\n";
+    }
+  }
+  for (const auto& [key, f] : latest) {
+    const StoredFigure* x = FindFigure(f.figures, "gyro_bias_dps.x");
+    if (!key.first.empty() && f.status == "fitted" && x)
+      out << "value " << key.first << " " << key.second << " " << x->value << "\n";
+  }
+  return out.str();
+}
+
+// Fits of three lots and single files, at two stations, recorded out of time order, with equal
+// times (the later record wins), refits of the same run, re-records and a run re-imported under
+// another lot. Fixed seed.
+std::vector<StoredFit> ShuffledHistory() {
+  std::mt19937 random(20);
+  const std::vector<std::string> lots = {"lot-a", "lot-b", "lot-c", ""};
+  std::vector<StoredFit> fits;
+  for (int i = 0; i < 80; ++i) {
+    const int unit = static_cast<int>(random() % 12);
+    const std::string lot = lots[unit % 4];
+    const std::string time =
+        "2026-0" + std::to_string(1 + random() % 3) + "-0" + std::to_string(1 + random() % 2) + "T00:00:00Z";
+    const char* verdicts[] = {"PASS", "FAIL", ""};
+    StoredFit fit =
+        MakeFit("SN" + std::to_string(unit), lot, time, static_cast<double>(i), verdicts[random() % 3]);
+    if (fit.verdict.empty()) fit.status = random() % 2 ? "not-fitted" : "error";
+    fit.station = random() % 2 ? "station-1" : "station-2";
+    fit.samples_sha256 = std::string(63, '2') + std::to_string(random() % 3);  // one of three runs per unit
+    fits.push_back(fit);
+    if (random() % 5 == 0) fits.push_back(fit);  // recorded again: a re-run or a merge
+    if (random() % 7 == 0) {
+      fit.lot = "lot-z";  // the same run re-imported under another lot keeps its first lot
+      fits.push_back(fit);
+    }
+  }
+  return fits;
+}
+
+const std::vector<std::string> kShuffledLots = {"lot-a", "lot-b", "lot-c", "lot-z", ""};
+
+TEST(StoreTest, LatestFitAnswersEqualARecomputationFromEveryFitWhateverTheRecordingOrder) {
+  ResultsStore store(FreshStore("latest"));
+  const std::vector<StoredFit> fits = ShuffledHistory();
+  for (size_t i = 0; i < fits.size(); ++i) {
+    if (i % 2 == 0) {
+      store.Record(fits[i]);
+    } else {
+      store.RecordAll({fits[i]});
+    }
+    if (i % 10 == 9 || i + 1 == fits.size()) {
+      ASSERT_EQ(Answers(&store, kShuffledLots), RecomputedAnswers(&store, kShuffledLots))
+          << "after " << i + 1;
+    }
+  }
+  EXPECT_NE(Answers(&store, kShuffledLots).find("lot-c"), std::string::npos);
+}
+
+TEST(StoreTest, AVersion2StoreGainsItsLatestFitsKeepingEveryRowAndEveryAnswer) {
+  const std::string target = FreshStore("v2");
+  std::vector<StoredFit> before;
+  std::string answers;
+  {
+    ResultsStore store(target);
+    for (const StoredFit& fit : ShuffledHistory()) store.Record(fit);
+    before = store.All();
+    answers = RecomputedAnswers(&store, kShuffledLots);
+  }
+  // The store as version 2 wrote it: no latest_fits.
+  ExecuteOnStore(target, std::string("DROP TABLE latest_fits; UPDATE schema_version SET version = 2;") +
+                             (StoreBackend() == "sqlite" ? " PRAGMA user_version = 2;" : ""));
+  ResultsStore store(target);
+  const std::vector<StoredFit> after = store.All();
+  ASSERT_EQ(after.size(), before.size());
+  for (size_t i = 0; i < after.size(); ++i) {
+    EXPECT_EQ(after[i].id, before[i].id);
+    EXPECT_EQ(FitKey(after[i]), FitKey(before[i]));
+    EXPECT_EQ(after[i].figures.size(), before[i].figures.size());
+  }
+  EXPECT_EQ(Answers(&store, kShuffledLots), answers);
+  store.Record(MakeFit("SN0", "lot-a", "2026-12-01T00:00:00Z", 7.0, "PASS"));  // and it keeps them
+  EXPECT_EQ(Answers(&store, kShuffledLots), RecomputedAnswers(&store, kShuffledLots));
 }
 
 // Two stations' SQLite stores, one with a fit the other has too (the same run uploaded twice).

@@ -123,18 +123,27 @@ LotHistory MakeLotHistory(ResultsStore* store, const std::string& current_lot, c
     h.yield_pct.push_back(y.units > 0 ? 100.0 * y.passed / y.units : 0.0);
     if (y.lot == current_lot) h.current = static_cast<int>(i);
   }
+  // One pass over every unit's values: per figure, per lot.
+  std::map<std::string, size_t> figure_index;
+  for (size_t i = 0; i < figures.size(); ++i) figure_index.emplace(figures[i], i);
+  std::vector<std::vector<std::vector<double>>> values(figures.size(),
+                                                       std::vector<std::vector<double>>(h.lots.size()));
+  std::vector<std::string> units(figures.size());
   const std::vector<LotValue> all = store->LotValues(figures);
-  for (const std::string& name : figures) {
-    std::vector<std::vector<double>> per_lot(h.lots.size());
+  auto lot = index.end();
+  for (const LotValue& v : all) {
+    if (lot == index.end() || lot->first != v.lot) lot = index.find(v.lot);  // the rows come by lot
+    if (lot == index.end()) continue;
+    const size_t f = figure_index.at(v.figure);
+    values[f][lot->second].push_back(v.value);
+    units[f] = v.figure_unit;
+  }
+  for (size_t f = 0; f < figures.size(); ++f) {
+    const std::string& name = figures[f];
+    const std::vector<std::vector<double>>& per_lot = values[f];
     LotTrend trend;
     trend.name = name;
-    for (const LotValue& v : all) {
-      if (v.figure != name) continue;
-      const auto lot = index.find(v.lot);
-      if (lot == index.end()) continue;
-      per_lot[lot->second].push_back(v.value);
-      trend.unit = v.figure_unit;
-    }
+    trend.unit = units[f];
     if (trend.unit.empty()) continue;  // no lot has it
     for (const std::vector<double>& values : per_lot) {
       const MeanSigma m = MeanAndSigma(values);

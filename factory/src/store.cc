@@ -222,8 +222,33 @@ CREATE INDEX figures_name ON figures (name, fit_id);
 CREATE INDEX figures_coefficient ON figures (coefficient, fit_id);
 )sql";
 
-std::string SchemaFor(const SqlConnection& db) {
-  std::string sql = kSchema;
+// Each unit's latest fit, kept as fits are recorded (kRecordLatest): the questions about units
+// (yield, a lot's page, the values across lots) read it instead of ranking every fit. Added in
+// version 3.
+constexpr const char* kLatestFitsSchema = R"sql(
+CREATE TABLE latest_fits (
+  lot TEXT NOT NULL, unit TEXT NOT NULL, fit_id BIGINT NOT NULL REFERENCES fits (id),
+  time_utc TEXT NOT NULL, PRIMARY KEY (lot, unit));
+)sql";
+
+// A unit's latest fit is its fit with the latest time_utc, of those the one recorded last (the
+// highest id); a unit is its run's (lot, unit). One statement, safe with concurrent writers: the
+// row is replaced only by a later fit. ?1 the new fit's id, ?2 its time, ?3 its run.
+constexpr const char* kRecordLatest =
+    "INSERT INTO latest_fits (lot, unit, fit_id, time_utc) SELECT r.lot, r.unit, CAST(?1 AS BIGINT), ?2 "
+    "FROM runs r WHERE r.run_key = ?3 ON CONFLICT (lot, unit) DO UPDATE SET fit_id = excluded.fit_id, "
+    "time_utc = excluded.time_utc WHERE excluded.time_utc > latest_fits.time_utc OR "
+    "(excluded.time_utc = latest_fits.time_utc AND excluded.fit_id > latest_fits.fit_id)";
+
+// The same answer computed from every fit: how a version 2 store's latest_fits is filled.
+constexpr const char* kFillLatest =
+    "INSERT INTO latest_fits (lot, unit, fit_id, time_utc) SELECT lot, unit, id, time_utc FROM "
+    "(SELECT r.lot AS lot, r.unit AS unit, f.id AS id, f.time_utc AS time_utc, ROW_NUMBER() OVER "
+    "(PARTITION BY r.lot, r.unit ORDER BY f.time_utc DESC, f.id DESC) AS n FROM fits f "
+    "JOIN runs r ON r.run_key = f.run_key) ranked WHERE n = 1";
+
+std::string SchemaFor(const SqlConnection& db, const std::string& schema) {
+  std::string sql = schema;
   const auto replace_all = [&](const std::string& from, const std::string& to) {
     for (size_t at = sql.find(from); at != std::string::npos; at = sql.find(from, at + to.size())) {
       sql.replace(at, from.size(), to);
@@ -251,16 +276,15 @@ std::vector<std::string*> TextFields(StoredFit* f) {
 // Each unit by its latest fit (a unit refitted after a fix counts as fixed): n = 1. A unit is a
 // lot's unit, or (lot "") a single fit's samples file.
 constexpr const char* kLatestPerUnit =
-    "WITH latest AS (SELECT f.id AS id, r.lot AS lot, r.unit AS unit, r.station AS station, "
-    "substr(f.time_utc, 1, 7) AS month, f.time_utc AS time_utc, f.status AS status, f.verdict AS verdict, "
-    "ROW_NUMBER() OVER (PARTITION BY r.lot, r.unit ORDER BY f.time_utc DESC, f.id DESC) AS n "
-    "FROM fits f JOIN runs r ON r.run_key = f.run_key) ";
+    "WITH latest AS (SELECT f.id AS id, l.lot AS lot, l.unit AS unit, r.station AS station, "
+    "substr(f.time_utc, 1, 7) AS month, f.time_utc AS time_utc, f.status AS status, f.verdict AS verdict "
+    "FROM latest_fits l JOIN fits f ON f.id = l.fit_id JOIN runs r ON r.run_key = f.run_key) ";
 
 // The counts of Yield() and YieldBy() over the units of `latest`, after the group's column.
 constexpr const char* kYieldCounts =
     ", count(*), sum(CASE WHEN verdict = 'PASS' THEN 1 ELSE 0 END), "
     "sum(CASE WHEN verdict = 'FAIL' THEN 1 ELSE 0 END), "
-    "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest WHERE n = 1 ";
+    "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest ";
 
 class Transaction {
  public:
@@ -309,7 +333,7 @@ void ResultsStore::Open() {
     bool empty = true;
     if (db_->HasTable("fits")) empty = false;
     if (!empty) throw InputError(path_, "not an imufit results store (no schema_version table)");
-    db_->Execute(SchemaFor(*db_));
+    db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema));
     db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
     db_->SchemaWritten(kStoreSchemaVersion);
   }
@@ -317,6 +341,7 @@ void ResultsStore::Open() {
   db_->Query("SELECT version FROM schema_version", {}, [&](const SqlRow& row) { found = row.Integer(0); });
   if (found > kStoreSchemaVersion || found < 1) throw UnsupportedVersion(path_, found);
   if (found == 1) MigrateFromVersion1();
+  if (found == 2) MigrateFromVersion2();
   transaction.Commit();
 }
 
@@ -349,10 +374,18 @@ void ResultsStore::MigrateFromVersion1() {
                fits[it->second].figures.push_back(std::move(g));
              });
   db_->Execute("DROP TABLE figures; DROP TABLE fits; DROP TABLE schema_version;");
-  db_->Execute(SchemaFor(*db_));
+  db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema));
   db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
   db_->SchemaWritten(kStoreSchemaVersion);
   for (const StoredFit& f : fits) Insert(f);
+}
+
+// Version 2: the same tables without latest_fits, which is created and filled from every fit.
+void ResultsStore::MigrateFromVersion2() {
+  db_->Execute(SchemaFor(*db_, kLatestFitsSchema));
+  db_->Execute(kFillLatest);
+  db_->Execute("UPDATE schema_version SET version = " + std::to_string(kStoreSchemaVersion));
+  db_->SchemaWritten(kStoreSchemaVersion);
 }
 
 int64_t ResultsStore::Record(const StoredFit& fit, const std::function<void()>& before_commit) {
@@ -424,6 +457,7 @@ int64_t ResultsStore::Insert(const StoredFit& fit, bool* added) {
                [&](const SqlRow& row) { id = row.Integer(0); });
     return id;
   }
+  db_->Query(kRecordLatest, {id, fit.time_utc, run_key}, ignore);
   for (size_t i = 0; i < fit.figures.size(); ++i) {
     const StoredFigure& g = fit.figures[i];
     db_->Query(
@@ -485,11 +519,8 @@ std::vector<StoredFit> ResultsStore::BySerial(const std::string& serial) {
 
 std::vector<StoredFit> ResultsStore::LatestOfLot(const std::string& lot) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<StoredFit> fits = Fits(
-      "r.lot = ?1 AND NOT EXISTS (SELECT 1 FROM fits f2 JOIN runs r2 ON r2.run_key = f2.run_key WHERE "
-      "r2.lot = r.lot AND r2.unit = r.unit AND (f2.time_utc > f.time_utc OR (f2.time_utc = f.time_utc AND "
-      "f2.id > f.id)))",
-      {lot});
+  std::vector<StoredFit> fits =
+      Fits("r.lot = ?1 AND f.id IN (SELECT fit_id FROM latest_fits WHERE lot = ?1)", {lot});
   std::sort(fits.begin(), fits.end(), [](const StoredFit& a, const StoredFit& b) { return a.unit < b.unit; });
   return fits;
 }
@@ -519,7 +550,7 @@ std::vector<GroupYield> ResultsStore::YieldBy(YieldGroup by) {
   const char* column = NameOf(kYieldGroupNames, by);
   const std::string sql =
       std::string(kLatestPerUnit) + "SELECT " + column + kYieldCounts +
-      (by == YieldGroup::kLot ? "AND lot <> '' GROUP BY lot ORDER BY min(time_utc), lot"
+      (by == YieldGroup::kLot ? "WHERE lot <> '' GROUP BY lot ORDER BY min(time_utc), lot"
                               : std::string("GROUP BY ") + column + " ORDER BY " + column);
   std::vector<GroupYield> yields;
   db_->Query(sql, {}, [&](const SqlRow& row) {
@@ -556,10 +587,10 @@ std::vector<LotValue> ResultsStore::LotValues(const std::vector<std::string>& fi
   std::vector<LotValue> values;
   if (figures.empty()) return values;
   db_->Query(
-      std::string(kLatestPerUnit) +
-          "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest l JOIN figures "
-          "g "
-          "ON g.fit_id = l.id WHERE l.n = 1 AND l.lot <> '' AND l.status = 'fitted' AND (g.name IN (" +
+      // latest_fits in its key's order: no runs to join, nothing to sort.
+      "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest_fits l "
+      "JOIN fits f ON f.id = l.fit_id JOIN figures g ON g.fit_id = l.fit_id WHERE l.lot <> '' AND "
+      "f.status = 'fitted' AND (g.name IN (" +
           list + ") OR g.coefficient IN (" + list + ")) ORDER BY l.lot, l.unit",
       std::vector<SqlValue>(figures.begin(), figures.end()), [&](const SqlRow& row) {
         const std::string name = row.Text(5), coefficient = row.Text(6);

@@ -14,13 +14,15 @@
 //        message, calibration_yaml)                        fit_key: UUIDv5 of the run and the fit
 //   figures(fit_id, name, coefficient, unit, value, sigma, expanded_u, limit_abs, outcome)
 //   attachments(fit_id, kind, path, sha256)                the certificate and its files, by reference
+//   latest_fits(lot, unit, fit_id, time_utc)               each unit's latest fit (latest time_utc,
+//        then highest id), kept in Record()'s transaction; yield and the lot pages read it
 // Record() writes one fit, its run, unit, station, figures and attachments in one transaction with
 // INSERT ... ON CONFLICT DO NOTHING: re-recording the same fit (a re-run, a merge, two writers at
-// once) changes nothing. A version 1 SQLite store is migrated in place, in one transaction, when
-// opened. Errors (cannot open or connect, not an imufit store, a newer schema, may not be written)
-// are InputErrors naming the file or database, raised when the store is opened: before any work.
-// Several processes may open, create and write one store at once: a busy SQLite database is waited
-// for (up to kStoreBusyWaitSeconds), never an error.
+// once) changes nothing. A version 1 SQLite store, and a version 2 store of either backend, is
+// migrated in place, in one transaction, when opened. Errors (cannot open or connect, not an imufit store, a
+// newer schema, may not be written) are InputErrors naming the file or database, raised when the store is
+// opened: before any work. Several processes may open, create and write one store at once: a busy SQLite
+// database is waited for (up to kStoreBusyWaitSeconds), never an error.
 #ifndef IMUFIT_FACTORY_STORE_H_
 #define IMUFIT_FACTORY_STORE_H_
 
@@ -38,7 +40,7 @@ namespace imufit {
 
 class SqlConnection;
 
-inline constexpr int kStoreSchemaVersion = 2;
+inline constexpr int kStoreSchemaVersion = 3;
 // How long opening or writing an SQLite store waits for another process that holds it.
 inline constexpr int kStoreBusyWaitSeconds = 60;
 
@@ -185,6 +187,7 @@ class ResultsStore {
  private:
   void Open();  // schema, version check, migration
   void MigrateFromVersion1();
+  void MigrateFromVersion2();
   int64_t Insert(const StoredFit& fit, bool* added = nullptr);  // inside a transaction
   std::vector<StoredFit> Fits(const std::string& where, const std::vector<std::string>& parameters);
 
