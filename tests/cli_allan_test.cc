@@ -188,6 +188,12 @@ TEST_F(CliTest, AllanNoiseYamlOfAShortStaticLogHoldsOnlyFiniteNumbers) {
   };
   visit(YAML::Load(text));
   EXPECT_GT(numbers, 10) << text;
+  // Kalibr's random walks, which 20 s cannot resolve, are their upper bounds: never 0.
+  const YAML::Node kalibr = YAML::Load(text)["noise"]["kalibr"];
+  for (const char* key : {"gyroscope_random_walk", "accelerometer_random_walk"}) {
+    ASSERT_TRUE(kalibr[key]) << key << "\n" << text;
+    EXPECT_GT(kalibr[key].as<double>(), 0.0) << key;
+  }
 }
 
 }  // namespace

@@ -43,11 +43,19 @@ std::string YamlString(const std::string& text) {
 
 // The largest fitted value of `term` over the columns of `kind` (Kalibr takes one number for all
 // three axes: the worst one is the safe choice), or nan when there is none.
+// The two-sided 95 % bound's one side: an unresolved term is given as value + kUpperBoundSigmas sigma.
+constexpr double kUpperBoundSigmas = 2.0;
+
+// The largest of the fitted axes of `kind` for `term`, each an unresolved term's upper bound
+// (Kalibr's noise model takes every term as present: a random walk the log cannot resolve is given
+// as what the log allows, never 0).
 double WorstAxis(const std::vector<NoiseColumnRecord>& columns, ColumnKind kind, int term) {
   double worst = std::nan("");
   for (const NoiseColumnRecord& column : columns) {
     if (column.kind != kind || !column.fitted) continue;
-    if (!(worst >= column.value[term])) worst = column.value[term];
+    const double figure = column.resolved[term] ? column.value[term]
+                                                : column.value[term] + kUpperBoundSigmas * column.sigma[term];
+    if (std::isfinite(figure) && !(worst >= figure)) worst = figure;
   }
   return worst;
 }
@@ -178,7 +186,8 @@ std::string NoiseYaml(const NoiseRecord& record) {
   };
   const bool has_gyro = has(ColumnKind::kGyro), has_accel = has(ColumnKind::kAccel);
   if (has_gyro || has_accel) {
-    yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor\n";
+    yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor (a term the log\n"
+            "           # does not resolve: its upper bound, value + 2 sigma)\n";
     if (has_gyro) {
       Scalar(yaml, "    ", "gyroscope_noise_density",
              WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk), "  # rad/s/sqrt(Hz)");
