@@ -112,7 +112,8 @@ struct PlanCheck {
 // lie at `temps_c`: (det M / det M*)^(1/4), M = mean of f f^T with f = (1, x, x^2, x^3), x the
 // temperature scaled to [-1, 1], and M* that of the D-optimal soaks {-1, -1/sqrt(5), +1/sqrt(5), +1}
 // (Hoel 1958; Kiefer-Wolfowitz: their variance function f^T M*^-1 f peaks at 4 exactly there).
-// 1 for those soaks, 0.959 for four equally spaced, 0.605 for a uniform ramp; 0 when M is singular.
+// 1 for those soaks, 0.959 for four equally spaced, 0.603 for a uniform ramp ((25/189)^(1/4)); 0
+// when M is singular.
 double CubicDEfficiency(const std::vector<double>& temps_c, std::array<double, 2> range_c);
 
 // Checks `segments` under `schedule` for the fit of `fit_options` (its bias stability from the
