@@ -55,15 +55,15 @@ bool ParseShortDecimal(std::string_view text, bool point_allowed, double* value)
   for (; p != end; ++p) {
     const unsigned digit = static_cast<unsigned>(*p - '0');
     if (digit <= 9) {
+      if (++count > 15) return false;  // before the digits could overflow: from_chars reads it
       digits = digits * 10 + digit;
-      ++count;
     } else if (*p == '.' && point == nullptr && point_allowed) {
       point = p;
     } else {
       return false;
     }
   }
-  if (count == 0 || count > 15) return false;
+  if (count == 0) return false;
   double magnitude = static_cast<double>(digits);
   if (point != nullptr) magnitude /= kPowersOfTen[end - point - 1];
   *value = negative ? -magnitude : magnitude;
