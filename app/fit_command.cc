@@ -144,21 +144,11 @@ void PrintRunNotes(const FitRunOptions& options, const FitRunResult& result) {
   }
 }
 
-// A run that does not determine the model, as one line: what is missing, then what the run held.
+// A run that does not determine the model: one line saying what is missing and what the run held.
 // Returns 1.
 int ReportUndetermined(const FitArguments& args, const FitRunOptions& options, const FitRunResult& result) {
-  const FitSummary& fit = result.fit;
-  const WindowStats& stats = result.run.stats;
-  std::string held = std::to_string(stats.samples) + " samples, " + std::to_string(stats.transition_samples) +
-                     " in transitions, " + std::to_string(stats.trimmed_samples) + " trimmed after moves, " +
-                     std::to_string(fit.windows_used) + " windows used, " +
-                     std::to_string(stats.short_windows) + " windows shorter than " +
-                     std::to_string(options.windows.min_samples) + " samples dropped";
-  if (const std::string note = TimeStampNote(stats); !note.empty()) held += "; time stamps: " + note;
-  if (const std::string note = SaturationNote(stats); !note.empty()) held += "; saturation: " + note;
-  std::fprintf(stderr,
-               "imufit: %s: the run does not determine the model, nothing written: %s (the run: %s)\n",
-               args.samples.c_str(), Join(fit.undetermined, "; ").c_str(), held.c_str());
+  std::fprintf(stderr, "imufit: %s, nothing written\n",
+               UndeterminedMessage(args.samples, options, result).c_str());
   return 1;
 }
 

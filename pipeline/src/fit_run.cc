@@ -6,6 +6,7 @@
 
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/model/text.h"
 #include "imufit/pipeline/consistency.h"
 #include "imufit/pipeline/unit_serial.h"
 #include "imufit/run/channel_check.h"
@@ -196,6 +197,21 @@ FitRunResult FitRun(Plan plan, std::string plan_sha256, const SamplesInMemory& s
   return FitRunOf(
       std::move(plan), std::move(plan_sha256),
       [&](const Plan& read) { return std::make_unique<RunReader>(read, samples, options.input); }, options);
+}
+
+std::string UndeterminedMessage(const std::string& samples, const FitRunOptions& options,
+                                const FitRunResult& result) {
+  const FitSummary& fit = result.fit;
+  const WindowStats& stats = result.run.stats;
+  std::string held = std::to_string(stats.samples) + " samples, " + std::to_string(stats.transition_samples) +
+                     " in transitions, " + std::to_string(stats.trimmed_samples) + " trimmed after moves, " +
+                     std::to_string(fit.windows_used) + " windows used, " +
+                     std::to_string(stats.short_windows) + " windows shorter than " +
+                     std::to_string(options.windows.min_samples) + " samples dropped";
+  if (const std::string note = TimeStampNote(stats); !note.empty()) held += "; time stamps: " + note;
+  if (const std::string note = SaturationNote(stats); !note.empty()) held += "; saturation: " + note;
+  return samples + ": the run does not determine the model: " + Join(fit.undetermined, "; ") +
+         " (the run: " + held + ")";
 }
 
 }  // namespace imufit

@@ -188,12 +188,9 @@ py::dict Fit(const py::object& plan, const py::object& samples, const py::dict& 
   const FitSummary& fit = result->fit;
   py::dict diagnostics = Diagnostics(*result);
   if (fit.status == FitStatus::kUndetermined) {
-    std::string message = samples_path + ": the run does not determine the model:";
     py::list missing;
-    for (const std::string& finding : fit.undetermined) {
-      message += "\n  - " + finding;
-      missing.append(finding);
-    }
+    for (const std::string& finding : fit.undetermined) missing.append(finding);
+    const std::string message = UndeterminedMessage(samples_path, options, *result);
     py::dict attributes;
     attributes["missing"] = missing;
     attributes["diagnostics"] = diagnostics;

@@ -145,6 +145,8 @@ def test_undetermined_run_raises_naming_what_is_missing(fixtures):
     assert error.value.missing
     for finding in error.value.missing:
         assert finding in str(error.value)
+    assert "\n" not in str(error.value), "one line, as the command line says it"
+    assert "the run:" in str(error.value)
     assert "temperature" in " ".join(error.value.missing)
     # The same run fits when the model asks only for what it has.
     fitted = imufit.fit(plan, run, gyro_temp_order=0, accel_temp_order=0)

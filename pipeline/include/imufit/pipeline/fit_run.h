@@ -105,6 +105,12 @@ FitRunResult FitRun(Plan plan, std::string plan_sha256, const SamplesInMemory& s
 FitRunResult FitRun(Plan plan, std::string plan_sha256, const std::string& samples_path,
                     const FitRunOptions& options);
 
+// Why a run does not determine the model, as one line (the CLI's error, Python's exception):
+// "<samples>: the run does not determine the model: <findings, "; "-separated> (the run: <counts>)".
+// `result.fit.status` is FitStatus::kUndetermined.
+std::string UndeterminedMessage(const std::string& samples, const FitRunOptions& options,
+                                const FitRunResult& result);
+
 }  // namespace imufit
 
 #endif  // IMUFIT_PIPELINE_FIT_RUN_H_
