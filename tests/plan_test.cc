@@ -119,12 +119,19 @@ Predicted Predict(const std::vector<TableSegment>& segments, const SimulationOpt
   return {sigmas(info.gyro), sigmas(info.accel)};
 }
 
-FitSummary FitOneRun(const std::vector<TableSegment>& segments, const SimulationOptions& schedule,
-                     const SensorModel& truth) {
+// The windows of a simulated run of `truth`.
+std::vector<Window> SimulatedWindows(const std::vector<TableSegment>& segments,
+                                     const SimulationOptions& schedule, const SensorModel& truth) {
   WindowBuilder builder(WindowOptions(), segments);
   SimulateRun(schedule, Site(), segments, truth,
               [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
-  return FitThermalModel(builder.Finish(), Site(), segments, FitOptionsFor(schedule));
+  return builder.Finish();
+}
+
+FitSummary FitOneRun(const std::vector<TableSegment>& segments, const SimulationOptions& schedule,
+                     const SensorModel& truth) {
+  return FitThermalModel(SimulatedWindows(segments, schedule, truth), Site(), segments,
+                         FitOptionsFor(schedule));
 }
 
 std::string ClassOf(bool gyro, int parameter) {
@@ -364,10 +371,7 @@ TEST(PlanPrediction, AFittedRunsLimitingCoefficientIsThePlansWithTheFitsSigma) {
     ASSERT_FALSE(check.rows.empty());
     EXPECT_EQ(check.rows.front().name, "gyro scale x");
     const FitOptions fit_options = FitOptionsFor(schedule);
-    WindowBuilder builder(WindowOptions(), segments);
-    SimulateRun(schedule, Site(), segments, InCounts(Truth(), raw_per_si),
-                [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
-    const std::vector<Window> windows = builder.Finish();
+    const std::vector<Window> windows = SimulatedWindows(segments, schedule, InCounts(Truth(), raw_per_si));
     const FitSummary fit = FitThermalModel(windows, Site(), segments, fit_options);
     ASSERT_TRUE(fit.IsSolutionUsable());
     const LimitingPrediction p = PredictLimiting(CalibrationOf(fit, fit_options), plan, windows, tolerances);
