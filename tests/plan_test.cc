@@ -414,5 +414,26 @@ TEST(PlanPrediction, TheCertificateRowSaysPredictedAndAchieved) {
             "not predicted: the calibration has no fit record or no sigmas");
 }
 
+// A limits file's coefficient criteria as tolerances: a limit on the value or its sigma as it is,
+// a [min, max] limit by its half-width, per cent in ppm, the smallest of a group's.
+TEST(PlanPrediction, LimitsGiveTheTolerancesOfTheirGroups) {
+  Limits limits;
+  const auto criterion = [](const std::string& quantity, double max_abs) {
+    LimitCriterion c;
+    c.quantity = quantity;
+    c.max_abs = max_abs;
+    return c;
+  };
+  limits.criteria = {criterion("gyro_bias_dps", 0.5), criterion("gyro_bias_dps", 0.01),
+                     criterion("accel_scale_error_pct", 0.2), criterion("accel_bias_mg", 0.0),
+                     criterion("fit_temp_range_c", 0.0)};
+  limits.criteria[3].min = -3.0;
+  limits.criteria[3].max = 1.0;
+  std::map<std::string, double> tolerances;
+  TolerancesFromLimits(limits, &tolerances);
+  EXPECT_EQ(tolerances, (std::map<std::string, double>{
+                            {"gyro.bias", 0.01}, {"accel.scale", 2000.0}, {"accel.bias", 2.0}}));
+}
+
 }  // namespace
 }  // namespace imufit
