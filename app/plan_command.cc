@@ -18,6 +18,7 @@
 #include "imufit/model/text.h"
 #include "imufit/pipeline/plan_check.h"
 #include "imufit/pipeline/plan_design.h"
+#include "imufit/pipeline/plan_prediction.h"
 
 namespace imufit {
 namespace {
@@ -42,33 +43,6 @@ struct PlanDesignArguments {
   CliOptions<PlanDesignOptions> design;  // PlanDesignOptionTable()
   ScheduleArguments schedule;
 };
-
-// The limits file's coefficient criteria as tolerances of their groups (a limit on the value or
-// on its sigma: z sigma must fit inside it), in the groups' display units.
-void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances) {
-  struct Map {
-    const char* quantity;
-    const char* group;
-    double factor;
-  };
-  static const Map kMaps[] = {{"gyro_bias_dps", "gyro.bias", 1.0},
-                              {"accel_bias_mg", "accel.bias", 1.0},
-                              {"gyro_scale_error_ppm", "gyro.scale", 1.0},
-                              {"gyro_scale_error_pct", "gyro.scale", 1e4},
-                              {"accel_scale_error_ppm", "accel.scale", 1.0},
-                              {"accel_scale_error_pct", "accel.scale", 1e4},
-                              {"gyro_misalignment_mrad", "gyro.misalignment", 1.0},
-                              {"accel_misalignment_mrad", "accel.misalignment", 1.0},
-                              {"gyro_g_sensitivity_dpsg", "gyro.g_sensitivity", 1.0}};
-  for (const LimitCriterion& criterion : limits.criteria) {
-    for (const Map& m : kMaps) {
-      if (criterion.quantity != m.quantity) continue;
-      const double tolerance = criterion.max_abs * m.factor;
-      auto [it, inserted] = tolerances->emplace(m.group, tolerance);
-      if (!inserted) it->second = std::min(it->second, tolerance);
-    }
-  }
-}
 
 SimulationOptions ScheduleOf(const ScheduleArguments& args, const char* command) {
   SimulationOptions schedule;

@@ -34,38 +34,15 @@ double PrintedArw(const std::string& summary, const std::string& column) {
 // correction, with the result of `imufit apply` then `imufit allan` to the last bit, and the
 // simulated noise density comes back.
 TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
-  const std::string plan = Write("static.yaml",
-                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
-                                 "  - {id: 1, up: [0, 0, 1]}\n");
   const std::string truth = Fixture("mems_truth.yaml");
-  constexpr double kGyroNoiseDensity = 8.7e-5;  // rad/s/sqrt(Hz); ARW = N * 180/pi * 60 deg/sqrt(h)
   // 300 s at 100 Hz fix the ARW to about 1 % (one sigma); not quantised, so the white noise is
   // the simulated one alone.
   constexpr double kArwRelativeTolerance = 0.05;
-  RunResult r = Run({"simulate",
-                     "-p",
-                     plan,
-                     "-c",
-                     truth,
-                     "-o",
-                     Path("raw.csv.gz"),
-                     "--rate",
-                     "100",
-                     "--dwell",
-                     "300",
-                     "--temps",
-                     "40",
-                     "--gyro-noise-density",
-                     "8.7e-5",
-                     "--accel-noise-density",
-                     "1.5e-3",
-                     "--seed",
-                     "11",
-                     "-q"});
-  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string plan = StaticPlan();
+  StaticRun("raw.csv.gz", 300, 40, 11);
 
   // Raw counts without a calibration: the warning names the cure.
-  r = Run({"allan", "-s", Path("raw.csv.gz"), "-c", "gyro_x", "-o", Path("raw_allan.csv"), "-q"});
+  RunResult r = Run({"allan", "-s", Path("raw.csv.gz"), "-c", "gyro_x", "-o", Path("raw_allan.csv"), "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("gyro_x has a mean of"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--calibration CAL.yaml"), std::string::npos) << r.err;
@@ -101,7 +78,7 @@ TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
   EXPECT_EQ(direct_yaml, applied_yaml);
   const auto summary_body = [](const std::string& summary) { return summary.substr(summary.find('\n')); };
   EXPECT_EQ(summary_body(direct_summary), summary_body(r.out));
-  const double expected_arw = kGyroNoiseDensity * 180.0 / M_PI * 60.0;
+  const double expected_arw = kStaticGyroNoiseDensity * 180.0 / M_PI * 60.0;
   for (const char* column : {"gyro_x", "gyro_y", "gyro_z"}) {
     const double arw = PrintedArw(direct_summary, column);
     EXPECT_NEAR(arw, expected_arw, kArwRelativeTolerance * expected_arw) << column << "\n" << direct_summary;
@@ -143,32 +120,9 @@ TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
 // A static log too short to resolve the slow terms: the noise file holds no `nan` or `inf`, every
 // number in it is finite, and the terms the log cannot resolve are marked `<key>_resolved: false`.
 TEST_F(CliTest, AllanNoiseYamlOfAShortStaticLogHoldsOnlyFiniteNumbers) {
-  const std::string plan = Write("static.yaml",
-                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
-                                 "  - {id: 1, up: [0, 0, 1]}\n");
-  RunResult r = Run({"simulate",
-                     "-p",
-                     plan,
-                     "-c",
-                     Fixture("mems_truth.yaml"),
-                     "-o",
-                     Path("short.csv"),
-                     "--rate",
-                     "100",
-                     "--dwell",
-                     "20",
-                     "--temps",
-                     "25",
-                     "--gyro-noise-density",
-                     "8.7e-5",
-                     "--accel-noise-density",
-                     "1.5e-3",
-                     "--seed",
-                     "5",
-                     "-q"});
-  ASSERT_EQ(r.status, 0) << r.err;
-  r = Run({"allan", "-s", Path("short.csv"), "--calibration", Fixture("mems_truth.yaml"), "-o",
-           Path("short_adev.csv"), "--noise-yaml", Path("short_noise.yaml"), "-q"});
+  StaticRun("short.csv", 20, 25, 5);
+  RunResult r = Run({"allan", "-s", Path("short.csv"), "--calibration", Fixture("mems_truth.yaml"), "-o",
+                     Path("short_adev.csv"), "--noise-yaml", Path("short_noise.yaml"), "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string text = ReadBytes(Path("short_noise.yaml"));
   EXPECT_EQ(text.find("nan"), std::string::npos) << text;

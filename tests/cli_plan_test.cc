@@ -127,36 +127,13 @@ TEST_F(CliPlanTest, LatitudeIsOptional) {
 // The unit's noise from `imufit allan --noise-yaml`: the same prediction as the densities it holds
 // typed by hand, and close to that of the densities the record was simulated with.
 TEST_F(CliPlanTest, NoiseFromAllanNoiseYaml) {
-  constexpr double kGyroDensity = 8.7e-5;           // rad/s/sqrt(Hz)
-  constexpr double kAccelDensity = 1.5e-3;          // m/s^2/sqrt(Hz)
+  constexpr double kGyroDensity = kStaticGyroNoiseDensity;
+  constexpr double kAccelDensity = kStaticAccelNoiseDensity;
   constexpr double kFittedDensityTolerance = 0.08;  // relative: 300 s at 100 Hz, worst of three axes
-  const std::string plan = Write("static.yaml",
-                                 "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
-                                 "  - {id: 1, up: [0, 0, 1]}\n");
   const std::string truth = Fixture("mems_truth.yaml");
-  RunResult r = Run({"simulate",
-                     "-p",
-                     plan,
-                     "-c",
-                     truth,
-                     "-o",
-                     Path("raw.csv.gz"),
-                     "--rate",
-                     "100",
-                     "--dwell",
-                     "300",
-                     "--temps",
-                     "40",
-                     "--gyro-noise-density",
-                     "8.7e-5",
-                     "--accel-noise-density",
-                     "1.5e-3",
-                     "--seed",
-                     "11",
-                     "-q"});
-  ASSERT_EQ(r.status, 0) << r.err;
-  r = Run({"allan", "-s", Path("raw.csv.gz"), "--calibration", truth, "-o", Path("allan.csv"), "--noise-yaml",
-           Path("noise.yaml"), "-q"});
+  StaticRun("raw.csv.gz", 300, 40, 11);
+  RunResult r = Run({"allan", "-s", Path("raw.csv.gz"), "--calibration", truth, "-o", Path("allan.csv"),
+                     "--noise-yaml", Path("noise.yaml"), "-q"});
   ASSERT_EQ(r.status, 0) << r.err;
   const YAML::Node kalibr = YAML::LoadFile(Path("noise.yaml"))["noise"]["kalibr"];
   const std::string gyro = kalibr["gyroscope_noise_density"].Scalar();

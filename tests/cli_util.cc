@@ -1,11 +1,19 @@
 #include "cli_util.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <sstream>
 
 namespace imufit::testing {
 
 namespace {
+
+// `value` as the command line takes it, to the last bit.
+std::string Number(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
 
 std::vector<std::string> Split(const std::string& line, char separator) {
   std::vector<std::string> fields;
@@ -88,6 +96,37 @@ std::vector<std::string> CliTest::HandSessionArgs(const std::string& out,
                                    "-q"};
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
+}
+
+std::string CliTest::StaticPlan() const {
+  return Write("static.yaml",
+               "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+               "  - {id: 1, up: [0, 0, 1]}\n");
+}
+
+std::string CliTest::StaticRun(const std::string& out, int dwell_s, int temp_c, int seed) const {
+  const RunResult r = Run({"simulate",
+                           "-p",
+                           StaticPlan(),
+                           "-c",
+                           Fixture("mems_truth.yaml"),
+                           "-o",
+                           Path(out),
+                           "--rate",
+                           "100",
+                           "--dwell",
+                           std::to_string(dwell_s),
+                           "--temps",
+                           std::to_string(temp_c),
+                           "--gyro-noise-density",
+                           Number(kStaticGyroNoiseDensity),
+                           "--accel-noise-density",
+                           Number(kStaticAccelNoiseDensity),
+                           "--seed",
+                           std::to_string(seed),
+                           "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  return Path(out);
 }
 
 std::pair<std::string, std::string> CliTest::SimulateNoiseless(const std::string& plan,

@@ -25,6 +25,9 @@ namespace imufit::testing {
 // Worst-case absolute error of a recovered rate (rad/s) or specific force (m/s^2).
 constexpr double kRecoveryToleranceSi = 1e-9;
 constexpr double kDegToRad = M_PI / 180.0;
+// The white noise of CliTest::StaticRun(): rad/s/sqrt(Hz) and m/s^2/sqrt(Hz).
+constexpr double kStaticGyroNoiseDensity = 8.7e-5;
+constexpr double kStaticAccelNoiseDensity = 1.5e-3;
 
 // A CSV file (gzip or not) split into its header and rows ('#' lines skipped), for checking outputs.
 struct Table {
@@ -56,6 +59,13 @@ class CliTest : public TempDirTest {
   // into `out`; `extra` adds options.
   static std::vector<std::string> HandSessionArgs(const std::string& out,
                                                   const std::vector<std::string>& extra);
+
+  // A one-segment static plan (the unit at rest, z up), written as static.yaml; returns its path.
+  std::string StaticPlan() const;
+  // Simulates the MEMS unit (fixtures/mems_truth.yaml, raw counts) on StaticPlan() for `dwell_s`
+  // at `temp_c`, 100 Hz, white noise kStaticGyroNoiseDensity and kStaticAccelNoiseDensity, seed
+  // `seed`, into `out` (in the test's folder); returns its path.
+  std::string StaticRun(const std::string& out, int dwell_s, int temp_c, int seed) const;
 
   // Runs a noiseless simulation at 20 Hz with 1 s dwells and 0.75 s transitions (`extra` adds
   // options or overrides these) and returns the paths of {samples, truth}.

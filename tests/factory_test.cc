@@ -341,6 +341,10 @@ TEST(FormatNumber, NoFigurePrintsASignedZero) {
   EXPECT_EQ(FormatNumber("%.1f", -0.06), "-0.1");
 }
 
+// A fitted run's own sigma against the plan's prediction on its windows (relative): the fixture's
+// reduced chi-square is near 1.
+constexpr double kPredictedSigmaTolerance = 0.10;
+
 // The certificate of the MEMS soak fixture: asserted on the struct, not on HTML.
 class CertificateTest : public FactoryTest {
  protected:
@@ -926,6 +930,26 @@ TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {
   EXPECT_FALSE(c.verdict->pass);
   EXPECT_EQ(c.verdict->criteria[0].name, "coverage");
   EXPECT_EQ(c.verdict->criteria[0].measured, 1.0);
+}
+
+// The settings name the plan's limiting coefficient (the limits' tolerances) predicted on the run's
+// windows, next to what the fit achieved with its U, in one row of the page.
+TEST_F(CertificateTest, TheSettingsNameThePlansLimitingCoefficient) {
+  const Certificate c = Make(kFixtures + "/plan_6pos.yaml", ReadLimits(Write("limits.yaml", kLimits)));
+  const LimitingPrediction& p = c.settings.limiting;
+  std::printf("%s\n", LimitingPredictionText(p).c_str());
+  ASSERT_EQ(p.why_not, "");
+  EXPECT_GT(p.tolerance, 0.0);
+  EXPECT_NEAR(p.achieved_sigma / p.predicted_sigma, 1.0, kPredictedSigmaTolerance);
+  if (!p.figure.empty()) EXPECT_GE(p.achieved_expanded, kCoverageFactor * p.achieved_sigma);
+  const Certificate without =
+      CertificateOf(FitRun(kFixtures + "/plan_6pos.yaml", kFixtures + "/mems_6pos_soak.csv.gz", {}));
+  EXPECT_EQ(without.settings.limiting.tolerance, 0.0);
+  EXPECT_EQ(LimitingPredictionText(without.settings.limiting).rfind("no tolerances given", 0), 0u);
+  if (!GnuplotAvailable()) GTEST_SKIP() << "no gnuplot on PATH: the page is not drawn";
+  const std::string html = CertificateHtml(c);
+  EXPECT_NE(html.find("limiting coefficient"), std::string::npos);
+  EXPECT_NE(html.find(LimitingPredictionText(p)), std::string::npos);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/model/constants.h"
 #include "imufit/pipeline/plan_check.h"
+#include "imufit/pipeline/plan_prediction.h"
 #include "imufit/run/windows.h"
 #include "imufit/sim/simulator.h"
 #include "test_models.h"
@@ -118,12 +119,19 @@ Predicted Predict(const std::vector<TableSegment>& segments, const SimulationOpt
   return {sigmas(info.gyro), sigmas(info.accel)};
 }
 
-FitSummary FitOneRun(const std::vector<TableSegment>& segments, const SimulationOptions& schedule,
-                     const SensorModel& truth) {
+// The windows of a simulated run of `truth`.
+std::vector<Window> SimulatedWindows(const std::vector<TableSegment>& segments,
+                                     const SimulationOptions& schedule, const SensorModel& truth) {
   WindowBuilder builder(WindowOptions(), segments);
   SimulateRun(schedule, Site(), segments, truth,
               [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
-  return FitThermalModel(builder.Finish(), Site(), segments, FitOptionsFor(schedule));
+  return builder.Finish();
+}
+
+FitSummary FitOneRun(const std::vector<TableSegment>& segments, const SimulationOptions& schedule,
+                     const SensorModel& truth) {
+  return FitThermalModel(SimulatedWindows(segments, schedule, truth), Site(), segments,
+                         FitOptionsFor(schedule));
 }
 
 std::string ClassOf(bool gyro, int parameter) {
@@ -307,6 +315,124 @@ TEST(PlanDesignClassics, PlanCheckReportsTheTemperatureEfficiency) {
   schedule.soak_temps_c = {-40.0, 22.5 - half, 22.5 + half, 85.0};
   EXPECT_NEAR(CheckPlan(segments, Site(), schedule, FitOptions(), PlanCheckOptions()).temperature_efficiency,
               1.0, kIdentityTolerance);
+}
+
+// A calibration as FitRun writes it, as far as the prediction reads it: the model, its sigmas and
+// the record of what was fitted with which weighting.
+Calibration CalibrationOf(const FitSummary& fit, const FitOptions& options) {
+  Calibration calibration;
+  calibration.model = fit.model;
+  calibration.sigma = fit.sigma;
+  FitRecord record;
+  record.gyro_temp_order = options.gyro_temp_order;
+  record.accel_temp_order = options.accel_temp_order;
+  record.g_sensitivity_fitted = options.fit_g_sensitivity;
+  record.fitted = options.Groups(true);
+  record.gyro_bias_stability_radps = options.gyro_bias_stability_radps;
+  record.accel_bias_stability_mps2 = options.accel_bias_stability_mps2;
+  record.bias_correlation_s = options.bias_correlation_s;
+  calibration.fit = record;
+  return calibration;
+}
+
+// The truth of Truth() in raw units of `raw_per_si` counts per SI unit (bias, scale, g-sensitivity).
+SensorModel InCounts(SensorModel model, double raw_per_si) {
+  for (int c = 0; c < kGyroCoefficients; ++c) {
+    if (c >= kMisalignmentCoefficient && c < kGSensitivityCoefficient) continue;
+    for (int k = 0; k < kPolynomialTerms; ++k) model.gyro[c * kPolynomialTerms + k] *= raw_per_si;
+  }
+  for (int c = 0; c < kMisalignmentCoefficient; ++c) {
+    for (int k = 0; k < kPolynomialTerms; ++k) model.accel[c * kPolynomialTerms + k] *= raw_per_si;
+  }
+  return model;
+}
+
+// The certificate's prediction on a fitted run names the coefficient `plan check` names for the
+// same plan and schedule, and its sigma is the fit's within the one-run tolerance: for a unit in
+// SI with a wandering bias and for one in counts (white noise), whose sigmas the prediction states
+// through the fitted scale factors.
+TEST(PlanPrediction, AFittedRunsLimitingCoefficientIsThePlansWithTheFitsSigma) {
+  // Without the +-300 deg/s about x, the gyro scale x is clearly the weakest of its group.
+  std::vector<TableSegment> segments;
+  for (const TableSegment& s : SixPositionPlan()) {
+    if (!(s.up.x() == 1.0 && std::abs(s.rate_radps) > 200.0 * kDegToRad)) segments.push_back(s);
+  }
+  Plan plan;
+  plan.segments = segments;
+  plan.site = Site();
+  // Tolerances far apart: the gyro scale limits, whatever the run's noise.
+  const std::map<std::string, double> tolerances = {{"gyro.scale", 1.0}, {"accel.scale", 1e3}};
+  for (const double raw_per_si : {1.0, 1000.0}) {
+    SimulationOptions schedule = Schedule(77);  // the noise is in SI
+    if (raw_per_si != 1.0) schedule.gyro_bias_instability = schedule.accel_bias_instability = 0.0;
+    PlanCheckOptions options;
+    options.tolerances = tolerances;
+    const PlanCheck check = CheckPlan(segments, Site(), schedule, FitOptions(), options);
+    ASSERT_FALSE(check.rows.empty());
+    EXPECT_EQ(check.rows.front().name, "gyro scale x");
+    const FitOptions fit_options = FitOptionsFor(schedule);
+    const std::vector<Window> windows = SimulatedWindows(segments, schedule, InCounts(Truth(), raw_per_si));
+    const FitSummary fit = FitThermalModel(windows, Site(), segments, fit_options);
+    ASSERT_TRUE(fit.IsSolutionUsable());
+    const LimitingPrediction p = PredictLimiting(CalibrationOf(fit, fit_options), plan, windows, tolerances);
+    ASSERT_EQ(p.why_not, "") << raw_per_si;
+    std::printf("%g raw per SI unit: %s\n", raw_per_si, LimitingPredictionText(p).c_str());
+    EXPECT_EQ(p.name, check.rows.front().name) << raw_per_si;
+    EXPECT_EQ(p.figure, "gyro_scale_per_dps.x") << raw_per_si;
+    EXPECT_NEAR(p.predicted_sigma / check.rows.front().sigma, 1.0, kReportedSigmaTolerance) << raw_per_si;
+    EXPECT_NEAR(p.achieved_sigma / p.predicted_sigma, 1.0, kReportedSigmaTolerance) << raw_per_si;
+    EXPECT_DOUBLE_EQ(p.tolerance, 1.0);
+  }
+}
+
+// The certificate's row, with and without tolerances, and where nothing can be predicted.
+TEST(PlanPrediction, TheCertificateRowSaysPredictedAndAchieved) {
+  LimitingPrediction p;
+  p.name = "gyro bias z";
+  p.unit = "deg/s";
+  p.tolerance = 0.01;
+  p.ratio = 0.0241;
+  p.predicted_sigma = 1.2e-4;
+  p.achieved_sigma = 1.3e-4;
+  p.achieved_expanded = 2.7e-4;
+  EXPECT_EQ(
+      LimitingPredictionText(p),
+      "gyro bias z: predicted sigma 0.00012 deg/s, achieved 0.00013 deg/s (U 0.00027 deg/s), at 25 degC; "
+      "tolerance 0.01 deg/s, predicted 2 sigma over the range / tolerance 0.0241");
+  p.tolerance = 0.0;
+  p.achieved_expanded = -1.0;
+  p.term = 1;
+  p.name = "gyro bias z (linear term)";
+  p.unit = "deg/s/degC";
+  EXPECT_EQ(
+      LimitingPredictionText(p),
+      "no tolerances given (no limits file); the sigma that grows most over the range, gyro bias z (linear "
+      "term): predicted sigma 0.00012 deg/s/degC, achieved 0.00013 deg/s/degC");
+  EXPECT_EQ(PredictLimiting(Calibration(), Plan(), {}, {}).why_not,
+            "the calibration has no fit record or no sigmas");
+  EXPECT_EQ(LimitingPredictionText(PredictLimiting(Calibration(), Plan(), {}, {})),
+            "not predicted: the calibration has no fit record or no sigmas");
+}
+
+// A limits file's coefficient criteria as tolerances: a limit on the value or its sigma as it is,
+// a [min, max] limit by its half-width, per cent in ppm, the smallest of a group's.
+TEST(PlanPrediction, LimitsGiveTheTolerancesOfTheirGroups) {
+  Limits limits;
+  const auto criterion = [](const std::string& quantity, double max_abs) {
+    LimitCriterion c;
+    c.quantity = quantity;
+    c.max_abs = max_abs;
+    return c;
+  };
+  limits.criteria = {criterion("gyro_bias_dps", 0.5), criterion("gyro_bias_dps", 0.01),
+                     criterion("accel_scale_error_pct", 0.2), criterion("accel_bias_mg", 0.0),
+                     criterion("fit_temp_range_c", 0.0)};
+  limits.criteria[3].min = -3.0;
+  limits.criteria[3].max = 1.0;
+  std::map<std::string, double> tolerances;
+  TolerancesFromLimits(limits, &tolerances);
+  EXPECT_EQ(tolerances, (std::map<std::string, double>{
+                            {"gyro.bias", 0.01}, {"accel.scale", 2000.0}, {"accel.bias", 2.0}}));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <utility>
 
@@ -184,6 +185,21 @@ void DescribeErrors(const CertificateSources& sources, Certificate* c) {
   c->residual_table_printed = internal::PrintedResidualRows(c->residual_table, &c->residual_rows_omitted);
 }
 
+// The plan's predicted limiting coefficient on the run's windows, with the U of its key figure
+// (the figure's U over its sigma, times the achieved sigma: the same in any unit).
+LimitingPrediction LimitingOfRun(const CertificateSources& sources,
+                                 const std::vector<KeyFigureRow>& figures) {
+  std::map<std::string, double> tolerances;
+  if (sources.limits) TolerancesFromLimits(*sources.limits, &tolerances);
+  LimitingPrediction p = PredictLimiting(sources.calibration, sources.plan, sources.run.windows, tolerances);
+  for (const KeyFigureRow& f : figures) {
+    if (f.name == p.figure && f.sigma > 0.0 && f.expanded >= 0.0 && p.achieved_sigma >= 0.0) {
+      p.achieved_expanded = p.achieved_sigma * f.expanded / f.sigma;
+    }
+  }
+  return p;
+}
+
 std::vector<ValidationRow> ValidationRows(const std::vector<HeldOutGroup>& folds) {
   std::vector<ValidationRow> rows;
   for (const HeldOutGroup& g : folds) {
@@ -247,6 +263,7 @@ Certificate MakeCertificate(const CertificateSources& sources) {
       ComputeBudget(cal, sources.plan, sources.run.windows,
                     sources.station ? sources.station->uncertainty : std::vector<StationUncertainty>());
   c.figures = FigureRows(cal, c.budget);
+  c.settings.limiting = LimitingOfRun(sources, c.figures);
   DescribeErrors(sources, &c);
   const bool samples_given = std::any_of(c.inputs.begin(), c.inputs.end(),
                                          [](const ReportInput& in) { return in.role == "samples"; });

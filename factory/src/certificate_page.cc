@@ -340,6 +340,7 @@ void FitSettingsTable(Html* h, const FitSettings& s) {
                                                       Fmt(", accel %g micro-g", s.accel_bias_stability_ug)
                                                 : "no (white noise only)"});
   }
+  Row(h, {"plan's limiting coefficient", LimitingPredictionText(s.limiting)});
   Row(h, {"trim after each move", Fmt("%g s", s.trim_s)});
   Row(h, {"window temperature span", Fmt("%g degC", s.window_temp_span_c)});
   h->Close("table").Close("div");

@@ -98,6 +98,8 @@ void AddRows(const SensorInformation& info, const PlanCheckOptions& options, std
       row.name = std::string(info.is_gyro ? "gyro " : "accel ") + kCoefficientNames[c].group + " " +
                  kCoefficientNames[c].axis + TermName(k);
       row.group = group;
+      row.gyro = info.is_gyro;
+      row.coefficient = c;
       row.term = k;
       row.unit = PlanGroupUnit(group) + (k == 0 ? "" : k == 1 ? "/degC" : "/degC^" + std::to_string(k));
       row.sigma = Sigma(a, info.covariance) * factor;
@@ -289,18 +291,9 @@ std::vector<Window> PlannedWindows(const std::vector<TableSegment>& segments, co
   return windows;
 }
 
-PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& site,
-                    const SimulationOptions& schedule, const FitOptions& fit_options,
-                    const PlanCheckOptions& options) {
-  FitOptions fit = fit_options;
-  if (schedule.gyro_bias_instability > 0.0) fit.gyro_bias_stability_radps = schedule.gyro_bias_instability;
-  if (schedule.accel_bias_instability > 0.0) fit.accel_bias_stability_mps2 = schedule.accel_bias_instability;
-  fit.bias_correlation_s = schedule.bias_correlation_s;
-  TableSite planned_site = site;
-  if (options.latitude_deg) planned_site.latitude_rad = *options.latitude_deg * kDegToRad;
-  const std::vector<Window> windows = PlannedWindows(segments, planned_site, schedule, WindowOptions());
-  const PlanInformation info =
-      ComputePlanInformation(windows, planned_site, segments, fit, options.weak_tolerance);
+PlanCheck CheckWindows(const std::vector<Window>& windows, const std::vector<TableSegment>& segments,
+                       const TableSite& site, const FitOptions& fit, const PlanCheckOptions& options) {
+  const PlanInformation info = ComputePlanInformation(windows, site, segments, fit, options.weak_tolerance);
   PlanCheck check;
   check.undetermined = info.undetermined;
   if (!check.undetermined.empty()) return check;
@@ -343,7 +336,21 @@ PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& 
     SegmentEffects(segments, windows, info, refs[order.front()], options, &check);
   }
   CorrelatedPairs(info, &check);
-  Hours(schedule, segments.size(), fit, &check);
+  return check;
+}
+
+PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& site,
+                    const SimulationOptions& schedule, const FitOptions& fit_options,
+                    const PlanCheckOptions& options) {
+  FitOptions fit = fit_options;
+  if (schedule.gyro_bias_instability > 0.0) fit.gyro_bias_stability_radps = schedule.gyro_bias_instability;
+  if (schedule.accel_bias_instability > 0.0) fit.accel_bias_stability_mps2 = schedule.accel_bias_instability;
+  fit.bias_correlation_s = schedule.bias_correlation_s;
+  TableSite planned_site = site;
+  if (options.latitude_deg) planned_site.latitude_rad = *options.latitude_deg * kDegToRad;
+  const std::vector<Window> windows = PlannedWindows(segments, planned_site, schedule, WindowOptions());
+  PlanCheck check = CheckWindows(windows, segments, planned_site, fit, options);
+  if (check.undetermined.empty()) Hours(schedule, segments.size(), fit, &check);
   return check;
 }
 

@@ -29,6 +29,7 @@
 #include "imufit/io/plan.h"
 #include "imufit/io/run_header.h"
 #include "imufit/io/station.h"
+#include "imufit/pipeline/plan_prediction.h"
 #include "imufit/pipeline/run_windows.h"
 
 namespace imufit {
@@ -177,6 +178,9 @@ struct FitSettings {
   double gyro_reduced_chi2 = 0.0, accel_reduced_chi2 = 0.0;
   double gyro_bias_stability_dph = 0.0, accel_bias_stability_ug = 0.0;  // 0: not in the sigmas
   double trim_s = 0.0, window_temp_span_c = 0.0;
+  // `plan check`'s limiting coefficient on this run's windows (the limits' tolerances), its predicted
+  // sigma next to the one the fit achieved (plan_prediction.h).
+  LimitingPrediction limiting;
 };
 
 struct RunSummary {

@@ -71,6 +71,8 @@ struct PlanRow {
   std::string name;   // "gyro bias x (linear term)": the fit's naming
   std::string group;  // "gyro.bias"
   std::string unit;   // "deg/s/degC"
+  bool gyro = true;
+  int coefficient = 0;  // sensor_model.h layout
   int term = 0;
   double sigma = 0.0;        // 1-sigma of the term
   double sigma_range = 0.0;  // of the coefficient's value, the largest over the plan's range (term 0)
@@ -121,6 +123,11 @@ double CubicDEfficiency(const std::vector<double>& temps_c, std::array<double, 2
 PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& site,
                     const SimulationOptions& schedule, const FitOptions& fit_options,
                     const PlanCheckOptions& options);
+
+// CheckPlan's analysis of given windows (the planned ones, or a fitted run's: NominalWindows() of
+// plan_prediction.h) for the fit of `fit`: everything but the hours, which need a schedule.
+PlanCheck CheckWindows(const std::vector<Window>& windows, const std::vector<TableSegment>& segments,
+                       const TableSite& site, const FitOptions& fit, const PlanCheckOptions& options);
 
 // The people's table and the machines' YAML.
 std::string PlanCheckText(const PlanCheck& check, const PlanCheckOptions& options);
