@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <exception>
+#include <mutex>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -17,13 +18,16 @@ namespace imufit {
 // lines it holds, whether a row stopped it, and the read error after its rows, if one came.
 // Blocks are reused, so that their memory is allocated (and paged in) once.
 struct ParallelSamplesReader::Block {
+  enum class State { kRead, kParsing, kParsed };
   std::string rows;
   bool first = false;  // the file's first block
+  State state = State::kRead;
   std::vector<Sample> samples;
   std::vector<uint32_t> lines;
   long line_count = 0;
   bool row_error = false;  // the parse stopped at a row: parsed again, located, when handed on
   std::exception_ptr read_error;
+  std::exception_ptr parse_error;  // anything but a row's error (out of memory), thrown when handed on
 };
 
 namespace {
@@ -31,6 +35,9 @@ namespace {
 // The CSV text of a block: small enough to stay in cache with its samples, large enough that
 // handing blocks between threads costs nothing.
 constexpr size_t kBlockBytes = 1 << 20;
+// Blocks read ahead of the one handed on, per parsing thread: while the caller's thread uses a
+// block, the others have blocks to parse.
+constexpr size_t kBlocksAheadPerThread = 2;
 
 }  // namespace
 
@@ -52,14 +59,25 @@ SamplesReader::SamplesReader(const SamplesReader& header_of, std::string_view ro
 }
 
 ParallelSamplesReader::ParallelSamplesReader(SamplesReader* header, int threads)
-    : header_(header), threads_(std::max(threads, 1)), line_before_(header->line_number()) {}
+    : header_(header), threads_(std::max(threads, 1)), line_before_(header->line_number()) {
+  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { Work(); });
+}
 
-ParallelSamplesReader::~ParallelSamplesReader() = default;  // waits for the blocks in flight
+ParallelSamplesReader::~ParallelSamplesReader() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  work_.notify_all();
+  for (std::thread& worker : workers_) worker.join();  // each finishes the block it parses
+}
 
 void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
   block->samples.clear();
   block->lines.clear();
   block->row_error = false;
+  block->parse_error = nullptr;
+  if (block->rows.empty()) return;  // a read error's
   try {
     SamplesReader reader(header, block->rows, 0, std::nullopt, block->first);
     Sample sample;
@@ -70,11 +88,39 @@ void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
     block->line_count = reader.line_number();
   } catch (const InputError&) {
     block->row_error = true;
+  } catch (...) {
+    block->parse_error = std::current_exception();
   }
 }
 
-bool ParallelSamplesReader::Launch() {
-  if (end_of_file_) return false;
+ParallelSamplesReader::Block* ParallelSamplesReader::Unparsed() const {
+  for (const std::unique_ptr<Block>& block : queue_) {
+    if (block->state == Block::State::kRead) return block.get();
+  }
+  return nullptr;
+}
+
+void ParallelSamplesReader::ParseLocked(Block* block, std::unique_lock<std::mutex>* lock) {
+  block->state = Block::State::kParsing;
+  lock->unlock();
+  Parse(*header_, block);
+  lock->lock();
+  block->state = Block::State::kParsed;
+}
+
+void ParallelSamplesReader::Work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    Block* block = nullptr;
+    work_.wait(lock, [&] { return stop_ || (block = Unparsed()) != nullptr; });
+    if (stop_) return;
+    ParseLocked(block, &lock);
+    parsed_.notify_one();  // the caller's thread may wait for it
+  }
+}
+
+bool ParallelSamplesReader::ReadBlock() {
+  if (end_of_file_ || queue_.size() >= kBlocksAheadPerThread * static_cast<size_t>(threads_)) return false;
   std::unique_ptr<Block> block;
   if (free_.empty()) {
     block = std::make_unique<Block>();
@@ -98,13 +144,12 @@ bool ParallelSamplesReader::Launch() {
   }
   block->first = !launched_;
   launched_ = true;
-  const SamplesReader* header = header_;
-  auto parse = [header, block = std::move(block)]() mutable {
-    if (!block->rows.empty()) Parse(*header, block.get());
-    return std::move(block);
-  };
-  in_flight_.push_back(
-      std::async(threads_ > 1 ? std::launch::async : std::launch::deferred, std::move(parse)));
+  block->state = Block::State::kRead;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(std::move(block));
+  }
+  work_.notify_one();
   return true;
 }
 
@@ -113,13 +158,26 @@ bool ParallelSamplesReader::Advance() {
     line_before_ += current_->line_count;
     free_.push_back(std::move(current_));
   }
-  while (static_cast<int>(in_flight_.size()) < threads_ && Launch()) {
+  // Only this thread reads blocks and takes them out of the queue; every thread parses them. While
+  // the block to hand on is parsed elsewhere, this thread reads and parses the ones after it.
+  for (;;) {
+    while (ReadBlock()) {
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (queue_.empty()) return false;
+    if (queue_.front()->state == Block::State::kParsed) {
+      current_ = std::move(queue_.front());
+      queue_.pop_front();
+      break;
+    }
+    if (Block* block = Unparsed()) {
+      ParseLocked(block, &lock);
+    } else {
+      parsed_.wait(lock, [&] { return queue_.front()->state == Block::State::kParsed; });
+    }
   }
-  if (in_flight_.empty()) return false;
-  current_ = in_flight_.front().get();
-  in_flight_.pop_front();
   next_ = 0;
-  Launch();  // the next block parses while this one is handed on
+  if (current_->parse_error) std::rethrow_exception(current_->parse_error);
   if (current_->rows.empty()) std::rethrow_exception(current_->read_error);
   // The block's first row against the last row before it: when its time does not increase (or
   // the row has an error of its own), parse it again after that row, as one reader would have.
