@@ -28,6 +28,8 @@ struct ParallelSamplesReader::Block {
   bool row_error = false;  // the parse stopped at a row: parsed again, located, when handed on
   std::exception_ptr read_error;
   std::exception_ptr parse_error;  // anything but a row's error (out of memory), thrown when handed on
+  std::string text;                // what the block work made of the samples
+  bool text_taken = false;
 };
 
 namespace {
@@ -58,8 +60,11 @@ SamplesReader::SamplesReader(const SamplesReader& header_of, std::string_view ro
   std::copy(std::begin(header_of.accel_columns_), std::end(header_of.accel_columns_), accel_columns_);
 }
 
-ParallelSamplesReader::ParallelSamplesReader(SamplesReader* header, int threads)
-    : header_(header), threads_(std::max(threads, 1)), line_before_(header->line_number()) {
+ParallelSamplesReader::ParallelSamplesReader(SamplesReader* header, int threads, BlockWork block_work)
+    : header_(header),
+      threads_(std::max(threads, 1)),
+      block_work_(std::move(block_work)),
+      line_before_(header->line_number()) {
   for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { Work(); });
 }
 
@@ -72,14 +77,15 @@ ParallelSamplesReader::~ParallelSamplesReader() {
   for (std::thread& worker : workers_) worker.join();  // each finishes the block it parses
 }
 
-void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
+void ParallelSamplesReader::Parse(Block* block) const {
   block->samples.clear();
   block->lines.clear();
+  block->text.clear();
   block->row_error = false;
   block->parse_error = nullptr;
   if (block->rows.empty()) return;  // a read error's
   try {
-    SamplesReader reader(header, block->rows, 0, std::nullopt, block->first);
+    SamplesReader reader(*header_, block->rows, 0, std::nullopt, block->first);
     Sample sample;
     while (reader.Next(&sample)) {
       block->samples.push_back(sample);
@@ -88,6 +94,12 @@ void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
     block->line_count = reader.line_number();
   } catch (const InputError&) {
     block->row_error = true;
+  } catch (...) {
+    block->parse_error = std::current_exception();
+    return;
+  }
+  try {
+    if (block_work_) block_work_(&block->samples, &block->text);  // the samples before a row error too
   } catch (...) {
     block->parse_error = std::current_exception();
   }
@@ -103,7 +115,7 @@ ParallelSamplesReader::Block* ParallelSamplesReader::Unparsed() const {
 void ParallelSamplesReader::ParseLocked(Block* block, std::unique_lock<std::mutex>* lock) {
   block->state = Block::State::kParsing;
   lock->unlock();
-  Parse(*header_, block);
+  Parse(block);
   lock->lock();
   block->state = Block::State::kParsed;
 }
@@ -177,6 +189,7 @@ bool ParallelSamplesReader::Advance() {
     }
   }
   next_ = 0;
+  current_->text_taken = false;
   if (current_->parse_error) std::rethrow_exception(current_->parse_error);
   if (current_->rows.empty()) std::rethrow_exception(current_->read_error);
   // The block's first row against the last row before it: when its time does not increase (or
@@ -211,6 +224,12 @@ bool ParallelSamplesReader::Next(Sample* sample) {
   ++next_;
   last_time_s_ = sample->time_s;
   return true;
+}
+
+std::string_view ParallelSamplesReader::TakeText() {
+  if (current_ == nullptr || current_->text_taken) return {};
+  current_->text_taken = true;
+  return current_->text;
 }
 
 void ParallelSamplesReader::Fail(const std::string& column, const std::string& message) const {

@@ -20,6 +20,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -29,10 +30,17 @@ namespace imufit {
 
 class ParallelSamplesReader {
  public:
+  // Work on the samples of one block, done on the thread that parsed them, before they are handed
+  // on: it may change them (not their number, time or order) and write what it makes of them to
+  // `text` (empty at the start). A correction, and the formatting of its rows, so that they run on
+  // every core.
+  using BlockWork = std::function<void(std::vector<Sample>* samples, std::string* text)>;
+
   // Reads the samples of `header`, a SamplesReader that has read its header and no row (it must
   // outlive this reader; what it hashes, it still hashes). `threads` is the number of threads that
-  // parse, the calling one included; 1 parses each block in the calling thread.
-  explicit ParallelSamplesReader(SamplesReader* header, int threads = 2);
+  // parse, the calling one included; 1 parses each block in the calling thread. `block_work`, when
+  // not null, is done on every block (it is called on several threads at once).
+  explicit ParallelSamplesReader(SamplesReader* header, int threads = 2, BlockWork block_work = nullptr);
   ~ParallelSamplesReader();
   ParallelSamplesReader(const ParallelSamplesReader&) = delete;
   ParallelSamplesReader& operator=(const ParallelSamplesReader&) = delete;
@@ -44,11 +52,14 @@ class ParallelSamplesReader {
   const std::string& path() const { return header_->path(); }
   // The line of the last sample.
   long line_number() const { return line_; }
+  // The text the block work made of the block of the last sample, the first time it is asked for
+  // after Next() entered that block; empty otherwise. Valid until the next Next().
+  std::string_view TakeText();
 
  private:
   struct Block;
-  // Parses `block`: its samples, until a row error.
-  static void Parse(const SamplesReader& header, Block* block);
+  // Parses `block`: its samples, until a row error; then does the block work on them.
+  void Parse(Block* block) const;
   // The oldest block read and not yet parsed, or null (under mutex_).
   Block* Unparsed() const;
   // Parses `block`, with `lock` (on mutex_) released meanwhile.
@@ -64,6 +75,7 @@ class ParallelSamplesReader {
 
   SamplesReader* header_;
   int threads_;
+  BlockWork block_work_;
   // Blocks in the file's order, read, being parsed or parsed. Only the caller's thread adds and
   // removes them; the parsing threads change their state (under mutex_).
   std::deque<std::unique_ptr<Block>> queue_;
