@@ -39,7 +39,7 @@ namespace {
 constexpr size_t kBlockBytes = 1 << 20;
 // Blocks read ahead of the one handed on, per parsing thread: while the caller's thread uses a
 // block, the others have blocks to parse.
-constexpr size_t kBlocksAheadPerThread = 2;
+constexpr size_t kBlocksAheadPerThread = 3;
 
 }  // namespace
 
@@ -141,7 +141,6 @@ bool ParallelSamplesReader::ReadBlock() {
     free_.pop_back();
   }
   block->read_error = nullptr;
-  block->rows.clear();
   try {
     if (!header_->csv_.NextBlock(&block->rows, kBlockBytes)) {
       end_of_file_ = true;

@@ -4,7 +4,7 @@
 // thread, which also decompresses and hashes; each block is parsed by a SamplesReader over the
 // block's text, counting its lines from the block's start, on whichever of `threads` threads is free:
 // `threads - 1` parsing threads and the calling thread itself, which, when the block it is to hand
-// on is still being parsed, parses the next one instead of waiting. At most 2 x `threads` blocks are
+// on is still being parsed, parses the next one instead of waiting. At most 3 x `threads` blocks are
 // read ahead of the reader's user, and their memory is reused, so memory stays bounded whatever the
 // file's length. Every error is the one a single SamplesReader gives, at the
 // same line and column, and comes after the samples before it: a block that stops at a row error is
