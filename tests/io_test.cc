@@ -833,6 +833,13 @@ TEST_F(IoTest, AGzipOutputOnAFullDiskSaysWhy) {
     EXPECT_NE(e.message().find("write failed: No space left on device"), std::string::npos) << e.what();
     EXPECT_EQ(e.file(), mount_point + "/" + name);
   }
+  // Written in many pieces, the compressing thread fails while more wait: a later Write() says why.
+  const InputError e = Catch([&] {
+    OutputFile file(mount_point + "/pieces.csv.gz");
+    for (int i = 0; i < 8; ++i) file.Write(incompressible);
+    file.Commit();
+  });
+  EXPECT_NE(e.message().find("write failed: No space left on device"), std::string::npos) << e.what();
   EXPECT_TRUE(fs::is_empty(mount_point)) << "a temporary file was left behind";
   EXPECT_EQ(RunProgram("/bin/umount", {mount_point}).status, 0);
 }
