@@ -12,12 +12,15 @@
 //   imufit fit peak memory        < 100 MB, also on a run 4 x as long (it does not grow with it)
 //
 // It prints the 1-minute load average first and warns when it is above 1: on a shared machine the
-// figures measure the sharing.
+// figures measure the sharing. There, as root, give the bench the CPU in a session of its own:
+//   setsid -w sh -c 'echo -20 > /proc/$$/autogroup; exec build-release/bench/fit_bench'
+// (nice alone does not: the scheduler shares the CPU between sessions first).
 //
 // Usage: fit_bench [--keep DIR] [--parse-only THREADS]
 //   --keep DIR            the run is simulated into DIR (default a temp dir), kept for the next
-//   --parse-only THREADS  only parses DIR's run once (0: one reader; N: blocks on N threads), for
-//                         a profiler (perf record fit_bench --keep DIR --parse-only 1)
+//   --parse-only THREADS  only parses DIR's run once (0: one reader; N: blocks on N threads, the
+//                         calling one included), for a profiler
+//                         (perf record fit_bench --keep DIR --parse-only 1)
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -170,7 +173,8 @@ int main(int argc, char** argv) {
   const double load = LoadAverage();
   std::printf("1-minute load average at the start: %.2f%s\n", load,
               load > 1.0
-                  ? "  WARNING: the machine is busy; these figures are not the targets' (a quiet machine's)"
+                  ? "  WARNING: the machine is busy; these figures are not the targets' (a quiet machine's;"
+                    " see this bench's header for running it in a session of its own at nice -20)"
                   : "");
   const bool temporary = dir.empty();
   if (temporary) dir = fs::temp_directory_path() / ("imufit_fit_bench_" + std::to_string(getpid()));

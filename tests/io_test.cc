@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/correct_file.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
 #include "imufit/io/file_reads.h"
@@ -655,6 +656,42 @@ TEST_F(IoTest, ParallelParsingGivesWhatOneReaderGives) {
   EXPECT_EQ(e.column(), 3);
 }
 
+// A file corrected on both cores (each block corrected and formatted where it was parsed) is, byte
+// for byte, what correcting it sample by sample writes, plain and gzip; a correction that is not
+// finite, in a later block, is refused at its row, and nothing is written.
+TEST_F(IoTest, AFileCorrectedOnBothCoresIsWhatOneSampleAtATimeWrites) {
+  std::string text = FixedWidthSamples(300000);  // ~20 MB: several blocks
+  Calibration calibration;
+  calibration.model = SensorModel::Identity();
+  for (int axis = 0; axis < 3; ++axis) {
+    calibration.model.gyro[(kBiasCoefficient + axis) * kPolynomialTerms + 1] = 1e-3 * (axis + 1);
+    calibration.model.accel[(kScaleCoefficient + axis) * kPolynomialTerms + 2] = 1e-5;
+  }
+  const std::string input = Write("raw.csv", text);
+  SamplesReader reader(input, false);
+  SamplesWriter expected(Path("expected.csv"), reader.has_segment(), "serial: SN1");
+  CorrectSamples(calibration, &reader, [&](const Sample& corrected) { expected.Write(corrected); });
+  expected.Commit();
+  for (const std::string name : {"got.csv", "got.csv.gz"}) {
+    CorrectSamplesFile(calibration, input, Path(name));
+    EXPECT_EQ(testing::ReadFile(Path(name)), Read(Path("expected.csv"))) << name;
+  }
+
+  // A bias cubic that overflows at 150 degC (x = 125: 1e303 x 125^3 > 1.8e308), at a late row.
+  calibration.model.gyro[kBiasCoefficient * kPolynomialTerms + 3] = 1e303;
+  const size_t data_start = text.find('\n', text.find('\n') + 1) + 1;  // line 3
+  const size_t row_bytes = text.find('\n', data_start) + 1 - data_start;
+  const long late = 250000;
+  text.replace(data_start + (late - 3) * row_bytes + 13, 6, "150.00");
+  const std::string hot = Write("hot.csv", text);
+  const InputError e = Catch([&] { CorrectSamplesFile(calibration, hot, Path("hot_out.csv.gz")); });
+  EXPECT_EQ(e.line(), late) << e.what();
+  EXPECT_EQ(e.column(), 2) << e.what();
+  EXPECT_NE(e.message().find("the correction at 150 degC is not a finite number"), std::string::npos)
+      << e.what();
+  EXPECT_FALSE(fs::exists(Path("hot_out.csv.gz")));
+}
+
 // ---------------------------------------------------------------- output files
 
 TEST_F(IoTest, AnUncommittedOutputLeavesTheOldFileIntact) {
@@ -796,6 +833,13 @@ TEST_F(IoTest, AGzipOutputOnAFullDiskSaysWhy) {
     EXPECT_NE(e.message().find("write failed: No space left on device"), std::string::npos) << e.what();
     EXPECT_EQ(e.file(), mount_point + "/" + name);
   }
+  // Written in many pieces, the compressing thread fails while more wait: a later Write() says why.
+  const InputError e = Catch([&] {
+    OutputFile file(mount_point + "/pieces.csv.gz");
+    for (int i = 0; i < 8; ++i) file.Write(incompressible);
+    file.Commit();
+  });
+  EXPECT_NE(e.message().find("write failed: No space left on device"), std::string::npos) << e.what();
   EXPECT_TRUE(fs::is_empty(mount_point)) << "a temporary file was left behind";
   EXPECT_EQ(RunProgram("/bin/umount", {mount_point}).status, 0);
 }

@@ -10,36 +10,37 @@ namespace imufit {
 
 namespace {
 
-// CorrectSamples over `reader`, a SamplesReader or a ParallelSamplesReader.
+// `raw` corrected into `corrected` (time_s, temp_c and segment as read).
+void CorrectOne(const Calibration& calibration, const Sample& raw, Sample* corrected) {
+  corrected->time_s = raw.time_s;
+  corrected->temp_c = raw.temp_c;
+  corrected->segment = raw.segment;
+  calibration.model.Correct(raw.temp_c, raw.gyro, raw.accel, &corrected->gyro, &corrected->accel);
+}
+
+bool Finite(const Sample& corrected) { return corrected.gyro.allFinite() && corrected.accel.allFinite(); }
+
+// Counts `corrected` in `report`, refusing a correction that is not finite at its row of `reader` (a
+// SamplesReader or a ParallelSamplesReader).
 template <typename Reader>
-CorrectFileReport CorrectEach(const Calibration& calibration, Reader* reader,
-                              const std::function<void(const Sample& corrected)>& sink) {
-  CorrectFileReport report;
-  Sample raw;
-  Sample corrected;
-  while (reader->Next(&raw)) {
-    corrected.time_s = raw.time_s;
-    corrected.temp_c = raw.temp_c;
-    corrected.segment = raw.segment;
-    calibration.model.Correct(raw.temp_c, raw.gyro, raw.accel, &corrected.gyro, &corrected.accel);
-    if (!corrected.gyro.allFinite() || !corrected.accel.allFinite()) {
-      // Never a non-finite number in the output: at an absurd temperature the polynomials overflow.
-      reader->Fail("temp_c", "the correction at " + FormatDouble(raw.temp_c) +
-                                 " degC is not a finite number (the calibration's fit range is [" +
-                                 FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
-                                 FormatDouble(calibration.fit_temp_range_c[1]) + "] degC)");
-    }
-    sink(corrected);
-    if (report.samples == 0) report.min_temp_c = report.max_temp_c = raw.temp_c;
-    report.min_temp_c = std::min(report.min_temp_c, raw.temp_c);
-    report.max_temp_c = std::max(report.max_temp_c, raw.temp_c);
-    if (raw.temp_c < calibration.fit_temp_range_c[0] - kFitRangeToleranceC ||
-        raw.temp_c > calibration.fit_temp_range_c[1] + kFitRangeToleranceC) {
-      ++report.outside_temp_range;
-    }
-    ++report.samples;
+void Count(const Calibration& calibration, const Reader& reader, const Sample& corrected,
+           CorrectFileReport* report) {
+  const double temp_c = corrected.temp_c;
+  if (!Finite(corrected)) {
+    // Never a non-finite number in the output: at an absurd temperature the polynomials overflow.
+    reader.Fail("temp_c", "the correction at " + FormatDouble(temp_c) +
+                              " degC is not a finite number (the calibration's fit range is [" +
+                              FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                              FormatDouble(calibration.fit_temp_range_c[1]) + "] degC)");
   }
-  return report;
+  if (report->samples == 0) report->min_temp_c = report->max_temp_c = temp_c;
+  report->min_temp_c = std::min(report->min_temp_c, temp_c);
+  report->max_temp_c = std::max(report->max_temp_c, temp_c);
+  if (temp_c < calibration.fit_temp_range_c[0] - kFitRangeToleranceC ||
+      temp_c > calibration.fit_temp_range_c[1] + kFitRangeToleranceC) {
+    ++report->outside_temp_range;
+  }
+  ++report->samples;
 }
 
 }  // namespace
@@ -47,7 +48,15 @@ CorrectFileReport CorrectEach(const Calibration& calibration, Reader* reader,
 CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* reader,
                                  const std::function<void(const Sample& corrected)>& sink) {
   RefuseCorrectedSamples(*reader);
-  return CorrectEach(calibration, reader, sink);
+  CorrectFileReport report;
+  Sample raw;
+  Sample corrected;
+  while (reader->Next(&raw)) {
+    CorrectOne(calibration, raw, &corrected);
+    Count(calibration, *reader, corrected, &report);
+    sink(corrected);
+  }
+  return report;
 }
 
 std::string CorrectedByComment(const Calibration& calibration, const std::string& calibration_sha256,
@@ -78,9 +87,24 @@ CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::
   if (!corrected_by.empty()) comment += (comment.empty() ? "" : "\n") + corrected_by;
   SamplesWriter writer(output_path, reader.has_segment(), comment);
   RefuseCorrectedSamples(reader);
-  ParallelSamplesReader parallel(&reader);  // parsed on the other core while this one corrects
-  const CorrectFileReport report =
-      CorrectEach(calibration, &parallel, [&writer](const Sample& corrected) { writer.Write(corrected); });
+  // Each block of the file is corrected and its rows formatted on the thread that parsed it (both
+  // cores); this one checks the samples and writes the rows in the file's order. The rows stop
+  // before a correction that is not finite, which is refused at its row.
+  const SampleColumns columns = writer.columns();
+  ParallelSamplesReader parallel(&reader, 2,
+                                 [&calibration, columns](std::vector<Sample>* samples, std::string* rows) {
+                                   for (Sample& sample : *samples) {
+                                     CorrectOne(calibration, Sample(sample), &sample);
+                                     if (!Finite(sample)) break;
+                                     SamplesWriter::AppendRow(sample, columns, rows);
+                                   }
+                                 });
+  CorrectFileReport report;
+  Sample corrected;
+  while (parallel.Next(&corrected)) {
+    writer.WriteRows(parallel.TakeText());
+    Count(calibration, parallel, corrected, &report);
+  }
   writer.Commit();
   return report;
 }

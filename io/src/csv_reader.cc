@@ -313,32 +313,32 @@ void CsvReader::Refill() {
 bool CsvReader::NextBlock(std::string* rows, size_t bytes) {
   if (read_error_) std::rethrow_exception(std::exchange(read_error_, nullptr));
   // The partial line the last block left (or what reading the header left), then the file's bytes.
-  rows->assign(text_ + begin_, end_ - begin_);
+  // `rows` is filled up to `size` and cut to it at the end: a reused string keeps its length, so
+  // that its bytes are not cleared only to be read over.
+  size_t size = end_ - begin_;
+  if (rows->size() < size) rows->resize(size);
+  std::memcpy(rows->data(), text_ + begin_, size);
   begin_ = end_ = 0;
   // After the last newline in rows (0 when there is none).
-  const auto end_of_lines = [rows] {
-    const void* newline = rows->empty() ? nullptr : ::memrchr(rows->data(), '\n', rows->size());
+  const auto end_of_lines = [rows, &size] {
+    const void* newline = size == 0 ? nullptr : ::memrchr(rows->data(), '\n', size);
     return newline == nullptr ? 0 : static_cast<size_t>(static_cast<const char*>(newline) - rows->data() + 1);
   };
   size_t last_line_end = 0;
   for (;;) {
     last_line_end = end_of_lines();
     // Full enough, or one line longer than any may be: it goes on as it is, to fail at its place.
-    if (eof_ || (last_line_end > 0 && rows->size() >= bytes) || rows->size() > kMaxLineBytes) break;
-    const size_t have = rows->size();
-    rows->resize(std::max(bytes, have + have / 2));
+    if (eof_ || (last_line_end > 0 && size >= bytes) || size > kMaxLineBytes) break;
+    rows->resize(std::max({rows->size(), bytes, size + size / 2}));
     try {
-      size_t got = 0;
-      while (have + got < rows->size() && !eof_) {
-        const size_t n = source_->Read(rows->data() + have + got, rows->size() - have - got);
+      while (size < rows->size() && !eof_) {
+        const size_t n = source_->Read(rows->data() + size, rows->size() - size);
         eof_ = n == 0;
-        got += n;
+        size += n;
       }
-      rows->resize(have + got);
     } catch (...) {
       // A read error comes after the whole lines read before it, as NextRow() reads them.
       read_error_ = std::current_exception();
-      rows->resize(have);
       eof_ = true;
       rows->resize(end_of_lines());
       if (rows->empty()) std::rethrow_exception(std::exchange(read_error_, nullptr));
@@ -347,13 +347,14 @@ bool CsvReader::NextBlock(std::string* rows, size_t bytes) {
     }
   }
   if (!eof_ && last_line_end > 0) {  // the partial last line waits for the next block
-    buffer_.assign(rows->begin() + last_line_end, rows->end());
+    buffer_.assign(rows->begin() + last_line_end, rows->begin() + size);
     text_ = buffer_.data();
     end_ = buffer_.size();
-    rows->resize(last_line_end);
+    size = last_line_end;
   }
-  bytes_read_ += static_cast<long long>(rows->size());
-  return !rows->empty();
+  rows->resize(size);
+  bytes_read_ += static_cast<long long>(size);
+  return size > 0;
 }
 
 void CsvReader::SplitLine(std::string_view line) {

@@ -3,6 +3,7 @@
 #include <isa-l/igzip_lib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -43,9 +44,52 @@ GzipWriter::GzipWriter(int fd, std::string path)
   z.level_buf_size = static_cast<uint32_t>(stream_->level_buffer.size());
   z.flush = NO_FLUSH;
   z.end_of_stream = 0;
+  thread_ = std::thread([this] { Compress(); });
 }
 
-GzipWriter::~GzipWriter() = default;
+GzipWriter::~GzipWriter() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+void GzipWriter::Compress() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    changed_.wait(lock, [this] { return stop_ || finishing_ || !pending_.empty(); });
+    if (stop_) break;
+    const bool end = pending_.empty();  // and finishing_
+    std::string data;
+    if (!end) {
+      data = std::move(pending_.front());
+      pending_.pop_front();
+    }
+    lock.unlock();
+    try {
+      constexpr size_t kMaxChunk = 1u << 30;  // avail_in is 32 bits
+      for (std::string_view rest = data; !rest.empty(); rest.remove_prefix(std::min(rest.size(), kMaxChunk)))
+        Deflate(rest.substr(0, kMaxChunk));
+      if (end) {
+        stream_->zstream.end_of_stream = 1;
+        Deflate(std::string_view());
+      }
+    } catch (...) {
+      lock.lock();
+      error_ = std::current_exception();
+      break;
+    }
+    lock.lock();
+    if (end) break;
+    data.clear();
+    free_.push_back(std::move(data));
+    changed_.notify_all();  // room for a Write()
+  }
+  done_ = true;
+  changed_.notify_all();
+}
 
 void GzipWriter::Deflate(std::string_view data) {
   isal_zstream& z = stream_->zstream;
@@ -61,18 +105,25 @@ void GzipWriter::Deflate(std::string_view data) {
   } while (z.avail_in > 0 || z.avail_out == 0 || (z.end_of_stream && z.internal_state.state != ZSTATE_END));
 }
 
-void GzipWriter::Write(std::string_view data) {
-  constexpr size_t kMaxChunk = 1u << 30;  // avail_in is 32 bits
-  while (!data.empty()) {
-    const std::string_view chunk = data.substr(0, kMaxChunk);
-    Deflate(chunk);
-    data.remove_prefix(chunk.size());
+void GzipWriter::Write(std::string* data) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return error_ != nullptr || pending_.size() < kMaxPending; });
+  if (error_) std::rethrow_exception(error_);
+  pending_.push_back(std::move(*data));
+  data->clear();
+  if (!free_.empty()) {
+    data->swap(free_.back());
+    free_.pop_back();
   }
+  changed_.notify_all();
 }
 
 void GzipWriter::Finish() {
-  stream_->zstream.end_of_stream = 1;
-  Deflate(std::string_view());
+  std::unique_lock<std::mutex> lock(mutex_);
+  finishing_ = true;
+  changed_.notify_all();
+  changed_.wait(lock, [this] { return done_; });
+  if (error_) std::rethrow_exception(error_);
 }
 
 }  // namespace imufit

@@ -214,7 +214,8 @@ void OutputFile::WriteNumber(double value) {
 void OutputFile::Flush() {
   if (buffer_.empty()) return;
   if (gz_ != nullptr) {
-    gz_->Write(buffer_);
+    gz_->Write(&buffer_);  // compressed on its thread; buffer_ is one it has compressed, or new
+    buffer_.reserve(kFlushBytes + 4096);
   } else {
     WriteAll(fd_, buffer_, path_);
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <exception>
+#include <mutex>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -17,13 +18,18 @@ namespace imufit {
 // lines it holds, whether a row stopped it, and the read error after its rows, if one came.
 // Blocks are reused, so that their memory is allocated (and paged in) once.
 struct ParallelSamplesReader::Block {
+  enum class State { kRead, kParsing, kParsed };
   std::string rows;
   bool first = false;  // the file's first block
+  State state = State::kRead;
   std::vector<Sample> samples;
   std::vector<uint32_t> lines;
   long line_count = 0;
   bool row_error = false;  // the parse stopped at a row: parsed again, located, when handed on
   std::exception_ptr read_error;
+  std::exception_ptr parse_error;  // anything but a row's error (out of memory), thrown when handed on
+  std::string text;                // what the block work made of the samples
+  bool text_taken = false;
 };
 
 namespace {
@@ -31,6 +37,9 @@ namespace {
 // The CSV text of a block: small enough to stay in cache with its samples, large enough that
 // handing blocks between threads costs nothing.
 constexpr size_t kBlockBytes = 1 << 20;
+// Blocks read ahead of the one handed on, per parsing thread: while the caller's thread uses a
+// block, the others have blocks to parse.
+constexpr size_t kBlocksAheadPerThread = 3;
 
 }  // namespace
 
@@ -51,17 +60,32 @@ SamplesReader::SamplesReader(const SamplesReader& header_of, std::string_view ro
   std::copy(std::begin(header_of.accel_columns_), std::end(header_of.accel_columns_), accel_columns_);
 }
 
-ParallelSamplesReader::ParallelSamplesReader(SamplesReader* header, int threads)
-    : header_(header), threads_(std::max(threads, 1)), line_before_(header->line_number()) {}
+ParallelSamplesReader::ParallelSamplesReader(SamplesReader* header, int threads, BlockWork block_work)
+    : header_(header),
+      threads_(std::max(threads, 1)),
+      block_work_(std::move(block_work)),
+      line_before_(header->line_number()) {
+  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { Work(); });
+}
 
-ParallelSamplesReader::~ParallelSamplesReader() = default;  // waits for the blocks in flight
+ParallelSamplesReader::~ParallelSamplesReader() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  work_.notify_all();
+  for (std::thread& worker : workers_) worker.join();  // each finishes the block it parses
+}
 
-void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
+void ParallelSamplesReader::Parse(Block* block) const {
   block->samples.clear();
   block->lines.clear();
+  block->text.clear();
   block->row_error = false;
+  block->parse_error = nullptr;
+  if (block->rows.empty()) return;  // a read error's
   try {
-    SamplesReader reader(header, block->rows, 0, std::nullopt, block->first);
+    SamplesReader reader(*header_, block->rows, 0, std::nullopt, block->first);
     Sample sample;
     while (reader.Next(&sample)) {
       block->samples.push_back(sample);
@@ -70,11 +94,45 @@ void ParallelSamplesReader::Parse(const SamplesReader& header, Block* block) {
     block->line_count = reader.line_number();
   } catch (const InputError&) {
     block->row_error = true;
+  } catch (...) {
+    block->parse_error = std::current_exception();
+    return;
+  }
+  try {
+    if (block_work_) block_work_(&block->samples, &block->text);  // the samples before a row error too
+  } catch (...) {
+    block->parse_error = std::current_exception();
   }
 }
 
-bool ParallelSamplesReader::Launch() {
-  if (end_of_file_) return false;
+ParallelSamplesReader::Block* ParallelSamplesReader::Unparsed() const {
+  for (const std::unique_ptr<Block>& block : queue_) {
+    if (block->state == Block::State::kRead) return block.get();
+  }
+  return nullptr;
+}
+
+void ParallelSamplesReader::ParseLocked(Block* block, std::unique_lock<std::mutex>* lock) {
+  block->state = Block::State::kParsing;
+  lock->unlock();
+  Parse(block);
+  lock->lock();
+  block->state = Block::State::kParsed;
+}
+
+void ParallelSamplesReader::Work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    Block* block = nullptr;
+    work_.wait(lock, [&] { return stop_ || (block = Unparsed()) != nullptr; });
+    if (stop_) return;
+    ParseLocked(block, &lock);
+    parsed_.notify_one();  // the caller's thread may wait for it
+  }
+}
+
+bool ParallelSamplesReader::ReadBlock() {
+  if (end_of_file_ || queue_.size() >= kBlocksAheadPerThread * static_cast<size_t>(threads_)) return false;
   std::unique_ptr<Block> block;
   if (free_.empty()) {
     block = std::make_unique<Block>();
@@ -83,7 +141,6 @@ bool ParallelSamplesReader::Launch() {
     free_.pop_back();
   }
   block->read_error = nullptr;
-  block->rows.clear();
   try {
     if (!header_->csv_.NextBlock(&block->rows, kBlockBytes)) {
       end_of_file_ = true;
@@ -98,13 +155,12 @@ bool ParallelSamplesReader::Launch() {
   }
   block->first = !launched_;
   launched_ = true;
-  const SamplesReader* header = header_;
-  auto parse = [header, block = std::move(block)]() mutable {
-    if (!block->rows.empty()) Parse(*header, block.get());
-    return std::move(block);
-  };
-  in_flight_.push_back(
-      std::async(threads_ > 1 ? std::launch::async : std::launch::deferred, std::move(parse)));
+  block->state = Block::State::kRead;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(std::move(block));
+  }
+  work_.notify_one();
   return true;
 }
 
@@ -113,13 +169,27 @@ bool ParallelSamplesReader::Advance() {
     line_before_ += current_->line_count;
     free_.push_back(std::move(current_));
   }
-  while (static_cast<int>(in_flight_.size()) < threads_ && Launch()) {
+  // Only this thread reads blocks and takes them out of the queue; every thread parses them. While
+  // the block to hand on is parsed elsewhere, this thread reads and parses the ones after it.
+  for (;;) {
+    while (ReadBlock()) {
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (queue_.empty()) return false;
+    if (queue_.front()->state == Block::State::kParsed) {
+      current_ = std::move(queue_.front());
+      queue_.pop_front();
+      break;
+    }
+    if (Block* block = Unparsed()) {
+      ParseLocked(block, &lock);
+    } else {
+      parsed_.wait(lock, [&] { return queue_.front()->state == Block::State::kParsed; });
+    }
   }
-  if (in_flight_.empty()) return false;
-  current_ = in_flight_.front().get();
-  in_flight_.pop_front();
   next_ = 0;
-  Launch();  // the next block parses while this one is handed on
+  current_->text_taken = false;
+  if (current_->parse_error) std::rethrow_exception(current_->parse_error);
   if (current_->rows.empty()) std::rethrow_exception(current_->read_error);
   // The block's first row against the last row before it: when its time does not increase (or
   // the row has an error of its own), parse it again after that row, as one reader would have.
@@ -153,6 +223,12 @@ bool ParallelSamplesReader::Next(Sample* sample) {
   ++next_;
   last_time_s_ = sample->time_s;
   return true;
+}
+
+std::string_view ParallelSamplesReader::TakeText() {
+  if (current_ == nullptr || current_->text_taken) return {};
+  current_->text_taken = true;
+  return current_->text;
 }
 
 void ParallelSamplesReader::Fail(const std::string& column, const std::string& message) const {

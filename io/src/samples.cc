@@ -255,12 +255,10 @@ SamplesWriter::SamplesWriter(std::string path, SampleColumns columns, const std:
   file_.Write("gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n");
 }
 
-void SamplesWriter::Write(const Sample& sample) {
-  // The row is formatted in one buffer and written at once: a write per field costs more than the
-  // numbers' formatting. Non-finite numbers are spelled as WriteNumber spells them.
-  char row[kMaxRowBytes];
+char* SamplesWriter::FormatRow(const Sample& sample, SampleColumns columns, char* row) {
+  // Non-finite numbers are spelled as WriteNumber spells them.
   char* end = row;
-  const auto number = [&end, &row](double value) {
+  const auto number = [&end, row](double value) {
     if (!std::isfinite(value)) {
       const std::string text = FormatDouble(value);
       end = std::copy(text.begin(), text.end(), end);
@@ -270,15 +268,27 @@ void SamplesWriter::Write(const Sample& sample) {
     *end++ = ',';
   };
   number(sample.time_s);
-  if (columns_.temp) number(sample.temp_c);
-  if (columns_.segment) {
+  if (columns.temp) number(sample.temp_c);
+  if (columns.segment) {
     end = std::to_chars(end, row + kMaxRowBytes, sample.segment).ptr;
     *end++ = ',';
   }
   for (int axis = 0; axis < 3; ++axis) number(sample.gyro(axis));
   for (int axis = 0; axis < 3; ++axis) number(sample.accel(axis));
   end[-1] = '\n';
-  file_.Write(std::string_view(row, end - row));
+  return end;
+}
+
+void SamplesWriter::AppendRow(const Sample& sample, SampleColumns columns, std::string* rows) {
+  char row[kMaxRowBytes];
+  rows->append(row, FormatRow(sample, columns, row) - row);
+}
+
+void SamplesWriter::Write(const Sample& sample) {
+  // The row is formatted in one buffer and written at once: a write per field costs more than the
+  // numbers' formatting.
+  char row[kMaxRowBytes];
+  file_.Write(std::string_view(row, FormatRow(sample, columns_, row) - row));
 }
 
 }  // namespace imufit

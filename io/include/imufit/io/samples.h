@@ -181,9 +181,16 @@ class SamplesWriter {
                 OutputTransaction* transaction = nullptr);
 
   void Write(const Sample& sample);
+  // Rows made by AppendRow with columns(), written as they are.
+  void WriteRows(std::string_view rows) { file_.Write(rows); }
   void Commit() { file_.Commit(); }
+  SampleColumns columns() const { return columns_; }
+  // Appends the row Write() writes for `sample` to `rows` (on any thread).
+  static void AppendRow(const Sample& sample, SampleColumns columns, std::string* rows);
 
  private:
+  // Formats the row of `sample` into `row` (kMaxRowBytes); returns its end.
+  static char* FormatRow(const Sample& sample, SampleColumns columns, char* row);
   // A row's bytes at most: 8 numbers of at most 24 characters and a segment id, with delimiters.
   static constexpr size_t kMaxRowBytes = 256;
   OutputFile file_;
