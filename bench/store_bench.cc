@@ -10,7 +10,9 @@
 // cluster that tests/postgres_fixture.sh starts and stops; where it cannot start, the bench says
 // why and measures SQLite only.
 //
-// Usage: store_bench [FITS]   (default 100000)
+// Usage: store_bench [FITS] [--keep]   (default 100000 fits; --keep leaves the SQLite file and the
+// PostgreSQL cluster in place and prints where, to EXPLAIN a query on them; stop the cluster with
+// tests/postgres_fixture.sh stop STATE)
 #include <libpq-fe.h>
 #include <sqlite3.h>
 #include <unistd.h>
@@ -189,6 +191,7 @@ bool Fixture(const char* action, const std::string& state) {
 
 int main(int argc, char** argv) {
   const int fits = argc > 1 ? std::atoi(argv[1]) : 100000;
+  const bool keep = argc > 2 && std::string(argv[2]) == "--keep";
   const fs::path folder = fs::temp_directory_path() / ("imufit_store_bench_" + std::to_string(getpid()));
   fs::create_directories(folder);
   const std::string sqlite_path = (folder / "store.db").string();
@@ -211,6 +214,10 @@ int main(int argc, char** argv) {
     FillPostgres(target, fits);
     std::printf("postgresql: filled in %.1f s\n", Seconds(start));
     Measure(target, "postgresql");
+  }
+  if (keep) {
+    std::printf("kept: %s, %s (state %s)\n", sqlite_path.c_str(), target.c_str(), state.c_str());
+    return 0;
   }
   Fixture("stop", state);
   fs::remove_all(folder);

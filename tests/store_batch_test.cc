@@ -19,8 +19,10 @@
 
 #include <gtest/gtest.h>
 
+#include "imufit/factory/lot_summary.h"
 #include "imufit/factory/shard.h"
 #include "imufit/factory/store.h"
+#include "imufit/factory/store_history.h"
 #include "imufit/io/calibration.h"
 #include "store_test_util.h"
 #include "test_util.h"
@@ -205,6 +207,51 @@ TEST_F(ShardTest, FourShardsAtOnceGiveEveryUnitOnceAndTheUnshardedLot) {
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("no lot named \"LOT-X\""), std::string::npos) << missing.err;
   EXPECT_FALSE(fs::exists(folder_ / "x.csv"));
+}
+
+// Guarded acceptance with the gyro bias X limit at a good unit's value: every good unit lies within
+// U of it (conditional). The lot built from the shards' store counts the conditional units as the
+// one from the unsharded batch's store does, and as the batch judged them.
+TEST_F(ShardTest, TheStoreBuiltLotCountsConditionalVerdictsAsTheUnshardedBatch) {
+  const std::string probe = FreshStore("shard_probe");
+  ASSERT_EQ(Imufit(folder_, Batch("out_probe", probe), "probe").status, 3);
+  double bias_x = 0.0;
+  {
+    ResultsStore store(probe);
+    const StoredFit good = store.LatestOfLot("LOT-S").at(1);  // unit-101: a good one
+    const StoredFigure* x = FindFigure(good.figures, "gyro_bias_dps.x");
+    ASSERT_NE(x, nullptr);
+    ASSERT_GT(x->expanded_u, 0.0);
+    bias_x = std::abs(x->value);
+  }
+  char limit[64];
+  std::snprintf(limit, sizeof limit, "%.17g", bias_x);
+  WriteText(folder_ / "limits.yaml", std::string(kLimits) + "  - {quantity: gyro_bias_dps, max_abs: " +
+                                         limit + ", axes: [x]}\ndecision_rule: guarded\n");
+  const std::string whole = FreshStore("guarded_whole"), sharded = FreshStore("guarded_two");
+  const testing::RunResult one = Imufit(folder_, Batch("out_whole", whole), "whole");
+  ASSERT_EQ(one.status, 3) << one.err;
+  for (int i = 0; i < 2; ++i) {
+    std::vector<std::string> shard = Batch("out_shards", sharded);
+    shard.insert(shard.end(), {"--shard", std::to_string(i) + "/2"});
+    const testing::RunResult r = Imufit(folder_, shard, "shard" + std::to_string(i));
+    EXPECT_TRUE(r.status == 0 || r.status == 3) << r.status << r.err;
+  }
+  const Limits limits = ReadLimits((folder_ / "limits.yaml").string());
+  ResultsStore a(whole), b(sharded);
+  const LotSummary from_whole = MakeLotSummary("LOT-S", StoredLot(&a, "LOT-S"), "test", limits);
+  const LotSummary from_shards = MakeLotSummary("LOT-S", StoredLot(&b, "LOT-S"), "test", limits);
+  EXPECT_GE(from_whole.conditional, kUnits - kUnits / 5);
+  EXPECT_EQ(from_shards.conditional, from_whole.conditional);
+  EXPECT_EQ(from_shards.passed, from_whole.passed);
+  EXPECT_EQ(from_shards.failed, from_whole.failed);
+  // as the batch judged them: guarded acceptance rejects each unit within U of the bias limit
+  const std::string batch_summary = testing::ReadBytes((folder_ / "out_whole" / "lot_summary.csv").string());
+  int rejected_on_bias = 0;
+  for (size_t at = batch_summary.find("|gyro_bias_dps.x| "); at != std::string::npos;
+       at = batch_summary.find("|gyro_bias_dps.x| ", at + 1))
+    ++rejected_on_bias;
+  EXPECT_EQ(from_whole.conditional, rejected_on_bias);
 }
 
 TEST_F(ShardTest, AShardStoppedPartWayAndRunAgainCompletes) {

@@ -24,7 +24,9 @@
 
 #include <gtest/gtest.h>
 
+#include "imufit/factory/lot_history.h"
 #include "imufit/factory/store.h"
+#include "imufit/factory/store_history.h"
 #include "imufit/io/error.h"
 #include "store_test_util.h"
 #include "test_util.h"
@@ -315,6 +317,87 @@ TEST(StoreTest, LatestFitAnswersEqualARecomputationFromEveryFitWhateverTheRecord
   EXPECT_NE(Answers(&store, kShuffledLots).find("lot-c"), std::string::npos);
 }
 
+// How far the store's lot statistics may lie from MeanAndSigma() over the same values, relative to
+// the sigma: round-off of the shifted sums, far below what a sum of squares without the shift loses
+// on these values (about 1e6 * 1e6 * 2e-16 / 1e-6 = 2e-4 of the variance, and sign errors).
+constexpr double kLotStatsRelTol = 1e-8;
+
+TEST(StoreTest, LotStatsEqualMeanAndSigmaOfTheLotValuesDespiteALargeCommonOffset) {
+  ResultsStore store(FreshStore("lot_stats"));
+  std::mt19937 random(7);
+  std::normal_distribution<double> spread(0.0, 1e-3);
+  constexpr double kOffset = 1e6;
+  for (const std::string lot : {"lot-a", "lot-b", "lot-c"}) {
+    for (int u = 0; u < 7; ++u) {
+      StoredFit fit = MakeFit(lot + "-SN" + std::to_string(u), lot, "2026-02-01T00:00:00Z",
+                              kOffset + (lot == "lot-b" ? 5e-3 : 0.0) + spread(random), "PASS");
+      store.Record(fit);
+      if (u == 3) {  // refitted later: the refit counts, the first fit not
+        fit.time_utc = "2026-03-01T00:00:00Z";
+        fit.figures[0].value = kOffset + spread(random);
+        store.Record(fit);
+      }
+    }
+  }
+  store.Record(MakeFit("single-SN", "lot-single", "2026-02-01T00:00:00Z", kOffset + 1e-3, "PASS"));
+  StoredFit not_fitted = MakeFit("lot-a-SN9", "lot-a", "2026-02-01T00:00:00Z", 0.0, "");
+  not_fitted.status = "not-fitted";
+  store.Record(not_fitted);
+  for (const std::string figure : {"gyro_bias_dps.x", "gyro.bias.x"}) {
+    std::map<std::string, std::vector<double>> values;
+    for (const LotValue& v : store.LotValues(figure)) values[v.lot].push_back(v.value);
+    const std::vector<LotFigureStats> stats = store.LotStats({figure});
+    ASSERT_EQ(stats.size(), values.size()) << figure;
+    for (const LotFigureStats& s : stats) {
+      SCOPED_TRACE(figure + " " + s.lot);
+      const MeanSigma expected = MeanAndSigma(values.at(s.lot));
+      EXPECT_EQ(s.figure, figure);
+      EXPECT_EQ(s.figure_unit, "deg/s");
+      EXPECT_EQ(s.count, expected.count);
+      EXPECT_NEAR(s.mean, expected.mean, kLotStatsRelTol * 1e-3);
+      EXPECT_NEAR(s.sigma, expected.sigma, kLotStatsRelTol * std::max(expected.sigma, 1e-3));
+      if (s.lot != "lot-single") EXPECT_GT(s.sigma, 1e-4);
+    }
+  }
+  EXPECT_TRUE(store.LotStats({"no_such_figure"}).empty());
+}
+
+TEST(StoreTest, AFiguresJudgementIsKeptAndTheStoredLotCountsConditionalUnitsAsTheBatchDid) {
+  const std::string target = FreshStore("judgement");
+  ResultsStore store(target);
+  const auto judged = [](StoredFit fit, const std::string& outcome, const std::string& judgement) {
+    fit.figures[0].limit_abs = 5.0;
+    fit.figures[0].outcome = outcome;
+    fit.figures[0].judgement = judgement;
+    return fit;
+  };
+  store.Record(
+      judged(MakeFit("SN1", "lot-j", "2026-05-01T00:00:00Z", 4.999, "PASS"), "pass", "conditional pass"));
+  store.Record(
+      judged(MakeFit("SN2", "lot-j", "2026-05-01T00:00:00Z", 5.001, "FAIL"), "fail", "conditional fail"));
+  store.Record(judged(MakeFit("SN3", "lot-j", "2026-05-01T00:00:00Z", 1.0, "PASS"), "pass", "PASS"));
+  StoredFit unresolved = MakeFit("SN4", "lot-j", "2026-05-01T00:00:00Z", 1.0, "PASS");
+  unresolved.figures[1].judgement = kNotResolved;
+  store.Record(unresolved);
+  const std::vector<StoredFit> fits = store.LatestOfLot("lot-j");
+  ASSERT_EQ(fits.size(), 4u);
+  EXPECT_EQ(fits[0].figures[0].judgement, "conditional pass");
+  EXPECT_EQ(fits[1].figures[0].judgement, "conditional fail");
+  EXPECT_EQ(fits[3].figures[1].judgement, kNotResolved);
+  const BatchResult lot = StoredLot(&store, "lot-j");
+  ASSERT_EQ(lot.units.size(), 4u);
+  EXPECT_EQ(lot.units[0].verdict_detail.Conditional(), 1);
+  EXPECT_EQ(lot.units[0].verdict_detail.criteria[0].outcome, Outcome::kConditionalPass);
+  EXPECT_TRUE(lot.units[0].verdict_detail.criteria[0].pass);
+  EXPECT_EQ(lot.units[1].verdict_detail.criteria[0].outcome, Outcome::kConditionalFail);
+  EXPECT_EQ(lot.units[2].verdict_detail.Conditional(), 0);
+  // and a merge carries it
+  const std::string copy = FreshSqliteStore("judgement_copy");
+  MergeStores({target}, copy);
+  ResultsStore merged(copy);
+  EXPECT_EQ(merged.LatestOfLot("lot-j")[1].figures[0].judgement, "conditional fail");
+}
+
 TEST(StoreTest, AVersion2StoreGainsItsLatestFitsKeepingEveryRowAndEveryAnswer) {
   const std::string target = FreshStore("v2");
   std::vector<StoredFit> before;
@@ -326,8 +409,10 @@ TEST(StoreTest, AVersion2StoreGainsItsLatestFitsKeepingEveryRowAndEveryAnswer) {
     answers = RecomputedAnswers(&store, kShuffledLots);
   }
   // The store as version 2 wrote it: no latest_fits.
-  ExecuteOnStore(target, std::string("DROP TABLE latest_fits; UPDATE schema_version SET version = 2;") +
-                             (StoreBackend() == "sqlite" ? " PRAGMA user_version = 2;" : ""));
+  ExecuteOnStore(target,
+                 std::string("DROP TABLE latest_fits; DROP INDEX figures_fit_value; ALTER TABLE "
+                             "figures DROP COLUMN judgement; UPDATE schema_version SET version = 2;") +
+                     (StoreBackend() == "sqlite" ? " PRAGMA user_version = 2;" : ""));
   ResultsStore store(target);
   const std::vector<StoredFit> after = store.All();
   ASSERT_EQ(after.size(), before.size());

@@ -137,7 +137,9 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
       if (c.name != "|" + g.name + "|") continue;
       g.limit_abs = c.limit;
       g.outcome = c.pass ? "pass" : "fail";
+      g.judgement = OutcomeName(c.outcome);
     }
+    if (!figure.unresolved.empty()) g.judgement = kNotResolved;
     row.figures.push_back(std::move(g));
   }
   std::exception_ptr output_error;  // the outputs' failure passes on; the store's is the unit's

@@ -123,34 +123,29 @@ LotHistory MakeLotHistory(ResultsStore* store, const std::string& current_lot, c
     h.yield_pct.push_back(y.units > 0 ? 100.0 * y.passed / y.units : 0.0);
     if (y.lot == current_lot) h.current = static_cast<int>(i);
   }
-  // One pass over every unit's values: per figure, per lot.
+  // Per figure, per lot: count, mean and sigma, computed by the store.
+  std::vector<LotTrend> trends(figures.size());
   std::map<std::string, size_t> figure_index;
-  for (size_t i = 0; i < figures.size(); ++i) figure_index.emplace(figures[i], i);
-  std::vector<std::vector<std::vector<double>>> values(figures.size(),
-                                                       std::vector<std::vector<double>>(h.lots.size()));
-  std::vector<std::string> units(figures.size());
-  const std::vector<LotValue> all = store->LotValues(figures);
-  auto lot = index.end();
-  for (const LotValue& v : all) {
-    if (lot == index.end() || lot->first != v.lot) lot = index.find(v.lot);  // the rows come by lot
+  for (size_t f = 0; f < figures.size(); ++f) {
+    figure_index.emplace(figures[f], f);
+    trends[f].name = figures[f];
+    trends[f].count.assign(h.lots.size(), 0);
+    trends[f].mean.assign(h.lots.size(), NAN);
+    trends[f].sigma.assign(h.lots.size(), NAN);
+  }
+  for (const LotFigureStats& s : store->LotStats(figures)) {
+    const auto lot = index.find(s.lot);
     if (lot == index.end()) continue;
-    const size_t f = figure_index.at(v.figure);
-    values[f][lot->second].push_back(v.value);
-    units[f] = v.figure_unit;
+    LotTrend& trend = trends[figure_index.at(s.figure)];
+    trend.unit = s.figure_unit;
+    trend.count[lot->second] = s.count;
+    trend.mean[lot->second] = s.mean;
+    trend.sigma[lot->second] = s.sigma;
   }
   for (size_t f = 0; f < figures.size(); ++f) {
+    LotTrend& trend = trends[f];
     const std::string& name = figures[f];
-    const std::vector<std::vector<double>>& per_lot = values[f];
-    LotTrend trend;
-    trend.name = name;
-    trend.unit = units[f];
     if (trend.unit.empty()) continue;  // no lot has it
-    for (const std::vector<double>& values : per_lot) {
-      const MeanSigma m = MeanAndSigma(values);
-      trend.count.push_back(m.count);
-      trend.mean.push_back(m.count > 0 ? m.mean : NAN);
-      trend.sigma.push_back(m.count > 0 ? m.sigma : NAN);
-    }
     if (limits != nullptr) trend.limits = FigureLimits(name, *limits);
     double lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < trend.mean.size(); ++i) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <thread>
@@ -208,7 +209,8 @@ CREATE TABLE figures (
   fit_id BIGINT NOT NULL REFERENCES fits (id), position INTEGER NOT NULL, name TEXT NOT NULL,
   coefficient TEXT NOT NULL, unit TEXT NOT NULL, value DOUBLE PRECISION NOT NULL,
   sigma DOUBLE PRECISION NOT NULL, expanded_u DOUBLE PRECISION NOT NULL,
-  limit_abs DOUBLE PRECISION NOT NULL, outcome TEXT NOT NULL, PRIMARY KEY (fit_id, name));
+  limit_abs DOUBLE PRECISION NOT NULL, outcome TEXT NOT NULL, judgement TEXT NOT NULL DEFAULT '',
+  PRIMARY KEY (fit_id, name));
 CREATE TABLE attachments (
   fit_id BIGINT NOT NULL REFERENCES fits (id), kind TEXT NOT NULL, path TEXT NOT NULL,
   sha256 TEXT NOT NULL, PRIMARY KEY (fit_id, kind, path));
@@ -229,6 +231,11 @@ constexpr const char* kLatestFitsSchema = R"sql(
 CREATE TABLE latest_fits (
   lot TEXT NOT NULL, unit TEXT NOT NULL, fit_id BIGINT NOT NULL REFERENCES fits (id),
   time_utc TEXT NOT NULL, PRIMARY KEY (lot, unit));
+)sql";
+
+// The values of a fit's figures, read without the table (LotStats()). Added in version 4.
+constexpr const char* kFigureValuesIndex = R"sql(
+CREATE INDEX IF NOT EXISTS figures_fit_value ON figures (fit_id, name, value, unit);
 )sql";
 
 // A unit's latest fit is its fit with the latest time_utc, of those the one recorded last (the
@@ -286,6 +293,30 @@ constexpr const char* kYieldCounts =
     "sum(CASE WHEN verdict = 'FAIL' THEN 1 ELSE 0 END), "
     "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest ";
 
+// The sums behind LotStats(), per lot and figure over each unit's latest fit: n, S1 = sum(x - k), S2 =
+// sum((x - k)^2), shifted by k, one stored value of the figure, so that an offset common to every
+// value (a scale factor of 16384 with a spread of 0.01) cancels before squaring: mean = k + S1 / n,
+// variance = (S2 - S1^2 / n) / (n - 1). The same SQL on both backends (SQLite has no stddev_samp).
+// kLotReference finds a figure's stored name (?1 a name or a coefficient) and its k.
+constexpr const char* kLotReference =
+    "SELECT name, value FROM figures WHERE name = ?1 OR coefficient = ?1 LIMIT 1";
+
+// The statement of the sums over `names` stored names: ?1, ?3, ... the names, ?2, ?4, ... their k.
+std::string LotSumsSql(size_t names) {
+  std::string shift = "CASE g.name", list;
+  for (size_t i = 0; i < names; ++i) {
+    const std::string name = "?" + std::to_string(2 * i + 1), k = "?" + std::to_string(2 * i + 2);
+    shift += " WHEN " + name + " THEN CAST(" + k + " AS DOUBLE PRECISION)";
+    list += (i ? ", " : "") + name;
+  }
+  return "SELECT lot, name, max(unit), count(*), sum(d), sum(d * d) FROM (SELECT l.lot AS lot, g.name AS "
+         "name, g.unit AS unit, g.value - " +
+         shift +
+         " END AS d FROM latest_fits l JOIN fits f ON f.id = l.fit_id JOIN figures g ON g.fit_id = l.fit_id "
+         "WHERE l.lot <> '' AND f.status = 'fitted' AND " +
+         (names == 1 ? "g.name = ?1" : "g.name IN (" + list + ")") + ") v GROUP BY lot, name";
+}
+
 class Transaction {
  public:
   Transaction(SqlConnection* db, bool exclusive) : db_(db) { db_->Begin(exclusive); }
@@ -333,15 +364,16 @@ void ResultsStore::Open() {
     bool empty = true;
     if (db_->HasTable("fits")) empty = false;
     if (!empty) throw InputError(path_, "not an imufit results store (no schema_version table)");
-    db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema));
+    db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kFigureValuesIndex));
     db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
     db_->SchemaWritten(kStoreSchemaVersion);
   }
   int64_t found = -1;
   db_->Query("SELECT version FROM schema_version", {}, [&](const SqlRow& row) { found = row.Integer(0); });
   if (found > kStoreSchemaVersion || found < 1) throw UnsupportedVersion(path_, found);
-  if (found == 1) MigrateFromVersion1();
+  if (found == 1) MigrateFromVersion1();  // to the current schema
   if (found == 2) MigrateFromVersion2();
+  if (found == 2 || found == 3) MigrateFromVersion3();
   transaction.Commit();
 }
 
@@ -374,7 +406,7 @@ void ResultsStore::MigrateFromVersion1() {
                fits[it->second].figures.push_back(std::move(g));
              });
   db_->Execute("DROP TABLE figures; DROP TABLE fits; DROP TABLE schema_version;");
-  db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema));
+  db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kFigureValuesIndex));
   db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
   db_->SchemaWritten(kStoreSchemaVersion);
   for (const StoredFit& f : fits) Insert(f);
@@ -384,6 +416,14 @@ void ResultsStore::MigrateFromVersion1() {
 void ResultsStore::MigrateFromVersion2() {
   db_->Execute(SchemaFor(*db_, kLatestFitsSchema));
   db_->Execute(kFillLatest);
+}
+
+// Version 3: without the index figures_fit_value and without figures.judgement (every row keeps
+// its outcome, with judgement '').
+void ResultsStore::MigrateFromVersion3() {
+  db_->Execute(kFigureValuesIndex);
+  db_->Execute(std::string("ALTER TABLE figures ADD COLUMN judgement ") + db_->TextType() +
+               " NOT NULL DEFAULT ''");
   db_->Execute("UPDATE schema_version SET version = " + std::to_string(kStoreSchemaVersion));
   db_->SchemaWritten(kStoreSchemaVersion);
 }
@@ -462,10 +502,9 @@ int64_t ResultsStore::Insert(const StoredFit& fit, bool* added) {
     const StoredFigure& g = fit.figures[i];
     db_->Query(
         "INSERT INTO figures (fit_id, position, name, coefficient, unit, value, sigma, expanded_u, "
-        "limit_abs, "
-        "outcome) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
+        "limit_abs, outcome, judgement) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)",
         {id, static_cast<int64_t>(i), g.name, g.coefficient, g.unit, g.value, g.sigma, g.expanded_u,
-         g.limit_abs, g.outcome},
+         g.limit_abs, g.outcome, g.judgement},
         ignore);
   }
   for (const StoredAttachment& a : fit.attachments) {
@@ -495,13 +534,14 @@ std::vector<StoredFit> ResultsStore::Fits(const std::string& where,
       where;
   db_->Query(
       "SELECT g.fit_id, g.name, g.coefficient, g.unit, g.value, g.sigma, g.expanded_u, g.limit_abs, "
-      "g.outcome FROM figures g" +
+      "g.outcome, g.judgement FROM figures g" +
           of_these + " ORDER BY g.fit_id, g.position",
       values, [&](const SqlRow& row) {
         StoredFigure g(Figure{row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5)});
         g.expanded_u = row.Double(6);
         g.limit_abs = row.Double(7);
         g.outcome = row.Text(8);
+        g.judgement = row.Text(9);
         fits[by_id.at(row.Integer(0))].figures.push_back(std::move(g));
       });
   db_->Query("SELECT g.fit_id, g.kind, g.path, g.sha256 FROM attachments g" + of_these +
@@ -600,6 +640,45 @@ std::vector<LotValue> ResultsStore::LotValues(const std::vector<std::string>& fi
         }
       });
   return values;
+}
+
+std::vector<LotFigureStats> ResultsStore::LotStats(const std::vector<std::string>& figures) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::map<std::string, double> reference;           // by stored name: k
+  std::multimap<std::string, std::string> asked_as;  // stored name -> the figure as asked
+  for (const std::string& figure : figures) {
+    db_->Query(kLotReference, {figure}, [&](const SqlRow& row) {
+      reference.emplace(row.Text(0), row.Double(1));
+      asked_as.emplace(row.Text(0), figure);
+    });
+  }
+  // SQLite joins by index lookups: a statement per figure reads each lot's units in key order
+  // (figures_fit_value). PostgreSQL hashes: one statement reads the figures once for all.
+  std::vector<std::vector<std::string>> batches;
+  for (const auto& [name, k] : reference) {
+    if (batches.empty() || std::string(db_->backend()) == "sqlite") batches.emplace_back();
+    batches.back().push_back(name);
+  }
+  std::vector<LotFigureStats> stats;
+  for (const std::vector<std::string>& names : batches) {
+    std::vector<SqlValue> parameters;
+    for (const std::string& name : names) parameters.insert(parameters.end(), {name, reference.at(name)});
+    db_->Query(LotSumsSql(names.size()), parameters, [&](const SqlRow& row) {
+      LotFigureStats s;
+      s.lot = row.Text(0);
+      s.figure_unit = row.Text(2);
+      s.count = static_cast<int>(row.Integer(3));
+      const double k = reference.at(row.Text(1)), s1 = row.Double(4), s2 = row.Double(5);
+      s.mean = k + s1 / s.count;
+      s.sigma = s.count > 1 ? std::sqrt(std::max(0.0, (s2 - s1 * s1 / s.count) / (s.count - 1))) : 0.0;
+      const auto [first, last] = asked_as.equal_range(row.Text(1));
+      for (auto it = first; it != last; ++it) {
+        s.figure = it->second;
+        stats.push_back(s);
+      }
+    });
+  }
+  return stats;
 }
 
 }  // namespace imufit

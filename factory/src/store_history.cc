@@ -144,7 +144,11 @@ BatchResult StoredLot(ResultsStore* store, const std::string& lot) {
       c.margin = g.limit_abs - c.measured;
       c.expanded = g.expanded_u;
       c.pass = g.outcome == "pass";
-      c.outcome = c.pass ? Outcome::kPass : Outcome::kFail;
+      c.outcome = c.pass ? Outcome::kPass : Outcome::kFail;  // a store of version 3 knows no more
+      for (Outcome o :
+           {Outcome::kPass, Outcome::kConditionalPass, Outcome::kConditionalFail, Outcome::kFail}) {
+        if (g.judgement == OutcomeName(o)) c.outcome = o;
+      }
       u.verdict_detail.criteria.push_back(c);
     }
     u.verdict_detail.pass = u.verdict == "PASS";

@@ -12,17 +12,18 @@
 //        and from wherever it is imported
 //   fits(id, fit_key, run_key, time_utc, software, fit_options, limits_sha256, status, verdict,
 //        message, calibration_yaml)                        fit_key: UUIDv5 of the run and the fit
-//   figures(fit_id, name, coefficient, unit, value, sigma, expanded_u, limit_abs, outcome)
+//   figures(fit_id, name, coefficient, unit, value, sigma, expanded_u, limit_abs, outcome, judgement)
 //   attachments(fit_id, kind, path, sha256)                the certificate and its files, by reference
 //   latest_fits(lot, unit, fit_id, time_utc)               each unit's latest fit (latest time_utc,
 //        then highest id), kept in Record()'s transaction; yield and the lot pages read it
 // Record() writes one fit, its run, unit, station, figures and attachments in one transaction with
 // INSERT ... ON CONFLICT DO NOTHING: re-recording the same fit (a re-run, a merge, two writers at
-// once) changes nothing. A version 1 SQLite store, and a version 2 store of either backend, is
-// migrated in place, in one transaction, when opened. Errors (cannot open or connect, not an imufit store, a
-// newer schema, may not be written) are InputErrors naming the file or database, raised when the store is
-// opened: before any work. Several processes may open, create and write one store at once: a busy SQLite
-// database is waited for (up to kStoreBusyWaitSeconds), never an error.
+// once) changes nothing. A version 1 SQLite store, and a version 2 or 3 store of either backend, is
+// migrated in place, in one transaction, when opened (3: adds the index figures_fit_value and
+// figures.judgement, '' in the rows it keeps). Errors (cannot
+// open or connect, not an imufit store, a newer schema, may not be written) are InputErrors naming the file
+// or database, raised when the store is opened: before any work. Several processes may open, create and write
+// one store at once: a busy SQLite database is waited for (up to kStoreBusyWaitSeconds), never an error.
 #ifndef IMUFIT_FACTORY_STORE_H_
 #define IMUFIT_FACTORY_STORE_H_
 
@@ -40,7 +41,7 @@ namespace imufit {
 
 class SqlConnection;
 
-inline constexpr int kStoreSchemaVersion = 3;
+inline constexpr int kStoreSchemaVersion = 4;
 // How long opening or writing an SQLite store waits for another process that holds it.
 inline constexpr int kStoreBusyWaitSeconds = 60;
 
@@ -48,13 +49,20 @@ inline constexpr int kStoreBusyWaitSeconds = 60;
 // written), or to read an existing one (`imufit history`).
 enum class StoreAccess { kRecord, kRead };
 
+// StoredFigure::judgement of a figure the run does not measure (Figure::unresolved).
+inline constexpr const char* kNotResolved = "not resolved";
+
 // A key figure as stored: the figure, its expanded uncertainty and how it was judged.
 struct StoredFigure : Figure {
   StoredFigure() = default;
   StoredFigure(const Figure& figure) : Figure(figure) {}  // NOLINT: a figure without a judgement
   double expanded_u = -1.0;  // U = k sigma (k = kCoverageFactor, certificate.h); < 0 without sigma
   double limit_abs = -1.0;   // the acceptance limit on |value|; < 0 without one
-  std::string outcome;       // "pass", "fail", "" (not judged)
+  std::string outcome;       // "pass", "fail" (accepted under the decision rule or not), "" (not judged)
+  // Where the value lies against its limit with U (ILAC-G8): OutcomeName() ("PASS", "conditional
+  // pass", "conditional fail", "FAIL"), "not resolved" (the run does not measure it), or "" (not
+  // judged, or recorded before schema version 4: then `outcome` alone is known).
+  std::string judgement;
 };
 
 // The stored figure called `name` (or with that coefficient path); nullptr when there is none.
@@ -136,6 +144,17 @@ struct LotValue {
   std::string figure;       // the figure as asked for (LotValues())
 };
 
+// One key figure over the fitted units of one lot (LotStats()): how many, their mean and sample
+// standard deviation (n - 1; 0 for one unit).
+struct LotFigureStats {
+  std::string lot;
+  std::string figure;       // as asked for
+  std::string figure_unit;  // "deg/s", ...
+  int count = 0;
+  double mean = 0.0;
+  double sigma = 0.0;
+};
+
 class ResultsStore {
  public:
   // Opens the store `target` names: a PostgreSQL URL or connection string (IsPostgresStore()), or
@@ -183,11 +202,15 @@ class ResultsStore {
   std::vector<LotValue> LotValues(const std::string& figure);
   // The same for several figures in one pass (the lot page's trends), by lot, then unit.
   std::vector<LotValue> LotValues(const std::vector<std::string>& figures);
+  // Per figure, per lot (lots in name order), the count, mean and sigma of the values LotValues()
+  // gives, computed by the database (the lot page's trends): nothing per unit leaves it.
+  std::vector<LotFigureStats> LotStats(const std::vector<std::string>& figures);
 
  private:
   void Open();  // schema, version check, migration
   void MigrateFromVersion1();
   void MigrateFromVersion2();
+  void MigrateFromVersion3();
   int64_t Insert(const StoredFit& fit, bool* added = nullptr);  // inside a transaction
   std::vector<StoredFit> Fits(const std::string& where, const std::vector<std::string>& parameters);
 
