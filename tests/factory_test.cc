@@ -941,7 +941,8 @@ TEST_F(CertificateTest, TheSettingsNameThePlansLimitingCoefficient) {
   ASSERT_EQ(p.why_not, "");
   EXPECT_GT(p.tolerance, 0.0);
   EXPECT_NEAR(p.achieved_sigma / p.predicted_sigma, 1.0, kPredictedSigmaTolerance);
-  if (!p.figure.empty()) EXPECT_GE(p.achieved_expanded, kCoverageFactor * p.achieved_sigma);
+  ASSERT_FALSE(p.figure.empty()) << "the limiting coefficient is a key figure with U";
+  EXPECT_GE(p.achieved_expanded, kCoverageFactor * p.achieved_sigma);
   const Certificate without =
       CertificateOf(FitRun(kFixtures + "/plan_6pos.yaml", kFixtures + "/mems_6pos_soak.csv.gz", {}));
   EXPECT_EQ(without.settings.limiting.tolerance, 0.0);
