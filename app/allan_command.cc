@@ -130,13 +130,12 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
       const bool engineer = *units.engineer_key != '\0';
       const double scale = engineer ? units.engineer_per_si : 1.0;
       const char* unit = engineer ? units.engineer_unit : units.si_unit;
-      const bool resolved = IsResolved(fit, k);
-      if (resolved) {
-        std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(fit.value[k] * scale).c_str(),
-                    Number(fit.sigma[k] * scale, 2).c_str(), unit);
-      } else {
-        std::printf("  %-26s %10s (< %s %s)", units.label, "not resolved",
-                    Number(2.0 * fit.sigma[k] * scale, 2).c_str(), unit);
+      const NoiseTermFigure figure = TermFigure(fit, k, scale);
+      if (figure.resolved) {
+        std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(figure.value).c_str(),
+                    Number(figure.sigma, 2).c_str(), unit);
+      } else {  // its estimate, interval and the figure to quote (column_analysis.h)
+        std::printf("  %-26s %s", units.label, TermFigureText(figure, unit).c_str());
       }
       double readout = std::nan("");
       std::string where;

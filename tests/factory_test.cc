@@ -795,24 +795,25 @@ TEST_F(CertificateTest, TheNoiseSectionIsDrawnByTheAllanPlotModule) {
   constexpr double kArwRelative = 0.15;  // 70 s at 20 Hz fixes the white noise to a few percent
   for (size_t a = 0; a < 3; ++a) {
     const NoiseAxis& axis = c.noise.axes[a];
-    ASSERT_TRUE(axis.arw_resolved) << axis.axis;
-    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr, 0.299, kArwRelative * 0.299) << axis.axis;
-    const std::string words = "gyro_" + axis.axis + " ARW " + FormatNumber("%.3g", axis.arw_deg_per_sqrt_hr);
+    ASSERT_TRUE(axis.arw_deg_per_sqrt_hr.resolved) << axis.axis;
+    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr.value, 0.299, kArwRelative * 0.299) << axis.axis;
+    const std::string words =
+        "gyro_" + axis.axis + " ARW " + FormatNumber("%.3g", axis.arw_deg_per_sqrt_hr.value);
     bool marked = false;
     for (const PlotNote& n : panel.notes) marked = marked || n.text.rfind(words, 0) == 0;
     EXPECT_TRUE(marked) << words;
   }
 }
 
-// The noise section streams the run: the longest static stretch (the first of equally long ones;
+// The noise section streams the run: the stretch nearest 25 degC (of equally near ones the longer;
 // a transition or a rate segment ends a stretch) is analysed exactly as `imufit allan` analyses the
 // same rates held at once, and the section is the caller's to measure: MakeCertificate() takes it.
-TEST_F(CertificateTest, TheNoiseSectionStreamsTheLongestStaticStretch) {
+TEST_F(CertificateTest, TheNoiseSectionStreamsTheStretchNearest25C) {
   const Plan plan = ReadPlan(kFixtures + "/plan_6pos.yaml");  // 1..6 static, 7.. rates
   Calibration calibration;
   calibration.model = SensorModel::Identity();
   calibration.model.gyro[kScaleCoefficient * kPolynomialTerms] = 2.0;  // raw x = 2 * rate
-  LongestStaticStretch collector(plan);
+  NoiseStretchFinder collector(plan);
   std::vector<double> expected_x;  // the longest stretch's rates, rad/s
   double t = 0.0;
   uint64_t state = 7;
@@ -926,6 +927,74 @@ TEST_F(CertificateTest, ASegmentTheRunNeverVisitedIsAWarningAndFailsCoverage) {
   EXPECT_FALSE(c.verdict->pass);
   EXPECT_EQ(c.verdict->criteria[0].name, "coverage");
   EXPECT_EQ(c.verdict->criteria[0].measured, 1.0);
+}
+
+// In a thermal run every soak has its static dwells: the noise is measured on the stretch nearest
+// 25 degC (data sheets quote it there), not on the first long one (the -40 degC soak), streaming
+// the simulated run sample by sample; the ARW read there is the simulated white noise.
+TEST(NoiseStretchTest, AThermalRunIsMeasuredAtTheSoakNearest25C) {
+  const Plan plan = ReadPlanText(
+      "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+      "  - {id: 1, up: [0, 0, 1]}\n  - {id: 2, up: [0, 0, 1], rate_dps: 50}\n  - {id: 3, up: [1, 0, 0]}\n",
+      "thermal.yaml");
+  SimulationOptions sim;
+  sim.soak_temps_c = {-40.0, 20.0, 29.0, 85.0};  // 29 degC is the nearest 25 (off by 4; 20 by 5)
+  sim.dwell_s = 200.0;
+  sim.gyro_noise_density = 2e-4;  // rad/s/sqrt(Hz)
+  sim.seed = 5;
+  const SensorModel truth = SensorModel::Identity();
+  const auto run = [&](const NoiseStretchOptions& options) {
+    NoiseStretchFinder finder(plan, options);
+    SimulateRun(sim, plan.site, plan.segments, truth,
+                [&](const Sample& raw, const SegmentTruth&) { finder.Add(raw); });
+    return finder.Finish();
+  };
+  StaticStretch stretch = run(NoiseStretchOptions());
+  EXPECT_EQ(stretch.segment, 1);  // of the two equally near and long, the first
+  EXPECT_EQ(stretch.mean_temp_c(), 29.0);
+  EXPECT_NE(stretch.chosen.find("of the 8 static stretches at least 60 s long, the one nearest 25 degC"),
+            std::string::npos)
+      << stretch.chosen;
+  Calibration calibration;
+  calibration.model = truth;
+  const NoiseSection section = GyroNoise(calibration, std::move(stretch));
+  ASSERT_TRUE(section.computed) << section.why_not;
+  EXPECT_EQ(section.temp_c, 29.0);
+  const double arw_true = DegPerSqrtHrFromRadPerSqrtS(sim.gyro_noise_density);
+  constexpr double kArwSigmas = 3.0;  // the fit's own sigma, worst case of three axes
+  ASSERT_EQ(section.axes.size(), 3u);
+  for (const NoiseAxis& axis : section.axes) {
+    ASSERT_TRUE(axis.arw_deg_per_sqrt_hr.resolved) << axis.axis;
+    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr.value, arw_true, kArwSigmas * axis.arw_deg_per_sqrt_hr.sigma)
+        << axis.axis;
+  }
+
+  // A segment the user names: its longest stretch (the first of equally long ones: -40 degC).
+  NoiseStretchOptions named;
+  named.segment = 3;
+  const StaticStretch third = run(named);
+  EXPECT_EQ(third.segment, 3);
+  EXPECT_EQ(third.mean_temp_c(), -40.0);
+  EXPECT_TRUE(third.named);
+  EXPECT_EQ(third.chosen, "segment 3 as named (--noise-segment), its longest of 4 stretches");
+  // A rate segment, or one the plan does not have, is refused naming the plan.
+  named.segment = 2;
+  EXPECT_THROW(NoiseStretchFinder(plan, named), InputError);
+  named.segment = 9;
+  try {
+    NoiseStretchFinder finder(plan, named);
+    ADD_FAILURE() << "segment 9 accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "thermal.yaml: noise_segment: the plan has no segment 9 (--noise-segment)");
+  }
+  // The option is one entry of the fit's table: the command line and the Python keyword follow.
+  const OptionEntry<FitRunOptions>* entry = FitRunOptionTable().Find("noise_segment");
+  ASSERT_NE(entry, nullptr);
+  EXPECT_EQ(entry->flag, "--noise-segment");
+  FitRunOptions options;
+  EXPECT_EQ(options.Describe().find("noise_segment"), std::string::npos);  // not set: fingerprint unchanged
+  options.noise_stretch.segment = 3;
+  EXPECT_NE(options.Describe().find("noise_segment=3"), std::string::npos);
 }
 
 }  // namespace

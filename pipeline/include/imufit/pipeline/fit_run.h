@@ -53,9 +53,11 @@ struct FitRunOptions {
   // is computed while they are read) so that a certificate can tell that a calibration and a run
   // belong together; computed when empty.
   std::string plan_sha256;
-  // Keep the run's longest static stretch (result.run.static_stretch) for a certificate's noise
-  // section; changes nothing else.
+  // Keep the run's noise stretch (result.run.static_stretch) for a certificate's noise section;
+  // changes nothing else.
   bool keep_static_stretch = false;
+  // Which static stretch that is (static_stretch.h; --noise-segment).
+  NoiseStretchOptions noise_stretch;
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
