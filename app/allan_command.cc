@@ -396,7 +396,7 @@ CommandRunner AddAllanCommand(CLI::App* root) {
                       "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
   command->add_option("--plot-units", args->plot_units,
                       "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
-                      "corrected file), rad/s, deg/s or deg/h");
+                      "corrected file), rad/s, deg/s or deg/h (then accelerometer panels in micro-g)");
   CLI::Option* scale = command->add_option(
       "--scale", args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "

@@ -997,5 +997,95 @@ TEST(NoiseStretchTest, AThermalRunIsMeasuredAtTheSoakNearest25C) {
   EXPECT_NE(options.Describe().find("noise_segment=3"), std::string::npos);
 }
 
+// A noise term the run does not resolve is given by what was estimated, its interval (estimate -+ 2
+// sigma, clipped at 0) and the figure to quote (the upper bound, "at most"), never as "< 2 sigma";
+// a resolved one as value +- sigma. The same words on the certificate's table and in imufit allan.
+TEST(NoiseFigureTest, AnUnresolvedTermIsItsEstimateIntervalAndAtMost) {
+  NoiseFitSummary fit;
+  fit.fitted = true;
+  fit.value[kBiasInstability] = 2.88 / DphFromRadps(1.0);  // rad/s
+  fit.sigma[kBiasInstability] = 2.0 / DphFromRadps(1.0);
+  fit.variance[kBiasInstability] = 1.0;  // within 2 of its 1.0 sigma: not resolved
+  fit.variance_sigma[kBiasInstability] = 1.0;
+  fit.value[kRandomWalk] = 0.3 / DegPerSqrtHrFromRadPerSqrtS(1.0);
+  fit.sigma[kRandomWalk] = 0.012 / DegPerSqrtHrFromRadPerSqrtS(1.0);
+  fit.variance[kRandomWalk] = 9.0;
+  fit.variance_sigma[kRandomWalk] = 1.0;
+  constexpr double kRounding = 1e-12;  // relative: the unit conversions' round trip
+  const NoiseTermFigure bias = TermFigure(fit, kBiasInstability, DphFromRadps(1.0));
+  EXPECT_FALSE(bias.resolved);
+  EXPECT_NEAR(bias.value, 2.88, kRounding * 2.88);
+  EXPECT_EQ(bias.lower(), 0.0);  // 2.88 - 4 clipped
+  EXPECT_NEAR(bias.upper(), 6.88, kRounding * 6.88);
+  EXPECT_EQ(bias.quoted(), bias.upper());
+  EXPECT_EQ(TermFigureText(bias, "deg/h"),
+            "at most 6.9 deg/h (not resolved: estimate 2.88 deg/h, interval 0 to 6.9 deg/h at 2 sigma)");
+  const NoiseTermFigure arw = TermFigure(fit, kRandomWalk, DegPerSqrtHrFromRadPerSqrtS(1.0));
+  EXPECT_TRUE(arw.resolved);
+  EXPECT_EQ(arw.quoted(), arw.value);
+  EXPECT_NEAR(arw.lower(), 0.276, 1e-12);
+  EXPECT_EQ(TermFigureText(arw, "deg/sqrt(h)"), "0.300 +- 0.012 deg/sqrt(h)");
+  // Large figures keep their digits (no exponent).
+  NoiseTermFigure large;
+  large.value = 1234.0;
+  large.sigma = 5000.0;
+  EXPECT_EQ(TermFigureText(large, ""),
+            "at most 11234 (not resolved: estimate 1234, interval 0 to 11234 at 2 sigma)");
+
+  // On the certificate: the noise figure judged by a limit says the same, and the table's cell.
+  Certificate c;
+  c.noise.computed = true;
+  c.noise.duration_s = 200.0;
+  NoiseAxis axis;
+  axis.axis = "x";
+  axis.fitted = true;
+  axis.arw_deg_per_sqrt_hr = arw;
+  axis.bias_instability_dph = bias;
+  c.noise.axes.push_back(axis);
+  const Figure* figure = FindFigure(MeasuredFigures(c), "gyro_bias_instability_dph.x");
+  ASSERT_NE(figure, nullptr);
+  EXPECT_NE(figure->unresolved.find("at most 6.9 deg/h (not resolved: estimate 2.88 deg/h"),
+            std::string::npos)
+      << figure->unresolved;
+  EXPECT_TRUE(FindFigure(MeasuredFigures(c), "gyro_arw_deg_per_sqrt_hr.x")->unresolved.empty());
+}
+
+// With engineer plot units an accelerometer panel is drawn in micro-g, the unit its bias
+// instability is printed in (the panel's words and the curve agree), not in m/s^2.
+TEST(AllanPlotUnitsTest, AnAccelerometerPanelIsInTheUnitItsFiguresArePrintedIn) {
+  ColumnAnalysis accel;
+  accel.name = "accel_z";
+  accel.kind = ColumnKind::kAccel;
+  accel.curve.estimator = AllanEstimator::kOadev;
+  accel.fit.fitted = true;
+  accel.fit.value[kRandomWalk] = 6e-4;  // m/s/sqrt(s)
+  accel.fit.sigma[kRandomWalk] = 6e-6;
+  accel.fit.variance[kRandomWalk] = 3.6e-7;
+  accel.fit.variance_sigma[kRandomWalk] = 1e-9;
+  for (int64_t m = 1; m <= 1024; m *= 2) {
+    AllanPoint p;
+    p.m = m;
+    p.tau_s = 0.01 * m;
+    p.dev = accel.fit.ModelDeviation(p.tau_s);
+    p.dev_lo = 0.9 * p.dev;
+    p.dev_hi = 1.1 * p.dev;
+    accel.curve.points.push_back(p);
+  }
+  accel.allan = accel.curve;
+  constexpr double kRelative = 1e-12;  // the same product in another order
+  const double ug_per_mps2 = 1e6 / kStandardGravityMps2;
+  const PlotFigure figure = AllanPlot({accel}, "", AllanPlotUnits::kDegPerHour);
+  ASSERT_EQ(figure.panels.size(), 1u);
+  const Plot& plot = figure.panels[0];
+  EXPECT_EQ(plot.y_label, "overlapping Allan deviation (\xc2\xb5g)");
+  ASSERT_FALSE(plot.series.empty());
+  EXPECT_NEAR(plot.series[0].y[0], accel.curve.points[0].dev * ug_per_mps2, kRelative * plot.series[0].y[0]);
+  // Native units keep the column's own.
+  const PlotFigure native = AllanPlot({accel}, "");
+  EXPECT_EQ(native.panels[0].y_label, "overlapping Allan deviation (m/s\xc2\xb2)");
+  EXPECT_NEAR(native.panels[0].series[0].y[0], accel.curve.points[0].dev,
+              kRelative * accel.curve.points[0].dev);
+}
+
 }  // namespace
 }  // namespace imufit
