@@ -137,8 +137,6 @@ TEST_F(CertificateLotTest, EveryVerdictItsReasonTheRuleAndTheBudgetOnStructsAndP
   options.output_dir = Path("out");
   options.limits_path = limits_path;
   options.shared_plan = kFixtures + "/plan_6pos.yaml";
-  options.fit.fit.gyro_temp_order = 1;
-  options.fit.fit.accel_temp_order = 1;
   const std::string pdf_problem = PdfProblem();
   options.write_pdf = pdf_problem.empty();
   const BatchResult batch = RunBatch(options);
