@@ -152,9 +152,9 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
     if (r.kind != ColumnKind::kOther) {
       const bool gyro = r.kind == ColumnKind::kGyro;
       std::printf("  Kalibr: %s_noise_density %s %s/sqrt(Hz), %s_random_walk %s %s/sqrt(Hz)\n",
-                  gyro ? "gyroscope" : "accelerometer", Number(fit.value[kRandomWalk]).c_str(),
+                  gyro ? "gyroscope" : "accelerometer", Number(TermFigure(fit, kRandomWalk).quoted()).c_str(),
                   gyro ? "rad/s" : "m/s^2", gyro ? "gyroscope" : "accelerometer",
-                  Number(fit.value[kRateRandomWalk]).c_str(), gyro ? "rad/s^2" : "m/s^3");
+                  Number(TermFigure(fit, kRateRandomWalk).quoted()).c_str(), gyro ? "rad/s^2" : "m/s^3");
     }
   }
 }

@@ -19,10 +19,15 @@ bool IsResolved(const NoiseFitSummary& fit, int term) {
 
 namespace {
 
-// `value` to `digits` significant digits, without an exponent (1234 -> "1234" at 2 digits, 0.0123
-// -> "0.012").
+// `value` to `digits` significant digits, without an exponent from 0.001 up (1234 -> "1234" at 2
+// digits, 0.0123 -> "0.012"), with one below (9.1e-07).
 std::string Significant(double value, int digits) {
   if (value == 0.0 || !std::isfinite(value)) return value == 0.0 ? "0" : std::to_string(value);
+  if (std::abs(value) < 1e-3) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*e", digits - 1, value);
+    return text;
+  }
   const int decimals = std::max(0, digits - 1 - static_cast<int>(std::floor(std::log10(std::abs(value)))));
   char text[64];
   std::snprintf(text, sizeof text, "%.*f", decimals, value);
