@@ -198,6 +198,7 @@ TEST_F(CertificateLotTest, EveryVerdictItsReasonTheRuleAndTheBudgetOnStructsAndP
   EXPECT_EQ(lot.passed, 1);
   EXPECT_EQ(lot.failed, 3);
   EXPECT_EQ(lot.conditional, 1);
+  EXPECT_EQ(lot.decision_rule, certificates[0].verdict->RuleText());
   ASSERT_EQ(lot.rows.size(), 4u);
   for (size_t u = 1; u < 4; ++u) EXPECT_FALSE(lot.rows[u].message.empty()) << lot.rows[u].unit;
   EXPECT_NE(lot.rows[3].message.find("not resolved"), std::string::npos) << lot.rows[3].message;
@@ -209,6 +210,7 @@ TEST_F(CertificateLotTest, EveryVerdictItsReasonTheRuleAndTheBudgetOnStructsAndP
     EXPECT_NE(html.find("Uncertainty budget"), std::string::npos) << unit.unit;
   }
   EXPECT_NE(ReadBytes(Path("out/unit-c/report.html")).find(OutcomeName(on_limit.outcome)), std::string::npos);
+  EXPECT_NE(ReadBytes(Path("out/lot.html")).find("guarded acceptance"), std::string::npos);
   // A noise term the run does not resolve is given as "at most" its upper bound.
   EXPECT_NE(ReadBytes(Path("out/unit-a/report.html")).find("data-at-most"), std::string::npos);
 
