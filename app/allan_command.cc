@@ -130,13 +130,12 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
       const bool engineer = *units.engineer_key != '\0';
       const double scale = engineer ? units.engineer_per_si : 1.0;
       const char* unit = engineer ? units.engineer_unit : units.si_unit;
-      const bool resolved = IsResolved(fit, k);
-      if (resolved) {
-        std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(fit.value[k] * scale).c_str(),
-                    Number(fit.sigma[k] * scale, 2).c_str(), unit);
-      } else {
-        std::printf("  %-26s %10s (< %s %s)", units.label, "not resolved",
-                    Number(2.0 * fit.sigma[k] * scale, 2).c_str(), unit);
+      const NoiseTermFigure figure = TermFigure(fit, k, scale);
+      if (figure.resolved) {
+        std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(figure.value).c_str(),
+                    Number(figure.sigma, 2).c_str(), unit);
+      } else {  // its estimate, interval and the figure to quote (column_analysis.h)
+        std::printf("  %-26s %s", units.label, TermFigureText(figure, unit).c_str());
       }
       double readout = std::nan("");
       std::string where;
@@ -153,9 +152,9 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
     if (r.kind != ColumnKind::kOther) {
       const bool gyro = r.kind == ColumnKind::kGyro;
       std::printf("  Kalibr: %s_noise_density %s %s/sqrt(Hz), %s_random_walk %s %s/sqrt(Hz)\n",
-                  gyro ? "gyroscope" : "accelerometer", Number(fit.value[kRandomWalk]).c_str(),
+                  gyro ? "gyroscope" : "accelerometer", Number(TermFigure(fit, kRandomWalk).quoted()).c_str(),
                   gyro ? "rad/s" : "m/s^2", gyro ? "gyroscope" : "accelerometer",
-                  Number(fit.value[kRateRandomWalk]).c_str(), gyro ? "rad/s^2" : "m/s^3");
+                  Number(TermFigure(fit, kRateRandomWalk).quoted()).c_str(), gyro ? "rad/s^2" : "m/s^3");
     }
   }
 }
@@ -397,7 +396,7 @@ CommandRunner AddAllanCommand(CLI::App* root) {
                       "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
   command->add_option("--plot-units", args->plot_units,
                       "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
-                      "corrected file), rad/s, deg/s or deg/h");
+                      "corrected file), rad/s, deg/s or deg/h (then accelerometer panels in micro-g)");
   CLI::Option* scale = command->add_option(
       "--scale", args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "

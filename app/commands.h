@@ -55,14 +55,20 @@ void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
 struct RunReadingArguments {
   CliOptions<WindowOptions> windows;
   SamplesInputArguments input;
+  CliOptions<NoiseStretchOptions> noise_stretch;  // the certificate's noise stretch (--noise-segment)
+  NoiseStretchOptions NoiseStretch() const {
+    NoiseStretchOptions options;
+    noise_stretch.Apply(&options);
+    return options;
+  }
   WindowOptions Windows() const {
     WindowOptions options;
     windows.Apply(&options);
     return options;
   }
 };
-// The options of WindowOptionTable() (--trim, --window-temp-span, ...), --temp-c and the
-// segmentation options (report: run_options.cc).
+// The options of WindowOptionTable() (--trim, --window-temp-span, ...), --temp-c, the
+// segmentation options and --noise-segment (report: run_options.cc).
 void AddRunReadingOptions(CLI::App* command, RunReadingArguments* args);
 
 // The options of a unit's fit, FitRunOptionTable(), defined once for `imufit fit` and `imufit

@@ -84,7 +84,8 @@ int RunReport(const ReportArguments& args) {
   // Read once for the windows, the hash and the noise section's static stretch.
   RunReader reader(sources.plan, args.samples, input);
   sources.header = reader.run_header();  // where the calibration's record does not say it
-  sources.run = reader.Read(windows, /*keep_static_stretch=*/true);
+  sources.noise_stretch = args.run.NoiseStretch();
+  sources.run = reader.Read(windows, sources.noise_stretch);
   sources.windows = windows;
   sources.inputs = {{"calibration", args.calibration, ""},
                     {"plan", args.plan, ""},

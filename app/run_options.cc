@@ -10,6 +10,7 @@ void AddRunReadingOptions(CLI::App* command, RunReadingArguments* args) {
   args->windows.Add(command, WindowOptionTable());
   AddTempOption(command, &args->input);
   AddSegmentationOptions(command, &args->input);
+  args->noise_stretch.Add(command, NoiseStretchOptionTable());
 }
 
 void AddFitRunOptions(CLI::App* command, FitRunArguments* args, const std::set<std::string>& except) {

@@ -189,10 +189,10 @@ TEST_P(CertifyTest, TheStretchHandedOnIsTheOneInTheFile) {
   EXPECT_EQ(handed_on.noise.temp_c, read_again.noise.temp_c);
   ASSERT_EQ(handed_on.noise.axes.size(), read_again.noise.axes.size());
   for (size_t axis = 0; axis < handed_on.noise.axes.size(); ++axis) {
-    EXPECT_EQ(handed_on.noise.axes[axis].arw_deg_per_sqrt_hr,
-              read_again.noise.axes[axis].arw_deg_per_sqrt_hr);
-    EXPECT_EQ(handed_on.noise.axes[axis].bias_instability_dph,
-              read_again.noise.axes[axis].bias_instability_dph);
+    EXPECT_EQ(handed_on.noise.axes[axis].arw_deg_per_sqrt_hr.value,
+              read_again.noise.axes[axis].arw_deg_per_sqrt_hr.value);
+    EXPECT_EQ(handed_on.noise.axes[axis].bias_instability_dph.value,
+              read_again.noise.axes[axis].bias_instability_dph.value);
   }
 }
 

@@ -1334,5 +1334,26 @@ TEST_F(FactoryCliTest, TheCertificateNamesTheRunTheItemAndTheLaboratory) {
   ExpectTroubleshootingQuotes(r.err);
 }
 
+// --noise-segment names the certificate's noise stretch: one the plan lacks, or a rate segment, is
+// exit 2 naming the plan, before anything is written; a static one is measured and said so.
+TEST_F(FactoryCliTest, NoiseSegmentNamesAStaticSegmentOfThePlan) {
+  const std::string plan = Write("plan.yaml", ReadBytes(kFixtures + "/plan_6pos.yaml"));
+  const std::string samples = Path("units/unit-01/samples.csv.gz");
+  for (const char* id : {"99", "7"}) {
+    const RunResult r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("noise.yaml"), "--report",
+                             Path("noise.html"), "--noise-segment", id, "-q"});
+    EXPECT_EQ(r.status, kExitBadInput) << r.err;
+    EXPECT_FALSE(fs::exists(Path("noise.yaml")));
+    EXPECT_NE(r.err.find("noise_segment: "), std::string::npos) << r.err;
+    ExpectTroubleshootingQuotes(r.err);
+  }
+  const RunResult r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("noise.yaml"), "--report",
+                           Path("noise.html"), "--noise-segment", "3", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The lot's runs dwell 3 s: too short for the Allan deviation, and the page says which it measured.
+  EXPECT_NE(ReadBytes(Path("noise.html")).find("the static stretch of segment 3 (--noise-segment) is"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace imufit

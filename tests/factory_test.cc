@@ -799,24 +799,25 @@ TEST_F(CertificateTest, TheNoiseSectionIsDrawnByTheAllanPlotModule) {
   constexpr double kArwRelative = 0.15;  // 70 s at 20 Hz fixes the white noise to a few percent
   for (size_t a = 0; a < 3; ++a) {
     const NoiseAxis& axis = c.noise.axes[a];
-    ASSERT_TRUE(axis.arw_resolved) << axis.axis;
-    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr, 0.299, kArwRelative * 0.299) << axis.axis;
-    const std::string words = "gyro_" + axis.axis + " ARW " + FormatNumber("%.3g", axis.arw_deg_per_sqrt_hr);
+    ASSERT_TRUE(axis.arw_deg_per_sqrt_hr.resolved) << axis.axis;
+    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr.value, 0.299, kArwRelative * 0.299) << axis.axis;
+    const std::string words =
+        "gyro_" + axis.axis + " ARW " + FormatNumber("%.3g", axis.arw_deg_per_sqrt_hr.value);
     bool marked = false;
     for (const PlotNote& n : panel.notes) marked = marked || n.text.rfind(words, 0) == 0;
     EXPECT_TRUE(marked) << words;
   }
 }
 
-// The noise section streams the run: the longest static stretch (the first of equally long ones;
+// The noise section streams the run: the stretch nearest 25 degC (of equally near ones the longer;
 // a transition or a rate segment ends a stretch) is analysed exactly as `imufit allan` analyses the
 // same rates held at once, and the section is the caller's to measure: MakeCertificate() takes it.
-TEST_F(CertificateTest, TheNoiseSectionStreamsTheLongestStaticStretch) {
+TEST_F(CertificateTest, TheNoiseSectionStreamsTheStretchNearest25C) {
   const Plan plan = ReadPlan(kFixtures + "/plan_6pos.yaml");  // 1..6 static, 7.. rates
   Calibration calibration;
   calibration.model = SensorModel::Identity();
   calibration.model.gyro[kScaleCoefficient * kPolynomialTerms] = 2.0;  // raw x = 2 * rate
-  LongestStaticStretch collector(plan);
+  NoiseStretchFinder collector(plan);
   std::vector<double> expected_x;  // the longest stretch's rates, rad/s
   double t = 0.0;
   uint64_t state = 7;
@@ -951,6 +952,164 @@ TEST_F(CertificateTest, TheSettingsNameThePlansLimitingCoefficient) {
   const std::string html = CertificateHtml(c);
   EXPECT_NE(html.find("limiting coefficient"), std::string::npos);
   EXPECT_NE(html.find(LimitingPredictionText(p)), std::string::npos);
+}
+
+// In a thermal run every soak has its static dwells: the noise is measured on the stretch nearest
+// 25 degC (data sheets quote it there), not on the first long one (the -40 degC soak), streaming
+// the simulated run sample by sample; the ARW read there is the simulated white noise.
+TEST(NoiseStretchTest, AThermalRunIsMeasuredAtTheSoakNearest25C) {
+  const Plan plan = ReadPlanText(
+      "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n"
+      "  - {id: 1, up: [0, 0, 1]}\n  - {id: 2, up: [0, 0, 1], rate_dps: 50}\n  - {id: 3, up: [1, 0, 0]}\n",
+      "thermal.yaml");
+  SimulationOptions sim;
+  sim.soak_temps_c = {-40.0, 20.0, 29.0, 85.0};  // 29 degC is the nearest 25 (off by 4; 20 by 5)
+  sim.dwell_s = 200.0;
+  sim.gyro_noise_density = 2e-4;  // rad/s/sqrt(Hz)
+  sim.seed = 5;
+  const SensorModel truth = SensorModel::Identity();
+  const auto run = [&](const NoiseStretchOptions& options) {
+    NoiseStretchFinder finder(plan, options);
+    SimulateRun(sim, plan.site, plan.segments, truth,
+                [&](const Sample& raw, const SegmentTruth&) { finder.Add(raw); });
+    return finder.Finish();
+  };
+  StaticStretch stretch = run(NoiseStretchOptions());
+  EXPECT_EQ(stretch.segment, 1);  // of the two equally near and long, the first
+  EXPECT_EQ(stretch.mean_temp_c(), 29.0);
+  EXPECT_NE(stretch.chosen.find("of the 8 static stretches at least 60 s long, the one nearest 25 degC"),
+            std::string::npos)
+      << stretch.chosen;
+  Calibration calibration;
+  calibration.model = truth;
+  const NoiseSection section = GyroNoise(calibration, std::move(stretch));
+  ASSERT_TRUE(section.computed) << section.why_not;
+  EXPECT_EQ(section.temp_c, 29.0);
+  const double arw_true = DegPerSqrtHrFromRadPerSqrtS(sim.gyro_noise_density);
+  constexpr double kArwSigmas = 3.0;  // the fit's own sigma, worst case of three axes
+  ASSERT_EQ(section.axes.size(), 3u);
+  for (const NoiseAxis& axis : section.axes) {
+    ASSERT_TRUE(axis.arw_deg_per_sqrt_hr.resolved) << axis.axis;
+    EXPECT_NEAR(axis.arw_deg_per_sqrt_hr.value, arw_true, kArwSigmas * axis.arw_deg_per_sqrt_hr.sigma)
+        << axis.axis;
+  }
+
+  // A segment the user names: its longest stretch (the first of equally long ones: -40 degC).
+  NoiseStretchOptions named;
+  named.segment = 3;
+  const StaticStretch third = run(named);
+  EXPECT_EQ(third.segment, 3);
+  EXPECT_EQ(third.mean_temp_c(), -40.0);
+  EXPECT_TRUE(third.named);
+  EXPECT_EQ(third.chosen, "segment 3 as named (--noise-segment), its longest of 4 stretches");
+  // A rate segment, or one the plan does not have, is refused naming the plan.
+  named.segment = 2;
+  EXPECT_THROW(NoiseStretchFinder(plan, named), InputError);
+  named.segment = 9;
+  try {
+    NoiseStretchFinder finder(plan, named);
+    ADD_FAILURE() << "segment 9 accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "thermal.yaml: noise_segment: the plan has no segment 9 (--noise-segment)");
+  }
+  // The option is one entry of the fit's table: the command line and the Python keyword follow.
+  const OptionEntry<FitRunOptions>* entry = FitRunOptionTable().Find("noise_segment");
+  ASSERT_NE(entry, nullptr);
+  EXPECT_EQ(entry->flag, "--noise-segment");
+  FitRunOptions options;
+  EXPECT_EQ(options.Describe().find("noise_segment"), std::string::npos);  // not set: fingerprint unchanged
+  options.noise_stretch.segment = 3;
+  EXPECT_NE(options.Describe().find("noise_segment=3"), std::string::npos);
+}
+
+// A noise term the run does not resolve is given by what was estimated, its interval (estimate -+ 2
+// sigma, clipped at 0) and the figure to quote (the upper bound, "at most"), never as "< 2 sigma";
+// a resolved one as value +- sigma. The same words on the certificate's table and in imufit allan.
+TEST(NoiseFigureTest, AnUnresolvedTermIsItsEstimateIntervalAndAtMost) {
+  NoiseFitSummary fit;
+  fit.fitted = true;
+  fit.value[kBiasInstability] = 2.88 / DphFromRadps(1.0);  // rad/s
+  fit.sigma[kBiasInstability] = 2.0 / DphFromRadps(1.0);
+  fit.variance[kBiasInstability] = 1.0;  // within 2 of its 1.0 sigma: not resolved
+  fit.variance_sigma[kBiasInstability] = 1.0;
+  fit.value[kRandomWalk] = 0.3 / DegPerSqrtHrFromRadPerSqrtS(1.0);
+  fit.sigma[kRandomWalk] = 0.012 / DegPerSqrtHrFromRadPerSqrtS(1.0);
+  fit.variance[kRandomWalk] = 9.0;
+  fit.variance_sigma[kRandomWalk] = 1.0;
+  constexpr double kRounding = 1e-12;  // relative: the unit conversions' round trip
+  const NoiseTermFigure bias = TermFigure(fit, kBiasInstability, DphFromRadps(1.0));
+  EXPECT_FALSE(bias.resolved);
+  EXPECT_NEAR(bias.value, 2.88, kRounding * 2.88);
+  EXPECT_EQ(bias.lower(), 0.0);  // 2.88 - 4 clipped
+  EXPECT_NEAR(bias.upper(), 6.88, kRounding * 6.88);
+  EXPECT_EQ(bias.quoted(), bias.upper());
+  EXPECT_EQ(TermFigureText(bias, "deg/h"),
+            "at most 6.9 deg/h (not resolved: estimate 2.88 deg/h, interval 0 to 6.9 deg/h at 2 sigma)");
+  const NoiseTermFigure arw = TermFigure(fit, kRandomWalk, DegPerSqrtHrFromRadPerSqrtS(1.0));
+  EXPECT_TRUE(arw.resolved);
+  EXPECT_EQ(arw.quoted(), arw.value);
+  EXPECT_NEAR(arw.lower(), 0.276, 1e-12);
+  EXPECT_EQ(TermFigureText(arw, "deg/sqrt(h)"), "0.300 +- 0.012 deg/sqrt(h)");
+  // Large figures keep their digits (no exponent).
+  NoiseTermFigure large;
+  large.value = 1234.0;
+  large.sigma = 5000.0;
+  EXPECT_EQ(TermFigureText(large, ""),
+            "at most 11234 (not resolved: estimate 1234, interval 0 to 11234 at 2 sigma)");
+
+  // On the certificate: the noise figure judged by a limit says the same, and the table's cell.
+  Certificate c;
+  c.noise.computed = true;
+  c.noise.duration_s = 200.0;
+  NoiseAxis axis;
+  axis.axis = "x";
+  axis.fitted = true;
+  axis.arw_deg_per_sqrt_hr = arw;
+  axis.bias_instability_dph = bias;
+  c.noise.axes.push_back(axis);
+  const Figure* figure = FindFigure(MeasuredFigures(c), "gyro_bias_instability_dph.x");
+  ASSERT_NE(figure, nullptr);
+  EXPECT_NE(figure->unresolved.find("at most 6.9 deg/h (not resolved: estimate 2.88 deg/h"),
+            std::string::npos)
+      << figure->unresolved;
+  EXPECT_TRUE(FindFigure(MeasuredFigures(c), "gyro_arw_deg_per_sqrt_hr.x")->unresolved.empty());
+}
+
+// With engineer plot units an accelerometer panel is drawn in micro-g, the unit its bias
+// instability is printed in (the panel's words and the curve agree), not in m/s^2.
+TEST(AllanPlotUnitsTest, AnAccelerometerPanelIsInTheUnitItsFiguresArePrintedIn) {
+  ColumnAnalysis accel;
+  accel.name = "accel_z";
+  accel.kind = ColumnKind::kAccel;
+  accel.curve.estimator = AllanEstimator::kOadev;
+  accel.fit.fitted = true;
+  accel.fit.value[kRandomWalk] = 6e-4;  // m/s/sqrt(s)
+  accel.fit.sigma[kRandomWalk] = 6e-6;
+  accel.fit.variance[kRandomWalk] = 3.6e-7;
+  accel.fit.variance_sigma[kRandomWalk] = 1e-9;
+  for (int64_t m = 1; m <= 1024; m *= 2) {
+    AllanPoint p;
+    p.m = m;
+    p.tau_s = 0.01 * m;
+    p.dev = accel.fit.ModelDeviation(p.tau_s);
+    p.dev_lo = 0.9 * p.dev;
+    p.dev_hi = 1.1 * p.dev;
+    accel.curve.points.push_back(p);
+  }
+  accel.allan = accel.curve;
+  constexpr double kRelative = 1e-12;  // the same product in another order
+  const double ug_per_mps2 = 1e6 / kStandardGravityMps2;
+  const PlotFigure figure = AllanPlot({accel}, "", AllanPlotUnits::kDegPerHour);
+  ASSERT_EQ(figure.panels.size(), 1u);
+  const Plot& plot = figure.panels[0];
+  EXPECT_EQ(plot.y_label, "overlapping Allan deviation (\xc2\xb5g)");
+  ASSERT_FALSE(plot.series.empty());
+  EXPECT_NEAR(plot.series[0].y[0], accel.curve.points[0].dev * ug_per_mps2, kRelative * plot.series[0].y[0]);
+  // Native units keep the column's own.
+  const PlotFigure native = AllanPlot({accel}, "");
+  EXPECT_EQ(native.panels[0].y_label, "overlapping Allan deviation (m/s\xc2\xb2)");
+  EXPECT_NEAR(native.panels[0].series[0].y[0], accel.curve.points[0].dev,
+              kRelative * accel.curve.points[0].dev);
 }
 
 }  // namespace

@@ -28,6 +28,7 @@ const std::map<std::string, std::string> kOtherTexts = {
     {"time_unit", "ms"},
     {"delimiter", ";"},
     {"column", "time_s=Zeit"},
+    {"noise_segment", "4"},
 };
 
 // Changes the option of `entry` in `options` to another valid value.

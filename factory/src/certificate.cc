@@ -248,7 +248,7 @@ void ReadCertificateFiles(CertificateSources* sources) {
   for (const ReportInput& input : inputs) {
     if (input.role != "samples" || input.path.empty()) continue;
     sources->noise = MeasureGyroNoise(sources->calibration, sources->plan, input.path, sources->samples_input,
-                                      sources->run.segmentation);
+                                      sources->run.segmentation, sources->noise_stretch);
   }
 }
 
@@ -302,6 +302,17 @@ std::string CertificateNumber(const std::string& serial, const std::string& date
 
 namespace {
 
+// A figure the certificate measures (not the calibration's): no sigma unless set.
+Figure MeasuredFigure(const std::string& name, const std::string& coefficient, const std::string& unit,
+                      double value = 0.0) {
+  Figure figure;
+  figure.name = name;
+  figure.coefficient = coefficient;
+  figure.unit = unit;
+  figure.value = value;
+  return figure;
+}
+
 // Why this run does not resolve a noise term, and how to supply it (Figure::unresolved).
 std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, bool arw) {
   const double needed_s = arw ? kMinAllanStretchS : kBiasInstabilityStretchS;
@@ -310,8 +321,12 @@ std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, bool ar
   if (!noise.computed) {
     text += "; " + noise.why_not + ")";
   } else {
-    text += "; its longest is " + FormatNumber("%.0f", noise.duration_s) + " s";
+    text += "; the stretch measured is " + FormatNumber("%.0f", noise.duration_s) + " s";
     if (axis != nullptr && !axis->why_not.empty()) text += ", " + axis->why_not;
+    if (axis != nullptr && axis->fitted) {
+      text += "; " + TermFigureText(arw ? axis->arw_deg_per_sqrt_hr : axis->bias_instability_dph,
+                                    arw ? "deg/sqrt(h)" : "deg/h");
+    }
     text += ")";
   }
   return text +
@@ -330,30 +345,33 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
       if (axis.axis == axis_name) a = &axis;
     }
     const std::string axis = axis_name;
-    Figure arw{"gyro_arw_deg_per_sqrt_hr." + axis, "certificate.gyro_" + axis + ".arw", "deg/sqrt(h)"};
-    Figure instability{"gyro_bias_instability_dph." + axis, "certificate.gyro_" + axis + ".bias_instability",
-                       "deg/h"};
-    if (a != nullptr && a->fitted && a->arw_resolved) {
-      arw.value = a->arw_deg_per_sqrt_hr;
-      arw.sigma = a->arw_sigma;
-    } else {
-      arw.unresolved = Unresolved(noise, a, true);
-    }
-    if (a != nullptr && a->fitted && a->bias_instability_resolved) {
-      instability.value = a->bias_instability_dph;
-      instability.sigma = a->bias_instability_sigma;
-    } else {
-      instability.unresolved = Unresolved(noise, a, false);
-    }
-    figures.push_back(arw);
-    figures.push_back(instability);
+    const auto noise_figure = [&](bool arw) {
+      Figure f = MeasuredFigure(
+          arw ? "gyro_arw_deg_per_sqrt_hr." + axis : "gyro_bias_instability_dph." + axis,
+          "certificate.gyro_" + axis + (arw ? ".arw" : ".bias_instability"), arw ? "deg/sqrt(h)" : "deg/h");
+      const NoiseTermFigure* term = a == nullptr || !a->fitted ? nullptr
+                                    : arw                      ? &a->arw_deg_per_sqrt_hr
+                                                               : &a->bias_instability_dph;
+      if (term != nullptr && term->resolved) {
+        f.value = term->value;
+        f.sigma = term->sigma;
+      } else {
+        f.unresolved = Unresolved(noise, a, arw);
+      }
+      figures.push_back(f);
+    };
+    noise_figure(true);
+    noise_figure(false);
   }
   // The worst window after correction, at any temperature of the run (the per-segment table's "all").
   if (!certificate.residual_table.empty()) {
     const ResidualRow& all = certificate.residual_table.back();
-    figures.push_back({"gyro_residual_max_dps", "certificate.gyro_residual_max", "deg/s", all.gyro_max_dps});
-    if (all.accel_windows > 0)
-      figures.push_back({"accel_residual_max_mg", "certificate.accel_residual_max", "mg", all.accel_max_mg});
+    figures.push_back(
+        MeasuredFigure("gyro_residual_max_dps", "certificate.gyro_residual_max", "deg/s", all.gyro_max_dps));
+    if (all.accel_windows > 0) {
+      figures.push_back(
+          MeasuredFigure("accel_residual_max_mg", "certificate.accel_residual_max", "mg", all.accel_max_mg));
+    }
   }
   return figures;
 }

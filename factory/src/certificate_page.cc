@@ -468,33 +468,41 @@ void ResidualTable(Html* h, const Certificate& c) {
   h->Element("p", note, {{"class", "note"}});
 }
 
-// A noise figure's cell: "value ± sigma", or "not resolved".
-void NoiseFigure(Html* h, const std::string& figure, bool resolved, double value, double sigma) {
-  if (!resolved) {
-    Num(h, "not resolved", {{"data-figure", figure}, {"data-value", "nan"}});
-    return;
-  }
-  Num(h, Fmt("%.3g", value) + " \xc2\xb1 " + Fmt("%.2g", sigma),
-      {{"data-figure", figure}, {"data-value", FormatDouble(value)}});
+// A noise figure's cell: "value ± sigma", or an unresolved term's upper bound with its estimate and
+// interval (TermFigureText).
+void NoiseFigure(Html* h, const std::string& figure, const NoiseTermFigure& term) {
+  HtmlAttributes attributes = {{"data-figure", figure},
+                               {"data-value", term.resolved ? FormatDouble(term.value) : "nan"}};
+  if (!term.resolved) attributes.push_back({"data-at-most", FormatDouble(term.upper())});
+  Num(h, TermFigureText(term, "", "\xc2\xb1"), attributes);
 }
 
 void NoiseTable(Html* h, const NoiseSection& noise) {
   h->Open("table").Open("thead");
   Row(h, {"axis", "ARW, deg/sqrt(h)", "bias instability, deg/h", "taus fitted"}, "th");
   h->Close("thead").Open("tbody");
+  bool unresolved = false;
   for (const NoiseAxis& a : noise.axes) {
     h->Open("tr").Element("td", "gyro_" + a.axis);
     if (!a.fitted) {
       h->Element("td", "not fitted: " + a.why_not, {{"colspan", "3"}}).Close("tr");
       continue;
     }
-    NoiseFigure(h, "gyro_arw_deg_per_sqrt_hr." + a.axis, a.arw_resolved, a.arw_deg_per_sqrt_hr, a.arw_sigma);
-    NoiseFigure(h, "gyro_bias_instability_dph." + a.axis, a.bias_instability_resolved, a.bias_instability_dph,
-                a.bias_instability_sigma);
+    NoiseFigure(h, "gyro_arw_deg_per_sqrt_hr." + a.axis, a.arw_deg_per_sqrt_hr);
+    NoiseFigure(h, "gyro_bias_instability_dph." + a.axis, a.bias_instability_dph);
+    unresolved = unresolved || !a.arw_deg_per_sqrt_hr.resolved || !a.bias_instability_dph.resolved;
     Num(h, Count(a.points));
     h->Close("tr");
   }
   h->Close("tbody").Close("table");
+  if (unresolved) {
+    h->Element(
+        "p",
+        "A term this run does not resolve (its variance coefficient within 2 standard uncertainties of "
+        "0) is given by its estimate and interval, estimate \xc2\xb1 2 sigma with the lower bound "
+        "clipped at 0: on a data sheet quote the upper bound, as \"at most\", not the estimate.",
+        {{"class", "note"}});
+  }
 }
 
 void Validation(Html* h, const Certificate& c) {
@@ -616,15 +624,17 @@ void ErrorPlots(Html* h, const Certificate& c, const CertificateSvgs& svgs) {
 }
 
 void NoisePlot(Html* h, const Certificate& c, const CertificateSvgs& svgs) {
-  h->Open("div", {{"class", "keep"}}).Element("h2", "Gyro noise (Allan deviation, longest static stretch)");
+  h->Open("div", {{"class", "keep"}}).Element("h2", "Gyro noise (Allan deviation of a static stretch)");
   if (!c.noise.computed) {
     h->Element("p", "Not drawn: " + c.noise.why_not + ".", {{"class", "note"}});
   } else {
     h->Element(
         "p",
-        "Segment " + Count(c.noise.segment) + ", " + Fmt("%.0f s", c.noise.duration_s) + " at " +
-            Fmt("%.1f degC", c.noise.temp_c) +
-            ": the raw outputs over the scale factor at that temperature. Bars: 68 % confidence; "
+        "Measured on segment " + Count(c.noise.segment) + ", " + Fmt("%.0f s", c.noise.duration_s) + " at " +
+            Fmt("%.1f degC", c.noise.temp_c) + " (" + c.noise.chosen +
+            "; another: --noise-segment): the raw outputs over the scale factor at that temperature. Bars: "
+            "68 % "
+            "confidence; "
             "lines: the IEEE 952 fit (solid) and its terms (dashed). ARW is read on the -1/2 line at "
             "\xcf\x84 = 1 s (the large dot), bias instability B at the fit's floor 0.664 B (a diamond).",
         {{"class", "note"}});

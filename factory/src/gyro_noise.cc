@@ -18,12 +18,8 @@ NoiseAxis AxisFigures(const char* axis, const NoiseFitSummary& fit) {
   a.why_not = fit.message;
   if (!fit.fitted) return a;
   a.points = fit.points_used;
-  a.arw_deg_per_sqrt_hr = DegPerSqrtHrFromRadPerSqrtS(fit.value[kRandomWalk]);
-  a.arw_sigma = DegPerSqrtHrFromRadPerSqrtS(fit.sigma[kRandomWalk]);
-  a.arw_resolved = IsResolved(fit, kRandomWalk);
-  a.bias_instability_dph = DphFromRadps(fit.value[kBiasInstability]);
-  a.bias_instability_sigma = DphFromRadps(fit.sigma[kBiasInstability]);
-  a.bias_instability_resolved = IsResolved(fit, kBiasInstability);
+  a.arw_deg_per_sqrt_hr = TermFigure(fit, kRandomWalk, DegPerSqrtHrFromRadPerSqrtS(1.0));
+  a.bias_instability_dph = TermFigure(fit, kBiasInstability, DphFromRadps(1.0));
   return a;
 }
 
@@ -33,18 +29,22 @@ NoiseSection GyroNoise(const Calibration& calibration, StaticStretch stretch) {
   const size_t n = static_cast<size_t>(stretch.size());
   NoiseSection section;
   section.duration_s = stretch.duration_s();
+  section.segment = stretch.segment;
+  section.chosen = stretch.chosen;
+  if (n > 0) section.temp_c = stretch.mean_temp_c();
   if (section.duration_s < kMinAllanStretchS) {
-    char text[160];
+    const std::string which = stretch.named ? "the static stretch of segment " +
+                                                  std::to_string(stretch.segment) + " (--noise-segment)"
+                                            : std::string("the longest static stretch");
+    char text[240];
     std::snprintf(text, sizeof text,
-                  "the longest static stretch is %.1f s, and the Allan deviation needs at least "
-                  "%.0f s (imufit allan measures the noise on a long static log)",
-                  section.duration_s, kMinAllanStretchS);
+                  "%s is %.1f s, and the Allan deviation needs at least %.0f s (imufit allan measures the "
+                  "noise on a long static log)",
+                  which.c_str(), section.duration_s, kMinAllanStretchS);
     section.why_not = text;
     return section;
   }
   section.computed = true;
-  section.segment = stretch.segment;
-  section.temp_c = stretch.temp_sum_c / n;
   const double tau0_s = section.duration_s / (n - 1);
   std::vector<int64_t> factors;
   AveragingFactors(TauSpec(), AllanEstimator::kOadev, static_cast<int64_t>(n), tau0_s, &factors);
@@ -67,9 +67,10 @@ NoiseSection GyroNoise(const Calibration& calibration, StaticStretch stretch) {
 
 NoiseSection MeasureGyroNoise(const Calibration& calibration, const Plan& plan,
                               const std::string& samples_path, const SamplesInput& input,
-                              const std::optional<Segmentation>& segmentation) {
+                              const std::optional<Segmentation>& segmentation,
+                              const NoiseStretchOptions& options) {
   try {
-    return GyroNoise(calibration, ReadStaticStretch(plan, samples_path, input, segmentation));
+    return GyroNoise(calibration, ReadStaticStretch(plan, samples_path, input, segmentation, options));
   } catch (const InputError& e) {  // the data, not the program: said in the section
     NoiseSection section;
     section.why_not = e.what();

@@ -117,6 +117,7 @@ void Summary(Html* h, const LotSummary& lot) {
   }
   h->Close("td").Close("tr");
   Row(h, {"acceptance limits", lot.limits_name.empty() ? "none given" : lot.limits_name});
+  if (!lot.decision_rule.empty()) Row(h, {"decision rule", lot.decision_rule});
   Row(h, {"written", lot.written_utc + " by " + lot.software + ", git " + lot.git_revision});
   h->Close("table");
 }

@@ -159,7 +159,4 @@ std::vector<ResidualRow> PrintedResidualRows(const std::vector<ResidualRow>& tab
   return rows;
 }
 
-// The Allan deviation of the gyro over the longest static stretch of the run (raw outputs over the
-// scale factor at the stretch's temperature: rad/s), with the IEEE 952 fit's ARW and bias
-
 }  // namespace imufit::internal

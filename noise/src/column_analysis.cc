@@ -1,5 +1,8 @@
 #include "imufit/noise/column_analysis.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace imufit {
@@ -12,6 +15,44 @@ ColumnKind ColumnKindOf(const std::string& column, const std::string& kind) {
 
 bool IsResolved(const NoiseFitSummary& fit, int term) {
   return fit.fitted && fit.variance[term] > kResolvedSigmas * fit.variance_sigma[term];
+}
+
+namespace {
+
+// `value` to `digits` significant digits, without an exponent from 0.001 up (1234 -> "1234" at 2
+// digits, 0.0123 -> "0.012"), with one below (9.1e-07).
+std::string Significant(double value, int digits) {
+  if (value == 0.0 || !std::isfinite(value)) return value == 0.0 ? "0" : std::to_string(value);
+  if (std::abs(value) < 1e-3) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*e", digits - 1, value);
+    return text;
+  }
+  const int decimals = std::max(0, digits - 1 - static_cast<int>(std::floor(std::log10(std::abs(value)))));
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+}  // namespace
+
+NoiseTermFigure TermFigure(const NoiseFitSummary& fit, int term, double scale) {
+  NoiseTermFigure figure;
+  figure.resolved = IsResolved(fit, term);
+  figure.value = fit.value[term] * scale;
+  figure.sigma = fit.sigma[term] * scale;
+  return figure;
+}
+
+std::string TermFigureText(const NoiseTermFigure& figure, const std::string& unit, const char* plus_minus) {
+  const std::string space_unit = unit.empty() ? "" : " " + unit;
+  if (figure.resolved) {
+    return Significant(figure.value, 3) + " " + plus_minus + " " + Significant(figure.sigma, 2) + space_unit;
+  }
+  const std::string upper = Significant(figure.upper(), 2) + space_unit;
+  return "at most " + upper + " (not resolved: estimate " + Significant(figure.value, 3) + space_unit +
+         ", interval " + Significant(figure.lower(), 2) + " to " + upper + " at " +
+         Significant(kNoiseIntervalSigmas, 1) + " sigma)";
 }
 
 ColumnAnalysis AnalyseColumn(std::string name, ColumnKind kind, std::vector<double> rates, double tau0_s,

@@ -131,7 +131,9 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
   result.serial = std::move(serial.serial);
   result.serial_warnings = std::move(serial.warnings);
   const RunHeader header = samples->run_header();
-  result.run = samples->Read(options.windows, options.keep_static_stretch);
+  result.run = samples->Read(options.windows, options.keep_static_stretch
+                                                  ? std::optional<NoiseStretchOptions>(options.noise_stretch)
+                                                  : std::nullopt);
   CheckBeforeFit(plan_path, samples_path, options, result);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   Plan check_plan;

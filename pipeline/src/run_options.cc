@@ -182,6 +182,7 @@ OptionTable<FitRunOptions> MakeFitRunOptionTable() {
   write_inconsistent.describe = [](const O& o) {
     return o.write_inconsistent ? "write_inconsistent=true" : "";
   };
+  t.Include(NoiseStretchOptionTable(), &O::noise_stretch);
   t.Flag("allow_serial_mismatch", "--allow-mismatch",
          "fit even when the stated serial (--serial, a batch unit's serial.txt) names another unit than the "
          "samples header (a warning, also on the certificate); without it such a unit is refused",

@@ -15,7 +15,7 @@ namespace {
 // not null.
 template <typename Reader>
 void ReadSamples(const Plan& plan, Reader* reader, Labeller* labeller, WindowBuilder* builder,
-                 LongestStaticStretch* stretch) {
+                 NoiseStretchFinder* stretch) {
   std::set<int> ids;
   for (const TableSegment& segment : plan.segments) ids.insert(segment.id);
   Sample sample;
@@ -48,7 +48,7 @@ RunReader::RunReader(const Plan& plan, const SamplesInMemory& samples, const Sam
       memory_(std::in_place, samples, input.seconds_per_time_unit),
       in_memory_(&samples) {}
 
-RunWindows RunReader::ReadMemory(WindowBuilder* builder, LongestStaticStretch* stretch) {
+RunWindows RunReader::ReadMemory(WindowBuilder* builder, NoiseStretchFinder* stretch) {
   RunWindows run;
   std::optional<Labeller> labeller;
   if (!memory_->has_segment()) {
@@ -61,12 +61,13 @@ RunWindows RunReader::ReadMemory(WindowBuilder* builder, LongestStaticStretch* s
   return run;
 }
 
-RunWindows RunReader::Read(const WindowOptions& options, bool keep_static_stretch) {
+RunWindows RunReader::Read(const WindowOptions& options,
+                           const std::optional<NoiseStretchOptions>& noise_stretch) {
   IMUFIT_CHECK(!read_, "RunReader::Read() reads the file once");
   read_ = true;
   WindowBuilder builder(options, plan_.segments);
-  std::optional<LongestStaticStretch> stretch;
-  if (keep_static_stretch) stretch.emplace(plan_);
+  std::optional<NoiseStretchFinder> stretch;
+  if (noise_stretch) stretch.emplace(plan_, *noise_stretch);
   const RunHeader header = run_header();
   RunWindows run;
   try {
@@ -98,7 +99,7 @@ void RunReader::CheckSpan(const WindowOptions& options, double span_s, long long
   if (!problem.empty()) throw InputError(name(), "time_s: " + problem);
 }
 
-RunWindows RunReader::ReadFile(WindowBuilder* builder, LongestStaticStretch* stretch) {
+RunWindows RunReader::ReadFile(WindowBuilder* builder, NoiseStretchFinder* stretch) {
   RunWindows run;
   // Without a segment column the first pass finds the segments and the second labels the samples.
   std::optional<SamplesReader> second_pass;

@@ -209,6 +209,7 @@ class _FitOptions(TypedDict, total=False):
     check_samples: PathLike
     check_plan: PathLike
     write_inconsistent: bool
+    noise_segment: str  # a static plan segment's id: the certificate's noise stretch (default: nearest 25 degC)
     allow_serial_mismatch: bool
 
 def fit(plan: PathLike | Mapping[str, Any], samples: PathLike | Mapping[str, Any], **options: Unpack[_FitOptions]) -> FitResult:

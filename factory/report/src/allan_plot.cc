@@ -62,13 +62,16 @@ const char* LongName(AllanEstimator estimator) {
   return "deviation";
 }
 
-// Plot units per SI unit, and their name, for a panel of `kind`.
+// Plot units per SI unit, and their name, for a panel of `kind`. In engineer units (deg/s, deg/h)
+// an accelerometer panel is in the unit its bias instability is printed in (micro-g).
 double Scale(ColumnKind kind, AllanPlotUnits units) {
-  if (kind != ColumnKind::kGyro || units == AllanPlotUnits::kNative) return 1.0;
+  if (kind == ColumnKind::kOther || units == AllanPlotUnits::kNative) return 1.0;
+  if (kind == ColumnKind::kAccel) return UnitsOf(kind, kBiasInstability).engineer_per_si;
   return units == AllanPlotUnits::kDegPerHour ? DphFromRadps(1.0) : DpsFromRadps(1.0);
 }
 std::string UnitName(ColumnKind kind, AllanPlotUnits units) {
-  if (kind != ColumnKind::kGyro || units == AllanPlotUnits::kNative) return Pretty(SiUnit(kind));
+  if (kind == ColumnKind::kOther || units == AllanPlotUnits::kNative) return Pretty(SiUnit(kind));
+  if (kind == ColumnKind::kAccel) return Pretty(UnitsOf(kind, kBiasInstability).engineer_unit);
   return units == AllanPlotUnits::kDegPerHour ? "\xc2\xb0/h" : "\xc2\xb0/s";
 }
 

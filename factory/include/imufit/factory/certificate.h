@@ -53,10 +53,11 @@ struct CertificateSources {
   // run.segmentation: the labels of a file without a segment column; run.static_stretch: the noise
   // section's samples, kept while the run was read (else ReadCertificateFiles reads the file).
   RunWindows run;
-  WindowOptions windows;            // how the run was cut into windows (trim, ...)
-  SamplesInput samples_input;       // how the samples file is read (--temp-c for a file without temp_c)
-  std::vector<HeldOutGroup> folds;  // empty when validation was not run
-  std::optional<Verdict> verdict;   // judged by the caller; replaced when `limits` is given
+  WindowOptions windows;              // how the run was cut into windows (trim, ...)
+  SamplesInput samples_input;         // how the samples file is read (--temp-c for a file without temp_c)
+  NoiseStretchOptions noise_stretch;  // which static stretch the noise is measured on (--noise-segment)
+  std::vector<HeldOutGroup> folds;    // empty when validation was not run
+  std::optional<Verdict> verdict;     // judged by the caller; replaced when `limits` is given
   // Acceptance limits: judged here, with the ARW and bias instability this certificate measures
   // taking the place of a `noise:` block's.
   std::optional<Limits> limits;

@@ -1,6 +1,6 @@
-// imufit — the certificate's gyro noise: the overlapping Allan deviation of the longest static
-// stretch of a run and its IEEE 952 fit (ARW, bias instability), the analysis `imufit allan` runs
-// on a long static log (noise/column_analysis.h).
+// imufit — the certificate's gyro noise: the overlapping Allan deviation of a static stretch of a
+// run (by default the one nearest 25 degC, pipeline/static_stretch.h) and its IEEE 952 fit (ARW, bias
+// instability), the analysis `imufit allan` runs on a long static log (noise/column_analysis.h).
 //
 // The stretch itself (pipeline/static_stretch.h) is gathered while the run is read into windows, so
 // the samples file is not read again for it; only the three raw gyro outputs of each of its samples
@@ -26,8 +26,6 @@
 
 namespace imufit {
 
-// The Allan section needs a static stretch at least this long, s.
-inline constexpr double kMinAllanStretchS = 60.0;
 // A bias instability is read at the floor of the Allan deviation, which a MEMS gyro reaches at tens
 // to hundreds of seconds: a stretch shorter than this rarely shows it, s.
 inline constexpr double kBiasInstabilityStretchS = 1800.0;
@@ -36,10 +34,10 @@ struct NoiseAxis {
   std::string axis;
   bool fitted = false;
   std::string why_not;
-  double arw_deg_per_sqrt_hr = 0.0, arw_sigma = 0.0;
-  bool arw_resolved = false;
-  double bias_instability_dph = 0.0, bias_instability_sigma = 0.0;
-  bool bias_instability_resolved = false;
+  // The fit's estimates with their intervals, resolved or not (column_analysis.h): ARW in
+  // deg/sqrt(h), bias instability in deg/h.
+  NoiseTermFigure arw_deg_per_sqrt_hr;
+  NoiseTermFigure bias_instability_dph;
   int points = 0;
 };
 
@@ -48,7 +46,8 @@ struct NoiseSection {
   std::string why_not;
   int segment = -1;
   double duration_s = 0.0;
-  double temp_c = 0.0;
+  double temp_c = 0.0;  // the stretch's mean temperature
+  std::string chosen;   // why this stretch (StaticStretch::chosen)
   std::vector<NoiseAxis> axes;
   // Per gyro axis ("gyro_x", ...), in rad/s: the overlapping Allan deviation and its IEEE 952 fit
   // as `imufit allan` computes them, drawn by the same plot (allan_plot.h) in deg/h.
@@ -60,11 +59,12 @@ struct NoiseSection {
 NoiseSection GyroNoise(const Calibration& calibration, StaticStretch stretch);
 
 // Reads `samples_path` as the fit read it (labelled from `segmentation`, or segmented again, when
-// the file has no segment column) for its longest static stretch (ReadStaticStretch). A file that cannot be
-// read or does not match the plan gives a section that says why, not an exception.
+// the file has no segment column) for its noise stretch (ReadStaticStretch). A file that cannot be
+// read or does not match the plan (or the options) gives a section that says why, not an exception.
 NoiseSection MeasureGyroNoise(const Calibration& calibration, const Plan& plan,
                               const std::string& samples_path, const SamplesInput& input,
-                              const std::optional<Segmentation>& segmentation);
+                              const std::optional<Segmentation>& segmentation,
+                              const NoiseStretchOptions& options = NoiseStretchOptions());
 
 }  // namespace imufit
 

@@ -28,6 +28,32 @@ ColumnKind ColumnKindOf(const std::string& column, const std::string& kind);
 inline constexpr double kResolvedSigmas = 2.0;
 bool IsResolved(const NoiseFitSummary& fit, int term);
 
+// A noise term's figure as a data sheet quotes it. The fit estimates `value` with the standard
+// uncertainty `sigma`; its interval is value -+ kNoiseIntervalSigmas sigma, the lower bound clipped
+// at 0 (an amplitude is not negative). A resolved term is quoted as its value (+- sigma); one the
+// data do not resolve as "at most" the interval's upper bound: its estimate is not a measurement,
+// and kResolvedSigmas sigma of the coefficient is not a bound on it.
+inline constexpr double kNoiseIntervalSigmas = 2.0;
+struct NoiseTermFigure {
+  bool resolved = false;
+  double value = 0.0;  // the fit's estimate
+  double sigma = 0.0;  // its standard uncertainty
+
+  double lower() const {
+    return value - kNoiseIntervalSigmas * sigma > 0.0 ? value - kNoiseIntervalSigmas * sigma : 0.0;
+  }
+  double upper() const { return value + kNoiseIntervalSigmas * sigma; }
+  // The figure to quote: the value when resolved, else the upper bound ("at most").
+  double quoted() const { return resolved ? value : upper(); }
+};
+// Term `term` of `fit` in a unit `scale` times the fit's (1 for SI).
+NoiseTermFigure TermFigure(const NoiseFitSummary& fit, int term, double scale = 1.0);
+// The figure in words, `unit` after each number: "0.344 +- 0.012 deg/sqrt(h)" when resolved, else
+// "at most 6.9 deg/h (not resolved: estimate 2.88 deg/h, interval 0 to 6.9 deg/h at 2 sigma)".
+// `plus_minus` writes +-: "+-" for a terminal, "\xc2\xb1" for a page.
+std::string TermFigureText(const NoiseTermFigure& figure, const std::string& unit,
+                           const char* plus_minus = "+-");
+
 struct ColumnAnalysis {
   std::string name;
   ColumnKind kind = ColumnKind::kOther;

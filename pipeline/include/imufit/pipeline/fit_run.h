@@ -5,7 +5,7 @@
 // asked, and builds the calibration to write (with its `sigma` tree and the fit's record, the
 // `fit:` block of io/fit_record.h). It writes nothing. The samples file is read once (twice without
 // a segment column, run_windows.h); what a certificate needs of it (the hash, the segmentation, the
-// longest static stretch) comes with the result, so that nobody reads it again. Bad input throws
+// noise stretch, static_stretch.h) comes with the result, so that nobody reads it again. Bad input throws
 // InputError; a run that does not determine the model, or a fit that does not converge, is reported
 // through `fit.status` (then `calibration` is not set). A samples file without a segment column is
 // labelled from the plan first (segment_run.h); when it does not match the plan, PlanMismatchError
@@ -53,9 +53,11 @@ struct FitRunOptions {
   // is computed while they are read) so that a certificate can tell that a calibration and a run
   // belong together; computed when empty.
   std::string plan_sha256;
-  // Keep the run's longest static stretch (result.run.static_stretch) for a certificate's noise
-  // section; changes nothing else.
+  // Keep the run's noise stretch (result.run.static_stretch) for a certificate's noise section;
+  // changes nothing else.
   bool keep_static_stretch = false;
+  // Which static stretch that is (static_stretch.h; --noise-segment).
+  NoiseStretchOptions noise_stretch;
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;

@@ -5,8 +5,8 @@
 //
 // A run is read as few times as the work needs: once for a file with a segment column, twice for
 // one without (the first pass finds the segments, segment_run.h). On the way the reader hashes the
-// file (its SHA-256, for the calibration and the certificate) and, when asked, keeps the longest
-// static stretch (static_stretch.h, the certificate's noise), so that nobody reads it again.
+// file (its SHA-256, for the calibration and the certificate) and, when asked, keeps the noise
+// stretch (static_stretch.h, the certificate's noise), so that nobody reads it again.
 #ifndef IMUFIT_PIPELINE_RUN_WINDOWS_H_
 #define IMUFIT_PIPELINE_RUN_WINDOWS_H_
 
@@ -33,7 +33,7 @@ struct RunWindows {
   std::optional<Segmentation> segmentation;
   // SHA-256 of the samples file's bytes as they are on disk, computed as they were read.
   std::string samples_sha256;
-  // The longest static stretch of the run, when the reading was asked to keep it.
+  // The run's noise stretch (static_stretch.h), when the reading was asked to keep it.
   std::optional<StaticStretch> static_stretch;
   // What the samples header says of the run (run_header.h; empty for a run held in memory).
   RunHeader header;
@@ -67,13 +67,15 @@ class RunReader {
   // Streams the samples through a WindowBuilder (once only). Throws InputError for bad input,
   // including a sample whose segment id the plan does not have (located at its line). A file
   // without a segment column is labelled first (one more pass over the file); then
-  // PlanMismatchError says where the log and the plan disagree.
-  RunWindows Read(const WindowOptions& options, bool keep_static_stretch = false);
+  // PlanMismatchError says where the log and the plan disagree. With `noise_stretch`, keeps the
+  // stretch it chooses (RunWindows::static_stretch; InputError when it names no static segment).
+  RunWindows Read(const WindowOptions& options,
+                  const std::optional<NoiseStretchOptions>& noise_stretch = std::nullopt);
 
  private:
   // The samples into `builder` (and `stretch` when not null): the run's segmentation and hash.
-  RunWindows ReadFile(WindowBuilder* builder, LongestStaticStretch* stretch);
-  RunWindows ReadMemory(WindowBuilder* builder, LongestStaticStretch* stretch);
+  RunWindows ReadFile(WindowBuilder* builder, NoiseStretchFinder* stretch);
+  RunWindows ReadMemory(WindowBuilder* builder, NoiseStretchFinder* stretch);
   // Throws InputError when a run of `span_s` over `intervals` sample intervals is too short for
   // every segment of the plan to outlast the trim (SpanProblem: time in another unit?).
   void CheckSpan(const WindowOptions& options, double span_s, long long intervals) const;

@@ -21,7 +21,8 @@
 
 namespace imufit {
 
-// The unit of the gyro panels' deviation axis (other kinds keep their column's own unit).
+// The unit of the gyro panels' deviation axis. With deg/s or deg/h the accelerometer panels are in
+// micro-g, the unit their bias instability is printed in; other columns keep their own unit.
 enum class AllanPlotUnits {
   kNative,        // "native" or "rad/s": the columns' own unit (rad/s for a corrected file)
   kDegPerSecond,  // "deg/s"
