@@ -90,6 +90,10 @@ std::vector<std::string> FillStatements(int fits) {
       "INSERT INTO latest_fits (lot, unit, fit_id, time_utc) SELECT r.lot, r.unit, f.id, f.time_utc FROM "
       "fits f "
       "JOIN runs r ON r.run_key = f.run_key",
+      // And their figures, as recording keeps them for the lot statistics.
+      "INSERT INTO latest_figures (name, lot, unit, figure_unit, value) SELECT g.name, l.lot, l.unit, "
+      "g.unit, "
+      "g.value FROM latest_fits l JOIN figures g ON g.fit_id = l.fit_id",
       "ANALYZE"};
 }
 
@@ -141,7 +145,11 @@ imufit::StoredFit NewFit(int i) {
   fit.verdict = "PASS";
   fit.calibration_yaml = std::string(4000, 'y');  // about a calibration file's size
   for (int k = 0; k < kFiguresPerFit; ++k) {
-    imufit::StoredFigure g(imufit::Figure{"figure_" + std::to_string(k), "", "deg/s", 0.001 * k, 0.01});
+    imufit::StoredFigure g;
+    g.name = "figure_" + std::to_string(k);
+    g.unit = "deg/s";
+    g.value = 0.001 * k;
+    g.sigma = 0.01;
     g.expanded_u = 0.02;
     fit.figures.push_back(g);
   }

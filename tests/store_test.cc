@@ -200,6 +200,13 @@ void ExecuteOnStore(const std::string& target, const std::string& sql) {
 }
 
 // One line per answer, in the order given: what YieldBy(), LatestOfLot() and LotValues() say.
+// A lot's statistics of a figure, to the digits the lot page prints.
+std::string LotStatsLine(const std::string& lot, const LotFigureStats& st) {
+  char text[160];
+  std::snprintf(text, sizeof text, "stats %s: %d %.6g %.6g\n", lot.c_str(), st.count, st.mean, st.sigma);
+  return text;
+}
+
 std::string Answers(ResultsStore* store, const std::vector<std::string>& lots) {
   std::ostringstream out;
   for (YieldGroup by : {YieldGroup::kLot, YieldGroup::kStation, YieldGroup::kMonth}) {
@@ -214,6 +221,7 @@ std::string Answers(ResultsStore* store, const std::vector<std::string>& lots) {
   }
   for (const LotValue& v : store->LotValues("gyro_bias_dps.x"))
     out << "value " << v.lot << " " << v.unit << " " << v.value << "\n";
+  for (const LotFigureStats& st : store->LotStats({"gyro_bias_dps.x"})) out << LotStatsLine(st.lot, st);
   return out.str();
 }
 
@@ -266,6 +274,19 @@ std::string RecomputedAnswers(ResultsStore* store, const std::vector<std::string
     const StoredFigure* x = FindFigure(f.figures, "gyro_bias_dps.x");
     if (!key.first.empty() && f.status == "fitted" && x)
       out << "value " << key.first << " " << key.second << " " << x->value << "\n";
+  }
+  std::map<std::string, std::vector<double>> values;  // by lot
+  for (const auto& [key, f] : latest) {
+    const StoredFigure* x = FindFigure(f.figures, "gyro_bias_dps.x");
+    if (!key.first.empty() && f.status == "fitted" && x) values[key.first].push_back(x->value);
+  }
+  for (const auto& [lot, v] : values) {
+    const MeanSigma m = MeanAndSigma(v);
+    LotFigureStats st;
+    st.count = m.count;
+    st.mean = m.mean;
+    st.sigma = m.sigma;
+    out << LotStatsLine(lot, st);
   }
   return out.str();
 }
@@ -408,9 +429,9 @@ TEST(StoreTest, AVersion2StoreGainsItsLatestFitsKeepingEveryRowAndEveryAnswer) {
     before = store.All();
     answers = RecomputedAnswers(&store, kShuffledLots);
   }
-  // The store as version 2 wrote it: no latest_fits.
+  // The store as version 2 wrote it: no latest_fits, latest_figures or judgement.
   ExecuteOnStore(target,
-                 std::string("DROP TABLE latest_fits; DROP INDEX figures_fit_value; ALTER TABLE "
+                 std::string("DROP TABLE latest_fits; DROP TABLE latest_figures; ALTER TABLE "
                              "figures DROP COLUMN judgement; UPDATE schema_version SET version = 2;") +
                      (StoreBackend() == "sqlite" ? " PRAGMA user_version = 2;" : ""));
   ResultsStore store(target);

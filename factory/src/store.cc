@@ -233,10 +233,32 @@ CREATE TABLE latest_fits (
   time_utc TEXT NOT NULL, PRIMARY KEY (lot, unit));
 )sql";
 
-// The values of a fit's figures, read without the table (LotStats()). Added in version 4.
-constexpr const char* kFigureValuesIndex = R"sql(
-CREATE INDEX IF NOT EXISTS figures_fit_value ON figures (fit_id, name, value, unit);
+// The figures of each fitted unit's latest fit, by name and lot (LotStats() reads it in index
+// order, one lot after another, instead of 100,000 look-ups per figure): kept with latest_fits in
+// the recording transaction (kRefreshLatestFigures; its key serves the unit's refresh). Added in version 4. `unit` is the lot's unit
+// (as in latest_fits), `figure_unit` the figure's physical unit.
+constexpr const char* kLatestFiguresSchema = R"sql(
+CREATE TABLE latest_figures (
+  name TEXT NOT NULL, lot TEXT NOT NULL, unit TEXT NOT NULL, figure_unit TEXT NOT NULL,
+  value DOUBLE PRECISION NOT NULL, PRIMARY KEY (lot, unit, name));
+CREATE INDEX latest_figures_values ON latest_figures (name, lot, value, figure_unit);
 )sql";
+
+// The figures of the unit of run ?1 as its latest fit now holds them: removed, then copied from
+// that fit when it is fitted (a unit whose latest fit failed has none).
+constexpr const char* kDropLatestFigures =
+    "DELETE FROM latest_figures WHERE lot = (SELECT lot FROM runs WHERE run_key = ?1) AND "
+    "unit = (SELECT unit FROM runs WHERE run_key = ?1)";
+constexpr const char* kLatestFiguresSelect =
+    "SELECT g.name, l.lot, l.unit, g.unit, g.value FROM latest_fits l JOIN fits f ON f.id = l.fit_id "
+    "JOIN figures g ON g.fit_id = l.fit_id WHERE f.status = 'fitted'";
+const std::string kRefreshLatestFigures =
+    std::string("INSERT INTO latest_figures (name, lot, unit, figure_unit, value) ") + kLatestFiguresSelect +
+    " AND l.lot = (SELECT lot FROM runs WHERE run_key = ?1) AND l.unit = (SELECT unit FROM runs WHERE "
+    "run_key = ?1)";
+// Every unit's: how a version 2 or 3 store's latest_figures is filled.
+const std::string kFillLatestFigures =
+    std::string("INSERT INTO latest_figures (name, lot, unit, figure_unit, value) ") + kLatestFiguresSelect;
 
 // A unit's latest fit is its fit with the latest time_utc, of those the one recorded last (the
 // highest id); a unit is its run's (lot, unit). One statement, safe with concurrent writers: the
@@ -303,18 +325,16 @@ constexpr const char* kLotReference =
 
 // The statement of the sums over `names` stored names: ?1, ?3, ... the names, ?2, ?4, ... their k.
 std::string LotSumsSql(size_t names) {
-  std::string shift = "CASE g.name", list;
+  std::string shift = "CASE name", list;
   for (size_t i = 0; i < names; ++i) {
     const std::string name = "?" + std::to_string(2 * i + 1), k = "?" + std::to_string(2 * i + 2);
     shift += " WHEN " + name + " THEN CAST(" + k + " AS DOUBLE PRECISION)";
     list += (i ? ", " : "") + name;
   }
-  return "SELECT lot, name, max(unit), count(*), sum(d), sum(d * d) FROM (SELECT l.lot AS lot, g.name AS "
-         "name, g.unit AS unit, g.value - " +
-         shift +
-         " END AS d FROM latest_fits l JOIN fits f ON f.id = l.fit_id JOIN figures g ON g.fit_id = l.fit_id "
-         "WHERE l.lot <> '' AND f.status = 'fitted' AND " +
-         (names == 1 ? "g.name = ?1" : "g.name IN (" + list + ")") + ") v GROUP BY lot, name";
+  return "SELECT lot, name, max(figure_unit), count(*), sum(d), sum(d * d) FROM (SELECT lot, name, "
+         "figure_unit, value - " +
+         shift + " END AS d FROM latest_figures WHERE lot <> '' AND name IN (" + list +
+         ")) v GROUP BY name, lot";
 }
 
 class Transaction {
@@ -344,6 +364,17 @@ const StoredFigure* FindFigure(const std::vector<StoredFigure>& figures, const s
   return nullptr;
 }
 
+// A figure from columns 1..5 of a row: name, coefficient, unit, value, sigma.
+StoredFigure StoredFigureOfRow(const SqlRow& row) {
+  Figure f;
+  f.name = row.Text(1);
+  f.coefficient = row.Text(2);
+  f.unit = row.Text(3);
+  f.value = row.Double(4);
+  f.sigma = row.Double(5);
+  return StoredFigure(std::move(f));
+}
+
 std::unique_ptr<SqlConnection> OpenSqlite(const std::string& path, StoreAccess access) {
   return std::make_unique<SqliteConnection>(path, access);
 }
@@ -364,7 +395,7 @@ void ResultsStore::Open() {
     bool empty = true;
     if (db_->HasTable("fits")) empty = false;
     if (!empty) throw InputError(path_, "not an imufit results store (no schema_version table)");
-    db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kFigureValuesIndex));
+    db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kLatestFiguresSchema));
     db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
     db_->SchemaWritten(kStoreSchemaVersion);
   }
@@ -401,12 +432,12 @@ void ResultsStore::MigrateFromVersion1() {
              [&](const SqlRow& row) {
                const auto it = by_id.find(row.Integer(0));
                if (it == by_id.end()) return;
-               StoredFigure g(Figure{row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5)});
+               StoredFigure g = StoredFigureOfRow(row);
                if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;
                fits[it->second].figures.push_back(std::move(g));
              });
   db_->Execute("DROP TABLE figures; DROP TABLE fits; DROP TABLE schema_version;");
-  db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kFigureValuesIndex));
+  db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kLatestFiguresSchema));
   db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
   db_->SchemaWritten(kStoreSchemaVersion);
   for (const StoredFit& f : fits) Insert(f);
@@ -418,10 +449,11 @@ void ResultsStore::MigrateFromVersion2() {
   db_->Execute(kFillLatest);
 }
 
-// Version 3: without the index figures_fit_value and without figures.judgement (every row keeps
-// its outcome, with judgement '').
+// Version 3: without latest_figures (filled from every unit's latest fit) and without
+// figures.judgement (every row keeps its outcome, with judgement '').
 void ResultsStore::MigrateFromVersion3() {
-  db_->Execute(kFigureValuesIndex);
+  db_->Execute(SchemaFor(*db_, kLatestFiguresSchema));
+  db_->Execute(kFillLatestFigures);
   db_->Execute(std::string("ALTER TABLE figures ADD COLUMN judgement ") + db_->TextType() +
                " NOT NULL DEFAULT ''");
   db_->Execute("UPDATE schema_version SET version = " + std::to_string(kStoreSchemaVersion));
@@ -507,6 +539,8 @@ int64_t ResultsStore::Insert(const StoredFit& fit, bool* added) {
          g.limit_abs, g.outcome, g.judgement},
         ignore);
   }
+  db_->Query(kDropLatestFigures, {run_key}, ignore);  // after the figures: the latest fit may be this
+  db_->Query(kRefreshLatestFigures, {run_key}, ignore);
   for (const StoredAttachment& a : fit.attachments) {
     db_->Query("INSERT INTO attachments (fit_id, kind, path, sha256) VALUES (?1, ?2, ?3, ?4)",
                {id, a.kind, a.path, a.sha256}, ignore);
@@ -537,7 +571,7 @@ std::vector<StoredFit> ResultsStore::Fits(const std::string& where,
       "g.outcome, g.judgement FROM figures g" +
           of_these + " ORDER BY g.fit_id, g.position",
       values, [&](const SqlRow& row) {
-        StoredFigure g(Figure{row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5)});
+        StoredFigure g = StoredFigureOfRow(row);
         g.expanded_u = row.Double(6);
         g.limit_abs = row.Double(7);
         g.outcome = row.Text(8);
@@ -652,32 +686,25 @@ std::vector<LotFigureStats> ResultsStore::LotStats(const std::vector<std::string
       asked_as.emplace(row.Text(0), figure);
     });
   }
-  // SQLite joins by index lookups: a statement per figure reads each lot's units in key order
-  // (figures_fit_value). PostgreSQL hashes: one statement reads the figures once for all.
-  std::vector<std::vector<std::string>> batches;
-  for (const auto& [name, k] : reference) {
-    if (batches.empty() || std::string(db_->backend()) == "sqlite") batches.emplace_back();
-    batches.back().push_back(name);
-  }
+  // One statement reads latest_figures in index order (name, lot): no look-up per unit.
   std::vector<LotFigureStats> stats;
-  for (const std::vector<std::string>& names : batches) {
-    std::vector<SqlValue> parameters;
-    for (const std::string& name : names) parameters.insert(parameters.end(), {name, reference.at(name)});
-    db_->Query(LotSumsSql(names.size()), parameters, [&](const SqlRow& row) {
-      LotFigureStats s;
-      s.lot = row.Text(0);
-      s.figure_unit = row.Text(2);
-      s.count = static_cast<int>(row.Integer(3));
-      const double k = reference.at(row.Text(1)), s1 = row.Double(4), s2 = row.Double(5);
-      s.mean = k + s1 / s.count;
-      s.sigma = s.count > 1 ? std::sqrt(std::max(0.0, (s2 - s1 * s1 / s.count) / (s.count - 1))) : 0.0;
-      const auto [first, last] = asked_as.equal_range(row.Text(1));
-      for (auto it = first; it != last; ++it) {
-        s.figure = it->second;
-        stats.push_back(s);
-      }
-    });
-  }
+  if (reference.empty()) return stats;
+  std::vector<SqlValue> parameters;
+  for (const auto& [name, k] : reference) parameters.insert(parameters.end(), {name, k});
+  db_->Query(LotSumsSql(reference.size()), parameters, [&](const SqlRow& row) {
+    LotFigureStats s;
+    s.lot = row.Text(0);
+    s.figure_unit = row.Text(2);
+    s.count = static_cast<int>(row.Integer(3));
+    const double k = reference.at(row.Text(1)), s1 = row.Double(4), s2 = row.Double(5);
+    s.mean = k + s1 / s.count;
+    s.sigma = s.count > 1 ? std::sqrt(std::max(0.0, (s2 - s1 * s1 / s.count) / (s.count - 1))) : 0.0;
+    const auto [first, last] = asked_as.equal_range(row.Text(1));
+    for (auto it = first; it != last; ++it) {
+      s.figure = it->second;
+      stats.push_back(s);
+    }
+  });
   return stats;
 }
 

@@ -16,10 +16,12 @@
 //   attachments(fit_id, kind, path, sha256)                the certificate and its files, by reference
 //   latest_fits(lot, unit, fit_id, time_utc)               each unit's latest fit (latest time_utc,
 //        then highest id), kept in Record()'s transaction; yield and the lot pages read it
+//   latest_figures(name, lot, unit, figure_unit, value)  the figures of each fitted unit's latest
+//        fit, kept with latest_fits; the lot statistics (LotStats()) read it
 // Record() writes one fit, its run, unit, station, figures and attachments in one transaction with
 // INSERT ... ON CONFLICT DO NOTHING: re-recording the same fit (a re-run, a merge, two writers at
 // once) changes nothing. A version 1 SQLite store, and a version 2 or 3 store of either backend, is
-// migrated in place, in one transaction, when opened (3: adds the index figures_fit_value and
+// migrated in place, in one transaction, when opened (3: adds latest_figures and
 // figures.judgement, '' in the rows it keeps). Errors (cannot
 // open or connect, not an imufit store, a newer schema, may not be written) are InputErrors naming the file
 // or database, raised when the store is opened: before any work. Several processes may open, create and write
