@@ -292,7 +292,7 @@ int RunFit(const FitArguments& args) {
   unit.warnings = result.serial_warnings;
   unit.plan_sha256 = result.plan_sha256;
   unit.samples_sha256 = result.run.samples_sha256;
-  const bool recorded = CertifyUnit(settings, {args.output, args.report, pdf, paper}, &unit);
+  const bool recorded = CertifyUnit(settings, {args.output, args.report, pdf, paper, {}}, &unit);
   if (!pdf.empty() && !args.quiet) std::printf("  wrote %s\n", pdf.c_str());
   return ReportCertified(args, unit, recorded);
 }

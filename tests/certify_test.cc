@@ -117,7 +117,9 @@ TEST_P(CertifyTest, FitReportAndStoreReadTheSamplesAtMostTwice) {
   unit.serial = unit.fit->serial;
   unit.plan_sha256 = unit.fit->plan_sha256;
   unit.samples_sha256 = unit.fit->run.samples_sha256;
-  ASSERT_TRUE(CertifyUnit(settings, {Path("calibration.yaml"), Path("report.html")}, &unit)) << unit.message;
+  ASSERT_TRUE(
+      CertifyUnit(settings, {Path("calibration.yaml"), Path("report.html"), "", Paper::kA4, {}}, &unit))
+      << unit.message;
 
   EXPECT_LE(reads.count(), 2) << "imufit fit --report --store reads the samples at most twice";
   EXPECT_EQ(reads.count(), Reads());

@@ -38,7 +38,7 @@ class LotTest : public testing::TempDirTest {
 };
 
 Figure MakeFigure(const std::string& name, const std::string& unit, double value, double sigma) {
-  return {name, "", unit, value, sigma};
+  return {name, "", unit, value, sigma, /*extrapolated=*/false, /*unresolved=*/""};
 }
 
 TEST_F(LotTest, FigureLimitsAreTheTightestIntervalTheValueCriteriaAllow) {

@@ -377,7 +377,9 @@ TEST(StoreTest, LotStatsEqualMeanAndSigmaOfTheLotValuesDespiteALargeCommonOffset
       EXPECT_EQ(s.count, expected.count);
       EXPECT_NEAR(s.mean, expected.mean, kLotStatsRelTol * 1e-3);
       EXPECT_NEAR(s.sigma, expected.sigma, kLotStatsRelTol * std::max(expected.sigma, 1e-3));
-      if (s.lot != "lot-single") EXPECT_GT(s.sigma, 1e-4);
+      if (s.lot != "lot-single") {
+        EXPECT_GT(s.sigma, 1e-4);
+      }
     }
   }
   EXPECT_TRUE(store.LotStats({"no_such_figure"}).empty());
