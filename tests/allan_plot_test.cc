@@ -126,5 +126,25 @@ TEST(AllanPlot, UnitNames) {
   EXPECT_EQ(units, AllanPlotUnits::kNative);  // untouched
 }
 
+// With engineer plot units an accelerometer panel is drawn in micro-g, the unit its bias
+// instability is printed in (the panel's words and the curve agree), not in m/s^2.
+TEST(AllanPlotTest, AnAccelerometerPanelIsInTheUnitItsFiguresArePrintedIn) {
+  ColumnAnalysis accel = ModelColumn("accel_z", 6e-4, 2e-5);  // m/s/sqrt(s), m/s^2
+  accel.kind = ColumnKind::kAccel;
+  const double ug_per_mps2 = 1e6 / kStandardGravityMps2;
+  const PlotFigure figure = AllanPlot({accel}, "", AllanPlotUnits::kDegPerHour);
+  ASSERT_EQ(figure.panels.size(), 1u);
+  const Plot& plot = figure.panels[0];
+  EXPECT_EQ(plot.y_label, "overlapping Allan deviation (\xc2\xb5g)");
+  ASSERT_FALSE(plot.series.empty());
+  EXPECT_NEAR(plot.series[0].y[0], accel.curve.points[0].dev * ug_per_mps2,
+              kModelRelative * plot.series[0].y[0]);
+  // Native units keep the column's own.
+  const PlotFigure native = AllanPlot({accel}, "");
+  EXPECT_EQ(native.panels[0].y_label, "overlapping Allan deviation (m/s\xc2\xb2)");
+  EXPECT_NEAR(native.panels[0].series[0].y[0], accel.curve.points[0].dev,
+              kModelRelative * accel.curve.points[0].dev);
+}
+
 }  // namespace
 }  // namespace imufit

@@ -1075,42 +1075,5 @@ TEST(NoiseFigureTest, AnUnresolvedTermIsItsEstimateIntervalAndAtMost) {
   EXPECT_TRUE(FindFigure(MeasuredFigures(c), "gyro_arw_deg_per_sqrt_hr.x")->unresolved.empty());
 }
 
-// With engineer plot units an accelerometer panel is drawn in micro-g, the unit its bias
-// instability is printed in (the panel's words and the curve agree), not in m/s^2.
-TEST(AllanPlotUnitsTest, AnAccelerometerPanelIsInTheUnitItsFiguresArePrintedIn) {
-  ColumnAnalysis accel;
-  accel.name = "accel_z";
-  accel.kind = ColumnKind::kAccel;
-  accel.curve.estimator = AllanEstimator::kOadev;
-  accel.fit.fitted = true;
-  accel.fit.value[kRandomWalk] = 6e-4;  // m/s/sqrt(s)
-  accel.fit.sigma[kRandomWalk] = 6e-6;
-  accel.fit.variance[kRandomWalk] = 3.6e-7;
-  accel.fit.variance_sigma[kRandomWalk] = 1e-9;
-  for (int64_t m = 1; m <= 1024; m *= 2) {
-    AllanPoint p;
-    p.m = m;
-    p.tau_s = 0.01 * m;
-    p.dev = accel.fit.ModelDeviation(p.tau_s);
-    p.dev_lo = 0.9 * p.dev;
-    p.dev_hi = 1.1 * p.dev;
-    accel.curve.points.push_back(p);
-  }
-  accel.allan = accel.curve;
-  constexpr double kRelative = 1e-12;  // the same product in another order
-  const double ug_per_mps2 = 1e6 / kStandardGravityMps2;
-  const PlotFigure figure = AllanPlot({accel}, "", AllanPlotUnits::kDegPerHour);
-  ASSERT_EQ(figure.panels.size(), 1u);
-  const Plot& plot = figure.panels[0];
-  EXPECT_EQ(plot.y_label, "overlapping Allan deviation (\xc2\xb5g)");
-  ASSERT_FALSE(plot.series.empty());
-  EXPECT_NEAR(plot.series[0].y[0], accel.curve.points[0].dev * ug_per_mps2, kRelative * plot.series[0].y[0]);
-  // Native units keep the column's own.
-  const PlotFigure native = AllanPlot({accel}, "");
-  EXPECT_EQ(native.panels[0].y_label, "overlapping Allan deviation (m/s\xc2\xb2)");
-  EXPECT_NEAR(native.panels[0].series[0].y[0], accel.curve.points[0].dev,
-              kRelative * accel.curve.points[0].dev);
-}
-
 }  // namespace
 }  // namespace imufit
