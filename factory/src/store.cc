@@ -235,8 +235,8 @@ CREATE TABLE latest_fits (
 
 // The figures of each fitted unit's latest fit, by name and lot (LotStats() reads it in index
 // order, one lot after another, instead of 100,000 look-ups per figure): kept with latest_fits in
-// the recording transaction (kRefreshLatestFigures; its key serves the unit's refresh). Added in version 4. `unit` is the lot's unit
-// (as in latest_fits), `figure_unit` the figure's physical unit.
+// the recording transaction (kRefreshLatestFigures; its key serves the unit's refresh). Added in
+// version 4. `unit` is the lot's unit (as in latest_fits), `figure_unit` the figure's physical unit.
 constexpr const char* kLatestFiguresSchema = R"sql(
 CREATE TABLE latest_figures (
   name TEXT NOT NULL, lot TEXT NOT NULL, unit TEXT NOT NULL, figure_unit TEXT NOT NULL,
