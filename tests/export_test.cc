@@ -207,8 +207,9 @@ TEST_F(ExportTest, EveryFormatMatchesItsGoldenFile) {
     const std::string output = update ? golden : Path(format.golden);
     const RunResult result = Export(format, output);
     ASSERT_EQ(result.status, 0) << format.name << ": " << result.err;
-    if (!update)
+    if (!update) {
       EXPECT_EQ(ReadBytes(output), ReadBytes(golden)) << format.name << ": differs from " << golden;
+    }
   }
 }
 

@@ -37,10 +37,6 @@ class LotTest : public testing::TempDirTest {
   }
 };
 
-Figure MakeFigure(const std::string& name, const std::string& unit, double value, double sigma) {
-  return {name, "", unit, value, sigma, /*extrapolated=*/false, /*unresolved=*/""};
-}
-
 TEST_F(LotTest, FigureLimitsAreTheTightestIntervalTheValueCriteriaAllow) {
   const Limits limits = WriteLimits(
       "nominal: {gyro_scale: 939.65, accel_scale: 208.838}\n"
@@ -109,8 +105,8 @@ BatchResult FiveUnits() {
     u.status = i == 3 ? "error" : "fitted";
     u.verdict = i == 3 ? "" : (i == 2 || i == 4) ? "FAIL" : "PASS";
     if (i != 3) {
-      u.figures = {MakeFigure("gyro_bias_dps.x", "deg/s", bias[i], 0.001),
-                   MakeFigure("accel_bias_mg.x", "mg", 10.0 + 0.1 * i, 0.01)};
+      u.figures = {MakeFigure("gyro_bias_dps.x", "", "deg/s", bias[i], 0.001),
+                   MakeFigure("accel_bias_mg.x", "", "mg", 10.0 + 0.1 * i, 0.01)};
     }
     batch.units.push_back(u);
   }
@@ -206,8 +202,8 @@ TEST_F(LotTest, LotSummaryHidesNoFigureAndPlotsEveryFigureAUnitFailedOn) {
   for (UnitOutcome& u : batch.units) {
     if (u.status != "fitted") continue;
     u.calibrated_utc = "2026-11-2" + u.unit.substr(6) + "T06:00:00Z";
-    u.figures.push_back(MakeFigure("accel_misalignment_mrad.xy", "mrad", 0.5, 0.02));
-    u.figures.push_back(MakeFigure("accel_residual_rms_mg", "mg", 0.8, -1.0));
+    u.figures.push_back(MakeFigure("accel_misalignment_mrad.xy", "", "mrad", 0.5, 0.02));
+    u.figures.push_back(MakeFigure("accel_residual_rms_mg", "", "mg", 0.8, -1.0));
   }
   CriterionResult failed;
   failed.name = "sigma(accel_misalignment_mrad.xy)";
@@ -300,7 +296,7 @@ void Record(ResultsStore* store, const std::string& lot, const std::string& unit
   fit.software = "imufit test";
   fit.status = status;
   fit.verdict = verdict;
-  if (status == "fitted") fit.figures = {MakeFigure("gyro_bias_dps.x", "deg/s", bias_dps, 0.01)};
+  if (status == "fitted") fit.figures = {MakeFigure("gyro_bias_dps.x", "", "deg/s", bias_dps, 0.01)};
   store->Record(fit);
 }
 

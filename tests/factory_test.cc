@@ -1067,12 +1067,15 @@ TEST(NoiseFigureTest, AnUnresolvedTermIsItsEstimateIntervalAndAtMost) {
   axis.arw_deg_per_sqrt_hr = arw;
   axis.bias_instability_dph = bias;
   c.noise.axes.push_back(axis);
-  const Figure* figure = FindFigure(MeasuredFigures(c), "gyro_bias_instability_dph.x");
+  const std::vector<Figure> measured = MeasuredFigures(c);  // FindFigure points into it
+  const Figure* figure = FindFigure(measured, "gyro_bias_instability_dph.x");
   ASSERT_NE(figure, nullptr);
   EXPECT_NE(figure->unresolved.find("at most 6.9 deg/h (not resolved: estimate 2.88 deg/h"),
             std::string::npos)
       << figure->unresolved;
-  EXPECT_TRUE(FindFigure(MeasuredFigures(c), "gyro_arw_deg_per_sqrt_hr.x")->unresolved.empty());
+  const Figure* arw_figure = FindFigure(measured, "gyro_arw_deg_per_sqrt_hr.x");
+  ASSERT_NE(arw_figure, nullptr);
+  EXPECT_TRUE(arw_figure->unresolved.empty());
 }
 
 }  // namespace

@@ -289,10 +289,12 @@ std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
     const CoefficientName& n = kCoefficientNames[coefficient];
     const EngineeringValue v = EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, temp_c);
     const auto& range = calibration.fit_temp_range_c;
-    figures.push_back({quantity + "." + n.axis,
-                       std::string(sensor == Sensor::kGyro ? "gyro." : "accel.") + n.group + "." + n.axis,
-                       EngineeringUnit(sensor, coefficient), v.value, v.sigma,
-                       range[1] > range[0] && (temp_c < range[0] || temp_c > range[1])});
+    Figure figure =
+        MakeFigure(quantity + "." + n.axis,
+                   std::string(sensor == Sensor::kGyro ? "gyro." : "accel.") + n.group + "." + n.axis,
+                   EngineeringUnit(sensor, coefficient), v.value, v.sigma);
+    figure.extrapolated = range[1] > range[0] && (temp_c < range[0] || temp_c > range[1]);
+    figures.push_back(std::move(figure));
   };
   for (int i = 0; i < 3; ++i) add("gyro_bias_dps", Sensor::kGyro, kBiasCoefficient + i);
   for (int i = 0; i < 3; ++i) add("accel_bias_mg", Sensor::kAccel, kBiasCoefficient + i);
@@ -315,20 +317,22 @@ std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
     for (const char* axis : axes) {
       if (const std::optional<std::array<double, 2>> pair =
               ReadNoiseFigure(calibration.extra, std::string("gyro_") + axis, key)) {
-        figures.push_back({std::string(name) + "." + axis, std::string("noise.gyro_") + axis + "." + key,
-                           unit, (*pair)[0], (*pair)[1]});
+        figures.push_back(MakeFigure(std::string(name) + "." + axis,
+                                     std::string("noise.gyro_") + axis + "." + key, unit, (*pair)[0],
+                                     (*pair)[1]));
       }
     }
   }
   if (const std::optional<double> rms = FitFigure(calibration, &FitRecord::gyro_residual_rms_radps)) {
-    figures.push_back({"gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(*rms), -1.0});
+    figures.push_back(
+        MakeFigure("gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(*rms)));
   }
   if (calibration.fit && calibration.fit->missing_segments && *calibration.fit->missing_segments >= 0) {
-    figures.push_back({"coverage", "fit.missing_segments", "segments missing",
-                       static_cast<double>(*calibration.fit->missing_segments), -1.0});
+    figures.push_back(MakeFigure("coverage", "fit.missing_segments", "segments missing",
+                                 static_cast<double>(*calibration.fit->missing_segments)));
   }
   if (const std::optional<double> rms = FitFigure(calibration, &FitRecord::accel_residual_rms_mps2)) {
-    figures.push_back({"accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(*rms), -1.0});
+    figures.push_back(MakeFigure("accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(*rms)));
   }
   return figures;
 }

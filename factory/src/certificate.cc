@@ -302,17 +302,6 @@ std::string CertificateNumber(const std::string& serial, const std::string& date
 
 namespace {
 
-// A figure the certificate measures (not the calibration's): no sigma unless set.
-Figure MeasuredFigure(const std::string& name, const std::string& coefficient, const std::string& unit,
-                      double value = 0.0) {
-  Figure figure;
-  figure.name = name;
-  figure.coefficient = coefficient;
-  figure.unit = unit;
-  figure.value = value;
-  return figure;
-}
-
 // Why this run does not resolve a noise term, and how to supply it (Figure::unresolved).
 std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, bool arw) {
   const double needed_s = arw ? kMinAllanStretchS : kBiasInstabilityStretchS;
@@ -346,9 +335,9 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
     }
     const std::string axis = axis_name;
     const auto noise_figure = [&](bool arw) {
-      Figure f = MeasuredFigure(
-          arw ? "gyro_arw_deg_per_sqrt_hr." + axis : "gyro_bias_instability_dph." + axis,
-          "certificate.gyro_" + axis + (arw ? ".arw" : ".bias_instability"), arw ? "deg/sqrt(h)" : "deg/h");
+      Figure f = MakeFigure(arw ? "gyro_arw_deg_per_sqrt_hr." + axis : "gyro_bias_instability_dph." + axis,
+                            "certificate.gyro_" + axis + (arw ? ".arw" : ".bias_instability"),
+                            arw ? "deg/sqrt(h)" : "deg/h");
       const NoiseTermFigure* term = a == nullptr || !a->fitted ? nullptr
                                     : arw                      ? &a->arw_deg_per_sqrt_hr
                                                                : &a->bias_instability_dph;
@@ -367,10 +356,10 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
   if (!certificate.residual_table.empty()) {
     const ResidualRow& all = certificate.residual_table.back();
     figures.push_back(
-        MeasuredFigure("gyro_residual_max_dps", "certificate.gyro_residual_max", "deg/s", all.gyro_max_dps));
+        MakeFigure("gyro_residual_max_dps", "certificate.gyro_residual_max", "deg/s", all.gyro_max_dps));
     if (all.accel_windows > 0) {
       figures.push_back(
-          MeasuredFigure("accel_residual_max_mg", "certificate.accel_residual_max", "mg", all.accel_max_mg));
+          MakeFigure("accel_residual_max_mg", "certificate.accel_residual_max", "mg", all.accel_max_mg));
     }
   }
   return figures;

@@ -366,13 +366,7 @@ const StoredFigure* FindFigure(const std::vector<StoredFigure>& figures, const s
 
 // A figure from columns 1..5 of a row: name, coefficient, unit, value, sigma.
 StoredFigure StoredFigureOfRow(const SqlRow& row) {
-  Figure f;
-  f.name = row.Text(1);
-  f.coefficient = row.Text(2);
-  f.unit = row.Text(3);
-  f.value = row.Double(4);
-  f.sigma = row.Double(5);
-  return StoredFigure(std::move(f));
+  return MakeFigure(row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5));
 }
 
 std::unique_ptr<SqlConnection> OpenSqlite(const std::string& path, StoreAccess access) {

@@ -9,6 +9,7 @@
 #define IMUFIT_FACTORY_ACCEPTANCE_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "imufit/factory/engineering_units.h"
@@ -34,6 +35,18 @@ struct Figure {
   // figure is then judged as missing, with this as the reason.
   std::string unresolved;
 };
+
+// A figure of `value` and 1-sigma `sigma` (< 0: none), within the fitted range and resolved.
+inline Figure MakeFigure(std::string name, std::string coefficient, std::string unit, double value = 0.0,
+                         double sigma = -1.0) {
+  Figure figure;
+  figure.name = std::move(name);
+  figure.coefficient = std::move(coefficient);
+  figure.unit = std::move(unit);
+  figure.value = value;
+  figure.sigma = sigma;
+  return figure;
+}
 
 // A figure or limit quantity in words, for a reader: "gyro_bias_dps.x" -> "Gyro bias X",
 // "gyro_g_sensitivity_dpsg.xy" -> "Gyro g-sensitivity X from Y", "gyro_misalignment_mrad.xy" ->
