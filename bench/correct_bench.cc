@@ -8,10 +8,16 @@
 // firmware holds), both loaded from the calibration's blob (`imufit export --format bin`). The
 // three alternate round by round, so that a machine shared with other work slows them alike.
 //
+// Last, what `imufit apply` does with a thermometer that repeats its reading (here 8 samples per
+// reading, an 800 Hz unit whose temperature updates at 100 Hz): the coefficients evaluated once per
+// reading and reused (SensorModel::CoefficientsAtTemperature + CorrectWith) against
+// SensorModel::Correct on every sample of the same arrays; the checksums must be equal.
+//
 // Usage: correct_bench [N] [calibration.yaml]   (default 1e7, fixtures/mems_truth.yaml)
 // Prints "correct_bench N seconds ns_per_sample checksum" (the C++ core: the line
 // bench/python_correct_bench.py reads), then the same for c_runtime_double and c_runtime_float,
-// each with its time as a fraction of the C++ core's.
+// each with its time as a fraction of the C++ core's; then per_sample_held and reused_coefficients
+// (its time as a fraction of per_sample_held's).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -80,15 +86,20 @@ int main(int argc, char** argv) {
   std::vector<double> omega_c(3 * n), a_c(3 * n);
   std::vector<float> omega_f(3 * n), a_f(3 * n);
 
-  const auto cpp_core = [&] {
-    Eigen::Vector3d omega_hat, a_hat;
-    for (long long i = 0; i < n; ++i) {
-      model.Correct(temp_c[i], Eigen::Vector3d(&gyro[3 * i]), Eigen::Vector3d(&accel[3 * i]), &omega_hat,
-                    &a_hat);
-      std::copy(omega_hat.data(), omega_hat.data() + 3, &omega[3 * i]);
-      std::copy(a_hat.data(), a_hat.data() + 3, &a[3 * i]);
-    }
+  // SensorModel::Correct on every sample, at the temperatures `temps`, into `omega_out` and `a_out`.
+  const auto per_sample = [&](const std::vector<double>& temps, std::vector<double>* omega_out,
+                              std::vector<double>* a_out) {
+    return [&, temps = &temps, omega_out, a_out] {
+      Eigen::Vector3d omega_hat, a_hat;
+      for (long long i = 0; i < n; ++i) {
+        model.Correct((*temps)[i], Eigen::Vector3d(&gyro[3 * i]), Eigen::Vector3d(&accel[3 * i]), &omega_hat,
+                      &a_hat);
+        std::copy(omega_hat.data(), omega_hat.data() + 3, &(*omega_out)[3 * i]);
+        std::copy(a_hat.data(), a_hat.data() + 3, &(*a_out)[3 * i]);
+      }
+    };
   };
+  const auto cpp_core = per_sample(temp_c, &omega, &a);
   const auto c_double = [&] {
     for (long long i = 0; i < n; ++i) {
       imufit_correct(&runtime, temp_c[i], &gyro[3 * i], &accel[3 * i], &omega_c[3 * i], &a_c[3 * i]);
@@ -99,14 +110,40 @@ int main(int argc, char** argv) {
       imufit_correct_f(&runtime_f, temp_f[i], &gyro_f[3 * i], &accel_f[3 * i], &omega_f[3 * i], &a_f[3 * i]);
     }
   };
-  double cpp_s = 1e300, double_s = 1e300, float_s = 1e300;
+  constexpr long long kSamplesPerReading = 8;
+  std::vector<double> temp_held(n);
+  for (long long i = 0; i < n; ++i) temp_held[i] = temp_c[i - i % kSamplesPerReading];
+  std::vector<double> omega_h(3 * n), a_h(3 * n), omega_r(3 * n), a_r(3 * n);
+  const auto per_sample_held = per_sample(temp_held, &omega_h, &a_h);
+  const auto reused_coefficients = [&] {
+    Eigen::Vector3d omega_hat, a_hat;
+    imufit::UnitCoefficients<double> coefficients;
+    for (long long i = 0; i < n; ++i) {
+      if (i == 0 || temp_held[i] != temp_held[i - 1])
+        coefficients = model.CoefficientsAtTemperature(temp_held[i]);
+      imufit::CorrectWith(coefficients, Eigen::Vector3d(&gyro[3 * i]), Eigen::Vector3d(&accel[3 * i]),
+                          &omega_hat, &a_hat);
+      std::copy(omega_hat.data(), omega_hat.data() + 3, &omega_r[3 * i]);
+      std::copy(a_hat.data(), a_hat.data() + 3, &a_r[3 * i]);
+    }
+  };
+
+  double cpp_s = 1e300, double_s = 1e300, float_s = 1e300, held_s = 1e300, reused_s = 1e300;
   for (int run = 0; run < 3; ++run) {
     cpp_s = BestSeconds(cpp_core, cpp_s);
     double_s = BestSeconds(c_double, double_s);
     float_s = BestSeconds(c_float, float_s);
+    held_s = BestSeconds(per_sample_held, held_s);
+    reused_s = BestSeconds(reused_coefficients, reused_s);
   }
   Print("correct_bench", n, cpp_s, Checksum(omega, a), 0.0);
   Print("c_runtime_double", n, double_s, Checksum(omega_c, a_c), cpp_s);
   Print("c_runtime_float", n, float_s, Checksum(omega_f, a_f), cpp_s);
+  Print("per_sample_held", n, held_s, Checksum(omega_h, a_h), 0.0);
+  Print("reused_coefficients", n, reused_s, Checksum(omega_r, a_r), held_s);
+  if (omega_r != omega_h || a_r != a_h) {
+    std::fprintf(stderr, "correct_bench: reused coefficients changed the correction\n");
+    return 1;
+  }
   return 0;
 }

@@ -546,12 +546,13 @@ TEST_F(IoTest, ShortDecimalsReadAsFromCharsReadsThem) {
 }
 
 // A samples file of `rows` rows in fixed-width columns (so a value can be replaced in place).
-std::string FixedWidthSamples(int rows) {
+std::string FixedWidthSamples(int rows, int samples_per_reading = 1) {
   std::string text = "# serial: SN1\ntime_s,temp_c,segment,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z\n";
   char row[128];
   for (int i = 0; i < rows; ++i) {
     std::snprintf(row, sizeof row, "%012.4f,%6.2f,%2d,%7d,%7d,%7d,%7d,%7d,%7d\n", 1.0 + i * 0.0125,
-                  20.0 + (i % 97) * 0.01, i % 7 - 1, i % 1009, -(i % 313), 7, i % 77, 3, -16384);
+                  20.0 + (i / samples_per_reading % 97) * 0.01, i % 7 - 1, i % 1009, -(i % 313), 7, i % 77, 3,
+                  -16384);
     text += row;
   }
   return text;
@@ -656,11 +657,12 @@ TEST_F(IoTest, ParallelParsingGivesWhatOneReaderGives) {
   EXPECT_EQ(e.column(), 3);
 }
 
-// A file corrected on both cores (each block corrected and formatted where it was parsed) is, byte
-// for byte, what correcting it sample by sample writes, plain and gzip; a correction that is not
-// finite, in a later block, is refused at its row, and nothing is written.
+// A file corrected on both cores (each block corrected and formatted where it was parsed), or by
+// CorrectSamples, is, byte for byte, what the shared model's Correct() on each sample writes, plain
+// and gzip, though both evaluate the coefficients once per thermometer reading (8 samples here); a
+// correction that is not finite, in a later block, is refused at its row, and nothing is written.
 TEST_F(IoTest, AFileCorrectedOnBothCoresIsWhatOneSampleAtATimeWrites) {
-  std::string text = FixedWidthSamples(300000);  // ~20 MB: several blocks
+  std::string text = FixedWidthSamples(300000, 8);  // ~20 MB: several blocks
   Calibration calibration;
   calibration.model = SensorModel::Identity();
   for (int axis = 0; axis < 3; ++axis) {
@@ -670,11 +672,21 @@ TEST_F(IoTest, AFileCorrectedOnBothCoresIsWhatOneSampleAtATimeWrites) {
   const std::string input = Write("raw.csv", text);
   SamplesReader reader(input, false);
   SamplesWriter expected(Path("expected.csv"), reader.has_segment(), "serial: SN1");
-  CorrectSamples(calibration, &reader, [&](const Sample& corrected) { expected.Write(corrected); });
+  Sample corrected;
+  while (reader.Next(&corrected)) {
+    calibration.model.Correct(corrected.temp_c, Eigen::Vector3d(corrected.gyro),
+                              Eigen::Vector3d(corrected.accel), &corrected.gyro, &corrected.accel);
+    expected.Write(corrected);
+  }
   expected.Commit();
+  SamplesReader again(input, false);
+  SamplesWriter streamed(Path("streamed.csv"), again.has_segment(), "serial: SN1");
+  CorrectSamples(calibration, &again, [&](const Sample& s) { streamed.Write(s); });
+  streamed.Commit();
+  EXPECT_TRUE(testing::SameText(testing::ReadFile(Path("streamed.csv")), Read(Path("expected.csv"))));
   for (const std::string name : {"got.csv", "got.csv.gz"}) {
     CorrectSamplesFile(calibration, input, Path(name));
-    EXPECT_EQ(testing::ReadFile(Path(name)), Read(Path("expected.csv"))) << name;
+    EXPECT_TRUE(testing::SameText(testing::ReadFile(Path(name)), Read(Path("expected.csv")))) << name;
   }
 
   // A bias cubic that overflows at 150 degC (x = 125: 1e303 x 125^3 > 1.8e308), at a late row.

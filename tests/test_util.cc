@@ -68,6 +68,21 @@ std::string ReadFile(const std::string& path) {
   return text;
 }
 
+::testing::AssertionResult SameText(const std::string& got, const std::string& expected) {
+  if (got == expected) return ::testing::AssertionSuccess();
+  const size_t at = static_cast<size_t>(
+      std::mismatch(got.begin(), got.end(), expected.begin(), expected.end()).first - got.begin());
+  const size_t line_start = got.rfind('\n', at == 0 ? 0 : at - 1);
+  const size_t begin = line_start == std::string::npos || at == 0 ? 0 : line_start + 1;
+  const auto line_of = [begin](const std::string& text) {
+    return text.substr(begin, text.find('\n', begin) - begin);
+  };
+  return ::testing::AssertionFailure()
+         << "the texts differ from line " << 1 + std::count(got.begin(), got.begin() + begin, '\n')
+         << ": got \"" << line_of(got) << "\", expected \"" << line_of(expected) << "\" (" << got.size()
+         << " against " << expected.size() << " bytes)";
+}
+
 RunResult RunProgram(const std::string& program, const std::vector<std::string>& args,
                      const std::string& out_path, const std::string& err_path) {
   posix_spawn_file_actions_t actions;

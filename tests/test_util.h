@@ -25,6 +25,11 @@ std::string ReadBytes(const std::string& path);
 // "<cannot open PATH>" when it cannot be read.
 std::string ReadFile(const std::string& path);
 
+// Whether `got` is `expected` byte for byte; when not, the first line that differs, with its number,
+// both versions and the lengths (EXPECT_EQ on two large texts builds an edit-distance diff that can
+// exhaust memory).
+::testing::AssertionResult SameText(const std::string& got, const std::string& expected);
+
 struct RunResult {
   int status = -1;  // exit status, or 128 + signal
   std::string out;

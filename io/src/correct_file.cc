@@ -1,6 +1,7 @@
 #include "imufit/io/correct_file.h"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "imufit/io/output_file.h"
@@ -10,13 +11,30 @@ namespace imufit {
 
 namespace {
 
-// `raw` corrected into `corrected` (time_s, temp_c and segment as read).
-void CorrectOne(const Calibration& calibration, const Sample& raw, Sample* corrected) {
-  corrected->time_s = raw.time_s;
-  corrected->temp_c = raw.temp_c;
-  corrected->segment = raw.segment;
-  calibration.model.Correct(raw.temp_c, raw.gyro, raw.accel, &corrected->gyro, &corrected->accel);
-}
+// Corrects samples in the order they come with one calibration's model, evaluating the coefficients
+// again only when the temperature changes (a thermometer repeats its reading over many samples): the
+// same numbers as SensorModel::Correct(), bit for bit.
+class Corrector {
+ public:
+  explicit Corrector(const SensorModel& model) : model_(model) {}
+
+  // `raw` corrected into `corrected` (time_s, temp_c and segment as read).
+  void Correct(const Sample& raw, Sample* corrected) {
+    if (!(raw.temp_c == temp_c_)) {  // also the first sample (NaN)
+      coefficients_ = model_.CoefficientsAtTemperature(raw.temp_c);
+      temp_c_ = raw.temp_c;
+    }
+    corrected->time_s = raw.time_s;
+    corrected->temp_c = raw.temp_c;
+    corrected->segment = raw.segment;
+    CorrectWith(coefficients_, raw.gyro, raw.accel, &corrected->gyro, &corrected->accel);
+  }
+
+ private:
+  const SensorModel& model_;
+  double temp_c_ = std::numeric_limits<double>::quiet_NaN();
+  UnitCoefficients<double> coefficients_;
+};
 
 bool Finite(const Sample& corrected) { return corrected.gyro.allFinite() && corrected.accel.allFinite(); }
 
@@ -49,10 +67,11 @@ CorrectFileReport CorrectSamples(const Calibration& calibration, SamplesReader* 
                                  const std::function<void(const Sample& corrected)>& sink) {
   RefuseCorrectedSamples(*reader);
   CorrectFileReport report;
+  Corrector corrector(calibration.model);
   Sample raw;
   Sample corrected;
   while (reader->Next(&raw)) {
-    CorrectOne(calibration, raw, &corrected);
+    corrector.Correct(raw, &corrected);
     Count(calibration, *reader, corrected, &report);
     sink(corrected);
   }
@@ -93,8 +112,9 @@ CorrectFileReport CorrectSamplesFile(const Calibration& calibration, const std::
   const SampleColumns columns = writer.columns();
   ParallelSamplesReader parallel(&reader, 2,
                                  [&calibration, columns](std::vector<Sample>* samples, std::string* rows) {
+                                   Corrector corrector(calibration.model);
                                    for (Sample& sample : *samples) {
-                                     CorrectOne(calibration, Sample(sample), &sample);
+                                     corrector.Correct(Sample(sample), &sample);
                                      if (!Finite(sample)) break;
                                      SamplesWriter::AppendRow(sample, columns, rows);
                                    }

@@ -127,18 +127,40 @@ Vector3<T> ForwardSensor(const SensorCoefficients<T>& c, const Vector3<T>& truth
   return c.scale.cwiseProduct(sensor_frame) + c.bias + c.g_sensitivity * specific_force_mps2;
 }
 
+// Both sensors' coefficients at one temperature: what the correction of a sample evaluates. A
+// consumer correcting many samples at one temperature (a thermometer updates far more slowly than
+// the samples come) evaluates them once and corrects each sample with CorrectWith().
+template <typename T>
+struct UnitCoefficients {
+  SensorCoefficients<T> gyro;
+  SensorCoefficients<T> accel;
+};
+
+// `gyro_params` and `accel_params` follow the layout above in the given temperature basis.
+template <typename T>
+UnitCoefficients<T> UnitCoefficientsAt(const T* gyro_params, const T* accel_params,
+                                       const TemperatureBasis& basis, const T& temp_c) {
+  const T x = basis.Argument(temp_c);
+  return {CoefficientsAt(gyro_params, kGyroCoefficients, x),
+          CoefficientsAt(accel_params, kAccelCoefficients, x)};
+}
+
 // The complete correction of one sample: the accelerometer first, then the gyro, whose
 // g-sensitivity term uses the corrected specific force of the same sample (docs/spec.md).
-// `gyro_params` and `accel_params` follow the layout above in the given temperature basis.
+template <typename T>
+void CorrectWith(const UnitCoefficients<T>& c, const Vector3<T>& gyro_m, const Vector3<T>& accel_m,
+                 Vector3<T>* omega_hat_radps, Vector3<T>* a_hat_mps2) {
+  *a_hat_mps2 = CorrectSensor(c.accel, accel_m, Vector3<T>::Zero().eval());
+  *omega_hat_radps = CorrectSensor(c.gyro, gyro_m, *a_hat_mps2);
+}
+
+// CorrectWith() the coefficients at `temp_c`.
 template <typename T>
 void CorrectSample(const T* gyro_params, const T* accel_params, const TemperatureBasis& basis,
                    const T& temp_c, const Vector3<T>& gyro_m, const Vector3<T>& accel_m,
                    Vector3<T>* omega_hat_radps, Vector3<T>* a_hat_mps2) {
-  const T x = basis.Argument(temp_c);
-  const SensorCoefficients<T> accel = CoefficientsAt(accel_params, kAccelCoefficients, x);
-  *a_hat_mps2 = CorrectSensor(accel, accel_m, Vector3<T>::Zero().eval());
-  const SensorCoefficients<T> gyro = CoefficientsAt(gyro_params, kGyroCoefficients, x);
-  *omega_hat_radps = CorrectSensor(gyro, gyro_m, *a_hat_mps2);
+  CorrectWith(UnitCoefficientsAt(gyro_params, accel_params, basis, temp_c), gyro_m, accel_m, omega_hat_radps,
+              a_hat_mps2);
 }
 
 // The raw outputs a unit with these coefficients produces for a true angular rate and specific
@@ -175,6 +197,11 @@ struct SensorModel {
   void Correct(double temp_c, const Eigen::Vector3d& gyro_m, const Eigen::Vector3d& accel_m,
                Eigen::Vector3d* omega_hat_radps, Eigen::Vector3d* a_hat_mps2) const {
     CorrectSample(gyro.data(), accel.data(), basis, temp_c, gyro_m, accel_m, omega_hat_radps, a_hat_mps2);
+  }
+
+  // Both sensors' coefficients at `temp_c`, for CorrectWith().
+  UnitCoefficients<double> CoefficientsAtTemperature(double temp_c) const {
+    return UnitCoefficientsAt(gyro.data(), accel.data(), basis, temp_c);
   }
 
   void Forward(double temp_c, const Eigen::Vector3d& omega_true_radps, const Eigen::Vector3d& a_true_mps2,
