@@ -358,7 +358,7 @@ int Verdict::Conditional() const {
   return conditional;
 }
 
-std::string Verdict::RuleText() const {
+std::string DecisionRuleText(DecisionRule rule, double guard_band_u) {
   if (rule == DecisionRule::kGuarded) {
     return "guarded acceptance (ILAC-G8): a value passes when it lies inside its limit by more than the "
            "guard "

@@ -167,10 +167,7 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
   s.git_revision = GitRevision();
   if (limits) {
     s.limits_name = limits->name.empty() ? limits->path : limits->name;
-    Verdict rule;  // the rule's words, as each certificate states them
-    rule.rule = limits->decision_rule;
-    rule.guard_band_u = limits->guard_band_u;
-    s.decision_rule = rule.RuleText();
+    s.decision_rule = DecisionRuleText(limits->decision_rule, limits->guard_band_u);  // as each certificate
   }
   s.units = static_cast<int>(batch.units.size());
   s.passed = batch.passed;

@@ -9,6 +9,7 @@
 #include "imufit/factory/acceptance.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/fit/truth_perturbation.h"
+#include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
 namespace {
@@ -94,27 +95,8 @@ TruthPerturbation Sum(const TruthPerturbation& a, const TruthPerturbation& b) {
 
 // The settings the calibration was fitted with (its `fit:` record), the held groups at their values.
 FitOptions RefitOptions(const Calibration& calibration) {
-  const FitRecord& record = *calibration.fit;
-  FitOptions options;
+  FitOptions options = FitOptionsOfRecord(*calibration.fit);
   options.held = calibration.model;
-  options.gyro_temp_order = record.gyro_temp_order.value_or(options.gyro_temp_order);
-  options.accel_temp_order = record.accel_temp_order.value_or(options.accel_temp_order);
-  options.fit_g_sensitivity = record.g_sensitivity_fitted.value_or(true);
-  if (record.loss) {
-    std::string error;
-    ParseRobustLoss(*record.loss, &options.loss, &error);
-  }
-  if (record.fitted) {
-    const auto has = [&](const char* group) {
-      return std::find(record.fitted->begin(), record.fitted->end(), group) != record.fitted->end();
-    };
-    options.gyro_fit = has("gyro.scale")  ? SensorFit::kAll
-                       : has("gyro.bias") ? SensorFit::kBias
-                                          : SensorFit::kNone;
-    options.accel_fit = has("accel.scale")  ? SensorFit::kAll
-                        : has("accel.bias") ? SensorFit::kBias
-                                            : SensorFit::kNone;
-  }
   options.num_threads = 1;
   return options;
 }

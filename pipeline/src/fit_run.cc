@@ -1,5 +1,6 @@
 #include "imufit/pipeline/fit_run.h"
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <set>
@@ -214,6 +215,29 @@ std::string UndeterminedMessage(const std::string& samples, const FitRunOptions&
   if (const std::string note = SaturationNote(stats); !note.empty()) held += "; saturation: " + note;
   return samples + ": the run does not determine the model: " + Join(fit.undetermined, "; ") +
          " (the run: " + held + ")";
+}
+
+FitOptions FitOptionsOfRecord(const FitRecord& record) {
+  FitOptions options;
+  options.gyro_temp_order = record.gyro_temp_order.value_or(options.gyro_temp_order);
+  options.accel_temp_order = record.accel_temp_order.value_or(options.accel_temp_order);
+  options.fit_g_sensitivity = record.g_sensitivity_fitted.value_or(true);
+  if (record.loss) {
+    std::string error;
+    ParseRobustLoss(*record.loss, &options.loss, &error);
+  }
+  if (record.fitted) {
+    const auto has = [&](const char* group) {
+      return std::find(record.fitted->begin(), record.fitted->end(), group) != record.fitted->end();
+    };
+    options.gyro_fit = has("gyro.scale")  ? SensorFit::kAll
+                       : has("gyro.bias") ? SensorFit::kBias
+                                          : SensorFit::kNone;
+    options.accel_fit = has("accel.scale")  ? SensorFit::kAll
+                        : has("accel.bias") ? SensorFit::kBias
+                                            : SensorFit::kNone;
+  }
+  return options;
 }
 
 }  // namespace imufit

@@ -10,28 +10,15 @@
 #include <vector>
 
 #include "imufit/model/constants.h"
+#include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
 namespace {
 
-// The fit the calibration's record describes, as far as it changes the information: the orders,
-// the groups fitted and the bias stability in the sigmas.
+// The fit the calibration's record describes, with the bias stability its sigmas were weighted by
+// (the information depends on it).
 FitOptions FitOptionsOf(const FitRecord& record) {
-  FitOptions options;
-  options.gyro_temp_order = record.gyro_temp_order.value_or(options.gyro_temp_order);
-  options.accel_temp_order = record.accel_temp_order.value_or(options.accel_temp_order);
-  options.fit_g_sensitivity = record.g_sensitivity_fitted.value_or(true);
-  if (record.fitted) {
-    const auto fits = [&](const char* group) {
-      return std::find(record.fitted->begin(), record.fitted->end(), group) != record.fitted->end();
-    };
-    options.gyro_fit = fits("gyro.scale")  ? SensorFit::kAll
-                       : fits("gyro.bias") ? SensorFit::kBias
-                                           : SensorFit::kNone;
-    options.accel_fit = fits("accel.scale")  ? SensorFit::kAll
-                        : fits("accel.bias") ? SensorFit::kBias
-                                             : SensorFit::kNone;
-  }
+  FitOptions options = FitOptionsOfRecord(record);
   options.gyro_bias_stability_radps = record.gyro_bias_stability_radps.value_or(0.0);
   options.accel_bias_stability_mps2 = record.accel_bias_stability_mps2.value_or(0.0);
   options.bias_correlation_s = record.bias_correlation_s.value_or(options.bias_correlation_s);

@@ -86,6 +86,10 @@ struct CriterionResult {
   std::string reason;  // why, when it is not a plain PASS: "within U = 0.002 deg/s of the limit"
 };
 
+// A decision rule in words, for the certificate and the lot page: "simple acceptance (ILAC-G8): ...";
+// `guard_band_u`, the guard band in U, for guarded acceptance.
+std::string DecisionRuleText(DecisionRule rule, double guard_band_u);
+
 struct Verdict {
   std::string limits_name;
   std::vector<CriterionResult> criteria;
@@ -96,8 +100,8 @@ struct Verdict {
   int Failed() const;
   // Criteria whose value lies within U of the limit (conditional pass or fail).
   int Conditional() const;
-  // The rule in words, for the certificate: "simple acceptance (ILAC-G8): ...".
-  std::string RuleText() const;
+  // The rule in words (DecisionRuleText).
+  std::string RuleText() const { return DecisionRuleText(rule, guard_band_u); }
   // "|gyro_g_sensitivity_dpsg.xx| 0.0712 > 0.05 deg/s/g; ..." — the failed criteria, one line.
   // `in_words`: the criteria by their titles ("Gyro g-sensitivity X from X 0.0712 deg/s/g (limit ...)").
   std::string FailedSummary(bool in_words = false) const;

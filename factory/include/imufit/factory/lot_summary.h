@@ -74,7 +74,7 @@ struct LotOutlier {
 struct LotSummary {
   std::string lot, written_utc, software, git_revision;
   std::string limits_name;    // the limits file's name, or its path; empty without limits
-  std::string decision_rule;  // the limits' decision rule in words (Verdict::RuleText); empty without
+  std::string decision_rule;  // the limits' decision rule in words (DecisionRuleText); empty without
   int units = 0, passed = 0, failed = 0, not_fitted = 0, errors = 0;
   // Units judged on a criterion within U of its limit (conditional pass or fail; also counted in
   // passed or failed as the decision rule decided).

@@ -107,6 +107,11 @@ FitRunResult FitRun(Plan plan, std::string plan_sha256, const SamplesInMemory& s
 FitRunResult FitRun(Plan plan, std::string plan_sha256, const std::string& samples_path,
                     const FitRunOptions& options);
 
+// The fit a calibration's `fit:` record describes, as FitRun records it: the temperature orders,
+// the groups fitted (the rest held) and the robust loss. Everything else, the weighting by bias
+// stability included, is FitOptions' default.
+FitOptions FitOptionsOfRecord(const FitRecord& record);
+
 // Why a run does not determine the model, as one line (the CLI's error, Python's exception):
 // "<samples>: the run does not determine the model: <findings, "; "-separated> (the run: <counts>)".
 // `result.fit.status` is FitStatus::kUndetermined.
