@@ -9,19 +9,19 @@
 #include <memory>
 
 #include "commands.h"
-#include "imufit/factory/allan_plot.h"
+#include "imufit/base/enum_names.h"
 #include "imufit/io/calibration.h"
-#include "imufit/io/correct_file.h"
 #include "imufit/io/error.h"
 #include "imufit/io/noise_file.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/path.h"
-#include "imufit/io/series_reader.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
-#include "imufit/model/enum_names.h"
 #include "imufit/noise/allan.h"
 #include "imufit/noise/column_analysis.h"
+#include "imufit/pipeline/correct_file.h"
+#include "imufit/pipeline/series_reader.h"
+#include "imufit/report/allan_plot.h"
 
 namespace imufit {
 namespace {

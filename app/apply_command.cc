@@ -4,9 +4,9 @@
 
 #include "commands.h"
 #include "imufit/io/calibration.h"
-#include "imufit/io/correct_file.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
+#include "imufit/pipeline/correct_file.h"
 #include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {

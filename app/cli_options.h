@@ -14,9 +14,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "imufit/base/option_table.h"
 #include "imufit/io/error.h"
 #include "imufit/io/units.h"
-#include "imufit/model/option_table.h"
 
 namespace imufit {
 

@@ -13,9 +13,9 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_options.h"
-#include "imufit/factory/pdf.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/segment_run.h"
+#include "imufit/report/pdf.h"
 
 namespace imufit {
 

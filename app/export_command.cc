@@ -4,9 +4,9 @@
 #include <vector>
 
 #include "commands.h"
+#include "imufit/export/export.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
-#include "imufit/io/export.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 

@@ -5,14 +5,14 @@
 #include <optional>
 
 #include "commands.h"
+#include "imufit/base/text.h"
 #include "imufit/factory/certify.h"
-#include "imufit/factory/engineering_units.h"
-#include "imufit/factory/store.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/error.h"
 #include "imufit/io/units.h"
-#include "imufit/model/text.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/report/engineering_units.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 namespace {

@@ -8,15 +8,15 @@
 #include <optional>
 
 #include "commands.h"
+#include "imufit/base/text.h"
 #include "imufit/factory/batch.h"
 #include "imufit/factory/lot_history.h"
 #include "imufit/factory/report.h"
-#include "imufit/factory/store.h"
 #include "imufit/factory/store_history.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
-#include "imufit/model/text.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 namespace {
@@ -151,12 +151,12 @@ int Serial(const HistoryArguments& args, ResultsStore* store) {
       }
       std::printf("%s", row.c_str());
       for (const std::string& name : kSummaryFigures) {
-        const Figure* figure = FindFigure(f.figures, name);
+        const StoredFigure* figure = FindFigure(f.figures, name);
         std::printf(",%s", figure ? FormatDouble(figure->value).c_str() : "");
       }
       std::printf("\n");
     } else {
-      const Figure* bias = FindFigure(f.figures, "gyro_bias_dps.x");
+      const StoredFigure* bias = FindFigure(f.figures, "gyro_bias_dps.x");
       std::printf("%-5lld %-22s %-14s %-12s %-12s %-8s %-18s %12s %12s  %s\n", static_cast<long long>(f.id),
                   f.time_utc.c_str(), f.lot.c_str(), f.station.empty() ? "-" : f.station.c_str(),
                   f.status.c_str(), f.verdict.empty() ? "-" : f.verdict.c_str(), f.software.c_str(),

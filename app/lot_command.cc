@@ -7,11 +7,11 @@
 #include "commands.h"
 #include "imufit/factory/lot_page.h"
 #include "imufit/factory/lot_summary.h"
-#include "imufit/factory/store.h"
 #include "imufit/factory/store_history.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 namespace {

@@ -10,15 +10,15 @@
 #include <vector>
 
 #include "commands.h"
+#include "imufit/base/text.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
-#include "imufit/model/text.h"
-#include "imufit/pipeline/plan_check.h"
-#include "imufit/pipeline/plan_design.h"
-#include "imufit/pipeline/plan_prediction.h"
+#include "imufit/plan/plan_check.h"
+#include "imufit/plan/plan_design.h"
+#include "imufit/plan/plan_prediction.h"
 
 namespace imufit {
 namespace {

@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "commands.h"
-#include "imufit/factory/store.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 namespace {

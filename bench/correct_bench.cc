@@ -25,8 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "imufit/export/export.h"
 #include "imufit/io/calibration.h"
-#include "imufit/io/export.h"
 #include "imufit_runtime.h"
 #define IMUFIT_RUNTIME_FLOAT
 #include "imufit_runtime.h"  // the float build: imufit_calibration_f, imufit_correct_f

@@ -19,8 +19,8 @@
 
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/io/plan.h"
-#include "imufit/pipeline/plan_check.h"
-#include "imufit/pipeline/plan_design.h"
+#include "imufit/plan/plan_check.h"
+#include "imufit/plan/plan_design.h"
 #include "imufit/run/windows.h"
 #include "imufit/sim/simulator.h"
 

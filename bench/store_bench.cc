@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "imufit/factory/lot_history.h"
-#include "imufit/factory/store.h"
+#include "imufit/store/store.h"
 
 namespace {
 

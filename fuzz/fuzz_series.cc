@@ -5,7 +5,7 @@
 
 #include "fuzz_util.h"
 #include "imufit/io/error.h"
-#include "imufit/io/series_reader.h"
+#include "imufit/pipeline/series_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace imufit;

@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "imufit/export/export.h"
 #include "imufit/io/calibration.h"
-#include "imufit/io/export.h"
 #include "imufit/io/sha256.h"
 #include "imufit_runtime.h"
 #define IMUFIT_RUNTIME_FLOAT

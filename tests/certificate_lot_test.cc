@@ -13,13 +13,13 @@
 
 #include "imufit/factory/batch.h"
 #include "imufit/factory/certificate.h"
-#include "imufit/factory/engineering_units.h"
 #include "imufit/factory/lot_summary.h"
-#include "imufit/factory/pdf.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
+#include "imufit/report/engineering_units.h"
+#include "imufit/report/pdf.h"
 #include "imufit/sim/simulator.h"
 #include "test_util.h"
 

@@ -14,7 +14,6 @@
 
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certify.h"
-#include "imufit/factory/store.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/file_reads.h"
 #include "imufit/io/plan.h"
@@ -24,6 +23,7 @@
 #include "imufit/pipeline/run_windows.h"
 #include "imufit/pipeline/static_stretch.h"
 #include "imufit/sim/simulator.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 namespace {

@@ -1,5 +1,5 @@
-// End-to-end tests of `imufit allan` on a raw-count log (the command's own tests, on rates, are in
-// noise_test.cc): `--calibration` corrects on the way in as `imufit apply` does.
+// End-to-end tests of `imufit allan` on a raw-count log (its tests on rates are in
+// cli_allan_rates_test.cc): `--calibration` corrects on the way in as `imufit apply` does.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>

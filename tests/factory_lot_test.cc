@@ -13,13 +13,14 @@
 #include <gtest/gtest.h>
 
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/certify.h"
 #include "imufit/factory/lot_history.h"
 #include "imufit/factory/lot_summary.h"
-#include "imufit/factory/plot.h"
 #include "imufit/factory/report.h"
-#include "imufit/factory/store.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/units.h"
+#include "imufit/report/plot.h"
+#include "imufit/store/store.h"
 #include "test_util.h"
 
 namespace imufit {
@@ -296,7 +297,8 @@ void Record(ResultsStore* store, const std::string& lot, const std::string& unit
   fit.software = "imufit test";
   fit.status = status;
   fit.verdict = verdict;
-  if (status == "fitted") fit.figures = {MakeFigure("gyro_bias_dps.x", "", "deg/s", bias_dps, 0.01)};
+  if (status == "fitted")
+    fit.figures = {StoredFigureOf(MakeFigure("gyro_bias_dps.x", "", "deg/s", bias_dps, 0.01))};
   store->Record(fit);
 }
 

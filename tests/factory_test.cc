@@ -16,13 +16,9 @@
 #include <gtest/gtest.h>
 
 #include "imufit/factory/acceptance.h"
-#include "imufit/factory/allan_plot.h"
 #include "imufit/factory/certificate.h"
-#include "imufit/factory/engineering_units.h"
-#include "imufit/factory/html.h"
-#include "imufit/factory/plot.h"
+#include "imufit/factory/certify.h"
 #include "imufit/factory/report.h"
-#include "imufit/factory/store.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
@@ -32,7 +28,12 @@
 #include "imufit/io/sha256.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/report/allan_plot.h"
+#include "imufit/report/engineering_units.h"
+#include "imufit/report/html.h"
+#include "imufit/report/plot.h"
 #include "imufit/sim/simulator.h"
+#include "imufit/store/store.h"
 #include "test_util.h"
 
 namespace imufit {
@@ -218,7 +219,7 @@ TEST_F(FactoryTest, StoreRecordsAndAnswers) {
       fit.verdict = i == 1 ? "FAIL" : "PASS";
       fit.calibration_yaml = CalibrationToYaml(truth);
       const std::vector<Figure> figures = KeyFigures(truth);
-      fit.figures.assign(figures.begin(), figures.end());
+      for (const Figure& figure : figures) fit.figures.push_back(StoredFigureOf(figure));
       fit.figures[0].value += i;
       EXPECT_GT(store.Record(fit), 0);
     }

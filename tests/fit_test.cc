@@ -9,11 +9,11 @@
 
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/fit/validation.h"
-#include "imufit/fit/window_cost.h"
 #include "imufit/model/constants.h"
 #include "imufit/run/windows.h"
 #include "imufit/sim/simulator.h"
 #include "test_models.h"
+#include "window_cost.h"
 
 namespace imufit {
 namespace {

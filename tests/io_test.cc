@@ -18,7 +18,6 @@
 #include <gtest/gtest.h>
 
 #include "imufit/io/calibration.h"
-#include "imufit/io/correct_file.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
 #include "imufit/io/file_reads.h"
@@ -30,6 +29,7 @@
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
+#include "imufit/pipeline/correct_file.h"
 #include "test_models.h"
 #include "test_util.h"
 

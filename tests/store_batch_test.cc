@@ -21,9 +21,9 @@
 
 #include "imufit/factory/lot_summary.h"
 #include "imufit/factory/shard.h"
-#include "imufit/factory/store.h"
 #include "imufit/factory/store_history.h"
 #include "imufit/io/calibration.h"
+#include "imufit/store/store.h"
 #include "store_test_util.h"
 #include "test_util.h"
 

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "imufit/factory/store.h"
 #include "imufit/factory/store_history.h"
+#include "imufit/store/store.h"
 #include "store_test_util.h"
 #include "test_util.h"
 

@@ -25,9 +25,9 @@
 #include <gtest/gtest.h>
 
 #include "imufit/factory/lot_history.h"
-#include "imufit/factory/store.h"
 #include "imufit/factory/store_history.h"
 #include "imufit/io/error.h"
+#include "imufit/store/store.h"
 #include "store_test_util.h"
 #include "test_util.h"
 

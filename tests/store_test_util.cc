@@ -71,9 +71,9 @@ StoredFit MakeFit(const std::string& serial, const std::string& lot, const std::
   fit.status = "fitted";
   fit.verdict = verdict;
   fit.calibration_yaml = "calibration of " + serial + "\n";
-  StoredFigure x(MakeFigure("gyro_bias_dps.x", "gyro.bias.x", "deg/s", bias_dps, 0.01));
+  StoredFigure x{"gyro_bias_dps.x", "gyro.bias.x", "deg/s", bias_dps, 0.01};
   x.expanded_u = 0.02;
-  fit.figures = {x, StoredFigure(MakeFigure("gyro_bias_dps.y", "gyro.bias.y", "deg/s", 0.0, 0.01))};
+  fit.figures = {x, StoredFigure{"gyro_bias_dps.y", "gyro.bias.y", "deg/s", 0.0, 0.01}};
   return fit;
 }
 

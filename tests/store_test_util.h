@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "imufit/factory/store.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 

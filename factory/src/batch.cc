@@ -19,16 +19,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/base/text.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/lot_summary.h"
 #include "imufit/factory/report.h"
-#include "imufit/factory/store.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
-#include "imufit/model/text.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 

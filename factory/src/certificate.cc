@@ -7,12 +7,12 @@
 #include <utility>
 
 #include "certificate_sections.h"
-#include "imufit/factory/engineering_units.h"
 #include "imufit/factory/git_revision.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/sha256.h"
 #include "imufit/model/check.h"
+#include "imufit/report/engineering_units.h"
 
 namespace imufit {
 namespace {

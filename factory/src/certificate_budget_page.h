@@ -4,7 +4,7 @@
 #define IMUFIT_FACTORY_SRC_CERTIFICATE_BUDGET_PAGE_H_
 
 #include "imufit/factory/certificate.h"
-#include "imufit/factory/html.h"
+#include "imufit/report/html.h"
 
 namespace imufit::internal {
 

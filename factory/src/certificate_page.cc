@@ -4,10 +4,10 @@
 #include <array>
 
 #include "certificate_budget_page.h"
-#include "imufit/factory/allan_plot.h"
-#include "imufit/factory/html.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/output_file.h"
+#include "imufit/report/allan_plot.h"
+#include "imufit/report/html.h"
 #include "page.h"
 
 namespace imufit {

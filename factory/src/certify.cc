@@ -104,6 +104,17 @@ std::string FileTimeUtc(const std::string& path) {
 
 }  // namespace
 
+StoredFigure StoredFigureOf(const Figure& figure) {
+  StoredFigure g;
+  g.name = figure.name;
+  g.coefficient = figure.coefficient;
+  g.unit = figure.unit;
+  g.value = figure.value;
+  g.sigma = figure.sigma;
+  if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;
+  return g;
+}
+
 bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransaction* outputs) {
   if (settings.store == nullptr) {
     if (outputs != nullptr) outputs->Commit();
@@ -131,8 +142,7 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
       header && !header->acquired_utc.empty() ? header->acquired_utc : FileTimeUtc(unit->samples_path);
   if (header) row.part_number = header->model;
   for (const Figure& figure : unit->figures) {
-    StoredFigure g(figure);
-    if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;
+    StoredFigure g = StoredFigureOf(figure);
     for (const CriterionResult& c : unit->verdict_detail.criteria) {
       if (c.name != "|" + g.name + "|") continue;
       g.limit_abs = c.limit;

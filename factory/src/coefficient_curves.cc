@@ -3,13 +3,13 @@
 #include <utility>
 
 #include "certificate_sections.h"
-#include "imufit/factory/engineering_units.h"
+#include "imufit/report/engineering_units.h"
 
 // The coefficients against temperature (Certificate::curves), with each window's own estimate.
 //
 // A window w at temperature T_w, corrected through the shared model (validation.h: accelerometer
 // first, the gyro's g-sensitivity from the corrected specific force a^), leaves the error
-// e = corrected - truth (SI) and, mapped to raw units as the fit weighs it (fit/window_cost.h),
+// e = corrected - truth (SI) and, mapped to raw units as the fit weighs it (fit/src/window_cost.h),
 //
 //   r = diag(S) inv(M) e = B - V - H a^ - diag(S) inv(M) truth           (raw; H = 0 for accel)
 //

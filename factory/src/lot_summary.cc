@@ -4,11 +4,11 @@
 #include <cctype>
 #include <cmath>
 
+#include "imufit/base/text.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/git_revision.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/output_file.h"
-#include "imufit/model/text.h"
 
 namespace imufit {
 

@@ -5,8 +5,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "imufit/base/text.h"
 #include "imufit/factory/report.h"
-#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {}  // namespace

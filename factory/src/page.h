@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "imufit/factory/history_page.h"
-#include "imufit/factory/html.h"
 #include "imufit/factory/lot_history.h"
-#include "imufit/factory/plot.h"
+#include "imufit/report/html.h"
+#include "imufit/report/plot.h"
 
 namespace imufit::internal {
 

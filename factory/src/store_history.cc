@@ -134,7 +134,7 @@ BatchResult StoredLot(ResultsStore* store, const std::string& lot) {
     if (f.status == "fitted") u.calibrated_utc = f.time_utc;  // a batch's: the calibration's created_utc
     u.calibration_yaml = std::move(f.calibration_yaml);
     for (const StoredFigure& g : f.figures) {
-      u.figures.push_back(g);
+      u.figures.push_back(MakeFigure(g.name, g.coefficient, g.unit, g.value, g.sigma));
       if (g.outcome.empty()) continue;
       CriterionResult c;
       c.name = "|" + g.name + "|";

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "certificate_sections.h"
-#include "imufit/factory/engineering_units.h"
+#include "imufit/report/engineering_units.h"
 
 namespace imufit::internal {
 namespace {

@@ -1,9 +1,9 @@
 // FitOptions: its option table (model/option_table.h), its names and its checks.
 #include <algorithm>
 
+#include "imufit/base/enum_names.h"
+#include "imufit/base/text.h"
 #include "imufit/fit/thermal_fit.h"
-#include "imufit/model/enum_names.h"
-#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {

@@ -9,9 +9,9 @@
 #include <glog/logging.h>
 #include <Eigen/SVD>
 
-#include "imufit/fit/window_cost.h"
 #include "imufit/model/check.h"
 #include "thermal_fit_state.h"
+#include "window_cost.h"
 
 namespace imufit::internal {
 namespace {

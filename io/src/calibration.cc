@@ -233,4 +233,20 @@ std::string UtcNow() {
   return text;
 }
 
+YAML::Node CalibrationTree(const Calibration& calibration) {
+  // The coefficients as the file writes them; the records as nodes (their further keys keep how
+  // they were read); `extra` as read (an emitted and re-read YAML would lose the quotes).
+  Calibration coefficients = calibration;
+  coefficients.extra.reset(YAML::Node(YAML::NodeType::Map));  // rebinds; `=` would empty the shared node
+  coefficients.fit.reset();
+  coefficients.check.reset();
+  YAML::Node root = YAML::Load(CalibrationToYaml(coefficients));
+  if (calibration.fit) root.force_insert("fit", FitRecordNode(*calibration.fit));
+  if (calibration.check) root.force_insert("check", CheckRecordNode(*calibration.check));
+  if (calibration.extra.IsMap()) {
+    for (const auto& entry : calibration.extra) root.force_insert(entry.first.Scalar(), entry.second);
+  }
+  return root;
+}
+
 }  // namespace imufit

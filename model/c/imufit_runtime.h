@@ -16,7 +16,7 @@
  * is formed, so the cubics are never extrapolated (a NaN temperature counts as below the range);
  * imufit_correct() then returns IMUFIT_TEMP_CLAMPED. This differs from `imufit apply`, which
  * evaluates the cubics at any temperature, warns about samples beyond the fitted range, and
- * refuses a correction that is not a finite number (io/include/imufit/io/correct_file.h). Inside
+ * refuses a correction that is not a finite number (io/include/imufit/pipeline/correct_file.h). Inside
  * the range the two agree (docs/export.md: within 1e-12 relative in the double build, within the
  * derived float32 bound in the float build).
  *

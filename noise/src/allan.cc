@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <thread>
 
+#include "imufit/base/enum_names.h"
 #include "imufit/model/check.h"
-#include "imufit/model/enum_names.h"
 #include "imufit/noise/statistics.h"
 
 namespace imufit {

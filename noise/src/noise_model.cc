@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "imufit/base/enum_names.h"
 #include "imufit/model/constants.h"
-#include "imufit/model/enum_names.h"
 
 namespace imufit {
 namespace {

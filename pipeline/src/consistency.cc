@@ -5,8 +5,8 @@
 #include <map>
 #include <set>
 
+#include "imufit/base/text.h"
 #include "imufit/model/constants.h"
-#include "imufit/model/text.h"
 
 namespace imufit {
 namespace {

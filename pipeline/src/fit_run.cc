@@ -5,9 +5,9 @@
 #include <memory>
 #include <set>
 
+#include "imufit/base/text.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
-#include "imufit/model/text.h"
 #include "imufit/pipeline/consistency.h"
 #include "imufit/pipeline/unit_serial.h"
 #include "imufit/run/channel_check.h"

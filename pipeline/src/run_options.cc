@@ -4,11 +4,11 @@
 #include <iterator>
 #include <type_traits>
 
+#include "imufit/base/enum_names.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
-#include "imufit/model/enum_names.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {

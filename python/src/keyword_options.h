@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "binding.h"
-#include "imufit/model/option_table.h"
+#include "imufit/base/option_table.h"
 
 namespace imufit::python {
 

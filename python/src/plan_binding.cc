@@ -8,8 +8,8 @@
 #include "binding.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
-#include "imufit/pipeline/plan_check.h"
-#include "imufit/pipeline/plan_design.h"
+#include "imufit/plan/plan_check.h"
+#include "imufit/plan/plan_design.h"
 #include "keyword_options.h"
 
 namespace imufit::python {

@@ -12,9 +12,9 @@
 #include <utility>
 #include <vector>
 
-#include "imufit/factory/engineering_units.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/limits.h"
+#include "imufit/report/engineering_units.h"
 
 namespace imufit {
 struct UncertaintyBudget;
@@ -65,6 +65,8 @@ const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& 
 enum class Outcome { kPass, kConditionalPass, kConditionalFail, kFail };
 // "PASS", "conditional pass", "conditional fail", "FAIL".
 const char* OutcomeName(Outcome outcome);
+// The judgement of a figure the run does not measure (Figure::unresolved), as stored.
+inline constexpr const char* kNotResolved = "not resolved";
 
 struct CriterionResult {
   std::string name;   // e.g. "|gyro_bias_dps.x|", "sigma(gyro_bias_dps.x)", "fit_temp_range_c"

@@ -29,12 +29,10 @@
 #include "imufit/io/plan.h"
 #include "imufit/io/run_header.h"
 #include "imufit/io/station.h"
-#include "imufit/pipeline/plan_prediction.h"
 #include "imufit/pipeline/run_windows.h"
+#include "imufit/plan/plan_prediction.h"
 
 namespace imufit {
-
-inline constexpr double kCoverageFactor = 2.0;  // k of the expanded uncertainty
 
 struct ReportInput {
   std::string role;    // "calibration", "plan", "samples", "limits", "station"

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "imufit/factory/certificate.h"
-#include "imufit/factory/plot.h"
 #include "imufit/io/output_file.h"
+#include "imufit/report/plot.h"
 
 namespace imufit {
 

@@ -23,12 +23,12 @@
 #include <vector>
 
 #include "imufit/factory/acceptance.h"
-#include "imufit/factory/pdf.h"
-#include "imufit/factory/store.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/station.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/report/pdf.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 
@@ -103,6 +103,9 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
 // judged with the noise it measured) when given, else the calibration's alone.
 void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
                const std::optional<Verdict>& certified, UnitOutcome* unit);
+
+// A key figure as the store keeps it, not yet judged: U = kCoverageFactor x sigma.
+StoredFigure StoredFigureOf(const Figure& figure);
 
 // Records `unit`, whatever its status, in settings.store when there is one (safe from several
 // threads at once), committing `outputs` (may be null) with the row: both or neither. Returns

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "imufit/factory/lot_history.h"
-#include "imufit/factory/plot.h"
+#include "imufit/report/plot.h"
 
 namespace imufit {
 

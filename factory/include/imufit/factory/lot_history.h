@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "imufit/factory/store.h"
 #include "imufit/io/limits.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 

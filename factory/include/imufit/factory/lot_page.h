@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "imufit/factory/lot_summary.h"
-#include "imufit/factory/plot.h"
+#include "imufit/report/plot.h"
 
 namespace imufit {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "imufit/factory/batch.h"
-#include "imufit/factory/store.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 

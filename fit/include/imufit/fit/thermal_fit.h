@@ -38,7 +38,7 @@
 #include <string>
 #include <vector>
 
-#include "imufit/model/option_table.h"
+#include "imufit/base/option_table.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 #include "imufit/run/windows.h"

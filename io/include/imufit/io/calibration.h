@@ -44,6 +44,9 @@ struct Calibration {
 Calibration ReadCalibration(const std::string& path);
 // The file's text; `calibration.model.basis.half_range_c` must be 1.
 std::string CalibrationToYaml(const Calibration& calibration);
+// The file's tree, as CalibrationToYaml() writes it, with `extra`'s keys as they were read (a quoted
+// "12" stays a string): what an exporter writes in another syntax (JSON).
+YAML::Node CalibrationTree(const Calibration& calibration);
 // Writes atomically (OutputFile), in `transaction` when not null.
 void WriteCalibration(const std::string& path, const Calibration& calibration,
                       OutputTransaction* transaction = nullptr);

@@ -37,6 +37,10 @@ namespace imufit {
 
 inline constexpr int kLimitsFormatVersion = 1;
 
+// k of an expanded uncertainty U = k sigma (GUM; about 95 % for a normal distribution): the U that
+// limits are judged with, that certificates print and that the results store keeps.
+inline constexpr double kCoverageFactor = 2.0;
+
 enum class LimitKind {
   kCoefficient,  // a 25 degC coefficient value per axis: |value| (or its 1-sigma) < max_abs
   kFigure,       // one number without axes (residual RMS): value < max_abs

@@ -22,8 +22,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "imufit/base/noise_terms.h"
 #include "imufit/io/output_file.h"
-#include "imufit/model/noise_terms.h"
 
 namespace imufit {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "imufit/model/noise_terms.h"
+#include "imufit/base/noise_terms.h"
 #include "imufit/noise/allan.h"
 #include "imufit/noise/noise_model.h"
 

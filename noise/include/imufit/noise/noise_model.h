@@ -41,7 +41,7 @@
 #include <string_view>
 #include <vector>
 
-#include "imufit/model/noise_terms.h"
+#include "imufit/base/noise_terms.h"
 #include "imufit/noise/allan.h"
 
 namespace imufit {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "imufit/base/option_table.h"
 #include "imufit/io/plan.h"
-#include "imufit/model/option_table.h"
 #include "imufit/model/sample.h"
 #include "imufit/model/temperature_polynomial.h"
 #include "imufit/pipeline/segment_run.h"

@@ -1,0 +1,121 @@
+// imufit — a calibration exported to where it is used (`imufit export`, docs/export.md).
+//
+//   c       a C header for the firmware runtime (model/c/imufit_runtime.h): an initializer macro
+//   bin     the runtime's packed little-endian blob (magic, version, length, CRC-32), for EEPROM
+//   px4     PX4 parameters in the ground station's tab-separated .params format: the TC_G0_* /
+//           TC_A0_* bias cubics, CAL_ACC0_xSCALE
+//   ardupilot  ArduPilot parameters (.parm): INS_TCAL1_* about its fixed 35 degC, offsets and
+//           accelerometer scale at the calibration temperature
+//   kalibr  Kalibr's imu.yaml: the noise densities and its scale-misalignment intrinsics
+//   imucal  imucal's Ferraris JSON (K, R, b, K_ga) at one temperature
+//   json    the whole calibration in JSON (the calibration file's schema, docs/calibration.schema.json)
+//
+// Every format that cannot hold the whole model measures its loss before anything is written: the
+// full model (`imufit apply`'s SensorModel::Correct) and the consumer's own equations, evaluated
+// with the consumer's arithmetic (float32 where it uses it) on the numbers exactly as the file
+// prints them, over the envelope: the calibration's fitted temperature range x every axis of the
+// angular rate in [-full_scale, full_scale] x every axis of the specific force in [-max_g, max_g] g.
+// The loss (worst case and RMS per axis, deg/s and mg) and the provenance are written into the
+// exported file's comments (or its comment field).
+#ifndef IMUFIT_EXPORT_EXPORT_H_
+#define IMUFIT_EXPORT_EXPORT_H_
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "imufit/io/calibration.h"
+
+namespace imufit {
+
+enum class ExportFormat { kC, kBin, kPx4, kArduPilot, kKalibr, kImucal, kJson };
+
+const char* ToString(ExportFormat format);
+// nullopt for a name that is not a format.
+std::optional<ExportFormat> ExportFormatFromString(std::string_view name);
+// "c, bin, px4, ardupilot, kalibr, imucal, json".
+std::string ExportFormatNames();
+
+struct ExportOptions {
+  ExportFormat format = ExportFormat::kJson;
+  // The envelope the loss is measured over (with the calibration's fitted temperature range).
+  double full_scale_dps = 500.0;  // each axis of the angular rate in [-full_scale_dps, full_scale_dps]
+  double max_g = 2.0;             // each axis of the specific force in [-max_g, max_g] standard g
+  // What the consumer's driver divides the unit's raw output by to give SI (px4, ardupilot,
+  // kalibr, which read rad/s and m/s^2 from a driver): raw per rad/s, raw per m/s^2. 1 for a unit
+  // that reports SI; 939.65 for a +/-2000 deg/s gyro at 16.4 LSB per deg/s.
+  double gyro_raw_per_radps = 1.0;
+  double accel_raw_per_mps2 = 1.0;
+  // The temperature the one-temperature formats (kalibr, imucal) are taken at, degC; by default
+  // the calibration's reference temperature clamped to its fitted range.
+  std::optional<double> temp_c;
+  // px4: the sensor's device ID (TC_G0_ID, TC_A0_ID, CAL_GYRO0_ID, CAL_ACC0_ID); required.
+  std::optional<long long> device_id;
+  // c: the C identifier the header is named by (NAME_INITIALIZER, NAME_H_).
+  std::string c_name = "imufit_unit";
+  // kalibr: the IMU's ROS topic.
+  std::string rostopic = "/imu0";
+  // Provenance, written into the file: the exporting program, the calibration file (its base
+  // name) and the SHA-256 of its bytes.
+  std::string software;
+  std::string calibration_file;
+  std::string calibration_sha256;
+};
+
+// The error of the consumer's correction against the full model over the envelope, per axis.
+struct ExportLoss {
+  bool measured = false;  // false: nothing is lost (json, and the coefficients of c and bin)
+  long long points = 0;   // samples of the envelope evaluated
+  Eigen::Vector3d gyro_worst_dps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_rms_dps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_worst_mg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_rms_mg = Eigen::Vector3d::Zero();
+};
+
+struct ExportResult {
+  std::string content;  // the file's bytes
+  ExportLoss loss;
+  std::string consumer;  // the consumer and the version of its equations that were emulated
+  std::string envelope;  // the envelope, in words
+};
+
+// Thrown when the calibration cannot be exported to the format (exit status 1): a term the
+// consumer requires is missing (kalibr without a noise block), a serial too long for the blob.
+class ExportError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Converts, measures the loss, and returns the file's content with the loss and provenance in it.
+// Throws InputError for options the format cannot use (a px4 export without a device ID, a
+// non-positive envelope) and ExportError when the calibration cannot be exported.
+ExportResult ExportCalibration(const Calibration& calibration, const ExportOptions& options);
+
+// The loss as lines of text ("gyro  worst x .. y .. z .. deg/s, rms ..."), each prefixed.
+std::string DescribeLoss(const ExportResult& result, const std::string& prefix);
+
+// One line saying by how much the loss exceeds the bounds (worst case over the axes, deg/s and
+// mg), or nullopt when it is within them.
+std::optional<std::string> LossBeyondBounds(const ExportLoss& loss, double max_gyro_dps, double max_accel_mg);
+
+// The --format bin blob of model/c/imufit_runtime.h. Throws ExportError for a serial over 63
+// bytes.
+std::string CalibrationBlob(const Calibration& calibration, const std::string& sha256_hex);
+
+// A bound on the error of the float build of the C runtime against the full model (double) for
+// one sample, per output axis, derived by propagating the float32 rounding of every operation the
+// runtime performs (docs/export.md). Valid for a temperature inside the fitted range that, like the
+// reference temperature and the raw values, is exact in float.
+struct FloatRuntimeBound {
+  Eigen::Vector3d omega_radps;
+  Eigen::Vector3d a_mps2;
+};
+FloatRuntimeBound FloatRuntimeErrorBound(const SensorModel& model, double temp_c,
+                                         const Eigen::Vector3d& gyro_raw, const Eigen::Vector3d& accel_raw);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_EXPORT_EXPORT_H_

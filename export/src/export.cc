@@ -1,0 +1,149 @@
+// `imufit export`: the formats, the dispatch, the provenance and the loss's words.
+#include "imufit/export/export.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "export_internal.h"
+#include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
+
+namespace imufit {
+namespace {
+
+struct FormatName {
+  ExportFormat format;
+  const char* name;
+};
+constexpr FormatName kFormatNames[] = {
+    {ExportFormat::kC, "c"},           {ExportFormat::kBin, "bin"},
+    {ExportFormat::kPx4, "px4"},       {ExportFormat::kArduPilot, "ardupilot"},
+    {ExportFormat::kKalibr, "kalibr"}, {ExportFormat::kImucal, "imucal"},
+    {ExportFormat::kJson, "json"}};
+
+std::string Figures(const Eigen::Vector3d& v) {
+  char text[96];
+  std::snprintf(text, sizeof text, "x %.3g y %.3g z %.3g", v.x(), v.y(), v.z());
+  return text;
+}
+
+}  // namespace
+
+const char* ToString(ExportFormat format) {
+  for (const FormatName& entry : kFormatNames) {
+    if (entry.format == format) return entry.name;
+  }
+  return "?";
+}
+
+std::optional<ExportFormat> ExportFormatFromString(std::string_view name) {
+  for (const FormatName& entry : kFormatNames) {
+    if (name == entry.name) return entry.format;
+  }
+  return std::nullopt;
+}
+
+std::string ExportFormatNames() {
+  std::string names;
+  for (const FormatName& entry : kFormatNames) names += (names.empty() ? "" : ", ") + std::string(entry.name);
+  return names;
+}
+
+ExportResult ExportCalibration(const Calibration& calibration, const ExportOptions& options) {
+  using namespace export_internal;
+  const Envelope envelope = EnvelopeOf(calibration, options);
+  for (const auto& [name, value] : {std::pair{"--gyro-raw-per-radps", options.gyro_raw_per_radps},
+                                    {"--accel-raw-per-mps2", options.accel_raw_per_mps2}}) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw InputError(name, "the driver's scale must be a positive number, not " + FormatDouble(value));
+    }
+  }
+  if (options.temp_c && !(*options.temp_c >= calibration.fit_temp_range_c[0] &&
+                          *options.temp_c <= calibration.fit_temp_range_c[1])) {
+    throw InputError("--temp-c", FormatDouble(*options.temp_c) +
+                                     " degC is outside the calibration's fitted range [" +
+                                     FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                                     FormatDouble(calibration.fit_temp_range_c[1]) + "] degC");
+  }
+  switch (options.format) {
+    case ExportFormat::kC:
+      return ExportC(calibration, options, envelope);
+    case ExportFormat::kBin:
+      return ExportBin(calibration, options, envelope);
+    case ExportFormat::kPx4:
+      return ExportPx4(calibration, options, envelope);
+    case ExportFormat::kArduPilot:
+      return ExportArduPilot(calibration, options, envelope);
+    case ExportFormat::kKalibr:
+      return ExportKalibr(calibration, options, envelope);
+    case ExportFormat::kImucal:
+      return ExportImucal(calibration, options, envelope);
+    case ExportFormat::kJson:
+      return ExportJson(calibration, options);
+  }
+  return {};
+}
+
+std::string DescribeLoss(const ExportResult& result, const std::string& prefix) {
+  const ExportLoss& loss = result.loss;
+  if (!loss.measured) return prefix + "loss: none (every coefficient written as the calibration's double)\n";
+  return prefix + "loss against the full model over " + result.envelope + " (" + std::to_string(loss.points) +
+         " points):\n" + prefix + "  gyro  worst " + Figures(loss.gyro_worst_dps) + " deg/s, rms " +
+         Figures(loss.gyro_rms_dps) + " deg/s\n" + prefix + "  accel worst " + Figures(loss.accel_worst_mg) +
+         " mg, rms " + Figures(loss.accel_rms_mg) + " mg\n";
+}
+
+std::optional<std::string> LossBeyondBounds(const ExportLoss& loss, double max_gyro_dps,
+                                            double max_accel_mg) {
+  if (!loss.measured) return std::nullopt;
+  const double gyro = loss.gyro_worst_dps.maxCoeff(), accel = loss.accel_worst_mg.maxCoeff();
+  std::string excess;
+  char text[200];
+  if (gyro > max_gyro_dps) {
+    std::snprintf(text, sizeof text,
+                  "the gyro's worst-case loss %.4g deg/s exceeds the bound %g deg/s by %.4g deg/s", gyro,
+                  max_gyro_dps, gyro - max_gyro_dps);
+    excess = text;
+  }
+  if (accel > max_accel_mg) {
+    std::snprintf(text, sizeof text,
+                  "the accelerometer's worst-case loss %.4g mg exceeds the bound %g mg by %.4g mg", accel,
+                  max_accel_mg, accel - max_accel_mg);
+    excess += (excess.empty() ? "" : "; ") + std::string(text);
+  }
+  if (excess.empty()) return std::nullopt;
+  return excess;
+}
+
+namespace export_internal {
+
+std::string CalibrationFileName(const ExportOptions& options) {
+  return CommentSafe(options.calibration_file.substr(options.calibration_file.find_last_of('/') + 1));
+}
+
+std::vector<std::string> ProvenanceLines(const Calibration& calibration, const ExportOptions& options,
+                                         const ExportResult& result) {
+  std::vector<std::string> lines = {
+      "imufit calibration of unit " +
+          CommentSafe(calibration.serial.empty() ? "(no serial)" : calibration.serial) + ", for " +
+          result.consumer,
+      "calibration: " + CalibrationFileName(options) + ", SHA-256 " + CommentSafe(options.calibration_sha256),
+      "calibration made by: " + CommentSafe(calibration.software) + ", " +
+          CommentSafe(calibration.created_utc),
+      "exported by: " + CommentSafe(options.software) + " (imufit export --format " +
+          ToString(options.format) + ")",
+      "fitted temperature range [" + FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+          FormatDouble(calibration.fit_temp_range_c[1]) + "] degC, reference temperature " +
+          FormatDouble(calibration.model.basis.center_c) + " degC"};
+  std::string loss = DescribeLoss(result, "");
+  for (size_t start = 0; start < loss.size();) {
+    const size_t end = loss.find('\n', start);
+    lines.push_back(loss.substr(start, end - start));
+    start = end + 1;
+  }
+  return lines;
+}
+
+}  // namespace export_internal
+}  // namespace imufit

@@ -1,0 +1,181 @@
+// The plan check after the run (plan_prediction.h): the run's windows at nominal values, checked,
+// and the limiting row's predicted sigma next to the calibration's.
+#include "imufit/plan/plan_prediction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "imufit/model/constants.h"
+#include "imufit/pipeline/fit_run.h"
+
+namespace imufit {
+namespace {
+
+// The fit the calibration's record describes, with the bias stability its sigmas were weighted by
+// (the information depends on it).
+FitOptions FitOptionsOf(const FitRecord& record) {
+  FitOptions options = FitOptionsOfRecord(record);
+  options.gyro_bias_stability_radps = record.gyro_bias_stability_radps.value_or(0.0);
+  options.accel_bias_stability_mps2 = record.accel_bias_stability_mps2.value_or(0.0);
+  options.bias_correlation_s = record.bias_correlation_s.value_or(options.bias_correlation_s);
+  return options;
+}
+
+// Scale factor of `axis` at `temp_c`, raw per SI unit.
+double ScaleAt(const SensorModel& model, bool gyro, int axis, double temp_c) {
+  const double* params =
+      (gyro ? model.gyro.data() : model.accel.data()) + (kScaleCoefficient + axis) * kPolynomialTerms;
+  return std::abs(EvaluateTemperaturePolynomial(params, model.basis.Argument(temp_c)));
+}
+
+// The calibration's 1-sigma of `row`'s term in the row's display unit: a raw-unit coefficient over
+// the scale factor of its axis (the row of a g-sensitivity) at 25 degC, as the nominal unit (scale
+// 1) states it. Exact for the 25 degC reference imufit writes.
+double AchievedSigma(const Calibration& calibration, const PlanRow& row) {
+  const SensorModel& model = calibration.model;
+  const double* sigmas = row.gyro ? calibration.sigma->gyro.data() : calibration.sigma->accel.data();
+  const int c = row.coefficient;
+  double divisor = 1.0;
+  if (c < kMisalignmentCoefficient) divisor = ScaleAt(model, row.gyro, c % 3, kReferenceTempC);
+  if (c >= kGSensitivityCoefficient)
+    divisor = ScaleAt(model, row.gyro, (c - kGSensitivityCoefficient) / 3, kReferenceTempC);
+  const double sigma = sigmas[c * kPolynomialTerms + row.term] / std::pow(model.basis.half_range_c, row.term);
+  return divisor > 0.0 ? sigma * PlanGroupFactor(row.group) / divisor : -1.0;
+}
+
+// The key figure (acceptance.h's KeyFigures names) of a 25 degC coefficient.
+std::string FigureOf(const PlanRow& row) {
+  static const std::map<std::string, std::string> kQuantities = {
+      {"gyro.bias", "gyro_bias_dps"},
+      {"accel.bias", "accel_bias_mg"},
+      {"gyro.scale", "gyro_scale_per_dps"},
+      {"accel.scale", "accel_scale_per_g"},
+      {"gyro.misalignment", "gyro_misalignment_mrad"},
+      {"accel.misalignment", "accel_misalignment_mrad"},
+      {"gyro.g_sensitivity", "gyro_g_sensitivity_dpsg"}};
+  const auto quantity = kQuantities.find(row.group);
+  if (row.term != 0 || quantity == kQuantities.end()) return "";
+  return quantity->second + "." + kCoefficientNames[row.coefficient].axis;
+}
+
+}  // namespace
+
+void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances) {
+  struct Map {
+    const char* quantity;
+    const char* group;
+    double factor;
+  };
+  static const Map kMaps[] = {{"gyro_bias_dps", "gyro.bias", 1.0},
+                              {"accel_bias_mg", "accel.bias", 1.0},
+                              {"gyro_scale_error_ppm", "gyro.scale", 1.0},
+                              {"gyro_scale_error_pct", "gyro.scale", 1e4},
+                              {"accel_scale_error_ppm", "accel.scale", 1.0},
+                              {"accel_scale_error_pct", "accel.scale", 1e4},
+                              {"gyro_misalignment_mrad", "gyro.misalignment", 1.0},
+                              {"accel_misalignment_mrad", "accel.misalignment", 1.0},
+                              {"gyro_g_sensitivity_dpsg", "gyro.g_sensitivity", 1.0}};
+  for (const LimitCriterion& criterion : limits.criteria) {
+    const double half_width = criterion.max_abs > 0.0          ? criterion.max_abs
+                              : criterion.min && criterion.max ? 0.5 * (*criterion.max - *criterion.min)
+                                                               : 0.0;
+    if (!(half_width > 0.0)) continue;
+    for (const Map& m : kMaps) {
+      if (criterion.quantity != m.quantity) continue;
+      const double tolerance = half_width * m.factor;
+      auto [it, inserted] = tolerances->emplace(m.group, tolerance);
+      if (!inserted) it->second = std::min(it->second, tolerance);
+    }
+  }
+}
+
+std::vector<Window> NominalWindows(const std::vector<Window>& run, const Plan& plan,
+                                   const SensorModel& fitted) {
+  std::map<int, const TableSegment*> segments;
+  for (const TableSegment& s : plan.segments) segments[s.id] = &s;
+  std::vector<Window> windows;
+  for (Window w : run) {
+    const auto segment = segments.find(w.segment);
+    if (segment == segments.end()) continue;
+    const SegmentTruth truth = segment->second->IsTurn()
+                                   ? TurnTruth(plan.site, *segment->second, w.DurationS())
+                                   : TruthOf(plan.site, *segment->second);
+    w.gyro_mean = truth.omega_radps;
+    w.accel_mean = truth.a_mps2;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double gyro_scale = ScaleAt(fitted, true, axis, w.temp_c);
+      const double accel_scale = ScaleAt(fitted, false, axis, w.temp_c);
+      if (!(gyro_scale > 0.0) || !(accel_scale > 0.0)) return {};
+      w.gyro_std[axis] /= gyro_scale;
+      w.gyro_noise[axis] /= gyro_scale;
+      w.accel_std[axis] /= accel_scale;
+      w.accel_noise[axis] /= accel_scale;
+    }
+    windows.push_back(w);
+  }
+  return windows;
+}
+
+LimitingPrediction PredictLimiting(const Calibration& calibration, const Plan& plan,
+                                   const std::vector<Window>& windows,
+                                   const std::map<std::string, double>& tolerances) {
+  LimitingPrediction prediction;
+  if (!calibration.fit || !calibration.sigma) {
+    prediction.why_not = "the calibration has no fit record or no sigmas";
+    return prediction;
+  }
+  const std::vector<Window> nominal = NominalWindows(windows, plan, calibration.model);
+  if (nominal.empty()) {
+    prediction.why_not = "no window of the run belongs to the plan";
+    return prediction;
+  }
+  PlanCheckOptions options;
+  options.tolerances = tolerances;
+  const PlanCheck check =
+      CheckWindows(nominal, plan.segments, plan.site, FitOptionsOf(*calibration.fit), options);
+  if (!check.undetermined.empty() || check.rows.empty()) {
+    prediction.why_not = "the run's windows do not determine the model at nominal values";
+    return prediction;
+  }
+  const PlanRow& row = check.rows.front();
+  prediction.name = row.name;
+  prediction.unit = row.unit;
+  prediction.term = row.term;
+  prediction.tolerance = row.tolerance;
+  prediction.ratio = row.ratio;
+  prediction.predicted_sigma = row.sigma;
+  prediction.achieved_sigma = AchievedSigma(calibration, row);
+  prediction.figure = FigureOf(row);
+  return prediction;
+}
+
+std::string LimitingPredictionText(const LimitingPrediction& p) {
+  if (!p.why_not.empty()) return "not predicted: " + p.why_not;
+  const auto number = [&](double value) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.3g ", value);
+    return text + p.unit;
+  };
+  std::string line = p.tolerance > 0.0
+                         ? p.name
+                         : "no tolerances given (no limits file); the sigma that grows most over "
+                           "the range, " +
+                               p.name;
+  line += ": predicted sigma " + number(p.predicted_sigma) + ", achieved " +
+          (p.achieved_sigma >= 0.0 ? number(p.achieved_sigma) : std::string("not stated"));
+  if (p.achieved_expanded >= 0.0) line += " (U " + number(p.achieved_expanded) + ")";
+  if (p.term == 0) line += ", at 25 degC";
+  if (p.tolerance > 0.0) {
+    char ratio[80];
+    std::snprintf(ratio, sizeof ratio, ", predicted %g sigma over the range / tolerance %.3g",
+                  PlanCheckOptions().z, p.ratio);
+    line += "; tolerance " + number(p.tolerance) + ratio;
+  }
+  return line;
+}
+
+}  // namespace imufit
