@@ -50,6 +50,48 @@ class PostgresRow : public SqlRow {
 
 using Result = std::unique_ptr<PGresult, decltype(&PQclear)>;
 
+// The password a connection string carries, as written ("" when none): after the user in a URL's
+// user information (postgresql://user:PASSWORD@host/db, even when the rest of the URL is malformed),
+// or a keyword/value string's password=PASSWORD (quoted or not).
+std::string PasswordIn(const std::string& target) {
+  const size_t scheme = target.find("://");
+  if (scheme != std::string::npos) {
+    const size_t start = scheme + 3;
+    const size_t at = target.find('@', start);
+    const size_t slash = target.find('/', start);
+    if (at == std::string::npos || (slash != std::string::npos && slash < at)) return "";
+    const size_t colon = target.find(':', start);
+    return colon != std::string::npos && colon < at ? target.substr(colon + 1, at - colon - 1) : "";
+  }
+  for (size_t key = target.find("password"); key != std::string::npos;
+       key = target.find("password", key + 1)) {
+    if (key > 0 && target[key - 1] != ' ' && target[key - 1] != '\t') continue;
+    size_t at = target.find_first_not_of(" \t", key + 8);
+    if (at == std::string::npos || target[at] != '=') continue;
+    at = target.find_first_not_of(" \t", at + 1);
+    if (at == std::string::npos) return "";
+    if (target[at] != '\'') return target.substr(at, target.find_first_of(" \t", at) - at);
+    std::string value;
+    for (size_t i = at + 1; i < target.size() && target[i] != '\''; ++i) {
+      if (target[i] == '\\' && i + 1 < target.size()) ++i;
+      value += target[i];
+    }
+    return value;
+  }
+  return "";
+}
+
+// `text` with every occurrence of the password `target` carries replaced: no message, log or
+// file ever holds a password.
+std::string WithoutPassword(std::string text, const std::string& target) {
+  const std::string password = PasswordIn(target);
+  if (password.empty()) return text;
+  for (size_t at = text.find(password); at != std::string::npos; at = text.find(password, at + 3)) {
+    text.replace(at, password.size(), "***");
+  }
+  return text;
+}
+
 // What errors name: database, host and user from the connection string (never a password).
 std::string DisplayName(const PQconninfoOption* options, const std::string& target) {
   std::string database, host;
@@ -58,7 +100,7 @@ std::string DisplayName(const PQconninfoOption* options, const std::string& targ
     if (std::string(o->keyword) == "dbname") database = o->val;
     if (std::string(o->keyword) == "host") host = o->val;
   }
-  if (database.empty() && host.empty()) return target;
+  if (database.empty() && host.empty()) return WithoutPassword(target, target);
   return "postgresql database " + (database.empty() ? std::string("(default)") : database) +
          (host.empty() ? "" : " on " + host);
 }
@@ -69,9 +111,10 @@ class PostgresConnection : public SqlConnection {
     char* error = nullptr;
     PQconninfoOption* options = PQconninfoParse(target.c_str(), &error);
     if (!options) {
-      const std::string message = error ? error : "out of memory";
+      const std::string message = error ? Trimmed(error) : "out of memory";
       PQfreemem(error);
-      throw InputError("results store", "not a PostgreSQL connection string: " + message);
+      throw InputError("results store",
+                       "not a PostgreSQL connection string: " + WithoutPassword(message, target));
     }
     name_ = DisplayName(options, target);
     bool has_password = false;
@@ -86,7 +129,8 @@ class PostgresConnection : public SqlConnection {
     if (PQstatus(connection_) != CONNECTION_OK) {
       const std::string message = PQerrorMessage(connection_);
       PQfinish(connection_);
-      throw InputError(name_, "cannot connect to the results store: " + Trimmed(message));
+      throw InputError(name_,
+                       "cannot connect to the results store: " + WithoutPassword(Trimmed(message), target));
     }
     Execute("SET client_min_messages = warning");
   }
@@ -114,11 +158,28 @@ class PostgresConnection : public SqlConnection {
   }
 
   void Begin(bool exclusive) override {
+    if (detached_) return Execute("SAVEPOINT imufit_step");  // inside the transaction that is never committed
     Execute("BEGIN");
     if (exclusive) Execute("SELECT pg_advisory_xact_lock(" + std::to_string(kSchemaLockKey) + ")");
   }
-  void Commit() override { Execute("COMMIT"); }
-  void Rollback() override { PQclear(PQexec(connection_, "ROLLBACK")); }
+  void Commit() override { Execute(detached_ ? "RELEASE SAVEPOINT imufit_step" : "COMMIT"); }
+  void Rollback() override {
+    PQclear(PQexec(connection_, detached_ ? "ROLLBACK TO SAVEPOINT imufit_step" : "ROLLBACK"));
+  }
+
+  // A read of an older schema: the migration and every later statement run in one transaction that
+  // is rolled back when the connection closes.
+  void Detach() override {
+    Execute("BEGIN");
+    detached_ = true;
+  }
+
+  std::vector<std::string> Tables() override {
+    std::vector<std::string> tables;
+    Query("SELECT table_name FROM information_schema.tables WHERE table_schema = current_schema() ORDER BY 1",
+          {}, [&](const SqlRow& row) { tables.push_back(row.Text(0)); });
+    return tables;
+  }
 
   bool HasTable(const std::string& table) override {
     bool found = false;
@@ -146,6 +207,7 @@ class PostgresConnection : public SqlConnection {
 
   std::string name_;
   PGconn* connection_ = nullptr;
+  bool detached_ = false;
 };
 
 }  // namespace
@@ -153,7 +215,7 @@ class PostgresConnection : public SqlConnection {
 bool IsPostgresStore(const std::string& target) {
   if (target.rfind("postgresql://", 0) == 0 || target.rfind("postgres://", 0) == 0) return true;
   // libpq's keyword/value form: "host=... dbname=..." (an SQLite file name has no '=' in practice).
-  for (const char* keyword : {"dbname=", "host=", "service="}) {
+  for (const char* keyword : {"dbname=", "host=", "hostaddr=", "port=", "user=", "password=", "service="}) {
     if (target.rfind(keyword, 0) == 0 || target.find(std::string(" ") + keyword) != std::string::npos)
       return true;
   }

@@ -12,6 +12,9 @@
 #include <variant>
 #include <vector>
 
+#include <string>
+#include <vector>
+
 #include "imufit/store/store.h"
 
 namespace imufit {
@@ -46,6 +49,18 @@ class SqlConnection {
   virtual void Commit() = 0;
   virtual void Rollback() = 0;  // harmless when no transaction is open
   virtual bool HasTable(const std::string& table) = 0;
+  // Every table of the database's schema (SQLite's main database; PostgreSQL's current schema),
+  // imufit's or not, in name order.
+  virtual std::vector<std::string> Tables() = 0;
+  // Whether this connection may change the database (a read of a read-only file may not).
+  virtual bool Writable() const { return true; }
+  // A read that must not change the database but needs it migrated: from now on the connection
+  // works on a private copy (SQLite: in memory) or inside a transaction that is never committed
+  // (PostgreSQL); nothing reaches the database.
+  virtual void Detach() = 0;
+  // Called once the database is known to be an imufit store of the current schema: the SQLite
+  // backend switches a writable file to WAL (never done to a database that is not imufit's).
+  virtual void Ready() {}
   // Called in the transaction that created or migrated the schema to `version` (SQLite keeps it in
   // its user_version too).
   virtual void SchemaWritten(int /*version*/) {}

@@ -25,6 +25,18 @@ InputError UnsupportedVersion(const std::string& name, int64_t found) {
                               std::to_string(kStoreSchemaVersion) + "; use the imufit that wrote it)");
 }
 
+// Why a database that holds other tables is not used: it is not imufit's.
+std::string ForeignDatabaseMessage(const std::vector<std::string>& tables) {
+  constexpr size_t kNamed = 4;  // tables named in the message; the rest are counted
+  std::string names;
+  for (size_t i = 0; i < tables.size() && i < kNamed; ++i) names += (i ? ", " : "") + tables[i];
+  if (tables.size() > kNamed) names += ", ...";
+  return "not an imufit results store: it holds " + std::to_string(tables.size()) +
+         (tables.size() == 1 ? " table" : " tables") + " of another application (" + names +
+         "), left as they are; imufit creates its store only in a new file or an empty database (give "
+         "another --store)";
+}
+
 // A prepared statement, finalized on scope exit.
 class Statement {
  public:
@@ -100,11 +112,7 @@ class SqliteConnection : public SqlConnection {
                          "records every fit in it (give another --store)");
       }
       CheckUserVersion();
-      if (flags != SQLITE_OPEN_READONLY) {
-        // Changing the journal mode takes the database exclusively and does not wait on its own.
-        ExecuteWaiting("PRAGMA journal_mode = WAL");
-        Execute("PRAGMA synchronous = NORMAL");  // durable across a process crash; WAL keeps it consistent
-      }
+      writable_ = flags != SQLITE_OPEN_READONLY;
       Execute("PRAGMA foreign_keys = ON");
     } catch (...) {
       sqlite3_close(db_);  // the destructor does not run for a constructor that throws
@@ -112,6 +120,45 @@ class SqliteConnection : public SqlConnection {
     }
   }
   ~SqliteConnection() override { sqlite3_close(db_); }
+
+  bool Writable() const override { return writable_; }
+
+  void Ready() override {
+    if (!writable_) return;
+    // Changing the journal mode takes the database exclusively and does not wait on its own.
+    ExecuteWaiting("PRAGMA journal_mode = WAL");
+    Execute("PRAGMA synchronous = NORMAL");  // durable across a process crash; WAL keeps it consistent
+  }
+
+  // The whole file copied into an in-memory database (SQLite's online backup), which the reader
+  // then migrates and queries; the file is not written.
+  void Detach() override {
+    sqlite3* memory = nullptr;
+    if (sqlite3_open_v2(":memory:", &memory, SQLITE_OPEN_READWRITE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
+        SQLITE_OK) {
+      sqlite3_close(memory);
+      throw InputError(path_, "results store: cannot open an in-memory copy to read it");
+    }
+    sqlite3_backup* backup = sqlite3_backup_init(memory, "main", db_, "main");
+    const int step = backup ? sqlite3_backup_step(backup, -1) : SQLITE_ERROR;
+    sqlite3_backup_finish(backup);
+    if (step != SQLITE_DONE) {
+      const std::string message = sqlite3_errmsg(memory);
+      sqlite3_close(memory);
+      throw InputError(path_, "results store: cannot copy it to read it: " + message);
+    }
+    sqlite3_close(db_);
+    db_ = memory;
+    writable_ = false;  // the copy is never written back: no WAL for it either
+    Execute("PRAGMA foreign_keys = ON");
+  }
+
+  std::vector<std::string> Tables() override {
+    std::vector<std::string> tables;
+    Query("SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT LIKE 'sqlite_%' ORDER BY name",
+          {}, [&](const SqlRow& row) { tables.push_back(row.Text(0)); });
+    return tables;
+  }
 
   const std::string& name() const override { return path_; }
   const char* backend() const override { return "sqlite"; }
@@ -189,6 +236,7 @@ class SqliteConnection : public SqlConnection {
 
   std::string path_;
   sqlite3* db_ = nullptr;
+  bool writable_ = false;
 };
 
 // The schema, once for both backends: TEXT and the numbered id are the backend's (TextType(),
@@ -380,7 +428,9 @@ std::unique_ptr<SqlConnection> OpenSqlite(const std::string& path, StoreAccess a
 }
 
 ResultsStore::ResultsStore(const std::string& target, StoreAccess access)
-    : path_(target), db_(IsPostgresStore(target) ? ConnectPostgres(target) : OpenSqlite(target, access)) {
+    : path_(target),
+      access_(access),
+      db_(IsPostgresStore(target) ? ConnectPostgres(target) : OpenSqlite(target, access)) {
   path_ = db_->name();
   Open();
 }
@@ -390,22 +440,46 @@ ResultsStore::~ResultsStore() = default;
 const char* ResultsStore::backend() const { return db_->backend(); }
 
 void ResultsStore::Open() {
-  Transaction transaction(db_.get(), /*exclusive=*/true);
-  if (!db_->HasTable("schema_version")) {
-    bool empty = true;
-    if (db_->HasTable("fits")) empty = false;
-    if (!empty) throw InputError(path_, "not an imufit results store (no schema_version table)");
-    db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kLatestFiguresSchema));
-    db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) + ")");
-    db_->SchemaWritten(kStoreSchemaVersion);
-  }
   int64_t found = -1;
-  db_->Query("SELECT version FROM schema_version", {}, [&](const SqlRow& row) { found = row.Integer(0); });
-  if (found > kStoreSchemaVersion || found < 1) throw UnsupportedVersion(path_, found);
-  if (found == 1) MigrateFromVersion1();  // to the current schema
-  if (found == 2) MigrateFromVersion2();
-  if (found == 2 || found == 3) MigrateFromVersion3();
-  transaction.Commit();
+  {
+    Transaction transaction(db_.get(), /*exclusive=*/true);
+    if (!db_->HasTable("schema_version")) {
+      // The schema goes only into a new file or an empty database, and never on a read: a database
+      // of another application is refused before anything in it changes (its journal mode included).
+      const std::vector<std::string> tables = db_->Tables();
+      if (!tables.empty()) throw InputError(path_, ForeignDatabaseMessage(tables));
+      if (access_ == StoreAccess::kRead) {
+        throw InputError(path_,
+                         "holds no results store: the database is empty (imufit fit --store and imufit "
+                         "batch --store create one; a read creates nothing)");
+      }
+      db_->Execute(SchemaFor(*db_, std::string(kSchema) + kLatestFitsSchema + kLatestFiguresSchema));
+      db_->Execute("INSERT INTO schema_version (version) VALUES (" + std::to_string(kStoreSchemaVersion) +
+                   ")");
+      db_->SchemaWritten(kStoreSchemaVersion);
+    }
+    db_->Query("SELECT version FROM schema_version", {}, [&](const SqlRow& row) { found = row.Integer(0); });
+    if (found > kStoreSchemaVersion || found < 1) throw UnsupportedVersion(path_, found);
+    if (found == kStoreSchemaVersion || access_ == StoreAccess::kRecord) {
+      Migrate(found);
+      transaction.Commit();
+    }
+  }
+  if (found != kStoreSchemaVersion && access_ == StoreAccess::kRead) {
+    // A read never writes, and a read-only store of an older schema can still be read: the
+    // migration runs on a private copy.
+    db_->Detach();
+    Transaction transaction(db_.get(), /*exclusive=*/true);
+    Migrate(found);
+    transaction.Commit();
+  }
+  db_->Ready();
+}
+
+void ResultsStore::Migrate(int64_t from_version) {
+  if (from_version == 1) MigrateFromVersion1();  // to the current schema
+  if (from_version == 2) MigrateFromVersion2();
+  if (from_version == 2 || from_version == 3) MigrateFromVersion3();
 }
 
 // Version 1 (SQLite only): fits(id, serial, unit, lot, time_utc, software, plan_sha256,

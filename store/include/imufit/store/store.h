@@ -47,7 +47,9 @@ inline constexpr int kStoreSchemaVersion = 4;
 inline constexpr int kStoreBusyWaitSeconds = 60;
 
 // How a store is opened: to record fits (created when missing; refused when it may not be
-// written), or to read an existing one (`imufit history`).
+// written), or to read an existing one (`imufit history`, `lot`, the sources of a merge): a read
+// never writes, creates nothing, and reads a store of an older schema through a migrated private
+// copy. Either way a database that holds tables of another application is refused untouched.
 enum class StoreAccess { kRecord, kRead };
 
 // A key figure as stored: its value, its expanded uncertainty and how it was judged. A plain row:
@@ -209,7 +211,8 @@ class ResultsStore {
   std::vector<LotFigureStats> LotStats(const std::vector<std::string>& figures);
 
  private:
-  void Open();  // schema, version check, migration
+  void Open();                         // schema, version check, migration
+  void Migrate(int64_t from_version);  // inside Open()'s transaction
   void MigrateFromVersion1();
   void MigrateFromVersion2();
   void MigrateFromVersion3();
@@ -217,6 +220,7 @@ class ResultsStore {
   std::vector<StoredFit> Fits(const std::string& where, const std::vector<std::string>& parameters);
 
   std::string path_;
+  StoreAccess access_;
   std::unique_ptr<SqlConnection> db_;
   std::mutex mutex_;  // one statement at a time on the connection
 };
@@ -233,7 +237,10 @@ struct MergeResult {
 
 // Copies every fit of each source store (SQLite files or PostgreSQL databases, which must exist)
 // into `destination` (created when it is a missing SQLite file), one transaction per source.
-// Idempotent: a fit the destination holds already (same content key) is left as it is.
+// Idempotent: a fit the destination holds already (same content key) is left as it is. Every
+// source is read (as `imufit history` reads: never written) before the destination is opened, so
+// a refused source leaves the destination untouched, or uncreated; a source that is the
+// destination itself is refused.
 std::vector<MergeResult> MergeStores(const std::vector<std::string>& sources, const std::string& destination);
 
 }  // namespace imufit
