@@ -112,7 +112,7 @@ CommandRunner AddBatchCommand(CLI::App* root) {
       "OUT_DIR/<serial>)");
   command->add_option("--samples-glob", b.samples_glob,
                       "each unit folder's samples file as the logger names it: the one file matching this "
-                      "pattern (e.g. '*_imu.csv.gz'; default samples.csv.gz, else samples.csv)");
+                      "pattern (e.g. '*_imu.csv.gz'; default samples.csv.gz or samples.csv, not both)");
   command->add_option("--output,-o", b.output_dir, "output folder")->required();
   command->add_option("--limits,-l", b.limits_path, "acceptance limits YAML (format imufit-limits)");
   command->add_option("--plan,-p", b.shared_plan, "plan for units without their own plan.yaml");

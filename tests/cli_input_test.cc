@@ -3,6 +3,7 @@
 // IMU cannot report (kelvin, fill values), and the calibration of the right unit.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -391,6 +392,69 @@ TEST_F(CliInputTest, ColumnMapReadsALoggersOwnNames) {
   r = Fit(logger);
   EXPECT_EQ(r.status, 2);
   ExpectOneLine(r, "no columns \"time_s\", \"gyro_y\" and \"temp_c\" in the header");
+}
+
+// Two units' logs in one file: a `# serial:` line among the samples naming another unit, or the
+// column names again (two files joined with cat), is refused at its line; a unit folder with both
+// samples.csv and samples.csv.gz is the unit's error, not a guess. The correct log still fits.
+TEST_F(CliInputTest, ALogOfTwoUnitsIsRefusedWhereTheSecondBegins) {
+  ASSERT_EQ(Run(SmallRunArgs(Path("a.csv"), {"--serial", "SN-A", "--seed", "3"})).status, 0);
+  ASSERT_EQ(Run(SmallRunArgs(Path("b.csv"), {"--serial", "SN-B", "--seed", "4"})).status, 0);
+  const std::string a = ReadBytes(Path("a.csv")), b = ReadBytes(Path("b.csv"));
+  const long a_lines = std::count(a.begin(), a.end(), '\n');
+  // b's samples shifted after a's in time, as a logger that keeps running writes them.
+  const std::string b_later = MapColumn(b, "time_s", [](const std::string& t, int) {
+    std::ostringstream text;
+    text.precision(17);
+    text << std::stod(t) + 100000.0;
+    return text.str();
+  });
+  // The second log's header kept (comments, then the column names), as `cat a.csv b.csv` gives.
+  std::ofstream(Path("cat.csv")) << a << b_later;
+  RunResult r = Fit(Path("cat.csv"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  // The error is at b's `# serial:` line, its second.
+  const long b_serial_line = a_lines + 1 + std::count(b.begin(), b.begin() + b.find("# serial:"), '\n');
+  ExpectOneLine(r,
+                "cat.csv:" + std::to_string(b_serial_line) +
+                    ":11: a second unit \"SN-B\" begins here, among the samples (the header names "
+                    "\"SN-A\"): two logs in one file? Split it at this line and fit each unit's log alone");
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  // Without the second header's comments: the column names among the samples.
+  std::string b_rows = b_later.substr(b_later.find("time_s"));
+  std::ofstream(Path("joined.csv")) << a << b_rows;
+  r = Fit(Path("joined.csv"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  ExpectOneLine(r, "joined.csv:" + std::to_string(a_lines + 1) +
+                       ":1: time_s: the column names again, among the samples: two logs in one file?");
+  // apply and allan read the same way.
+  r = Run({"apply", "-c", Fixture("mems_truth.yaml"), "-s", Path("cat.csv"), "-o", Path("out.csv"),
+           "--allow-mismatch"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("a second unit \"SN-B\" begins here"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("out.csv")));
+  // The same serial repeated among the samples (a logger that repeats its header) is one unit.
+  std::string repeated = a;
+  const size_t middle = repeated.find('\n', repeated.size() / 2) + 1;
+  repeated.insert(middle, "# serial: SN-A\n");
+  std::ofstream(Path("repeated.csv")) << repeated;
+  r = Fit(Path("repeated.csv"));
+  EXPECT_EQ(r.status, 0) << r.err;
+
+  // A batch unit folder with both files: that unit's error, naming both.
+  const fs::path units = Path("units");
+  fs::create_directories(units / "u1");
+  fs::copy_file(Fixture("plan_6pos.yaml"), units / "u1" / "plan.yaml");
+  fs::copy_file(Path("a.csv"), units / "u1" / "samples.csv");
+  ASSERT_EQ(Run(SmallRunArgs((units / "u1" / "samples.csv.gz").string(), {"--serial", "SN-A", "--seed", "9"}))
+                .status,
+            0);
+  r = Run({"batch", units.string(), "-o", Path("batch_out"), "-q"});
+  EXPECT_NE(r.status, 0) << r.err;
+  const std::string summary = ReadBytes(Path("batch_out") + "/lot_summary.csv");
+  EXPECT_NE(summary.find("holds both samples.csv and samples.csv.gz: which is this unit's run?"),
+            std::string::npos)
+      << summary << r.err;
 }
 
 }  // namespace

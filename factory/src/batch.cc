@@ -203,13 +203,18 @@ std::string FolderContents(const fs::path& dir) {
   return "it has: " + Join(shown, ", ") + (more > 0 ? " and " + std::to_string(more) + " more" : "");
 }
 
-// The unit folder's samples file: the one file matching --samples-glob, else samples.csv.gz, else
-// samples.csv.
+// The unit folder's samples file: the one file matching --samples-glob, else samples.csv.gz or
+// samples.csv. A folder with both (today's run beside yesterday's) is refused: which one is this
+// unit's run is not imufit's to guess.
 std::string FindSamples(const BatchOptions& options, const fs::path& unit_dir) {
   if (options.samples_glob.empty()) {
-    for (const char* name : {"samples.csv.gz", "samples.csv"}) {
-      if (fs::exists(unit_dir / name)) return (unit_dir / name).string();
+    const bool gz = fs::exists(unit_dir / "samples.csv.gz"), plain = fs::exists(unit_dir / "samples.csv");
+    if (gz && plain) {
+      throw InputError(unit_dir.string(),
+                       "holds both samples.csv and samples.csv.gz: which is this unit's run? (move the other "
+                       "away, or name one with --samples-glob)");
     }
+    if (gz || plain) return (unit_dir / (gz ? "samples.csv.gz" : "samples.csv")).string();
     throw InputError(unit_dir.string(), "no samples.csv or samples.csv.gz (" + FolderContents(unit_dir) +
                                             "; --samples-glob names the logger's samples file)");
   }

@@ -438,8 +438,17 @@ void CsvReader::SplitLine(std::string_view line) {
 
 bool CsvReader::NextRow() {
   std::string_view line;
+  row_comments_.clear();
   while (NextLine(&line)) {
-    if (line.empty() || line.front() == '#') continue;
+    if (line.empty()) continue;
+    if (line.front() == '#') {
+      if (row_comments_.size() < kMaxRowComments) {
+        const std::string_view text = Trim(line.substr(1));
+        const long column = static_cast<long>(text.data() - line.data()) + 1;
+        row_comments_.push_back({line_number_, column, std::string(text.substr(0, kMaxHeaderCommentBytes))});
+      }
+      continue;
+    }
     if (Trim(line).empty()) continue;
     SplitLine(line);
     if (field_count_ > header_.size()) {

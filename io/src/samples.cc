@@ -1,13 +1,16 @@
 #include "imufit/io/samples.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
@@ -25,16 +28,36 @@ bool HasControlCharacter(const std::string& text) {
                      [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
 }
 
+// Whether a row's field, as written, is the column name `name` (blanks around it and case aside).
+bool IsColumnName(std::string_view field, const std::string& name) {
+  const size_t first = field.find_first_not_of(" \t\r");
+  const size_t last = field.find_last_not_of(" \t\r");
+  field = first == std::string_view::npos ? std::string_view() : field.substr(first, last - first + 1);
+  return field.size() == name.size() &&
+         std::equal(field.begin(), field.end(), name.begin(), [](char a, char b) {
+           return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+         });
+}
+
+// The serial a comment states (`serial: SN0001`, its text after the key, trimmed), and the column
+// where it starts; nullopt for another comment. Throws for an empty serial.
+std::optional<std::pair<std::string, long>> SerialOfComment(const std::string& path,
+                                                            const CsvReader::Comment& comment) {
+  if (comment.text.compare(0, kSerialKey.size(), kSerialKey) != 0) return std::nullopt;
+  const size_t first = comment.text.find_first_not_of(" \t", kSerialKey.size());
+  const long column = comment.column + static_cast<long>(std::min(first, comment.text.size()));
+  if (first == std::string::npos) throw InputError(path, comment.line, column, "an empty serial");
+  return std::make_pair(comment.text.substr(first), column);
+}
+
 // The serial of LocateSamplesSerial, from a reader that has read the header.
 SamplesSerial SerialInHeader(const CsvReader& csv) {
   const std::string& path = csv.path();
   SamplesSerial serial;
   for (const CsvReader::Comment& comment : csv.header_comments()) {
-    if (comment.text.compare(0, kSerialKey.size(), kSerialKey) != 0) continue;
-    const size_t first = comment.text.find_first_not_of(" \t", kSerialKey.size());
-    const long column = comment.column + static_cast<long>(std::min(first, comment.text.size()));
-    if (first == std::string::npos) throw InputError(path, comment.line, column, "an empty serial");
-    const std::string found = comment.text.substr(first);
+    const auto stated = SerialOfComment(path, comment);
+    if (!stated) continue;
+    const auto& [found, column] = *stated;
     if (!serial.serial.empty() && found != serial.serial) {
       // Two units in one file, or a header pasted onto another unit's log: certify neither.
       throw InputError(
@@ -98,12 +121,49 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, const Sampl
   }
 }
 
+// A `# serial:` line among the rows naming another unit than the header: two units' logs in one
+// file (two runs concatenated). Fitting them as one unit would give a calibration of neither.
+void SamplesReader::CheckRowComments() const {
+  for (const CsvReader::Comment& comment : csv_.row_comments()) {
+    const auto stated = SerialOfComment(csv_.path(), comment);
+    if (!stated || stated->first == serial_.serial) continue;
+    const std::string header = serial_.serial.empty() ? "the header names no unit"
+                                                      : "the header names " + QuoteForMessage(serial_.serial);
+    throw InputError(csv_.path(), comment.line, stated->second,
+                     "a second unit " + QuoteForMessage(stated->first) + " begins here, among the samples (" +
+                         header +
+                         "): two logs in one file? Split it at this line and fit each unit's log "
+                         "alone");
+  }
+}
+
+// The row's time; a row that repeats the column names (a second log's header, two files joined
+// with cat) is said to be one.
+double SamplesReader::TimeOfRow() const {
+  try {
+    return csv_.Number(time_column_);
+  } catch (const InputError&) {
+    bool header = csv_.field_count() == csv_.header().size();
+    for (size_t i = 0; header && i < csv_.header().size(); ++i) {
+      header = IsColumnName(csv_.Field(static_cast<int>(i)), csv_.header()[i]);
+    }
+    if (header) {
+      csv_.Fail(time_column_,
+                "the column names again, among the samples: two logs in one file? Split it at this line "
+                "and fit each unit's log alone");
+    }
+    throw;
+  }
+}
+
 bool SamplesReader::Next(Sample* sample) {
-  if (!csv_.NextRow()) {
+  const bool row = csv_.NextRow();
+  if (!csv_.row_comments().empty()) CheckRowComments();
+  if (!row) {
     if (rows_ > 1 && rows_ <= kIntervalProbeRows) CheckInterval();
     return false;
   }
-  sample->time_s = csv_.Number(time_column_) * seconds_per_time_unit_;
+  sample->time_s = TimeOfRow() * seconds_per_time_unit_;
   if (rows_ > 0 && !(sample->time_s > last_time_s_)) {
     csv_.Fail(time_column_, FormatDouble(sample->time_s) + " s does not increase (the row before has " +
                                 FormatDouble(last_time_s_) + " s)");

@@ -40,7 +40,8 @@ struct BatchOptions {
   std::string units_dir;   // a folder of unit folders; or:
   std::string units_list;  // a file listing the units: "serial, samples[, plan]" a line (CSV or blanks)
   // The samples file in each unit folder: the one file whose name matches this shell pattern
-  // (fnmatch, e.g. "*_imu.csv.gz"); empty: samples.csv.gz, else samples.csv.
+  // (fnmatch, e.g. "*_imu.csv.gz"); empty: samples.csv.gz or samples.csv (a folder with both is
+  // refused: the unit's error).
   std::string samples_glob;
   std::string output_dir;
   std::string limits_path;      // empty: no verdicts

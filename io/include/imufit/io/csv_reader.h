@@ -59,6 +59,8 @@ class CsvReader {
   CsvReader& operator=(const CsvReader&) = delete;
 
   const std::vector<std::string>& header() const { return header_; }
+  // How many fields the current row has.
+  size_t field_count() const { return field_count_; }
   // A comment line before the header: its line number, its text after the '#', trimmed, and the
   // 1-based character column where that text starts (the
   // first kMaxHeaderComments, each cut to kMaxHeaderCommentBytes). Loggers put what describes
@@ -69,6 +71,10 @@ class CsvReader {
     std::string text;
   };
   const std::vector<Comment>& header_comments() const { return header_comments_; }
+  // The comment lines after the header that NextRow() passed over since the row before (the
+  // first kMaxRowComments of them): a `# serial:` there means a second run begins.
+  static constexpr size_t kMaxRowComments = 16;
+  const std::vector<Comment>& row_comments() const { return row_comments_; }
   // The index of the column called `name`, if there is one: the column of that exact name, else the
   // one column whose name differs from it in case only (a logger's "Time_S").
   std::optional<int> FindColumn(std::string_view name) const;
@@ -136,6 +142,7 @@ class CsvReader {
   long long bytes_read_ = 0;
   std::vector<std::string> header_;
   std::vector<Comment> header_comments_;
+  std::vector<Comment> row_comments_;
   void AddField(std::string_view field) {
     if (field_count_ == fields_.size()) {
       if (field_count_ >= kMaxColumns) TooManyFields();

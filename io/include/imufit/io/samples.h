@@ -116,6 +116,8 @@ class SamplesReader {
  private:
   friend class ParallelSamplesReader;  // reads the file's blocks (parallel_samples.h)
   void CheckTemperature(double temp_c) const;
+  void CheckRowComments() const;
+  double TimeOfRow() const;
   void CheckInterval() const;
   // Throws when two of `columns` (RequireColumns' answer) are one column of the file.
   void CheckDistinct(const std::vector<int>& columns) const;
