@@ -266,8 +266,9 @@ int RunFit(const FitArguments& args) {
   unit.samples_path = args.samples;
   unit.fit = FitRun(args.plan, args.samples, options);
   const FitRunResult& result = *unit.fit;
-  for (const std::string& warning : result.serial_warnings) {
-    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  for (const auto* warnings : {&result.serial_warnings, &result.run_warnings}) {
+    for (const std::string& warning : *warnings)
+      std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
   }
   if (!result.inconsistency.empty()) {
     std::fprintf(stderr,
@@ -290,6 +291,7 @@ int RunFit(const FitArguments& args) {
   }
   unit.serial = result.serial;
   unit.warnings = result.serial_warnings;
+  unit.warnings.insert(unit.warnings.end(), result.run_warnings.begin(), result.run_warnings.end());
   unit.plan_sha256 = result.plan_sha256;
   unit.samples_sha256 = result.run.samples_sha256;
   const bool recorded = CertifyUnit(settings, {args.output, args.report, pdf, paper, {}}, &unit);

@@ -45,6 +45,15 @@ int WriteLotHistoryPage(const HistoryArguments& args, ResultsStore* store) {
   return 0;
 }
 
+// The first few of `names`, and how many more.
+std::string JoinFirst(const std::vector<std::string>& names) {
+  constexpr size_t kShown = 8;
+  std::string text;
+  for (size_t i = 0; i < names.size() && i < kShown; ++i) text += (i ? ", " : "") + names[i];
+  if (names.size() > kShown) text += " and " + std::to_string(names.size() - kShown) + " more";
+  return text;
+}
+
 // Yield of each group (the lots: `--lot [NAME]`, one lot or all; `--by GROUP`).
 void PrintYields(const std::vector<GroupYield>& yields, const std::string& heading, bool csv) {
   if (csv) {
@@ -73,16 +82,23 @@ int Yields(const HistoryArguments& args, ResultsStore* store) {
   if (!args.by.empty() && !ValueOf(kYieldGroupNames, args.by, &by))
     throw InputError("--by", QuoteForMessage(args.by) + " is not one of " + AllNames(kYieldGroupNames));
   std::vector<GroupYield> yields;
+  std::vector<std::string> groups;
   for (const GroupYield& y : store->YieldBy(by)) {
+    groups.push_back(y.group);
     if (args.lot.empty() || y.group == args.lot) yields.push_back(y);
+  }
+  // A lot the store does not hold is a mistake whatever is printed (as `imufit lot` and --html say).
+  if (!args.lot.empty() && yields.empty()) {
+    throw InputError(store->path(), "no lot named " + QuoteForMessage(args.lot) +
+                                        (groups.empty() ? " (the store holds no lots)"
+                                                        : " (it holds: " + JoinFirst(groups) + ")"));
   }
   if (!args.html.empty()) {
     WriteFileAtomically(args.html, YieldPageHtml(store->path(), by, yields));
     return 0;
   }
   PrintYields(yields, NameOf(kYieldGroupNames, by), args.csv);
-  if (yields.empty() && !args.csv)
-    std::printf("(no lots%s)\n", args.lot.empty() ? "" : (" named " + args.lot).c_str());
+  if (yields.empty() && !args.csv) std::printf("(no lots)\n");
   return 0;
 }
 

@@ -457,5 +457,70 @@ TEST_F(CliInputTest, ALogOfTwoUnitsIsRefusedWhereTheSecondBegins) {
       << summary << r.err;
 }
 
+// Files as other tools write them: pandas' to_csv() puts an index column with an empty name first;
+// it is another column, ignored, and the fit is the one of the file without it.
+TEST_F(CliInputTest, PandasIndexColumnIsIgnored) {
+  const std::string raw = RawRun();
+  std::istringstream lines(ReadBytes(raw));
+  std::string line, pandas;
+  long row = -1;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    pandas += (row < 0 ? std::string(",") : std::to_string(row) + ",") + line + "\n";
+    ++row;
+  }
+  std::ofstream(Path("pandas.csv")) << pandas;
+  ASSERT_EQ(Fit(raw).status, 0);
+  const std::string plain = ReadBytes(Path("cal.yaml"));
+  const RunResult r = Fit(Path("pandas.csv"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string indexed = ReadBytes(Path("cal.yaml"));
+  // The same coefficients (the record names another file, with another hash).
+  EXPECT_EQ(indexed.substr(0, indexed.find("\nfit:")), plain.substr(0, plain.find("\nfit:")));
+}
+
+// A plan segment the log never visits is named by the fit (a warning; the calibration's record
+// lists it), and the fit goes on with the others.
+TEST_F(CliInputTest, APlanSegmentTheLogNeverVisitsIsNamed) {
+  const std::string raw = RawRun();
+  std::string plan = ReadBytes(Fixture("plan_6pos.yaml"));
+  plan += "  - {id: 40, up: [0.6, 0, 0.8], north: [0.8, 0, -0.6]}\n";
+  std::ofstream(Path("plan_extra.yaml")) << plan;
+  const RunResult r = Run({"fit", "-p", Path("plan_extra.yaml"), "-s", raw, "-o", Path("cal.yaml"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "imufit: warning: " + raw + ": plan segment 40 of " + Path("plan_extra.yaml") +
+                       " has no usable window in the log (never visited, or every visit too short): fitted "
+                       "without it\n");
+  EXPECT_NE(ReadBytes(Path("cal.yaml")).find("segments_without_windows: [40]"), std::string::npos);
+}
+
+// A units list as a spreadsheet saves it (a UTF-8 byte order mark, quoted fields, a comma inside
+// a quoted path) is read as CSV; a batch whose output folder lies inside its units folder does not
+// take that folder for a unit when it runs again.
+TEST_F(CliInputTest, AUnitsListAsSpreadsheetsSaveItAndAnOutputFolderAmongTheUnits) {
+  const fs::path lot = Path("lot");
+  fs::create_directories(lot / "u1");
+  fs::copy_file(Fixture("plan_6pos.yaml"), lot / "u1" / "plan.yaml");
+  ASSERT_EQ(Run(SmallRunArgs((lot / "u1" / "run, first.csv").string(), {"--serial", "SN1"})).status, 0);
+  std::ofstream(Path("units.csv")) << "\xEF\xBB\xBFserial,samples,plan\r\n"
+                                      "\"SN1\",\"lot/u1/run, first.csv\",\"lot/u1/plan.yaml\"\r\n";
+  RunResult r = Run({"batch", "--units-list", Path("units.csv"), "-o", Path("list_out"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  const std::string listed = ReadBytes(Path("list_out") + "/lot_summary.csv");
+  EXPECT_NE(listed.find("\nSN1,"), std::string::npos) << listed;
+  EXPECT_EQ(listed.find("serial,"), listed.rfind("serial,"))
+      << "one header, no unit called serial: " << listed;
+  EXPECT_EQ(std::count(listed.begin(), listed.end(), '\n'), 2) << listed;
+
+  fs::rename(lot / "u1" / "run, first.csv", lot / "u1" / "samples.csv");
+  for (int run = 0; run < 2; ++run) {
+    r = Run({"batch", lot.string(), "-o", (lot / "out").string(), "-q"});
+    EXPECT_EQ(r.status, 0) << "run " << run << ": " << r.err;
+    const std::string summary = ReadBytes((lot / "out" / "lot_summary.csv").string());
+    EXPECT_EQ(summary.find("\nout,"), std::string::npos) << "run " << run << ": " << summary;
+    EXPECT_EQ(std::count(summary.begin(), summary.end(), '\n'), 2) << "run " << run << ": " << summary;
+  }
+}
+
 }  // namespace
 }  // namespace imufit::testing

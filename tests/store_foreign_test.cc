@@ -177,5 +177,21 @@ TEST(StoreForeignTest, NoMessageHoldsAPassword) {
   }
 }
 
+// `history --lot NAME` with a lot the store does not hold is refused whatever is printed (as
+// `--html` and `imufit lot` refuse it), naming the lots it holds.
+TEST(StoreForeignTest, HistoryOfALotTheStoreDoesNotHoldIsRefusedInEveryForm) {
+  const std::string target = FreshStore("history_unknown");
+  ResultsStore(target).Record(MakeFit("SN1", "lot-h", "2026-05-01T00:00:00Z", 1.0, "PASS"));
+  const std::string base = FreshSqliteStore("history_unknown_output");
+  for (const std::vector<std::string>& form : {std::vector<std::string>{}, {"--csv"}}) {
+    std::vector<std::string> args = {"history", target, "--lot", "LOT-UNKNOWN"};
+    args.insert(args.end(), form.begin(), form.end());
+    const testing::RunResult r = testing::RunProgram(IMUFIT_EXE, args, base + ".out", base + ".err");
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("no lot named \"LOT-UNKNOWN\" (it holds: lot-h)"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+  }
+}
+
 }  // namespace
 }  // namespace imufit

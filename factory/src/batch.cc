@@ -332,6 +332,7 @@ void FitUnit(const Shared& shared, const UnitInput& input, const UnitPaths& path
   FitRunResult& result = *unit->fit;
   if (!result.serial.empty()) unit->serial = result.serial;  // serial.txt, the samples', the plan's
   unit->warnings = result.serial_warnings;
+  unit->warnings.insert(unit->warnings.end(), result.run_warnings.begin(), result.run_warnings.end());
   if (result.serial.empty()) unit->warnings.push_back(kSerialNotStated);
   if (result.fit.status == FitStatus::kUndetermined) {
     unit->status = "not-fitted";
@@ -467,11 +468,15 @@ std::string LotName(const BatchOptions& options) {
   return name.empty() ? units.parent_path().filename().string() : name;  // "units/" ends in ""
 }
 
-// The unit folders of `shard`, in name order (not .git and the like).
-std::vector<UnitInput> ListUnits(const std::string& units_dir, const Shard& shard) {
+// The unit folders of `shard`, in name order (not .git and the like, nor the batch's own output
+// folder when it lies among them: a re-run does not take its outputs for a unit).
+std::vector<UnitInput> ListUnits(const std::string& units_dir, const std::string& output_dir,
+                                 const Shard& shard) {
   std::vector<UnitInput> units;
   for (const fs::directory_entry& entry : fs::directory_iterator(units_dir)) {
     const std::string name = entry.path().filename().string();
+    std::error_code error;
+    if (fs::equivalent(entry.path(), output_dir, error)) continue;
     if (entry.is_directory() && name[0] != '.' && ShardOf(name, shard.count) == shard.index) {
       UnitInput unit;
       unit.name = name;
@@ -484,18 +489,40 @@ std::vector<UnitInput> ListUnits(const std::string& units_dir, const Shard& shar
   return units;
 }
 
-// The fields of a unit list's line: comma-separated (trimmed) when it has a comma, else separated
-// by blanks.
+// The fields of a unit list's line: comma-separated (trimmed) when it has a comma, read as CSV
+// (RFC 4180: a field in double quotes may hold commas, "" is a quote, as a spreadsheet writes it),
+// else separated by blanks.
 std::vector<std::string> ListFields(const std::string& line) {
   std::vector<std::string> fields;
   std::string field;
   if (line.find(',') != std::string::npos) {
-    std::istringstream cells(line);
-    while (std::getline(cells, field, ',')) {
-      const size_t first = field.find_first_not_of(" \t"), last = field.find_last_not_of(" \t");
-      fields.push_back(first == std::string::npos ? "" : field.substr(first, last - first + 1));
+    const auto trimmed = [](const std::string& text) {
+      const size_t first = text.find_first_not_of(" \t"), last = text.find_last_not_of(" \t");
+      return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+    };
+    bool quoted = false, was_quoted = false;
+    for (size_t i = 0; i <= line.size(); ++i) {
+      const char c = i < line.size() ? line[i] : ',';
+      if (quoted) {
+        if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+          field += '"';
+          ++i;
+        } else if (c == '"') {
+          quoted = false;
+        } else {
+          field += c;
+        }
+      } else if (c == '"' && trimmed(field).empty()) {
+        quoted = was_quoted = true;
+        field.clear();
+      } else if (c == ',') {
+        fields.push_back(was_quoted ? field : trimmed(field));
+        field.clear();
+        was_quoted = false;
+      } else if (!was_quoted || (c != ' ' && c != '\t')) {
+        field += c;
+      }
     }
-    if (line.back() == ',') fields.push_back("");
   } else {
     std::istringstream words(line);
     while (words >> field) fields.push_back(field);
@@ -514,6 +541,7 @@ std::vector<UnitInput> ReadUnitsList(const std::string& list, const Shard& shard
   std::string line;
   for (long number = 1; std::getline(stream, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
     const std::vector<std::string> f = ListFields(line);
     if (f.empty() || f[0].empty() || f[0][0] == '#' ||
         (units.empty() && lines_of.empty() && f[0] == "serial"))
@@ -549,7 +577,7 @@ void Prepare(const BatchOptions& options, Shared* shared, std::vector<UnitInput>
     throw InputError("imufit batch", problem);
   if (options.units_list.empty() && !fs::is_directory(options.units_dir))
     throw InputError(options.units_dir, "not a folder");
-  *units = options.units_list.empty() ? ListUnits(options.units_dir, options.shard)
+  *units = options.units_list.empty() ? ListUnits(options.units_dir, options.output_dir, options.shard)
                                       : ReadUnitsList(options.units_list, options.shard);
   shared->options = &options;
   shared->fit_options = options.fit.Describe();

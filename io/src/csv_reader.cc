@@ -150,10 +150,10 @@ CsvReader::CsvReader(std::string path, Sha256* raw_digest, const CsvDialect& dia
     header_.reserve(field_count_);
     for (size_t i = 0; i < field_count_; ++i) {
       const std::string_view name = Trim(fields_[i]);
-      if (name.empty()) {
-        throw InputError(path_, line_number_, static_cast<long>(i) + 1, "empty column name in the header");
-      }
       header_.emplace_back(name);
+      // A column without a name (pandas' index, a spreadsheet's row numbers, a delimiter at the end
+      // of the line) is another column, never looked up: the readers ignore what they do not name.
+      if (name.empty()) continue;
       if (!seen.insert(header_.back()).second) {
         throw InputError(path_, line_number_, static_cast<long>(i) + 1,
                          "column " + QuoteForMessage(name) + " appears twice in the header");

@@ -147,6 +147,15 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
   RecordRunHeader(header, &result.record);
+  if (const std::vector<int>& missing = *result.record.segments_without_windows; !missing.empty()) {
+    std::string ids;
+    for (const int id : missing) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+    result.run_warnings.push_back(
+        samples_path + ": plan " + (missing.size() == 1 ? "segment " : "segments ") + ids + " of " +
+        plan_path + (missing.size() == 1 ? " has" : " have") +
+        " no usable window in the log (never visited, or every visit too short): fitted without " +
+        (missing.size() == 1 ? "it" : "them"));
+  }
   if (!result.fit.IsSolutionUsable()) return result;
   result.inconsistency = Inconsistency(result.fit, result.run.windows, options.fit);
   if (!result.inconsistency.empty()) {

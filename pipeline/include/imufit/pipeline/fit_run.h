@@ -82,6 +82,10 @@ struct FitRunResult {
   std::string serial;
   // Sources of the serial that disagree with it, one message each (unit_serial.h).
   std::vector<std::string> serial_warnings;
+  // What the run lacks that the fit went on without, one message each: plan segments without a
+  // single usable window (never visited, or every visit too short). The calibration's record lists
+  // them too (fit record `segments_without_windows`).
+  std::vector<std::string> run_warnings;
   Plan plan;
   std::string plan_sha256;  // the samples' is run.samples_sha256
   RunWindows run;
