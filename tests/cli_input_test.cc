@@ -2,9 +2,11 @@
 // column (--time-unit, and the sample interval judged against what a plan needs), temperatures an
 // IMU cannot report (kelvin, fill values), and the calibration of the right unit.
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -520,6 +522,139 @@ TEST_F(CliInputTest, AUnitsListAsSpreadsheetsSaveItAndAnOutputFolderAmongTheUnit
     EXPECT_EQ(summary.find("\nout,"), std::string::npos) << "run " << run << ": " << summary;
     EXPECT_EQ(std::count(summary.begin(), summary.end(), '\n'), 2) << "run " << run << ": " << summary;
   }
+}
+
+// `text` with the header's column names renamed by `names` (old -> new, all at once).
+std::string RenameColumns(const std::string& text, const std::map<std::string, std::string>& names) {
+  const size_t header = text.find("time_s");
+  const size_t end = text.find('\n', header);
+  std::istringstream fields(text.substr(header, end - header));
+  std::string field, renamed;
+  while (std::getline(fields, field, ',')) {
+    const auto found = names.find(field);
+    renamed += (renamed.empty() ? "" : ",") + (found == names.end() ? field : found->second);
+  }
+  return text.substr(0, header) + renamed + text.substr(end);
+}
+
+std::string Negated(const std::string& field, int) { return Scaled(field, -1.0); }
+
+// Channels that respond, but to another axis than their own, are not called dead: two exchanged
+// gyro channels (with the column map that reads them back, which then fits as the log as planned),
+// an inverted sign, the unit mounted rotated 90 deg about z (both sensors turned alike).
+TEST_F(CliInputTest, ChannelsSwappedInvertedOrRotatedAreSaidSoNotDead) {
+  const std::string raw = RawRun();
+  const std::string text = ReadBytes(raw);
+  ASSERT_EQ(Fit(raw).status, 0);
+  const std::string planned = ReadBytes(Path("cal.yaml"));
+  fs::remove(Path("cal.yaml"));
+
+  std::ofstream(Path("swapped.csv")) << RenameColumns(text, {{"gyro_x", "gyro_y"}, {"gyro_y", "gyro_x"}});
+  RunResult r = Fit(Path("swapped.csv"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  ExpectOneLine(r,
+                "swapped.csv: gyro x and y look exchanged; the logger's channel map? read them back with "
+                "--column gyro_x=gyro_y --column gyro_y=gyro_x (the accelerometer follows the plan: not "
+                "the mounting); nothing written");
+  EXPECT_EQ(r.err.find("dead"), std::string::npos) << r.err;
+  r = Fit(Path("swapped.csv"), {"--column", "gyro_x=gyro_y", "--column", "gyro_y=gyro_x"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string mapped = ReadBytes(Path("cal.yaml"));
+  EXPECT_EQ(mapped.substr(0, mapped.find("\nfit:")), planned.substr(0, planned.find("\nfit:")));
+
+  std::ofstream(Path("inverted.csv")) << MapColumn(text, "gyro_y", Negated);
+  r = Fit(Path("inverted.csv"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  ExpectOneLine(r,
+                "inverted.csv: gyro_y reads with its sign inverted (a left-handed frame: the logger's "
+                "channel signs?); fix the logger's channel map and signs (the accelerometer follows the "
+                "plan: not the mounting); nothing written");
+
+  // Mounted turned 90 deg about z: the unit's x is the plan's y, its y the plan's -x.
+  std::string rotated = text;
+  for (const char* sensor : {"gyro", "accel"}) {
+    const std::string x = std::string(sensor) + "_x", y = std::string(sensor) + "_y";
+    rotated = MapColumn(rotated, x, Negated);
+    rotated = RenameColumns(rotated, {{x, y}, {y, x}});
+  }
+  std::ofstream(Path("rotated.csv")) << rotated;
+  r = Fit(Path("rotated.csv"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("both sensors read the plan's axes turned (gyro_x follows the plan's +y axis, gyro_y "
+                       "follows the plan's -x axis; accel_x follows the plan's +y axis, accel_y follows the "
+                       "plan's -x axis): the unit looks mounted rotated 90 deg about (+1z)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("dead"), std::string::npos) << r.err;
+}
+
+// A lever arm written in millimetres is said to be one, at its place in the plan.
+TEST_F(CliInputTest, ALeverArmInMillimetresIsNamed) {
+  std::string plan = ReadBytes(Fixture("plan_6pos.yaml"));
+  for (size_t at = plan.find("[0.012, -0.008, 0.005]"); at != std::string::npos;
+       at = plan.find("[0.012, -0.008, 0.005]")) {
+    plan.replace(at, std::strlen("[0.012, -0.008, 0.005]"), "[12, -8, 5]");
+  }
+  std::ofstream(Path("plan_mm.yaml")) << plan;
+  const RunResult r = Run({"fit", "-p", Path("plan_mm.yaml"), "-s", RawRun(), "-o", Path("cal.yaml"), "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  ExpectOneLine(r,
+                "plan_mm.yaml:18:56: segments[6].lever_arm_m: the sensor lies 15.264337522473747 m from "
+                "the table's axis: millimetres? lever_arm_m is in metres (0.012, -0.008, 0.005 if these "
+                "are mm)");
+}
+
+// Each channel is judged against what the plan predicts for each of its windows: faces at 1 g and
+// corners at 0.58 g lie on one line, so a plan of faces and corners is not taken for a dead axis.
+TEST_F(CliInputTest, APlanOfFacesAndCornersIsNotADeadAxis) {
+  std::string plan = "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81274\nsegments:\n";
+  int id = 1;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const int sign : {1, -1}) {
+      std::string up = "[0, 0, 0]";
+      up[1 + 3 * axis] = sign > 0 ? '1' : '-';
+      if (sign < 0) up = up.substr(0, 1 + 3 * axis) + "-1" + up.substr(2 + 3 * axis);
+      plan += "  - {id: " + std::to_string(id++) + ", up: " + up + "}\n";
+    }
+  }
+  for (const int x : {1, -1})
+    for (const int y : {1, -1})
+      for (const int z : {1, -1})
+        plan += "  - {id: " + std::to_string(id++) + ", up: [" + std::to_string(x) + ", " +
+                std::to_string(y) + ", " + std::to_string(z) + "]}\n";
+  for (const char* up : {"[1, 0, 0]", "[0, 1, 0]", "[0, 0, 1]"}) {
+    for (const int rate : {200, -200}) {
+      plan +=
+          "  - {id: " + std::to_string(id++) + ", up: " + up + ", rate_dps: " + std::to_string(rate) + "}\n";
+    }
+  }
+  std::ofstream(Path("corners.yaml")) << plan;
+  ASSERT_EQ(Run({"simulate",
+                 "--plan",
+                 Path("corners.yaml"),
+                 "--calibration",
+                 Fixture("mems_truth.yaml"),
+                 "-o",
+                 Path("corners.csv"),
+                 "--temps=-20,10,40,70",
+                 "--rate",
+                 "20",
+                 "--dwell",
+                 "3",
+                 "--transition",
+                 "1",
+                 "--gyro-noise-density",
+                 "8.7e-5",
+                 "--accel-noise-density",
+                 "1.5e-3",
+                 "--quantize",
+                 "-q"})
+                .status,
+            0);
+  const RunResult r = Run({"fit", "-p", Path("corners.yaml"), "-s", Path("corners.csv"), "-o",
+                           Path("cal.yaml"), "-q", "--gyro-temp-order", "1", "--accel-temp-order", "1"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("does not respond"), std::string::npos) << r.err;
 }
 
 }  // namespace

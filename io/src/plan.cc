@@ -118,6 +118,14 @@ Plan ReadPlanNode(const YAML::Node& root_node, const std::string& path) {
     if (entry.Has("lever_arm_m")) {
       const std::vector<double> r = entry["lever_arm_m"].Doubles(3);
       segment.lever_arm_m = Eigen::Vector3d(r[0], r[1], r[2]);
+      // An offset from the table's axis past any rate table's (a centrifuge's arm aside) is a length
+      // written in millimetres: at 300 deg/s, 12 "m" would be a specific force of 34 g.
+      if (const double arm_m = segment.lever_arm_m->norm(); arm_m > kMaxLeverArmM) {
+        entry["lever_arm_m"].Fail("the sensor lies " + FormatDouble(arm_m) +
+                                  " m from the table's axis: " + "millimetres? lever_arm_m is in metres (" +
+                                  FormatDouble(r[0] / 1000.0) + ", " + FormatDouble(r[1] / 1000.0) + ", " +
+                                  FormatDouble(r[2] / 1000.0) + " if these are mm)");
+      }
     }
     plan.segments.push_back(segment);
   }

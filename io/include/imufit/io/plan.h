@@ -5,8 +5,9 @@
 // degree in the file); angle_deg -> angle_rad, `axis` normalised. A plan is refused (InputError)
 // when a vector is zero or not three numbers, `north` is not horizontal or is given on a rate or
 // turn segment, `axis` is given on a static segment, `angle_deg` is 0 or comes with `rate_dps` or
-// `lever_arm_m`, an id repeats, a key is unknown, or format/version are not ones this reader
-// knows. The truth of each kind of segment: docs/conventions.md.
+// `lever_arm_m`, a lever arm is longer than kMaxLeverArmM (millimetres written as metres), an id
+// repeats, a key is unknown, or format/version are not ones this reader knows. The truth of each
+// kind of segment: docs/conventions.md.
 #ifndef IMUFIT_IO_PLAN_H_
 #define IMUFIT_IO_PLAN_H_
 
@@ -18,6 +19,9 @@
 namespace imufit {
 
 inline constexpr int kPlanFormatVersion = 1;
+// The longest lever arm (sensor from the table's axis) a plan may give, m: past any rate table's
+// offsets; a centrifuge's arm is out of scope.
+inline constexpr double kMaxLeverArmM = 3.0;
 
 struct Plan {
   std::string path;    // the file it was read from

@@ -8,9 +8,16 @@
 //  - a channel with one value in every sample is at its rail when that value is at the full scale
 //    given (WindowOptions::gyro_full_scale_raw, accel_full_scale_raw) or a converter's limit
 //    (+-(2^k - 1), -2^k for k = 7 .. 31), else stuck;
-//  - a channel that does not respond: between the windows whose planned truth lies along its axis
-//    (at least half the largest, kResponseShare) with either sign, its raw means differ by no more
-//    than kResponseSigmas times their scatter (the noise and the temperature drift of the means).
+//  - channels that respond to another axis than their own: each sensor's raw window means fitted
+//    as offset + K truth over every window whose truth the plan knows; when every channel follows
+//    one planned axis (kAxisShare of its response) with a clear slope, and that signed axis map
+//    is not the identity, the finding says so in a person's terms (two channels exchanged, a sign
+//    inverted, the unit mounted rotated when both sensors are turned alike) with the remedy (a
+//    column map, the mounting), instead of calling the channels dead;
+//  - a channel that does not respond: the slope of its raw window means against the planned truth
+//    along its axis (a straight line: faces at 1 g and corners at 0.58 g lie on it) is within
+//    kResponseSigmas standard errors of 0 (the scatter of the means about the line and their noise),
+//    when the plan drives its axis both ways.
 #ifndef IMUFIT_RUN_CHANNEL_CHECK_H_
 #define IMUFIT_RUN_CHANNEL_CHECK_H_
 
