@@ -350,69 +350,54 @@ int RunAllan(const AllanArguments& args) {
 
 }  // namespace
 
-CommandRunner AddAllanCommand(CLI::App* root) {
+CommandRunner AddAllanCommand(CliCommand command) {
   auto args = std::make_shared<AllanArguments>();
-  CLI::App* command = root->add_subcommand(
-      "allan",
-      "Allan deviation of columns of a samples file, with confidence intervals, the IEEE 952 noise terms "
-      "(quantization, random walk, bias instability, rate random walk, ramp) and Kalibr noise densities. "
-      "Columns are rates in SI units (a corrected file: gyro rad/s, accel m/s^2), or raw counts corrected on "
-      "the "
-      "way in with --calibration. Writes "
-      "column,estimator,tau_s,terms,dev,dev_lo,dev_hi.");
-  command->add_option("--samples,-s", args->samples, "samples CSV (or .csv.gz) with time_s and the columns")
-      ->required();
+  command.Option("--samples,-s", &args->samples, "samples CSV (or .csv.gz) with time_s and the columns")
+      .Required();
   command
-      ->add_option("--columns,-c", args->columns,
-                   "columns to analyse, comma-separated (default: every gyro_* and accel_* column)")
-      ->delimiter(',');
-  command->add_option("--output,-o", args->output, "Allan deviation CSV to write (.gz compresses)")
-      ->required();
-  command->add_option("--estimator,-e", args->estimator,
-                      "adev, oadev (default), mdev, tdev, hdev, ohdev or totdev");
-  command->add_option("--taus,-t", args->taus,
-                      "octave (default: tau0 * 1, 2, 4, ...), decade (1, 2, 4, 10, 20, 40, ...), all, "
-                      "per-decade:K (K log-spaced taus per decade), or taus in seconds: 1,10,100");
-  command->add_option("--confidence", args->confidence,
-                      "two-sided confidence of dev_lo..dev_hi (default 0.683)");
-  command->add_option("--edf-noise", args->edf_noise,
-                      "noise type for the confidence intervals' degrees of freedom: auto (default, lag-1 "
-                      "autocorrelation per tau), wpm, fpm, wfm, ffm, rwfm");
-  command->add_option(
-      "--kind", args->kind,
-      "auto (default: gyro_* are gyros in rad/s, accel_* accelerometers in m/s^2), gyro, accel, "
-      "or other (no engineer units)");
-  command->add_option(
-      "--time-tolerance", args->time_tolerance,
-      "largest deviation of a time step from the sample interval, in intervals (default 0.1)");
-  command->add_option("--gaps", args->gaps,
-                      "error (default): a gap in time_s is an error; bridge: join the data across gaps");
-  command->add_option(
-      "--min-clusters", args->min_clusters,
+      .Option("--columns,-c", &args->columns,
+              "columns to analyse, comma-separated (default: every gyro_* and accel_* column)")
+      .Delimiter(',');
+  command.Option("--output,-o", &args->output, "Allan deviation CSV to write (.gz compresses)").Required();
+  command.Option("--estimator,-e", &args->estimator,
+                 "adev, oadev (default), mdev, tdev, hdev, ohdev or totdev");
+  command.Option("--taus,-t", &args->taus,
+                 "octave (default: tau0 * 1, 2, 4, ...), decade (1, 2, 4, 10, 20, 40, ...), all, "
+                 "per-decade:K (K log-spaced taus per decade), or taus in seconds: 1,10,100");
+  command.Option("--confidence", &args->confidence, "two-sided confidence of dev_lo..dev_hi (default 0.683)");
+  command.Option("--edf-noise", &args->edf_noise,
+                 "noise type for the confidence intervals' degrees of freedom: auto (default, lag-1 "
+                 "autocorrelation per tau), wpm, fpm, wfm, ffm, rwfm");
+  command.Option("--kind", &args->kind,
+                 "auto (default: gyro_* are gyros in rad/s, accel_* accelerometers in m/s^2), gyro, accel, "
+                 "or other (no engineer units)");
+  command.Option("--time-tolerance", &args->time_tolerance,
+                 "largest deviation of a time step from the sample interval, in intervals (default 0.1)");
+  command.Option("--gaps", &args->gaps,
+                 "error (default): a gap in time_s is an error; bridge: join the data across gaps");
+  command.Option(
+      "--min-clusters", &args->min_clusters,
       "the noise fit leaves out taus with fewer than this many intervals in the record (default 8)");
-  command->add_option("--noise-yaml", args->noise_yaml,
-                      "write the noise terms as YAML (top-level key noise:)");
-  command->add_option("--plot", args->plot,
-                      "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
-  command->add_option("--plot-units", args->plot_units,
-                      "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
-                      "corrected file), rad/s, deg/s or deg/h (then accelerometer panels in micro-g)");
-  CLI::Option* scale = command->add_option(
-      "--scale", args->scale,
+  command.Option("--noise-yaml", &args->noise_yaml, "write the noise terms as YAML (top-level key noise:)");
+  command.Option("--plot", &args->plot, "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
+  command.Option("--plot-units", &args->plot_units,
+                 "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
+                 "corrected file), rad/s, deg/s or deg/h (then accelerometer panels in micro-g)");
+  CliOption scale = command.Option(
+      "--scale", &args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "
       "columns are raw counts (default 1)");
-  CLI::Option* calibration =
+  CliOption calibration =
       command
-          ->add_option(
-              "--calibration", args->calibration,
-              "the unit's calibration YAML: correct the raw samples through it first, as imufit apply "
-              "does (then the columns are among gyro_*, accel_* and temp_c)")
-          ->excludes(scale);
+          .Option("--calibration", &args->calibration,
+                  "the unit's calibration YAML: correct the raw samples through it first, as imufit apply "
+                  "does (then the columns are among gyro_*, accel_* and temp_c)")
+          .Excludes(scale);
   AddTempOption(command, &args->input);
   AddAllowMismatchFlag(command, &args->allow_mismatch);
-  args->input.TempOption()->needs(calibration);  // a temperature only matters to the correction
-  command->add_option("--threads", args->threads, "worker threads (default 0: all cores)");
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
+  args->input.TempOption().Needs(calibration);  // a temperature only matters to the correction
+  command.Option("--threads", &args->threads, "worker threads (default 0: all cores)");
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunAllan(*args); };
 }
 

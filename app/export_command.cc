@@ -21,9 +21,9 @@ struct ExportArguments {
   bool force = false;
   bool quiet = false;
   double temp_c = 0.0;
-  CLI::Option* temp_c_option = nullptr;
+  CliOption temp_c_option;
   long long device_id = 0;
-  CLI::Option* device_id_option = nullptr;
+  CliOption device_id_option;
   ExportOptions options;
 };
 
@@ -40,8 +40,8 @@ int RunExport(ExportArguments args) {
   const Calibration calibration = ReadCalibration(args.calibration);
   ExportOptions& options = args.options;
   options.format = *format;
-  if (args.temp_c_option->count() > 0) options.temp_c = args.temp_c;
-  if (args.device_id_option->count() > 0) options.device_id = args.device_id;
+  if (args.temp_c_option.Given()) options.temp_c = args.temp_c;
+  if (args.device_id_option.Given()) options.device_id = args.device_id;
   options.software = SoftwareVersion();
   options.calibration_file = args.calibration;
   options.calibration_sha256 = Sha256OfFile(args.calibration);
@@ -63,52 +63,41 @@ int RunExport(ExportArguments args) {
 
 }  // namespace
 
-CommandRunner AddExportCommand(CLI::App* root) {
+CommandRunner AddExportCommand(CliCommand command) {
   auto args = std::make_shared<ExportArguments>();
-  CLI::App* command = root->add_subcommand("export",
-                                           "Write a calibration for where it is used: the C runtime (c, "
-                                           "bin), PX4, ArduPilot, Kalibr, imucal or JSON. "
-                                           "A format that cannot hold the whole model measures its loss over "
-                                           "the envelope first and refuses (exit 1) "
-                                           "beyond --max-loss.");
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")
-      ->required();
-  command->add_option("--format,-f", args->format, "c, bin, px4, ardupilot, kalibr, imucal or json")
-      ->required();
-  command->add_option("--output,-o", args->output, "the file to write")->required();
+  command.Option("--calibration,-c", &args->calibration, "calibration YAML (imufit fit's output)").Required();
+  command.Option("--format,-f", &args->format, "c, bin, px4, ardupilot, kalibr, imucal or json").Required();
+  command.Option("--output,-o", &args->output, "the file to write").Required();
   command
-      ->add_option("--max-loss", args->max_loss,
-                   "largest worst-case loss over the envelope accepted, gyro deg/s and accelerometer mg")
-      ->delimiter(',')
-      ->expected(2)
-      ->capture_default_str();
-  command->add_flag("--force", args->force, "write a lossy export even beyond --max-loss");
+      .Option("--max-loss", &args->max_loss,
+              "largest worst-case loss over the envelope accepted, gyro deg/s and accelerometer mg")
+      .Delimiter(',')
+      .Expected(2)
+      .ShowDefault();
+  command.Flag("--force", &args->force, "write a lossy export even beyond --max-loss");
   command
-      ->add_option("--full-scale-dps", args->options.full_scale_dps,
-                   "the envelope: the largest angular rate on each axis, deg/s")
-      ->capture_default_str();
+      .Option("--full-scale-dps", &args->options.full_scale_dps,
+              "the envelope: the largest angular rate on each axis, deg/s")
+      .ShowDefault();
+  command.Option("--max-g", &args->options.max_g, "the envelope: the largest specific force on each axis, g")
+      .ShowDefault();
   command
-      ->add_option("--max-g", args->options.max_g, "the envelope: the largest specific force on each axis, g")
-      ->capture_default_str();
+      .Option("--gyro-raw-per-radps", &args->options.gyro_raw_per_radps,
+              "px4, ardupilot, kalibr: what the driver divides the raw gyro output by to give rad/s")
+      .ShowDefault();
   command
-      ->add_option("--gyro-raw-per-radps", args->options.gyro_raw_per_radps,
-                   "px4, ardupilot, kalibr: what the driver divides the raw gyro output by to give rad/s")
-      ->capture_default_str();
-  command
-      ->add_option(
-          "--accel-raw-per-mps2", args->options.accel_raw_per_mps2,
-          "px4, ardupilot, kalibr: what the driver divides the raw accelerometer output by to give m/s^2")
-      ->capture_default_str();
-  args->temp_c_option = command->add_option("--temp-c", args->temp_c,
-                                            "kalibr, imucal: the temperature the one-temperature formats are "
-                                            "taken at, degC (default: the reference)");
-  args->device_id_option = command->add_option("--device-id", args->device_id,
-                                               "px4: the sensor's device ID (TC_G0_ID, CAL_ACC0_ID)");
-  command->add_option("--c-name", args->options.c_name, "c: the C name of the unit (NAME_INITIALIZER)")
-      ->capture_default_str();
-  command->add_option("--rostopic", args->options.rostopic, "kalibr: the IMU's ROS topic")
-      ->capture_default_str();
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
+      .Option("--accel-raw-per-mps2", &args->options.accel_raw_per_mps2,
+              "px4, ardupilot, kalibr: what the driver divides the raw accelerometer output by to give m/s^2")
+      .ShowDefault();
+  args->temp_c_option = command.Option("--temp-c", &args->temp_c,
+                                       "kalibr, imucal: the temperature the one-temperature formats are "
+                                       "taken at, degC (default: the reference)");
+  args->device_id_option =
+      command.Option("--device-id", &args->device_id, "px4: the sensor's device ID (TC_G0_ID, CAL_ACC0_ID)");
+  command.Option("--c-name", &args->options.c_name, "c: the C name of the unit (NAME_INITIALIZER)")
+      .ShowDefault();
+  command.Option("--rostopic", &args->options.rostopic, "kalibr: the IMU's ROS topic").ShowDefault();
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunExport(*args); };
 }
 

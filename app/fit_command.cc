@@ -299,35 +299,28 @@ int RunFit(const FitArguments& args) {
 
 }  // namespace
 
-CommandRunner AddFitCommand(CLI::App* root) {
+CommandRunner AddFitCommand(CliCommand command) {
   auto args = std::make_shared<FitArguments>();
-  CLI::App* command = root->add_subcommand(
-      "fit",
-      "Fit biases, scale factors, misalignments, gyro g-sensitivity and their cubic temperature "
-      "dependence to a rate-table run; write the calibration YAML with 1-sigma uncertainties. Exit 1 when "
-      "the run does not determine the model (the message says what is missing) or the fit does not "
-      "converge.");
-  command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();
-  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
-  command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
+  command.Option("--plan,-p", &args->plan, "plan YAML of the run").Required();
+  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
+  command.Option("--output,-o", &args->output, "calibration YAML to write").Required();
   AddFitRunOptions(command, &args->run);
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
-  command->add_option(
-      "--limits,-l", args->limits,
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
+  command.Option(
+      "--limits,-l", &args->limits,
       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
-  command->add_option(
-      "--serial", args->serial,
+  command.Option(
+      "--serial", &args->serial,
       "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial); one "
       "that contradicts the samples header is refused (exit 2) unless --allow-mismatch");
-  command->add_option("--report", args->report,
-                      "write the unit's calibration certificate (self-contained HTML)");
+  command.Option("--report", &args->report, "write the unit's calibration certificate (self-contained HTML)");
   AddPdfOptions(command, &args->pdf);
   AddCustomerOptions(command, &args->customer);
-  command->add_option(
-      "--station", args->station,
+  command.Option(
+      "--station", &args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
-  command->add_option(
-      "--store", args->store,
+  command.Option(
+      "--store", &args->store,
       "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");
   return [args] { return RunFit(*args); };
 }
