@@ -171,7 +171,7 @@ class CliOptions {
             kind.set(b.numbers, options);
           } else {
             if (const std::string error = kind.set(b.text, options); !error.empty()) {
-              throw InputError(b.entry->flag, error);
+              throw InputError(b.entry->flag.substr(0, b.entry->flag.find(',')), error);
             }
           }
         },

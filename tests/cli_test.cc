@@ -144,6 +144,29 @@ TEST_F(CliTest, ParseErrorsAreOneImufitLineNamingTheCommand) {
   EXPECT_EQ(Listing(), std::set<std::string>{});
 }
 
+TEST_F(CliTest, ExportTakesFormatNamesInAnyCaseAndRefusesOptionsTheFormatDoesNotUse) {
+  // The export option table says which formats an option serves (issue 30 item 7).
+  const std::string calibration = Fixture("mems_truth.yaml");
+  RunResult r = Run({"export", "-c", calibration, "-f", "JSON", "-o", Path("unit.json"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(Path("unit.json")));
+  r = Run({"export", "-c", calibration, "-f", "json", "-o", Path("x.json"), "--device-id", "7"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "imufit: --device-id: only px4 use it, not json\n");
+  r = Run({"export", "-c", calibration, "-f", "Px4", "-o", Path("x.params"), "--device-id", "7", "--temp-c",
+           "20"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "imufit: --temp-c: only kalibr, imucal use it, not px4\n");
+  r = Run({"export", "-c", calibration, "-f", "c", "-o", Path("x.h"), "--rostopic", "/imu1"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--rostopic: only kalibr use it"), std::string::npos) << r.err;
+  // The help lists the formats from the format table, and each option the formats it serves.
+  const RunResult help = Run({"export", "--help"});
+  EXPECT_NE(help.out.find("c, bin, px4, ardupilot, kalibr, imucal, json"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("px4: the sensor's device ID"), std::string::npos) << help.out;
+  EXPECT_EQ(Listing(), std::set<std::string>{"unit.json"});
+}
+
 TEST_F(CliTest, BadInvocationsExitTwo) {
   EXPECT_EQ(Run({}).status, 2);
   EXPECT_EQ(Run({"no-such-command"}).status, 2);
