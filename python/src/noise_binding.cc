@@ -256,6 +256,10 @@ void BindNoise(py::module_& m) {
       "e.g. rad/s) sampled every tau0_s seconds, at taus 'octave', 'decade', 'all', 'per-decade:K' or a "
       "sequence of taus in s, with confidence intervals. What `imufit allan` writes for one column.");
 
+  m.def(
+      "allan_options", [] { return DescribeKeywords(AllanOptionTable()); },
+      "{name: (default, description)} of the options imufit.allan() takes by name (`imufit allan`'s).");
+
   BindNoiseTerms(m);
   m.def(
       "noise_terms", &NoiseTerms, py::arg("data"), py::arg("tau0_s") = py::none(), py::arg("taus") = "octave",
@@ -263,6 +267,9 @@ void BindNoise(py::module_& m) {
       "The IEEE 952 noise terms (quantization, ARW, bias instability, RRW, ramp) with 1-sigma, fitted to the "
       "overlapping Allan deviation of rates `data` (shape (N,), every tau0_s seconds, at `taus`) or to an "
       "AllanResult (adev, oadev or totdev). `terms` limits the fit to the named terms.");
+  m.def(
+      "noise_terms_options", [] { return DescribeKeywords(NoiseFitOptionTable()); },
+      "{name: (default, description)} of the noise fit's options (min_clusters is noise_terms()'s).");
 }
 
 }  // namespace imufit::python
