@@ -78,20 +78,9 @@ OptionTable<ExportOptions> MakeExportOptionTable() {
         o->device_id = id;
         return "";
       });
-  t.Text(
-      "c_name", "--c-name", ForFormats("c_name", "the C name of the unit (NAME_INITIALIZER)"),
-      [](const O& o) { return o.c_name; },
-      [](const std::string& text, O* o) {
-        o->c_name = text;
-        return std::string();
-      });
-  t.Text(
-      "rostopic", "--rostopic", ForFormats("rostopic", "the IMU's ROS topic"),
-      [](const O& o) { return o.rostopic; },
-      [](const std::string& text, O* o) {
-        o->rostopic = text;
-        return std::string();
-      });
+  t.String("c_name", "--c-name", ForFormats("c_name", "the C name of the unit (NAME_INITIALIZER)"),
+           &O::c_name);
+  t.String("rostopic", "--rostopic", ForFormats("rostopic", "the IMU's ROS topic"), &O::rostopic);
   return t;
 }
 
