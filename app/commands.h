@@ -5,7 +5,6 @@
 #ifndef IMUFIT_APP_COMMANDS_H_
 #define IMUFIT_APP_COMMANDS_H_
 
-#include <functional>
 #include <set>
 #include <string>
 

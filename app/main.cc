@@ -2,6 +2,7 @@
 // the exit status of exit_status.h (docs/spec.md section 4).
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
