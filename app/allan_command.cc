@@ -325,7 +325,7 @@ void WriteOutputs(const AllanArguments& args, const AllanSettings& settings, con
 
 int RunAllan(const AllanArguments& args) {
   AllanSettings settings = ParseSettings(args);
-  if (!CheckOutputs(args, &settings)) return 1;
+  if (!CheckOutputs(args, &settings)) return kExitNotDone;
   UniformSeries series = ReadSeries(args, settings);
   const int64_t n = static_cast<int64_t>(series.columns[0].size());
   const std::vector<ColumnAnalysis> results = AnalyseColumns(args, settings, &series);

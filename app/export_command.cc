@@ -29,8 +29,8 @@ ExportOptions ResolveOptions(const ExportArguments& args) {
   args.options.Apply(&options);
   for (const OptionEntry<ExportOptions>& entry : ExportOptionTable().entries()) {
     if (args.options.Given(entry.key) && !ExportOptionServes(entry.key, options.format)) {
-      throw InputError(entry.flag, "only " + ExportOptionFormats(entry.key) + " use it, not " +
-                                       ToString(options.format));
+      throw InputError(entry.flag,
+                       "only " + ExportOptionFormats(entry.key) + " use it, not " + ToString(options.format));
     }
   }
   if (const std::string problem = options.Validate(); !problem.empty())

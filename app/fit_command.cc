@@ -149,7 +149,7 @@ void PrintRunNotes(const FitRunOptions& options, const FitRunResult& result) {
 int ReportUndetermined(const FitArguments& args, const FitRunOptions& options, const FitRunResult& result) {
   std::fprintf(stderr, "imufit: %s, nothing written\n",
                UndeterminedMessage(args.samples, options, result).c_str());
-  return 1;
+  return kExitNotDone;
 }
 
 // The fit: the run, the residuals, the windows the robust loss down-weighted, the coefficients.
@@ -217,11 +217,11 @@ void PrintValidation(const std::vector<HeldOutGroup>& folds) {
 }
 
 // After CertifyUnit: the verdict, the files written, the store. Returns the exit status: 0,
-// kExitFailedLimits, or 2 when the store refused the fit (then nothing was written).
+// kExitFailedLimits, or kExitBadInput when the store refused the fit (then nothing was written).
 int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool recorded) {
   if (!recorded) {
     std::fprintf(stderr, "imufit: %s; nothing written\n", unit.message.c_str());
-    return 2;
+    return kExitBadInput;
   }
   if (!args.report.empty()) WarnIfNoSerial(unit.fit->calibration->serial, args.samples);
   const bool judged = !unit.verdict.empty();
@@ -279,7 +279,7 @@ int RunFit(const FitArguments& args) {
   if (!result.calibration) {
     std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(),
                  result.fit.BriefReport().c_str());
-    return 1;
+    return kExitNotDone;
   }
   if (!args.quiet) {
     PrintFit(options, result);

@@ -85,9 +85,9 @@ int RunPlanCheck(const PlanCheckArguments& args) {
   if (!check.undetermined.empty()) {
     std::fprintf(stderr, "imufit: the plan does not determine the model (%zu finding%s)\n",
                  check.undetermined.size(), check.undetermined.size() == 1 ? "" : "s");
-    return 1;
+    return kExitNotDone;
   }
-  return check.tolerance_unmet ? 3 : 0;
+  return check.tolerance_unmet ? kExitFailedLimits : kExitDone;
 }
 
 int RunPlanDesign(const PlanDesignArguments& args) {
@@ -108,9 +108,9 @@ int RunPlanDesign(const PlanDesignArguments& args) {
   std::fputs(PlanDesignText(design, options).c_str(), stdout);
   if (!design.undetermined.empty()) {
     std::fprintf(stderr, "imufit: even every candidate cannot determine the model\n");
-    return 1;
+    return kExitNotDone;
   }
-  if (!design.met) return 3;
+  if (!design.met) return kExitFailedLimits;
   Plan plan;
   plan.site = candidates.site;
   if (options.check.latitude_deg) plan.site.latitude_rad = *options.check.latitude_deg * kDegToRad;
@@ -170,7 +170,7 @@ CommandRunner AddPlanCommand(CliCommand command) {
   return [check_args, design_args, check, design]() -> int {
     if (check.Parsed()) return RunPlanCheck(*check_args);
     if (design.Parsed()) return RunPlanDesign(*design_args);
-    return 2;
+    return kExitBadInput;
   };
 }
 
