@@ -1,7 +1,7 @@
 // imufit — the command line as the commands see it: options, flags and subcommands, without CLI11
 // in the header. CLI11 is header-only (Debian 12 ships 2.1.2, without the precompiled mode of 2.3)
 // and costs seconds of compilation in every translation unit that includes <CLI/CLI.hpp>: only
-// cli.cc and main.cc do. A CliCommand is a subcommand; a CliOption one of its options, a handle
+// cli.cc does. A CliCommand is a subcommand; a CliOption one of its options, a handle
 // (copyable, null until added) through which its constraints are set and, after parsing, whether it
 // was given is read. CliProgram is the program: the commands' table (main.cc) adds them, and it
 // parses.
