@@ -30,21 +30,17 @@ struct AllanArguments {
   std::string samples;
   std::vector<std::string> columns;
   std::string output;
-  std::string estimator = "oadev";
+  CliOptions<AllanOptions> allan;           // AllanOptionTable(): --estimator, --confidence, ...
+  CliOptions<NoiseFitOptions> noise_fit;    // NoiseFitOptionTable(): --min-clusters
+  CliOptions<UniformSeriesOptions> series;  // UniformSeriesOptionTable(): --time-tolerance, --gaps
   std::string taus = "octave";
-  std::string edf_noise = "auto";
   std::string kind = "auto";
-  std::string gaps = "error";
   std::string noise_yaml;
   std::string plot;
   std::string plot_units = "native";
   double scale = 1.0;
   std::string calibration;      // correct the raw samples through it first (as imufit apply does)
   SamplesInputArguments input;  // --temp-c, for a raw log without temp_c; --time-unit
-  double confidence = 0.683;
-  double time_tolerance = 0.1;
-  double min_clusters = 8.0;
-  int threads = 0;
   bool quiet = false;
   bool allow_mismatch = false;  // with --calibration
 };
@@ -99,19 +95,29 @@ void PlausibilityWarnings(const AllanArguments& args, const UniformSeries& serie
   }
 }
 
+// The analysis and what it needs, parsed and checked before anything is read.
+struct AllanSettings {
+  AllanOptions options;
+  NoiseFitOptions fit_options;
+  UniformSeriesOptions series_options;
+  TauSpec tau_spec;
+  double seconds_per_unit = 1.0;  // of the time column
+  AllanPlotUnits plot_units = AllanPlotUnits::kNative;
+};
+
 // What was analysed, for the summary and the plot's title: the samples, and the calibration they
 // were corrected through (the figures are the corrected unit's).
 std::string Analysed(const AllanArguments& args) {
   return args.calibration.empty() ? args.samples : args.samples + " corrected by " + args.calibration;
 }
 
-void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64_t sample_count,
-                  const std::vector<ColumnAnalysis>& results) {
+void PrintSummary(const AllanArguments& args, const AllanSettings& settings, const UniformSeries& series,
+                  int64_t sample_count, const std::vector<ColumnAnalysis>& results) {
   std::printf("%s: %lld samples at %s s (%s s), %s, %zu taus, %.3g %% confidence\n", Analysed(args).c_str(),
               static_cast<long long>(sample_count), Number(series.sample_interval_s, 6).c_str(),
               Number(series.end_time_s - series.start_time_s - series.bridged_time_s, 6).c_str(),
               ToString(results.front().curve.estimator), results.front().curve.points.size(),
-              100.0 * args.confidence);
+              100.0 * settings.options.confidence);
   if (series.gaps_bridged > 0) {
     std::printf("  bridged %lld gap(s) totalling %s s\n", static_cast<long long>(series.gaps_bridged),
                 Number(series.bridged_time_s).c_str());
@@ -159,38 +165,21 @@ void PrintSummary(const AllanArguments& args, const UniformSeries& series, int64
   }
 }
 
-// The analysis and what it needs, parsed and checked before anything is read.
-struct AllanSettings {
-  AllanOptions options;
-  NoiseFitOptions fit_options;
-  TauSpec tau_spec;
-  double seconds_per_unit = 1.0;  // of the time column
-  AllanPlotUnits plot_units = AllanPlotUnits::kNative;
-};
-
 AllanSettings ParseSettings(const AllanArguments& args) {
   AllanSettings settings;
-  if (!ParseAllanEstimator(args.estimator, &settings.options.estimator)) {
-    BadInvocation("--estimator " + QuoteForMessage(args.estimator) +
-                  " is not one of: " + AllanEstimatorNames());
-  }
-  if (!ParseEdfNoise(args.edf_noise, &settings.options.edf_noise)) {
-    BadInvocation("--edf-noise " + QuoteForMessage(args.edf_noise) + " is not one of: " + EdfNoiseNames());
-  }
+  args.allan.Apply(&settings.options);
+  args.noise_fit.Apply(&settings.fit_options);
+  args.series.Apply(&settings.series_options);
   if (const std::string problem = ParseTauSpec(args.taus, &settings.tau_spec); !problem.empty()) {
     BadInvocation("--taus: " + problem);
   }
   if (args.kind != "auto" && args.kind != "gyro" && args.kind != "accel" && args.kind != "other") {
     BadInvocation("--kind " + QuoteForMessage(args.kind) + " is not one of: auto, gyro, accel, other");
   }
-  if (args.gaps != "error" && args.gaps != "bridge") {
-    BadInvocation("--gaps " + QuoteForMessage(args.gaps) + " is not one of: error, bridge");
+  for (const std::string& problem :
+       {settings.options.Validate(), settings.fit_options.Validate(), settings.series_options.Validate()}) {
+    if (!problem.empty()) BadInvocation(problem);
   }
-  settings.options.confidence = args.confidence;
-  settings.options.threads = args.threads;
-  if (const std::string problem = settings.options.Validate(); !problem.empty()) BadInvocation(problem);
-  settings.fit_options.min_clusters = args.min_clusters;
-  if (const std::string problem = settings.fit_options.Validate(); !problem.empty()) BadInvocation(problem);
   return settings;
 }
 
@@ -228,10 +217,8 @@ bool CheckOutputs(const AllanArguments& args, AllanSettings* settings) {
 
 // The columns asked for, uniformly sampled, times in seconds: as they are, or corrected through
 // the calibration (the samples imufit apply would write, without the file).
-UniformSeries ReadSeries(const AllanArguments& args, double seconds_per_unit) {
-  UniformSeriesOptions series_options;
-  series_options.time_tolerance = args.time_tolerance;
-  series_options.bridge_gaps = args.gaps == "bridge";
+UniformSeries ReadSeries(const AllanArguments& args, const AllanSettings& settings) {
+  const UniformSeriesOptions& series_options = settings.series_options;
   UniformSeries series;
   if (args.calibration.empty()) {
     series = ReadUniformSeries(args.samples, args.columns, series_options);
@@ -243,10 +230,10 @@ UniformSeries ReadSeries(const AllanArguments& args, double seconds_per_unit) {
     WarnOutsideFitTempRange(calibration, correction);
     return series;  // SamplesReader has read the times in seconds
   }
-  series.sample_interval_s *= seconds_per_unit;
-  series.start_time_s *= seconds_per_unit;
-  series.end_time_s *= seconds_per_unit;
-  series.bridged_time_s *= seconds_per_unit;
+  series.sample_interval_s *= settings.seconds_per_unit;
+  series.start_time_s *= settings.seconds_per_unit;
+  series.end_time_s *= settings.seconds_per_unit;
+  series.bridged_time_s *= settings.seconds_per_unit;
   return series;
 }
 
@@ -330,7 +317,7 @@ void WriteOutputs(const AllanArguments& args, const AllanSettings& settings, con
     char title[512];
     std::snprintf(title, sizeof title, "%s: %s, tau0 = %g s, %lld samples, %.3g %% confidence",
                   Analysed(args).c_str(), ToString(results.front().curve.estimator), series.sample_interval_s,
-                  static_cast<long long>(sample_count), 100.0 * args.confidence);
+                  static_cast<long long>(sample_count), 100.0 * settings.options.confidence);
     DrawFile(AllanPlot(results, title, settings.plot_units), args.plot, &written);
   }
   written.Commit();
@@ -338,81 +325,57 @@ void WriteOutputs(const AllanArguments& args, const AllanSettings& settings, con
 
 int RunAllan(const AllanArguments& args) {
   AllanSettings settings = ParseSettings(args);
-  if (!CheckOutputs(args, &settings)) return 1;
-  UniformSeries series = ReadSeries(args, settings.seconds_per_unit);
+  if (!CheckOutputs(args, &settings)) return kExitNotDone;
+  UniformSeries series = ReadSeries(args, settings);
   const int64_t n = static_cast<int64_t>(series.columns[0].size());
   const std::vector<ColumnAnalysis> results = AnalyseColumns(args, settings, &series);
   PlausibilityWarnings(args, series, results);
   WriteOutputs(args, settings, series, n, results);
-  if (!args.quiet) PrintSummary(args, series, n, results);
+  if (!args.quiet) PrintSummary(args, settings, series, n, results);
   return 0;
 }
 
 }  // namespace
 
-CommandRunner AddAllanCommand(CLI::App* root) {
+CommandRunner AddAllanCommand(CliCommand command) {
   auto args = std::make_shared<AllanArguments>();
-  CLI::App* command = root->add_subcommand(
-      "allan",
-      "Allan deviation of columns of a samples file, with confidence intervals, the IEEE 952 noise terms "
-      "(quantization, random walk, bias instability, rate random walk, ramp) and Kalibr noise densities. "
-      "Columns are rates in SI units (a corrected file: gyro rad/s, accel m/s^2), or raw counts corrected on "
-      "the "
-      "way in with --calibration. Writes "
-      "column,estimator,tau_s,terms,dev,dev_lo,dev_hi.");
-  command->add_option("--samples,-s", args->samples, "samples CSV (or .csv.gz) with time_s and the columns")
-      ->required();
+  command.Option("--samples,-s", &args->samples, "samples CSV (or .csv.gz) with time_s and the columns")
+      .Required();
   command
-      ->add_option("--columns,-c", args->columns,
-                   "columns to analyse, comma-separated (default: every gyro_* and accel_* column)")
-      ->delimiter(',');
-  command->add_option("--output,-o", args->output, "Allan deviation CSV to write (.gz compresses)")
-      ->required();
-  command->add_option("--estimator,-e", args->estimator,
-                      "adev, oadev (default), mdev, tdev, hdev, ohdev or totdev");
-  command->add_option("--taus,-t", args->taus,
-                      "octave (default: tau0 * 1, 2, 4, ...), decade (1, 2, 4, 10, 20, 40, ...), all, "
-                      "per-decade:K (K log-spaced taus per decade), or taus in seconds: 1,10,100");
-  command->add_option("--confidence", args->confidence,
-                      "two-sided confidence of dev_lo..dev_hi (default 0.683)");
-  command->add_option("--edf-noise", args->edf_noise,
-                      "noise type for the confidence intervals' degrees of freedom: auto (default, lag-1 "
-                      "autocorrelation per tau), wpm, fpm, wfm, ffm, rwfm");
-  command->add_option(
-      "--kind", args->kind,
-      "auto (default: gyro_* are gyros in rad/s, accel_* accelerometers in m/s^2), gyro, accel, "
-      "or other (no engineer units)");
-  command->add_option(
-      "--time-tolerance", args->time_tolerance,
-      "largest deviation of a time step from the sample interval, in intervals (default 0.1)");
-  command->add_option("--gaps", args->gaps,
-                      "error (default): a gap in time_s is an error; bridge: join the data across gaps");
-  command->add_option(
-      "--min-clusters", args->min_clusters,
-      "the noise fit leaves out taus with fewer than this many intervals in the record (default 8)");
-  command->add_option("--noise-yaml", args->noise_yaml,
-                      "write the noise terms as YAML (top-level key noise:)");
-  command->add_option("--plot", args->plot,
-                      "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
-  command->add_option("--plot-units", args->plot_units,
-                      "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
-                      "corrected file), rad/s, deg/s or deg/h (then accelerometer panels in micro-g)");
-  CLI::Option* scale = command->add_option(
-      "--scale", args->scale,
+      .Option("--columns,-c", &args->columns,
+              "columns to analyse, comma-separated (default: every gyro_* and accel_* column)")
+      .Delimiter(',');
+  command.Option("--output,-o", &args->output, "Allan deviation CSV to write (.gz compresses)").Required();
+  args->allan.AddOne(command, AllanOptionTable(), "estimator");
+  command.Option("--taus,-t", &args->taus,
+                 "octave (default: tau0 * 1, 2, 4, ...), decade (1, 2, 4, 10, 20, 40, ...), all, "
+                 "per-decade:K (K log-spaced taus per decade), or taus in seconds: 1,10,100");
+  args->allan.Add(command, AllanOptionTable(), {"estimator", "threads"});
+  command.Option("--kind", &args->kind,
+                 "auto (default: gyro_* are gyros in rad/s, accel_* accelerometers in m/s^2), gyro, accel, "
+                 "or other (no engineer units)");
+  args->series.Add(command, UniformSeriesOptionTable());
+  args->noise_fit.Add(command, NoiseFitOptionTable());
+  command.Option("--noise-yaml", &args->noise_yaml, "write the noise terms as YAML (top-level key noise:)");
+  command.Option("--plot", &args->plot, "draw the curves, fits and read-outs with gnuplot (.svg or .png)");
+  command.Option("--plot-units", &args->plot_units,
+                 "unit of the plot's gyro panels: native (default: the columns' own, rad/s for a "
+                 "corrected file), rad/s, deg/s or deg/h (then accelerometer panels in micro-g)");
+  CliOption scale = command.Option(
+      "--scale", &args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "
       "columns are raw counts (default 1)");
-  CLI::Option* calibration =
+  CliOption calibration =
       command
-          ->add_option(
-              "--calibration", args->calibration,
-              "the unit's calibration YAML: correct the raw samples through it first, as imufit apply "
-              "does (then the columns are among gyro_*, accel_* and temp_c)")
-          ->excludes(scale);
+          .Option("--calibration", &args->calibration,
+                  "the unit's calibration YAML: correct the raw samples through it first, as imufit apply "
+                  "does (then the columns are among gyro_*, accel_* and temp_c)")
+          .Excludes(scale);
   AddTempOption(command, &args->input);
   AddAllowMismatchFlag(command, &args->allow_mismatch);
-  args->input.TempOption()->needs(calibration);  // a temperature only matters to the correction
-  command->add_option("--threads", args->threads, "worker threads (default 0: all cores)");
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
+  args->input.TempOption().Needs(calibration);  // a temperature only matters to the correction
+  args->allan.AddOne(command, AllanOptionTable(), "threads");
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunAllan(*args); };
 }
 

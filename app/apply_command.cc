@@ -62,26 +62,20 @@ void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileRe
       report.min_temp_c, report.max_temp_c);
 }
 
-void AddAllowMismatchFlag(CLI::App* command, bool* allow_mismatch) {
-  command->add_flag("--allow-mismatch", *allow_mismatch,
-                    "correct even when the calibration names another unit than the samples header (a "
-                    "warning); without it such a log is refused");
+void AddAllowMismatchFlag(CliCommand command, bool* allow_mismatch) {
+  command.Flag("--allow-mismatch", allow_mismatch,
+               "correct even when the calibration names another unit than the samples header (a "
+               "warning); without it such a log is refused");
 }
 
-CommandRunner AddApplyCommand(CLI::App* root) {
+CommandRunner AddApplyCommand(CliCommand command) {
   auto args = std::make_shared<ApplyArguments>();
-  CLI::App* command = root->add_subcommand(
-      "apply",
-      "Correct raw samples with a calibration: writes time_s, temp_c, segment (if present), gyro in "
-      "rad/s and accel in m/s^2, body frame.");
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")
-      ->required();
-  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
-  command->add_option("--output,-o", args->output, "corrected samples CSV to write (.gz compresses)")
-      ->required();
+  command.Option("--calibration,-c", &args->calibration, "calibration YAML (imufit fit's output)").Required();
+  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
+  command.Option("--output,-o", &args->output, "corrected samples CSV to write (.gz compresses)").Required();
   AddTempOption(command, &args->input);
   AddAllowMismatchFlag(command, &args->allow_mismatch);
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunApply(*args); };
 }
 

@@ -15,9 +15,8 @@ namespace imufit {
 namespace {
 
 struct BatchArguments {
-  BatchOptions batch;
-  FitRunArguments run;  // every unit is fitted with these, as imufit fit would fit it
-  bool no_report = false;
+  CliOptions<BatchOptions> batch;  // BatchOptionTable(): the folders, --jobs, --max-units, --no-report
+  FitRunArguments run;             // every unit is fitted with these, as imufit fit would fit it
   PdfArguments pdf;
   CustomerArguments customer;
   bool quiet = false;
@@ -44,15 +43,15 @@ void ShowProgress(const BatchProgress& p, bool terminal) {
   std::fflush(stderr);
 }
 
-int RunBatchCommand(BatchArguments args) {
-  BatchOptions& options = args.batch;
+int RunBatchCommand(const BatchArguments& args) {
+  BatchOptions options;
+  args.batch.Apply(&options);
   options.fit = args.run.Resolve();
   options.fit.software = SoftwareVersion();
   options.fit.fit.num_threads = 1;  // parallel over units instead
   const bool terminal = isatty(STDERR_FILENO) != 0;
   if (!args.quiet) options.progress = [terminal](const BatchProgress& p) { ShowProgress(p, terminal); };
-  options.write_reports = !args.no_report;
-  if (args.pdf.pdf && args.no_report)
+  if (args.pdf.pdf && !options.write_reports)
     throw InputError("--pdf", "prints the certificates: leave out --no-report");
   options.paper = args.pdf.Resolve();
   args.customer.Check();
@@ -92,54 +91,19 @@ int RunBatchCommand(BatchArguments args) {
 
 }  // namespace
 
-CommandRunner AddBatchCommand(CLI::App* root) {
+CommandRunner AddBatchCommand(CliCommand command) {
   auto args = std::make_shared<BatchArguments>();
-  BatchOptions& b = args->batch;
-  CLI::App* command = root->add_subcommand(
-      "batch",
-      "Fit every unit of a lot: each folder of UNITS_DIR is a unit (plan.yaml and samples.csv[.gz], or "
-      "samples "
-      "only with --plan). Writes OUT_DIR/<unit>/calibration.yaml, report.html and manifest.yaml, and "
-      "OUT_DIR/lot_summary.csv; every unit is fitted with the fit options below, as imufit fit would fit it; "
-      "a re-run skips units whose inputs, fit options and software are unchanged. Exit 0 every "
-      "unit "
-      "passed, 3 some unit failed its limits or could not be fitted, 1 stopped early, 2 bad invocation.");
-  command->add_option("units_dir", b.units_dir, "folder of unit folders (or --units-list)");
-  command->add_option(
-      "--units-list", b.units_list,
-      "file listing the units instead of UNITS_DIR: a line per unit, \"serial, samples file[, "
-      "plan]\" (CSV or blank-separated; paths relative to the list; a unit's outputs go to "
-      "OUT_DIR/<serial>)");
-  command->add_option("--samples-glob", b.samples_glob,
-                      "each unit folder's samples file as the logger names it: the one file matching this "
-                      "pattern (e.g. '*_imu.csv.gz'; default samples.csv.gz or samples.csv, not both)");
-  command->add_option("--output,-o", b.output_dir, "output folder")->required();
-  command->add_option("--limits,-l", b.limits_path, "acceptance limits YAML (format imufit-limits)");
-  command->add_option("--plan,-p", b.shared_plan, "plan for units without their own plan.yaml");
-  command->add_option(
-      "--store", b.store_path,
-      "results store to record every fit in: an SQLite file, or a PostgreSQL URL or connection "
-      "string (postgresql://host/db; the password from ~/.pgpass or PGPASSFILE)");
-  command->add_option(
-      "--shard", args->shard,
-      "fit only this shard of the lot: I/N (units whose folder name hashes to I of N), auto "
-      "(Slurm array), auto/N (Kubernetes JOB_COMPLETION_INDEX or GNU parallel's PARALLEL_SEQ); "
-      "with shards, the lot page comes from the store (imufit history --lot)");
-  command->add_option(
-      "--station", b.station_path,
-      "station file (format imufit-station: station, operator, equipment) shown on every certificate");
-  command->add_option("--lot", b.lot, "the lot's name in the store (default: the units folder's name)");
-  command->add_option("--jobs,-j", b.jobs, "units fitted in parallel (0: all cores)")->capture_default_str();
-  command
-      ->add_option("--max-units", b.max_units,
-                   "stop after fitting this many units (0: all); a later run resumes the lot")
-      ->capture_default_str();
-  command->add_flag("--no-report", args->no_report, "write no report.html per unit");
+  args->batch.Add(command, BatchOptionTable());
+  args->batch.Find("output_dir").Required();
+  command.Option("--shard", &args->shard,
+                 "fit only this shard of the lot: I/N (units whose folder name hashes to I of N), auto "
+                 "(Slurm array), auto/N (Kubernetes JOB_COMPLETION_INDEX or GNU parallel's PARALLEL_SEQ); "
+                 "with shards, the lot page comes from the store (imufit history --lot)");
   AddPdfOptions(command, &args->pdf);
   AddCustomerOptions(command, &args->customer);
   // Not --threads (units run in parallel instead) nor a check run (a lot has no held-out runs).
   AddFitRunOptions(command, &args->run, {"threads", "check_samples", "check_plan"});
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
   return [args] { return RunBatchCommand(*args); };
 }
 

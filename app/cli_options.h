@@ -1,7 +1,7 @@
-// imufit — the command-line options of an option table (model/option_table.h): each entry with a
-// flag becomes a CLI11 option with the entry's help, unit and default; after parsing, Apply() sets
-// the options given into the struct, converted to SI. Options not given keep the struct's defaults,
-// so that the command and the library cannot disagree about them.
+// imufit — the command-line options of an option table (base/option_table.h): each entry with a
+// flag becomes an option of the command (cli.h) with the entry's help, unit and default; after parsing,
+// Apply() sets the options given into the struct, converted to SI. Options not given keep the struct's
+// defaults, so that the command and the library cannot disagree about them.
 #ifndef IMUFIT_APP_CLI_OPTIONS_H_
 #define IMUFIT_APP_CLI_OPTIONS_H_
 
@@ -12,8 +12,7 @@
 #include <type_traits>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
+#include "cli.h"
 #include "imufit/base/option_table.h"
 #include "imufit/io/error.h"
 #include "imufit/io/units.h"
@@ -57,34 +56,31 @@ class CliOptions {
   using Entry = OptionEntry<Options>;
 
   // Adds every entry of `table` that has a flag, but those whose keys are in `except`.
-  void Add(CLI::App* command, const OptionTable<Options>& table, const std::set<std::string>& except = {}) {
+  void Add(CliCommand command, const OptionTable<Options>& table, const std::set<std::string>& except = {}) {
     for (const Entry& entry : table.entries()) {
       if (!entry.flag.empty() && except.count(entry.key) == 0) AddEntry(command, entry);
     }
   }
   // Adds the entry of `key` alone.
-  void AddOne(CLI::App* command, const OptionTable<Options>& table, const std::string& key) {
+  void AddOne(CliCommand command, const OptionTable<Options>& table, const std::string& key) {
     const Entry* entry = table.Find(key);
     if (entry != nullptr && !entry->flag.empty()) AddEntry(command, *entry);
   }
 
-  // The CLI11 option of `key` (for constraints between options), nullptr when not added.
-  CLI::Option* Find(const std::string& key) const {
+  // The option of `key` (for constraints between options), null when not added.
+  CliOption Find(const std::string& key) const {
     for (const auto& b : bindings_) {
       if (b->entry->key == key) return b->option;
     }
-    return nullptr;
+    return CliOption();
   }
   // Whether the option of `key` was given on the command line.
-  bool Given(const std::string& key) const {
-    const CLI::Option* option = Find(key);
-    return option != nullptr && option->count() > 0;
-  }
+  bool Given(const std::string& key) const { return Find(key).Given(); }
 
   // The text given for the option of `key` (a path, a name), "" when not given.
   std::string GivenText(const std::string& key) const {
     for (const auto& b : bindings_) {
-      if (b->entry->key == key) return b->option->count() > 0 ? b->text : "";
+      if (b->entry->key == key) return b->option.Given() ? b->text : "";
     }
     return "";
   }
@@ -93,7 +89,7 @@ class CliOptions {
   // (a bad name) throws InputError naming the flag.
   void Apply(Options* options) const {
     for (const auto& b : bindings_) {
-      if (b->option->count() > 0) Set(*b, options);
+      if (b->option.Given()) Set(*b, options);
     }
   }
 
@@ -101,7 +97,7 @@ class CliOptions {
   // One option: its entry and where CLI11 puts what it parses.
   struct Binding {
     const Entry* entry = nullptr;
-    CLI::Option* option = nullptr;
+    CliOption option;
     double number = 0.0;
     int integer = 0;
     std::uint64_t unsigned_integer = 0;
@@ -117,7 +113,7 @@ class CliOptions {
     return text.str();
   }
 
-  void AddEntry(CLI::App* command, const Entry& entry) {
+  void AddEntry(CliCommand command, const Entry& entry) {
     auto binding = std::make_shared<Binding>();
     Binding& b = *binding;
     b.entry = &entry;
@@ -127,29 +123,30 @@ class CliOptions {
           using Kind = std::decay_t<decltype(kind)>;
           const auto help = [&entry](const std::string& unit) { return entry.HelpWithUnit(unit); };
           if constexpr (std::is_same_v<Kind, NumberOption<Options, double>>) {
-            b.option = command->add_option(entry.flag, b.number, help(CliUnitName(kind.cli_unit, entry.unit)))
-                           ->default_str(Text(CliFromSi(kind.cli_unit, kind.Get(defaults))));
+            b.option = command.Option(entry.flag, &b.number, help(CliUnitName(kind.cli_unit, entry.unit)));
+            b.option.DefaultText(Text(CliFromSi(kind.cli_unit, kind.Get(defaults))));
           } else if constexpr (std::is_same_v<Kind, NumberOption<Options, int>>) {
-            b.option = command->add_option(entry.flag, b.integer, help(entry.unit))
-                           ->default_str(Text(kind.Get(defaults)));
+            b.option = command.Option(entry.flag, &b.integer, help(entry.unit));
+            b.option.DefaultText(Text(kind.Get(defaults)));
           } else if constexpr (std::is_same_v<Kind, NumberOption<Options, std::uint64_t>>) {
-            b.option = command->add_option(entry.flag, b.unsigned_integer, help(entry.unit))
-                           ->default_str(Text(kind.Get(defaults)));
+            b.option = command.Option(entry.flag, &b.unsigned_integer, help(entry.unit));
+            b.option.DefaultText(Text(kind.Get(defaults)));
           } else if constexpr (std::is_same_v<Kind, FlagOption<Options>>) {
             b.option =
-                command->add_flag(entry.flag, b.flag, (kind.cli_negates ? "turns off: " : "") + entry.help);
+                command.Flag(entry.flag, &b.flag, (kind.cli_negates ? "turns off: " : "") + entry.help);
           } else if constexpr (std::is_same_v<Kind, OptionalNumberOption<Options>>) {
-            b.option = command->add_option(entry.flag, b.number, help(entry.unit));
+            b.option = command.Option(entry.flag, &b.number, help(entry.unit));
           } else if constexpr (std::is_same_v<Kind, NumbersOption<Options>>) {
             std::string shown;
             for (double value : kind.Get(defaults)) shown += (shown.empty() ? "" : ",") + Text(value);
-            b.option = command->add_option(entry.flag, b.numbers, help(entry.unit))->delimiter(',');
-            if (kind.count > 0) b.option->expected(static_cast<int>(kind.count));
-            if (!shown.empty()) b.option->default_str(shown);
+            b.option = command.Option(entry.flag, &b.numbers, help(entry.unit));
+            b.option.Delimiter(',');
+            if (kind.count > 0) b.option.Expected(static_cast<int>(kind.count));
+            if (!shown.empty()) b.option.DefaultText(shown);
           } else {
-            b.option = command->add_option(entry.flag, b.text, entry.help);
-            if (entry.repeatable) b.option->multi_option_policy(CLI::MultiOptionPolicy::Join);
-            if (const std::string shown = kind.Get(defaults); !shown.empty()) b.option->default_str(shown);
+            b.option = command.Option(entry.flag, &b.text, entry.help);
+            if (entry.repeatable) b.option.JoinRepeated();
+            if (const std::string shown = kind.Get(defaults); !shown.empty()) b.option.DefaultText(shown);
           }
         },
         entry.value);
@@ -174,7 +171,7 @@ class CliOptions {
             kind.set(b.numbers, options);
           } else {
             if (const std::string error = kind.set(b.text, options); !error.empty()) {
-              throw InputError(b.entry->flag, error);
+              throw InputError(b.entry->flag.substr(0, b.entry->flag.find(',')), error);
             }
           }
         },

@@ -1,17 +1,14 @@
 // imufit — the subcommands of the `imufit` program. Each Add*Command registers its options on
-// `root` and returns the function that runs it once the command line has been parsed; that
-// function returns the exit status of docs/spec.md section 4 (0 done, 1 could not be done, 2 bad
-// input; 3 done but failed acceptance limits) and lets InputError escape to main(), which prints it and
-// returns 2.
+// `command` (the table of main.cc names and describes it) and returns the function that runs it
+// once the command line has been parsed; that function returns an exit status of exit_status.h
+// and lets InputError escape to main(), which prints it and returns kExitBadInput.
 #ifndef IMUFIT_APP_COMMANDS_H_
 #define IMUFIT_APP_COMMANDS_H_
 
-#include <functional>
 #include <set>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
+#include "cli.h"
 #include "cli_options.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/segment_run.h"
@@ -19,27 +16,25 @@
 
 namespace imufit {
 
-using CommandRunner = std::function<int()>;
-
-CommandRunner AddApplyCommand(CLI::App* root);
-CommandRunner AddFitCommand(CLI::App* root);
-CommandRunner AddSimulateCommand(CLI::App* root);
-CommandRunner AddAllanCommand(CLI::App* root);
-CommandRunner AddBatchCommand(CLI::App* root);
-CommandRunner AddHistoryCommand(CLI::App* root);
-CommandRunner AddLotCommand(CLI::App* root);
-CommandRunner AddStoreCommand(CLI::App* root);
-CommandRunner AddReportCommand(CLI::App* root);
-CommandRunner AddSegmentCommand(CLI::App* root);
-CommandRunner AddPlanCommand(CLI::App* root);
-CommandRunner AddExportCommand(CLI::App* root);
+CommandRunner AddApplyCommand(CliCommand command);
+CommandRunner AddFitCommand(CliCommand command);
+CommandRunner AddSimulateCommand(CliCommand command);
+CommandRunner AddAllanCommand(CliCommand command);
+CommandRunner AddBatchCommand(CliCommand command);
+CommandRunner AddHistoryCommand(CliCommand command);
+CommandRunner AddLotCommand(CliCommand command);
+CommandRunner AddStoreCommand(CliCommand command);
+CommandRunner AddReportCommand(CliCommand command);
+CommandRunner AddSegmentCommand(CliCommand command);
+CommandRunner AddPlanCommand(CliCommand command);
+CommandRunner AddExportCommand(CliCommand command);
 
 // How a command reads samples files without a temp_c or segment column: the options of
 // SamplesInputOptionTable() (segment_command.cc).
 struct SamplesInputArguments {
   CliOptions<SamplesInput> options;
   bool HasTemp() const { return options.Given("temp_c"); }
-  CLI::Option* TempOption() const { return options.Find("temp_c"); }  // after AddTempOption
+  CliOption TempOption() const { return options.Find("temp_c"); }  // after AddTempOption
   SamplesInput Get() const {
     SamplesInput input;
     options.Apply(&input);
@@ -47,9 +42,9 @@ struct SamplesInputArguments {
   }
 };
 // --temp-c, --time-unit, --delimiter, --decimal-comma and --column: how a file is read.
-void AddTempOption(CLI::App* command, SamplesInputArguments* args);
+void AddTempOption(CliCommand command, SamplesInputArguments* args);
 // The segmentation options: --segment-window, --min-steady, --direction-tolerance, ...
-void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args);
+void AddSegmentationOptions(CliCommand command, SamplesInputArguments* args);
 
 // How a run is read into windows: what a certificate must read as the fit read it.
 struct RunReadingArguments {
@@ -69,7 +64,7 @@ struct RunReadingArguments {
 };
 // The options of WindowOptionTable() (--trim, --window-temp-span, ...), --temp-c, the
 // segmentation options and --noise-segment (report: run_options.cc).
-void AddRunReadingOptions(CLI::App* command, RunReadingArguments* args);
+void AddRunReadingOptions(CliCommand command, RunReadingArguments* args);
 
 // The options of a unit's fit, FitRunOptionTable(), defined once for `imufit fit` and `imufit
 // batch` so that the two cannot drift apart (run_options.cc).
@@ -81,7 +76,7 @@ struct FitRunArguments {
   FitRunOptions Resolve() const;
 };
 // Every option of FitRunOptionTable() but those whose keys are in `except`.
-void AddFitRunOptions(CLI::App* command, FitRunArguments* args, const std::set<std::string>& except = {});
+void AddFitRunOptions(CliCommand command, FitRunArguments* args, const std::set<std::string>& except = {});
 
 struct Calibration;
 struct CorrectFileReport;
@@ -92,7 +87,7 @@ struct CorrectFileReport;
 // (AddAllowMismatchFlag).
 Calibration ReadUnitCalibration(const std::string& calibration_path, const std::string& samples_path,
                                 bool allow_mismatch);
-void AddAllowMismatchFlag(CLI::App* command, bool* allow_mismatch);
+void AddAllowMismatchFlag(CliCommand command, bool* allow_mismatch);
 // Warns once, with a count, when corrected samples lay outside the calibration's fit temperature
 // range (an extrapolation): apply_command.cc; apply and allan --calibration share it.
 void WarnOutsideFitTempRange(const Calibration& calibration, const CorrectFileReport& report);
@@ -111,7 +106,7 @@ struct PdfArguments {
   // (exit 1) before any work when Chromium cannot be found.
   Paper Resolve() const;
 };
-void AddPdfOptions(CLI::App* command, PdfArguments* args);
+void AddPdfOptions(CliCommand command, PdfArguments* args);
 
 // --customer and --order: whom a certificate is issued to (report_command.cc; fit --report, report
 // and batch share them).
@@ -120,11 +115,7 @@ struct CustomerArguments {
   // Throws InputError naming the option for a value that is not one line of printable text.
   void Check() const;
 };
-void AddCustomerOptions(CLI::App* command, CustomerArguments* args);
-
-// Exit status 3 (an addition to docs/spec.md section 4, docs/factory.md): the job was done, but a unit
-// failed its acceptance limits (or, in a batch, could not be fitted).
-inline constexpr int kExitFailedLimits = 3;
+void AddCustomerOptions(CliCommand command, CustomerArguments* args);
 
 // "imufit 0.1.0 (git abc123)" — the software string written into calibration files.
 std::string SoftwareVersion();

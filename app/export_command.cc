@@ -15,33 +15,36 @@ namespace {
 
 struct ExportArguments {
   std::string calibration;
-  std::string format;
   std::string output;
   std::vector<double> max_loss = {0.5, 10.0};  // worst case: deg/s, mg
   bool force = false;
   bool quiet = false;
-  double temp_c = 0.0;
-  CLI::Option* temp_c_option = nullptr;
-  long long device_id = 0;
-  CLI::Option* device_id_option = nullptr;
-  ExportOptions options;
+  CliOptions<ExportOptions> options;  // ExportOptionTable(): --format, the envelope, the formats' own
 };
 
-int RunExport(ExportArguments args) {
-  const std::optional<ExportFormat> format = ExportFormatFromString(args.format);
-  if (!format) {
-    throw InputError("--format",
-                     QuoteForMessage(args.format) + " is not a format (" + ExportFormatNames() + ")");
+// The options given, for the format given: an option that serves other formats only is refused
+// (InputError naming it and the formats it serves).
+ExportOptions ResolveOptions(const ExportArguments& args) {
+  ExportOptions options;
+  args.options.Apply(&options);
+  for (const OptionEntry<ExportOptions>& entry : ExportOptionTable().entries()) {
+    if (args.options.Given(entry.key) && !ExportOptionServes(entry.key, options.format)) {
+      throw InputError(entry.flag,
+                       "only " + ExportOptionFormats(entry.key) + " use it, not " + ToString(options.format));
+    }
   }
+  if (const std::string problem = options.Validate(); !problem.empty())
+    throw InputError("imufit export", problem);
+  return options;
+}
+
+int RunExport(const ExportArguments& args) {
+  ExportOptions options = ResolveOptions(args);
   if (!(args.max_loss[0] >= 0.0) || !(args.max_loss[1] >= 0.0)) {
     throw InputError("--max-loss", "the bounds must be two non-negative numbers: deg/s,mg");
   }
   RefuseToOverwriteInputs(args.output, {args.calibration});
   const Calibration calibration = ReadCalibration(args.calibration);
-  ExportOptions& options = args.options;
-  options.format = *format;
-  if (args.temp_c_option->count() > 0) options.temp_c = args.temp_c;
-  if (args.device_id_option->count() > 0) options.device_id = args.device_id;
   options.software = SoftwareVersion();
   options.calibration_file = args.calibration;
   options.calibration_sha256 = Sha256OfFile(args.calibration);
@@ -51,64 +54,33 @@ int RunExport(ExportArguments args) {
           LossBeyondBounds(result.loss, args.max_loss[0], args.max_loss[1])) {
     if (!args.force) {
       std::fprintf(stderr, "imufit: %s export refused: %s (--max-loss, --force); nothing written\n",
-                   ToString(*format), excess->c_str());
-      return 1;
+                   ToString(options.format), excess->c_str());
+      return kExitNotDone;
     }
     std::fprintf(stderr, "imufit: warning: %s (written anyway: --force)\n", excess->c_str());
   }
   WriteFileAtomically(args.output, result.content);
-  if (!args.quiet) std::printf("wrote %s (%s)\n", args.output.c_str(), ToString(*format));
-  return 0;
+  if (!args.quiet) std::printf("wrote %s (%s)\n", args.output.c_str(), ToString(options.format));
+  return kExitDone;
 }
 
 }  // namespace
 
-CommandRunner AddExportCommand(CLI::App* root) {
+CommandRunner AddExportCommand(CliCommand command) {
   auto args = std::make_shared<ExportArguments>();
-  CLI::App* command = root->add_subcommand("export",
-                                           "Write a calibration for where it is used: the C runtime (c, "
-                                           "bin), PX4, ArduPilot, Kalibr, imucal or JSON. "
-                                           "A format that cannot hold the whole model measures its loss over "
-                                           "the envelope first and refuses (exit 1) "
-                                           "beyond --max-loss.");
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML (imufit fit's output)")
-      ->required();
-  command->add_option("--format,-f", args->format, "c, bin, px4, ardupilot, kalibr, imucal or json")
-      ->required();
-  command->add_option("--output,-o", args->output, "the file to write")->required();
+  command.Option("--calibration,-c", &args->calibration, "calibration YAML (imufit fit's output)").Required();
+  args->options.AddOne(command, ExportOptionTable(), "format");
+  args->options.Find("format").Required().DefaultText("");
+  command.Option("--output,-o", &args->output, "the file to write").Required();
   command
-      ->add_option("--max-loss", args->max_loss,
-                   "largest worst-case loss over the envelope accepted, gyro deg/s and accelerometer mg")
-      ->delimiter(',')
-      ->expected(2)
-      ->capture_default_str();
-  command->add_flag("--force", args->force, "write a lossy export even beyond --max-loss");
-  command
-      ->add_option("--full-scale-dps", args->options.full_scale_dps,
-                   "the envelope: the largest angular rate on each axis, deg/s")
-      ->capture_default_str();
-  command
-      ->add_option("--max-g", args->options.max_g, "the envelope: the largest specific force on each axis, g")
-      ->capture_default_str();
-  command
-      ->add_option("--gyro-raw-per-radps", args->options.gyro_raw_per_radps,
-                   "px4, ardupilot, kalibr: what the driver divides the raw gyro output by to give rad/s")
-      ->capture_default_str();
-  command
-      ->add_option(
-          "--accel-raw-per-mps2", args->options.accel_raw_per_mps2,
-          "px4, ardupilot, kalibr: what the driver divides the raw accelerometer output by to give m/s^2")
-      ->capture_default_str();
-  args->temp_c_option = command->add_option("--temp-c", args->temp_c,
-                                            "kalibr, imucal: the temperature the one-temperature formats are "
-                                            "taken at, degC (default: the reference)");
-  args->device_id_option = command->add_option("--device-id", args->device_id,
-                                               "px4: the sensor's device ID (TC_G0_ID, CAL_ACC0_ID)");
-  command->add_option("--c-name", args->options.c_name, "c: the C name of the unit (NAME_INITIALIZER)")
-      ->capture_default_str();
-  command->add_option("--rostopic", args->options.rostopic, "kalibr: the IMU's ROS topic")
-      ->capture_default_str();
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but warnings and errors");
+      .Option("--max-loss", &args->max_loss,
+              "largest worst-case loss over the envelope accepted, gyro deg/s and accelerometer mg")
+      .Delimiter(',')
+      .Expected(2)
+      .ShowDefault();
+  command.Flag("--force", &args->force, "write a lossy export even beyond --max-loss");
+  args->options.Add(command, ExportOptionTable(), {"format"});
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunExport(*args); };
 }
 

@@ -149,7 +149,7 @@ void PrintRunNotes(const FitRunOptions& options, const FitRunResult& result) {
 int ReportUndetermined(const FitArguments& args, const FitRunOptions& options, const FitRunResult& result) {
   std::fprintf(stderr, "imufit: %s, nothing written\n",
                UndeterminedMessage(args.samples, options, result).c_str());
-  return 1;
+  return kExitNotDone;
 }
 
 // The fit: the run, the residuals, the windows the robust loss down-weighted, the coefficients.
@@ -217,11 +217,11 @@ void PrintValidation(const std::vector<HeldOutGroup>& folds) {
 }
 
 // After CertifyUnit: the verdict, the files written, the store. Returns the exit status: 0,
-// kExitFailedLimits, or 2 when the store refused the fit (then nothing was written).
+// kExitFailedLimits, or kExitBadInput when the store refused the fit (then nothing was written).
 int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool recorded) {
   if (!recorded) {
     std::fprintf(stderr, "imufit: %s; nothing written\n", unit.message.c_str());
-    return 2;
+    return kExitBadInput;
   }
   if (!args.report.empty()) WarnIfNoSerial(unit.fit->calibration->serial, args.samples);
   const bool judged = !unit.verdict.empty();
@@ -280,7 +280,7 @@ int RunFit(const FitArguments& args) {
   if (!result.calibration) {
     std::fprintf(stderr, "imufit: %s: %s; nothing written\n", args.samples.c_str(),
                  result.fit.BriefReport().c_str());
-    return 1;
+    return kExitNotDone;
   }
   if (!args.quiet) {
     PrintFit(options, result);
@@ -301,35 +301,28 @@ int RunFit(const FitArguments& args) {
 
 }  // namespace
 
-CommandRunner AddFitCommand(CLI::App* root) {
+CommandRunner AddFitCommand(CliCommand command) {
   auto args = std::make_shared<FitArguments>();
-  CLI::App* command = root->add_subcommand(
-      "fit",
-      "Fit biases, scale factors, misalignments, gyro g-sensitivity and their cubic temperature "
-      "dependence to a rate-table run; write the calibration YAML with 1-sigma uncertainties. Exit 1 when "
-      "the run does not determine the model (the message says what is missing) or the fit does not "
-      "converge.");
-  command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();
-  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
-  command->add_option("--output,-o", args->output, "calibration YAML to write")->required();
+  command.Option("--plan,-p", &args->plan, "plan YAML of the run").Required();
+  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
+  command.Option("--output,-o", &args->output, "calibration YAML to write").Required();
   AddFitRunOptions(command, &args->run);
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
-  command->add_option(
-      "--limits,-l", args->limits,
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
+  command.Option(
+      "--limits,-l", &args->limits,
       "acceptance limits YAML: print the verdict criterion by criterion; exit 3 when the unit fails");
-  command->add_option(
-      "--serial", args->serial,
+  command.Option(
+      "--serial", &args->serial,
       "the unit's serial (default: the samples header's '# serial:' line, else the plan's serial); one "
       "that contradicts the samples header is refused (exit 2) unless --allow-mismatch");
-  command->add_option("--report", args->report,
-                      "write the unit's calibration certificate (self-contained HTML)");
+  command.Option("--report", &args->report, "write the unit's calibration certificate (self-contained HTML)");
   AddPdfOptions(command, &args->pdf);
   AddCustomerOptions(command, &args->customer);
-  command->add_option(
-      "--station", args->station,
+  command.Option(
+      "--station", &args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
-  command->add_option(
-      "--store", args->store,
+  command.Option(
+      "--store", &args->store,
       "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");
   return [args] { return RunFit(*args); };
 }

@@ -206,32 +206,25 @@ int RunHistory(const HistoryArguments& args) {
 
 }  // namespace
 
-CommandRunner AddHistoryCommand(CLI::App* root) {
+CommandRunner AddHistoryCommand(CliCommand command) {
   auto args = std::make_shared<HistoryArguments>();
-  CLI::App* command = root->add_subcommand(
-      "history",
-      "Query the results store across stations: every calibration of a serial (--serial), the yield "
-      "of lots (--lot [NAME]) or by station or month (--by), a key figure over time (--trend "
-      "gyro.bias.x, or a figure name such as gyro_bias_dps.x; with --serial, one unit's; with "
-      "--station, that station's drift).");
   command
-      ->add_option("store", args->store,
-                   "results store written by imufit batch/fit --store: an SQLite file or a PostgreSQL URL")
-      ->required();
-  command->add_option("--serial", args->serial, "a unit's serial");
-  CLI::Option* lot =
-      command->add_option("--lot", args->lot, "yield of this lot (no name: of every lot)")->expected(0, 1);
-  command->add_option("--by", args->by, "yield by lot, station or month (YYYY-MM of the fit, UTC)");
-  command->add_option("--trend", args->trend, "a key figure over time");
-  command->add_option("--station", args->station, "with --trend: only this station's fits (its drift)");
-  command->add_flag("--csv", args->csv, "print CSV instead of a table");
-  command->add_option("--html", args->html,
-                      "write the answer as an HTML page (with --lot: every lot's yield and key figures "
-                      "as charts, NAME highlighted)");
-  command->add_option("--limits", args->limits,
-                      "with --lot --html: draw these acceptance limits on the charts");
+      .Option("store", &args->store,
+              "results store written by imufit batch/fit --store: an SQLite file or a PostgreSQL URL")
+      .Required();
+  command.Option("--serial", &args->serial, "a unit's serial");
+  CliOption lot =
+      command.Option("--lot", &args->lot, "yield of this lot (no name: of every lot)").Expected(0, 1);
+  command.Option("--by", &args->by, "yield by lot, station or month (YYYY-MM of the fit, UTC)");
+  command.Option("--trend", &args->trend, "a key figure over time");
+  command.Option("--station", &args->station, "with --trend: only this station's fits (its drift)");
+  command.Flag("--csv", &args->csv, "print CSV instead of a table");
+  command.Option("--html", &args->html,
+                 "write the answer as an HTML page (with --lot: every lot's yield and key figures "
+                 "as charts, NAME highlighted)");
+  command.Option("--limits", &args->limits, "with --lot --html: draw these acceptance limits on the charts");
   return [args, lot] {
-    args->lot_given = lot->count() > 0;
+    args->lot_given = lot.Given();
     return RunHistory(*args);
   };
 }

@@ -48,18 +48,13 @@ int RunLot(const LotArguments& args) {
 
 }  // namespace
 
-CommandRunner AddLotCommand(CLI::App* root) {
+CommandRunner AddLotCommand(CliCommand command) {
   auto args = std::make_shared<LotArguments>();
-  CLI::App* command = root->add_subcommand(
-      "lot",
-      "Write a lot's page and summary from the results store, each unit by its latest fit in the lot: "
-      "for a lot fitted in shards (imufit batch --shard), whose shards leave the lot page to the store.");
-  command->add_option("--store", args->store, "the results store: an SQLite file or a PostgreSQL URL")
-      ->required();
-  command->add_option("--lot", args->lot, "the lot's name in the store")->required();
-  command->add_option("--html", args->html, "write the lot page (as the batch's lot.html) here");
-  command->add_option("--csv", args->csv, "write the lot summary (as the batch's lot_summary.csv) here");
-  command->add_option("--limits,-l", args->limits, "the acceptance limits the lot was judged with (drawn)");
+  command.Option("--store", &args->store, "the results store: an SQLite file or a PostgreSQL URL").Required();
+  command.Option("--lot", &args->lot, "the lot's name in the store").Required();
+  command.Option("--html", &args->html, "write the lot page (as the batch's lot.html) here");
+  command.Option("--csv", &args->csv, "write the lot summary (as the batch's lot_summary.csv) here");
+  command.Option("--limits,-l", &args->limits, "the acceptance limits the lot was judged with (drawn)");
   return [args] { return RunLot(*args); };
 }
 

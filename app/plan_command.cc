@@ -85,9 +85,9 @@ int RunPlanCheck(const PlanCheckArguments& args) {
   if (!check.undetermined.empty()) {
     std::fprintf(stderr, "imufit: the plan does not determine the model (%zu finding%s)\n",
                  check.undetermined.size(), check.undetermined.size() == 1 ? "" : "s");
-    return 1;
+    return kExitNotDone;
   }
-  return check.tolerance_unmet ? 3 : 0;
+  return check.tolerance_unmet ? kExitFailedLimits : kExitDone;
 }
 
 int RunPlanDesign(const PlanDesignArguments& args) {
@@ -108,9 +108,9 @@ int RunPlanDesign(const PlanDesignArguments& args) {
   std::fputs(PlanDesignText(design, options).c_str(), stdout);
   if (!design.undetermined.empty()) {
     std::fprintf(stderr, "imufit: even every candidate cannot determine the model\n");
-    return 1;
+    return kExitNotDone;
   }
-  if (!design.met) return 3;
+  if (!design.met) return kExitFailedLimits;
   Plan plan;
   plan.site = candidates.site;
   if (options.check.latitude_deg) plan.site.latitude_rad = *options.check.latitude_deg * kDegToRad;
@@ -129,51 +129,48 @@ int RunPlanDesign(const PlanDesignArguments& args) {
 }  // namespace
 
 // The schedule's options, the noise YAML and the limits, on `command`.
-void AddScheduleOptions(CLI::App* command, ScheduleArguments* args) {
+void AddScheduleOptions(CliCommand command, ScheduleArguments* args) {
   args->options.Add(
       command, SimulationOptionTable(),
       {"start_time_s", "temp_noise_c", "quantize", "time_jitter_s", "drop_probability", "drop_burst",
        "gyro_full_scale_raw", "accel_full_scale_raw", "seed", "gyro_random_walk", "accel_random_walk"});
-  command->add_option("--limits", args->limits,
-                      "acceptance limits YAML: its coefficient limits as tolerances");
-  command->add_option("--noise-yaml", args->noise_yaml,
-                      "the unit's noise from `imufit allan --noise-yaml` (the worst axis of each sensor); "
-                      "--*-noise-density and --*-bias-instability given as well override it");
+  command.Option("--limits", &args->limits, "acceptance limits YAML: its coefficient limits as tolerances");
+  command.Option("--noise-yaml", &args->noise_yaml,
+                 "the unit's noise from `imufit allan --noise-yaml` (the worst axis of each sensor); "
+                 "--*-noise-density and --*-bias-instability given as well override it");
 }
 
-CommandRunner AddPlanCommand(CLI::App* root) {
+CommandRunner AddPlanCommand(CliCommand command) {
   auto check_args = std::make_shared<PlanCheckArguments>();
   auto design_args = std::make_shared<PlanDesignArguments>();
-  CLI::App* plan =
-      root->add_subcommand("plan", "Judge or design a calibration plan before the run (docs/plan.md).");
-  plan->require_subcommand(1);
-  CLI::App* check = plan->add_subcommand(
+  command.RequireSubcommand();
+  CliCommand check = command.Subcommand(
       "check",
       "Predict the 1-sigma of every coefficient a run of PLAN will give the fit (its own Jacobians and "
       "weights, no noise simulated), against tolerances; name what limits the plan. Exit 3 when a "
       "tolerance cannot be met.");
-  check->add_option("plan", check_args->plan, "plan YAML")->required();
+  check.Option("plan", &check_args->plan, "plan YAML").Required();
   AddScheduleOptions(check, &check_args->schedule);
-  check_args->schedule.options.Find("ramp_c")->excludes(check_args->schedule.options.Find("soak_temps_c"));
+  check_args->schedule.options.Find("ramp_c").Excludes(check_args->schedule.options.Find("soak_temps_c"));
   check_args->check.Add(check, PlanCheckOptionTable());
-  check->add_option("--format", check_args->format, "text (a table), yaml or json")
-      ->check(CLI::IsMember({"text", "yaml", "json"}));
+  check.Option("--format", &check_args->format, "text (a table), yaml or json")
+      .OneOf({"text", "yaml", "json"});
 
-  CLI::App* design = plan->add_subcommand(
+  CliCommand design = command.Subcommand(
       "design",
       "Choose, from candidate positions, rates and temperature set-points, the plan that meets the "
       "tolerances in the fewest hours (greedy by information per second, then exchange); write it to -o "
       "and print the predicted table before and after the exchange. Exit 3 when no plan of the "
       "candidates meets them.");
-  design->add_option("-o,--output", design_args->output, "the plan YAML to write")->required();
-  design->add_option("--candidates", design_args->candidates,
-                     "a plan whose segments are the candidates (and whose site is the run's)");
+  design.Option("-o,--output", &design_args->output, "the plan YAML to write").Required();
+  design.Option("--candidates", &design_args->candidates,
+                "a plan whose segments are the candidates (and whose site is the run's)");
   AddScheduleOptions(design, &design_args->schedule);
   design_args->design.Add(design, PlanDesignOptionTable());
   return [check_args, design_args, check, design]() -> int {
-    if (check->parsed()) return RunPlanCheck(*check_args);
-    if (design->parsed()) return RunPlanDesign(*design_args);
-    return 2;
+    if (check.Parsed()) return RunPlanCheck(*check_args);
+    if (design.Parsed()) return RunPlanDesign(*design_args);
+    return kExitBadInput;
   };
 }
 

@@ -134,18 +134,16 @@ void CustomerArguments::Check() const {
   }
 }
 
-void AddCustomerOptions(CLI::App* command, CustomerArguments* args) {
-  command->add_option("--customer", args->customer,
-                      "the customer the certificate is issued to (printed on it)");
-  command->add_option("--order", args->order,
-                      "the customer's order or job number (printed on the certificate)");
+void AddCustomerOptions(CliCommand command, CustomerArguments* args) {
+  command.Option("--customer", &args->customer, "the customer the certificate is issued to (printed on it)");
+  command.Option("--order", &args->order, "the customer's order or job number (printed on the certificate)");
 }
 
-void AddPdfOptions(CLI::App* command, PdfArguments* args) {
-  command->add_flag("--pdf", args->pdf,
-                    "also print the certificate to PDF beside its HTML (report.html -> report.pdf; a batch's "
-                    "lot.pdf too), with headless Chromium");
-  command->add_option("--paper", args->paper, "paper of --pdf: " + AllNames(kPaperNames) + " (default A4)");
+void AddPdfOptions(CliCommand command, PdfArguments* args) {
+  command.Flag("--pdf", &args->pdf,
+               "also print the certificate to PDF beside its HTML (report.html -> report.pdf; a batch's "
+               "lot.pdf too), with headless Chromium");
+  command.Option("--paper", &args->paper, "paper of --pdf: " + AllNames(kPaperNames) + " (default A4)");
 }
 
 void WarnIfNoSerial(const std::string& serial, const std::string& file) {
@@ -156,29 +154,24 @@ void WarnIfNoSerial(const std::string& serial, const std::string& file) {
                file.c_str());
 }
 
-CommandRunner AddReportCommand(CLI::App* root) {
+CommandRunner AddReportCommand(CliCommand command) {
   auto args = std::make_shared<ReportArguments>();
-  CLI::App* command = root->add_subcommand(
-      "report",
-      "Write a unit's calibration certificate (one self-contained HTML file) from its calibration and the "
-      "run it "
-      "was fitted to; with --limits, the acceptance verdict too (exit 3 when it fails).");
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML")->required();
-  command->add_option("--plan,-p", args->plan, "plan YAML of the run")->required();
-  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz) of the run")->required();
-  command->add_option("--limits,-l", args->limits, "acceptance limits YAML");
-  command->add_option("--output,-o", args->output, "HTML file to write")->required();
-  command->add_option("--serial", args->serial,
-                      "the unit's serial (default: the calibration's, else the samples header's, else the "
-                      "plan's); one that contradicts the samples header is refused unless --allow-mismatch");
-  command->add_option(
-      "--station", args->station,
+  command.Option("--calibration,-c", &args->calibration, "calibration YAML").Required();
+  command.Option("--plan,-p", &args->plan, "plan YAML of the run").Required();
+  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz) of the run").Required();
+  command.Option("--limits,-l", &args->limits, "acceptance limits YAML");
+  command.Option("--output,-o", &args->output, "HTML file to write").Required();
+  command.Option("--serial", &args->serial,
+                 "the unit's serial (default: the calibration's, else the samples header's, else the "
+                 "plan's); one that contradicts the samples header is refused unless --allow-mismatch");
+  command.Option(
+      "--station", &args->station,
       "station file (format imufit-station: station, operator, equipment) shown on the certificate");
   AddPdfOptions(command, &args->pdf);
   AddCustomerOptions(command, &args->customer);
-  command->add_flag("--allow-mismatch", args->allow_mismatch,
-                    "certify even when the calibration records other plan/samples hashes than these files', "
-                    "or --serial names another unit than the samples header (the certificate says so)");
+  command.Flag("--allow-mismatch", &args->allow_mismatch,
+               "certify even when the calibration records other plan/samples hashes than these files', "
+               "or --serial names another unit than the samples header (the certificate says so)");
   // The run must be cut into windows as the fit cut it: give the options the fit was given.
   AddRunReadingOptions(command, &args->run);
   return [args] { return RunReport(*args); };

@@ -6,14 +6,14 @@
 
 namespace imufit {
 
-void AddRunReadingOptions(CLI::App* command, RunReadingArguments* args) {
+void AddRunReadingOptions(CliCommand command, RunReadingArguments* args) {
   args->windows.Add(command, WindowOptionTable());
   AddTempOption(command, &args->input);
   AddSegmentationOptions(command, &args->input);
   args->noise_stretch.Add(command, NoiseStretchOptionTable());
 }
 
-void AddFitRunOptions(CLI::App* command, FitRunArguments* args, const std::set<std::string>& except) {
+void AddFitRunOptions(CliCommand command, FitRunArguments* args, const std::set<std::string>& except) {
   args->options.Add(command, FitRunOptionTable(), except);
 }
 

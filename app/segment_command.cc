@@ -52,32 +52,25 @@ int RunSegment(const SegmentArguments& args) {
 const std::set<std::string> kFileReadingKeys = {"temp_c", "time_unit", "delimiter", "decimal_comma",
                                                 "column"};
 
-void AddTempOption(CLI::App* command, SamplesInputArguments* args) {
+void AddTempOption(CliCommand command, SamplesInputArguments* args) {
   for (const std::string& key : kFileReadingKeys)
     args->options.AddOne(command, SamplesInputOptionTable(), key);
 }
 
-void AddSegmentationOptions(CLI::App* command, SamplesInputArguments* args) {
+void AddSegmentationOptions(CliCommand command, SamplesInputArguments* args) {
   args->options.Add(command, SamplesInputOptionTable(), kFileReadingKeys);
 }
 
-CommandRunner AddSegmentCommand(CLI::App* root) {
+CommandRunner AddSegmentCommand(CliCommand command) {
   auto args = std::make_shared<SegmentArguments>();
-  CLI::App* command = root->add_subcommand(
-      "segment",
-      "Find the plan's segments (rests, constant rates, turns) in a log without a segment column, print the "
-      "match with times, and write the samples with a segment column (-1 while moving). Exit 1 when the log "
-      "and the plan disagree (missing, extra or reordered segments; the message gives the time).");
   command
-      ->add_option("--plan,-p", args->plan,
-                   "plan YAML of the run: its segments in the order the table ran them")
-      ->required();
-  command->add_option("--samples,-s", args->samples, "raw samples CSV (or .csv.gz)")->required();
-  command->add_option("--output,-o", args->output, "labelled samples CSV to write (.gz compresses)")
-      ->required();
+      .Option("--plan,-p", &args->plan, "plan YAML of the run: its segments in the order the table ran them")
+      .Required();
+  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
+  command.Option("--output,-o", &args->output, "labelled samples CSV to write (.gz compresses)").Required();
   AddTempOption(command, &args->input);
   AddSegmentationOptions(command, &args->input);
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
   return [args] { return RunSegment(*args); };
 }
 

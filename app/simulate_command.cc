@@ -89,31 +89,25 @@ int RunSimulate(SimulateArguments args) {
 
 }  // namespace
 
-CommandRunner AddSimulateCommand(CLI::App* root) {
+CommandRunner AddSimulateCommand(CliCommand command) {
   auto args = std::make_shared<SimulateArguments>();
-  CLI::App* command = root->add_subcommand(
-      "simulate",
-      "Write a rate-table run for a plan from a known calibration (the truth), with noise, a "
-      "temperature schedule and a seed. Noise densities are in Kalibr's units.");
-  command->add_option("--plan,-p", args->plan, "plan YAML")->required();
-  command->add_option("--calibration,-c", args->calibration, "calibration YAML used as the truth")
-      ->required();
-  command->add_option("--output,-o", args->output, "samples CSV to write (.gz compresses)")->required();
-  command->add_option("--truth", args->truth_output,
-                      "also write the true rate (rad/s) and specific force (m/s^2) of every sample, in "
-                      "the corrected-samples layout");
+  command.Option("--plan,-p", &args->plan, "plan YAML").Required();
+  command.Option("--calibration,-c", &args->calibration, "calibration YAML used as the truth").Required();
+  command.Option("--output,-o", &args->output, "samples CSV to write (.gz compresses)").Required();
+  command.Option("--truth", &args->truth_output,
+                 "also write the true rate (rad/s) and specific force (m/s^2) of every sample, in "
+                 "the corrected-samples layout");
   args->options.Add(command, SimulationOptionTable());
-  args->options.Find("ramp_c")->excludes(args->options.Find("soak_temps_c"));
-  args->options.Find("passes")->needs(args->options.Find("ramp_c"));
-  command->add_flag("--no-segment-column", args->no_segment_column,
-                    "leave the segment column out (an unlabelled log; --truth keeps the true labels)");
-  command->add_flag(
-      "--no-temp-column", args->no_temp_column,
-      "leave the temp_c column out (a log without a thermometer; --truth keeps the temperatures)");
-  command->add_option("--serial", args->serial,
-                      "the unit's serial, written into the header of the samples (and --truth) as "
-                      "'# serial: SERIAL', where fit, report and batch find it");
-  command->add_flag("--quiet,-q", args->quiet, "print nothing but errors");
+  args->options.Find("ramp_c").Excludes(args->options.Find("soak_temps_c"));
+  args->options.Find("passes").Needs(args->options.Find("ramp_c"));
+  command.Flag("--no-segment-column", &args->no_segment_column,
+               "leave the segment column out (an unlabelled log; --truth keeps the true labels)");
+  command.Flag("--no-temp-column", &args->no_temp_column,
+               "leave the temp_c column out (a log without a thermometer; --truth keeps the temperatures)");
+  command.Option("--serial", &args->serial,
+                 "the unit's serial, written into the header of the samples (and --truth) as "
+                 "'# serial: SERIAL', where fit, report and batch find it");
+  command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
   return [args] { return RunSimulate(*args); };
 }
 

@@ -24,18 +24,16 @@ int RunMerge(const MergeArguments& args) {
 
 }  // namespace
 
-CommandRunner AddStoreCommand(CLI::App* root) {
+CommandRunner AddStoreCommand(CliCommand command) {
   auto args = std::make_shared<MergeArguments>();
-  CLI::App* command = root->add_subcommand("store", "Manage results stores: merge station stores into one.");
-  command->require_subcommand(1);
-  CLI::App* merge = command->add_subcommand(
+  command.RequireSubcommand();
+  CliCommand merge = command.Subcommand(
       "merge",
       "Copy every fit of the SRC stores into DEST (a PostgreSQL URL or connection string, or an SQLite "
       "file); a fit DEST holds already is left as it is, so merging again changes nothing.");
-  merge->add_option("sources", args->sources, "station stores (SQLite files, or PostgreSQL URLs)")
-      ->required();
-  merge->add_option("--into", args->into, "the store to merge into (created when a missing SQLite file)")
-      ->required();
+  merge.Option("sources", &args->sources, "station stores (SQLite files, or PostgreSQL URLs)").Required();
+  merge.Option("--into", &args->into, "the store to merge into (created when a missing SQLite file)")
+      .Required();
   return [args] { return RunMerge(*args); };
 }
 

@@ -1,6 +1,8 @@
-// The option tables (model/option_table.h): the fingerprint FitRunOptions::Describe() sees every
-// option that can change a fit, and only those; Validate() names the option and its value; the
-// enum name tables parse what they print.
+// The option tables (base/option_table.h): the fingerprint FitRunOptions::Describe() sees every
+// option that can change a fit, and only those; Validate() names the option and its value (the
+// fit's, the simulation's, Allan's, the noise fit's, the uniform series', the export's and the
+// batch's tables); the export's formats and the options that serve them; the enum name tables
+// parse what they print.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +12,12 @@
 #include <type_traits>
 
 #include "imufit/base/enum_names.h"
+#include "imufit/export/export.h"
+#include "imufit/factory/batch.h"
+#include "imufit/noise/allan.h"
+#include "imufit/noise/noise_model.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/pipeline/series_reader.h"
 #include "imufit/sim/simulator.h"
 
 namespace imufit {
@@ -146,17 +153,92 @@ bool PutOutsideRange(const OptionEntry<Options>& entry, Options* options) {
       entry.value);
 }
 
+// Every option of `table` with a range, put outside it in otherwise valid options (`valid`), makes
+// Validate() name it first; at least `min_checked` of them.
 template <typename Options>
-void ExpectEveryRangeNamedWhenBroken(const OptionTable<Options>& table) {
+void ExpectEveryRangeNamedWhenBroken(const OptionTable<Options>& table, int min_checked = 11,
+                                     const Options& valid = Options()) {
   int checked = 0;
+  ASSERT_EQ(valid.Validate(), "");
   for (const OptionEntry<Options>& entry : table.entries()) {
-    Options options;
+    Options options = valid;
     if (!PutOutsideRange(entry, &options)) continue;
     const std::string problem = options.Validate();
     EXPECT_EQ(problem.rfind(entry.key + " = ", 0), 0u) << entry.key << ": " << problem;
     ++checked;
   }
-  EXPECT_GT(checked, 10);
+  EXPECT_GE(checked, min_checked);
+}
+
+// Keys and flags unique, every option described, and every text option reads back what it prints
+// for the defaults.
+template <typename Options>
+void ExpectWellFormed(const OptionTable<Options>& table) {
+  std::map<std::string, int> keys, flags;
+  const Options defaults;
+  for (const OptionEntry<Options>& entry : table.entries()) {
+    ++keys[entry.key];
+    if (!entry.flag.empty()) ++flags[entry.flag];
+    EXPECT_FALSE(entry.help.empty()) << entry.key;
+    if (const auto* text = std::get_if<TextOption<Options>>(&entry.value)) {
+      Options read = defaults;
+      const std::string shown = text->Get(defaults);
+      if (!shown.empty()) EXPECT_EQ(text->set(shown, &read), "") << entry.key;
+      EXPECT_EQ(text->Get(read), shown) << entry.key;
+    }
+  }
+  for (const auto& [key, count] : keys) EXPECT_EQ(count, 1) << key;
+  for (const auto& [flag, count] : flags) EXPECT_EQ(count, 1) << flag;
+}
+
+BatchOptions ValidBatch() {
+  BatchOptions batch;
+  batch.units_dir = "units";
+  batch.output_dir = "out";
+  return batch;
+}
+
+TEST(OptionTables, TheAllanNoiseSeriesExportAndBatchTablesAreWellFormedAndNameWhatIsWrong) {
+  ExpectWellFormed(AllanOptionTable());
+  ExpectWellFormed(NoiseFitOptionTable());
+  ExpectWellFormed(UniformSeriesOptionTable());
+  ExpectWellFormed(ExportOptionTable());
+  ExpectWellFormed(BatchOptionTable());
+  ExpectEveryRangeNamedWhenBroken(AllanOptionTable(), 2);
+  ExpectEveryRangeNamedWhenBroken(NoiseFitOptionTable(), 2);
+  ExpectEveryRangeNamedWhenBroken(UniformSeriesOptionTable(), 1);
+  ExpectEveryRangeNamedWhenBroken(ExportOptionTable(), 4);
+  ExpectEveryRangeNamedWhenBroken(BatchOptionTable(), 2, ValidBatch());
+
+  AllanOptions allan;
+  allan.confidence = 1.0;
+  EXPECT_EQ(allan.Validate().rfind("confidence = 1: must lie in (0, 1) (", 0), 0u) << allan.Validate();
+  UniformSeriesOptions series;
+  series.time_tolerance = 0.5;
+  EXPECT_EQ(series.Validate().rfind("time_tolerance = 0.5: must lie in (0, 0.5) (", 0), 0u)
+      << series.Validate();
+}
+
+TEST(OptionTables, ExportFormatsAndTheOptionsThatServeThem) {
+  EXPECT_EQ(ExportFormatFromString("PX4"), ExportFormat::kPx4);
+  EXPECT_EQ(ExportFormatFromString("ArduPilot"), ExportFormat::kArduPilot);
+  EXPECT_EQ(ExportFormatFromString("px"), std::nullopt);
+  EXPECT_EQ(ExportFormatFromString("px4 "), std::nullopt);
+  ExportOptions options;
+  const auto& format = std::get<TextOption<ExportOptions>>(ExportOptionTable().Find("format")->value);
+  EXPECT_EQ(format.set("Kalibr", &options), "");
+  EXPECT_EQ(options.format, ExportFormat::kKalibr);
+  EXPECT_EQ(format.set("mavlink", &options), "\"mavlink\" is not a format (" + ExportFormatNames() + ")");
+  EXPECT_TRUE(ExportOptionServes("device_id", ExportFormat::kPx4));
+  EXPECT_FALSE(ExportOptionServes("device_id", ExportFormat::kJson));
+  EXPECT_TRUE(ExportOptionServes("full_scale_dps", ExportFormat::kJson));
+  EXPECT_EQ(ExportOptionFormats("temp_c"), "kalibr, imucal");
+  EXPECT_EQ(ExportOptionFormats("max_g"), "");
+  // The help of an option that serves some formats names them, from the same table.
+  for (const OptionEntry<ExportOptions>& entry : ExportOptionTable().entries()) {
+    const std::string formats = ExportOptionFormats(entry.key);
+    if (!formats.empty()) EXPECT_EQ(entry.help.rfind(formats + ": ", 0), 0u) << entry.key;
+  }
 }
 
 TEST(OptionTables, ValidateNamesTheOptionAndItsValue) {

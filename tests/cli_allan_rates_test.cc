@@ -185,7 +185,7 @@ TEST_F(AllanCliTest, BadInputIsExitTwoWithALocatedMessage) {
   EXPECT_NE(error_.find(short_file + ": too short: 3 samples"), std::string::npos) << error_;
   // Bad options, each naming what is allowed.
   EXPECT_EQ(Run("allan -s '" + samples + "' -e avar" + common), 2);
-  EXPECT_NE(error_.find("--estimator \"avar\" is not one of: adev, oadev, mdev, tdev, hdev, ohdev, totdev"),
+  EXPECT_NE(error_.find("--estimator: \"avar\" is not one of: adev, oadev, mdev, tdev, hdev, ohdev, totdev"),
             std::string::npos)
       << error_;
   EXPECT_EQ(Run("allan -s '" + samples + "' -t 0.015" + common), 2);
@@ -194,7 +194,13 @@ TEST_F(AllanCliTest, BadInputIsExitTwoWithALocatedMessage) {
   EXPECT_EQ(Run("allan -s '" + samples + "' -t weekly" + common), 2);
   EXPECT_NE(error_.find("allowed: octave, decade, all, per-decade:K"), std::string::npos) << error_;
   EXPECT_EQ(Run("allan -s '" + samples + "' --confidence 1.5" + common), 2);
-  EXPECT_NE(error_.find("confidence must lie strictly between 0 and 1"), std::string::npos) << error_;
+  EXPECT_NE(error_.find("confidence = 1.5: must lie in (0, 1)"), std::string::npos) << error_;
+  EXPECT_EQ(Run("allan -s '" + samples + "' --gaps join" + common), 2);
+  EXPECT_NE(error_.find("--gaps: \"join\" is not one of: error, bridge"), std::string::npos) << error_;
+  EXPECT_EQ(Run("allan -s '" + samples + "' --time-tolerance 0.5" + common), 2);
+  EXPECT_NE(error_.find("time_tolerance = 0.5: must lie in (0, 0.5)"), std::string::npos) << error_;
+  EXPECT_EQ(Run("allan -s '" + samples + "' --min-clusters 1" + common), 2);
+  EXPECT_NE(error_.find("min_clusters = 1: must be >= 2"), std::string::npos) << error_;
   // Never its own input; and nothing written by any failed run.
   EXPECT_EQ(Run("allan -s '" + samples + "' -o '" + samples + "'"), 2);
   EXPECT_NE(error_.find("is also an input"), std::string::npos) << error_;

@@ -59,6 +59,114 @@ TEST_F(CliTest, HelpOfTheProgramAndOfEverySubcommandExitsZero) {
   EXPECT_NE(version.out.find("imufit"), std::string::npos);
 }
 
+// The rows of the table that follows `heading` in `page`: each row's first cell, unquoted.
+std::vector<std::string> FirstCellsOfTable(const std::string& page, const std::string& heading) {
+  std::vector<std::string> cells;
+  const size_t start = page.find(heading);
+  if (start == std::string::npos) return cells;
+  std::stringstream lines(page.substr(start));
+  std::string line;
+  bool in_table = false;
+  while (std::getline(lines, line)) {
+    if (line.rfind("|", 0) != 0) {
+      if (in_table) break;
+      continue;
+    }
+    in_table = true;
+    std::string cell = line.substr(1, line.find('|', 1) - 1);
+    cell.erase(std::remove(cell.begin(), cell.end(), '`'), cell.end());
+    cell.erase(0, cell.find_first_not_of(' '));
+    cell.erase(cell.find_last_not_of(' ') + 1);
+    if (cell.empty() || cell.find("---") != std::string::npos) continue;
+    cells.push_back(cell);
+  }
+  return cells.size() > 0 ? std::vector<std::string>(cells.begin() + 1, cells.end()) : cells;  // no header
+}
+
+TEST_F(CliTest, SpecListsTheCommandsAndExitStatusesOfTheProgram) {
+  // The program's help is derived from its command table and its exit-status table (app/main.cc,
+  // app/exit_status.h); docs/spec.md section 4 must list the same.
+  const std::string spec = ReadFile(Fixture("../docs/spec.md"));
+  const RunResult help = Run({"--help"});
+  ASSERT_EQ(help.status, 0) << help.err;
+  std::set<std::string> documented;
+  for (const std::string& cell : FirstCellsOfTable(spec, "## 4. The command line")) {
+    std::stringstream words(cell);
+    std::string program, command;
+    words >> program >> command;
+    EXPECT_EQ(program, "imufit") << cell;
+    documented.insert(command);
+  }
+  const std::vector<std::string> listed = SubcommandsIn(help.out);
+  EXPECT_EQ(documented, std::set<std::string>(listed.begin(), listed.end()));
+
+  std::set<std::string> documented_statuses;
+  for (const std::string& cell : FirstCellsOfTable(spec, "### Exit statuses"))
+    documented_statuses.insert(cell);
+  // "Exit status: 0 done, 1 the job could not be done, ...": the number starting each item.
+  std::string text = help.out.substr(help.out.find("Exit status: ") + 13);
+  text = text.substr(0, text.find('.'));
+  std::set<std::string> helped_statuses;
+  std::stringstream items(text);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    std::stringstream words(item);
+    std::string status;
+    words >> status;
+    helped_statuses.insert(status);
+  }
+  EXPECT_EQ(documented_statuses, helped_statuses) << help.out;
+  EXPECT_EQ(documented_statuses, (std::set<std::string>{"0", "1", "2", "3"}));
+}
+
+TEST_F(CliTest, ParseErrorsAreOneImufitLineNamingTheCommand) {
+  // CLI11 words them; the program puts them on one line, as every other error (issue 31 item 7).
+  const RunResult loss = Run({"export", "-c", Fixture("mems_truth.yaml"), "--format", "json", "-o",
+                              Path("out.json"), "--max-loss", "1"});
+  EXPECT_EQ(loss.status, 2);
+  EXPECT_EQ(loss.err, "imufit: export: --max-loss: At least 2 required but received 1\n");
+  EXPECT_EQ(loss.out, "");
+  const RunResult missing = Run({"plan", "check"});
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_EQ(missing.err, "imufit: plan check: plan is required\n");
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"apply", "--no-such-option"},
+           {"allan", "-s", "x.csv", "-o", Path("a.csv"), "--confidence", "x"},
+           {"no-such-command"},
+           {}}) {
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("imufit: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    if (!args.empty() && args[0] != "no-such-command")
+      EXPECT_EQ(r.err.rfind("imufit: " + args[0] + ": ", 0), 0u) << r.err;
+  }
+  EXPECT_EQ(Listing(), std::set<std::string>{});
+}
+
+TEST_F(CliTest, ExportTakesFormatNamesInAnyCaseAndRefusesOptionsTheFormatDoesNotUse) {
+  // The export option table says which formats an option serves (issue 30 item 7).
+  const std::string calibration = Fixture("mems_truth.yaml");
+  RunResult r = Run({"export", "-c", calibration, "-f", "JSON", "-o", Path("unit.json"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(Path("unit.json")));
+  r = Run({"export", "-c", calibration, "-f", "json", "-o", Path("x.json"), "--device-id", "7"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "imufit: --device-id: only px4 use it, not json\n");
+  r = Run({"export", "-c", calibration, "-f", "Px4", "-o", Path("x.params"), "--device-id", "7", "--temp-c",
+           "20"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "imufit: --temp-c: only kalibr, imucal use it, not px4\n");
+  r = Run({"export", "-c", calibration, "-f", "c", "-o", Path("x.h"), "--rostopic", "/imu1"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--rostopic: only kalibr use it"), std::string::npos) << r.err;
+  // The help lists the formats from the format table, and each option the formats it serves.
+  const RunResult help = Run({"export", "--help"});
+  EXPECT_NE(help.out.find("c, bin, px4, ardupilot, kalibr, imucal, json"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("px4: the sensor's device ID"), std::string::npos) << help.out;
+  EXPECT_EQ(Listing(), std::set<std::string>{"unit.json"});
+}
+
 TEST_F(CliTest, BadInvocationsExitTwo) {
   EXPECT_EQ(Run({}).status, 2);
   EXPECT_EQ(Run({"no-such-command"}).status, 2);

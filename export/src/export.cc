@@ -38,8 +38,14 @@ const char* ToString(ExportFormat format) {
 }
 
 std::optional<ExportFormat> ExportFormatFromString(std::string_view name) {
+  const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
   for (const FormatName& entry : kFormatNames) {
-    if (name == entry.name) return entry.format;
+    const std::string_view entry_name = entry.name;
+    if (name.size() == entry_name.size() &&
+        std::equal(name.begin(), name.end(), entry_name.begin(),
+                   [&lower](char a, char b) { return lower(a) == lower(b); })) {
+      return entry.format;
+    }
   }
   return std::nullopt;
 }
@@ -52,13 +58,8 @@ std::string ExportFormatNames() {
 
 ExportResult ExportCalibration(const Calibration& calibration, const ExportOptions& options) {
   using namespace export_internal;
+  if (const std::string problem = options.Validate(); !problem.empty()) throw InputError("export", problem);
   const Envelope envelope = EnvelopeOf(calibration, options);
-  for (const auto& [name, value] : {std::pair{"--gyro-raw-per-radps", options.gyro_raw_per_radps},
-                                    {"--accel-raw-per-mps2", options.accel_raw_per_mps2}}) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      throw InputError(name, "the driver's scale must be a positive number, not " + FormatDouble(value));
-    }
-  }
   if (options.temp_c && !(*options.temp_c >= calibration.fit_temp_range_c[0] &&
                           *options.temp_c <= calibration.fit_temp_range_c[1])) {
     throw InputError("--temp-c", FormatDouble(*options.temp_c) +

@@ -680,8 +680,7 @@ std::string BatchOptions::Validate() const {
   if (!units_list.empty() && !samples_glob.empty())
     return "--samples-glob names the samples file in unit folders; a --units-list names each itself";
   if (output_dir.empty()) return "no output folder";
-  if (jobs < 0) return "jobs must be >= 0";
-  if (max_units < 0) return "max_units must be >= 0";
+  if (std::string problem = ValidateOptions(BatchOptionTable(), *this); !problem.empty()) return problem;
   if (shard.count < 1 || shard.index < 0 || shard.index >= shard.count)
     return "shard index must be below the count";
   return fit.Validate();

@@ -467,11 +467,7 @@ std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int6
 }
 
 std::string AllanOptions::Validate() const {
-  if (!(confidence > 0.0 && confidence < 1.0)) {
-    return "confidence must lie strictly between 0 and 1 (0.683 is one sigma), not " +
-           std::to_string(confidence);
-  }
-  if (threads < 0) return "threads must be 0 (all) or positive";
+  if (std::string problem = ValidateOptions(AllanOptionTable(), *this); !problem.empty()) return problem;
   if (max_noise_id_points < kMinNoiseIdPoints) {
     return "max_noise_id_points must be at least " + std::to_string(kMinNoiseIdPoints);
   }

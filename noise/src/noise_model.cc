@@ -302,11 +302,7 @@ double NoiseTermBasis(int term, double tau_s) {
   return 0.0;
 }
 
-std::string NoiseFitOptions::Validate() const {
-  if (!(min_clusters >= 2.0)) return "min_clusters must be at least 2";
-  if (iterations < 1) return "iterations must be at least 1";
-  return "";
-}
+std::string NoiseFitOptions::Validate() const { return ValidateOptions(NoiseFitOptionTable(), *this); }
 
 double NoiseFitSummary::ModelDeviation(double tau_s) const {
   double sum = 0.0;

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <utility>
 
+#include "imufit/base/enum_names.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
@@ -119,9 +120,26 @@ class SeriesBuilder {
 };
 
 void CheckTolerance(const std::string& path, const UniformSeriesOptions& options) {
-  if (!(options.time_tolerance > 0.0 && options.time_tolerance < 0.5)) {
-    throw InputError(path, "the time tolerance must lie between 0 and 0.5 sample intervals");
-  }
+  if (const std::string problem = options.Validate(); !problem.empty()) throw InputError(path, problem);
+}
+
+// How a gap in the time column is taken: "error" or "bridge" (bridge_gaps).
+constexpr EnumName<bool> kGapNames[] = {{false, "error"}, {true, "bridge"}};
+
+OptionTable<UniformSeriesOptions> MakeUniformSeriesOptionTable() {
+  using O = UniformSeriesOptions;
+  OptionTable<O> t;
+  t.Number("time_tolerance", "--time-tolerance",
+           "largest deviation of a time step from the sample interval, in sample intervals", "",
+           &O::time_tolerance, Between(0.0, 0.5, /*min_open=*/true, /*max_open=*/true));
+  t.Text(
+      "gaps", "--gaps", "error: a gap in time_s is an error; bridge: join the data across gaps",
+      [](const O& o) { return std::string(NameOf(kGapNames, o.bridge_gaps)); },
+      [](const std::string& text, O* o) -> std::string {
+        if (ValueOf(kGapNames, text, &o->bridge_gaps)) return "";
+        return "\"" + text + "\" is not one of: " + AllNames(kGapNames);
+      });
+  return t;
 }
 
 // The columns of a corrected sample ReadCorrectedSeries offers, and the value of each.
@@ -135,6 +153,15 @@ double CorrectedValue(const Sample& corrected, int index) {
 }
 
 }  // namespace
+
+const OptionTable<UniformSeriesOptions>& UniformSeriesOptionTable() {
+  static const OptionTable<UniformSeriesOptions> table = MakeUniformSeriesOptionTable();
+  return table;
+}
+
+std::string UniformSeriesOptions::Validate() const {
+  return ValidateOptions(UniformSeriesOptionTable(), *this);
+}
 
 UniformSeries ReadUniformSeries(const std::string& path, const std::vector<std::string>& columns,
                                 const UniformSeriesOptions& options) {

@@ -375,15 +375,19 @@ class AllanResult:
 def allan(
     y: ArrayLike,
     tau0_s: float,
-    estimator: str = "oadev",
+    estimator: str = ...,
     taus: str | Sequence[float] = "octave",
-    confidence: float = 0.683,
-    edf_noise: str = "auto",
-    threads: int = 0,
+    confidence: float = ...,
+    edf_noise: str = ...,
+    threads: int = ...,
 ) -> AllanResult:
     """Allan deviation (adev, oadev, mdev, tdev, hdev, ohdev, totdev) of rates y (N,) (e.g. rad/s)
     sampled every tau0_s s, at taus "octave" | "decade" | "all" | "per-decade:K" | taus in s.
-    Same numbers as `imufit allan` for one column."""
+    Same numbers as `imufit allan` for one column. The defaults of estimator, confidence (one
+    sigma), edf_noise and threads: allan_options() (tests/test_options.py checks the keywords)."""
+
+def allan_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of allan()'s options from the library's option table."""
 
 class NoiseTerms:
     """IEEE 952 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2,
@@ -438,8 +442,12 @@ def noise_terms(
     data: ArrayLike | AllanResult,
     tau0_s: float | None = None,
     taus: str | Sequence[float] = "octave",
-    min_clusters: float = 8.0,
+    min_clusters: float = ...,
     terms: Sequence[str] | None = None,
 ) -> NoiseTerms:
     """IEEE 952 terms with 1-sigma, fitted to the oadev of rates `data` ((N,), every tau0_s s) or to
-    an adev / oadev / totdev AllanResult. `terms` limits the fit to the named terms."""
+    an adev / oadev / totdev AllanResult. `terms` limits the fit to the named terms. The default of
+    min_clusters: noise_terms_options()."""
+
+def noise_terms_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of the noise fit's options from the library's option table."""

@@ -33,7 +33,7 @@ void SetKeyword(const OptionEntry<Options>& entry, const std::string& function, 
         } else if constexpr (std::is_same_v<Kind, TextOption<Options>>) {
           const std::string text = kind.path ? PathString(value) : value.cast<std::string>();
           if (const std::string error = kind.set(text, options); !error.empty())
-            ThrowBadArgument(function, error);
+            ThrowBadArgument(function, entry.key + " " + error);
         } else {
           kind.field(*options) =
               value.template cast<std::remove_reference_t<decltype(kind.field(*options))>>();

@@ -10,6 +10,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/noise/allan.h"
 #include "imufit/noise/noise_model.h"
+#include "keyword_options.h"
 
 namespace imufit::python {
 namespace {
@@ -126,15 +127,12 @@ AllanResult AllanOfRates(const py::object& y, double tau0_s, const std::string& 
                          int threads) {
   const std::string where = "imufit.allan";
   AllanOptions options;
-  if (!ParseAllanEstimator(estimator, &options.estimator)) {
-    ThrowBadArgument(where,
-                     "estimator " + QuoteForMessage(estimator) + " is not one of: " + AllanEstimatorNames());
-  }
-  if (!ParseEdfNoise(edf_noise, &options.edf_noise)) {
-    ThrowBadArgument(where, "edf_noise " + QuoteForMessage(edf_noise) + " is not one of: " + EdfNoiseNames());
-  }
-  options.confidence = confidence;
-  options.threads = threads;
+  py::dict keywords;  // read, and refused, as AllanOptionTable() says
+  keywords["estimator"] = estimator;
+  keywords["confidence"] = confidence;
+  keywords["edf_noise"] = edf_noise;
+  keywords["threads"] = threads;
+  ApplyKeywords(AllanOptionTable(), where, keywords, &options);
   return Allan(where, Rates(where, y), tau0_s, Taus(where, taus), options);
 }
 
@@ -246,21 +244,32 @@ void BindNoiseTerms(py::module_& m) {
 
 void BindNoise(py::module_& m) {
   BindAllanResult(m);
+  // The defaults are AllanOptions' and NoiseFitOptions' (their option tables).
+  const AllanOptions allan_defaults;
   m.def(
-      "allan", &AllanOfRates, py::arg("y"), py::arg("tau0_s"), py::arg("estimator") = "oadev",
-      py::arg("taus") = "octave", py::arg("confidence") = 0.683, py::arg("edf_noise") = "auto",
-      py::arg("threads") = 0,
+      "allan", &AllanOfRates, py::arg("y"), py::arg("tau0_s"),
+      py::arg("estimator") = std::string(ToString(allan_defaults.estimator)), py::arg("taus") = "octave",
+      py::arg("confidence") = allan_defaults.confidence,
+      py::arg("edf_noise") = std::string(ToString(allan_defaults.edf_noise)),
+      py::arg("threads") = allan_defaults.threads,
       "Allan deviation (or a relative: adev, oadev, mdev, tdev, hdev, ohdev, totdev) of rates y (shape (N,), "
       "e.g. rad/s) sampled every tau0_s seconds, at taus 'octave', 'decade', 'all', 'per-decade:K' or a "
       "sequence of taus in s, with confidence intervals. What `imufit allan` writes for one column.");
 
+  m.def(
+      "allan_options", [] { return DescribeKeywords(AllanOptionTable()); },
+      "{name: (default, description)} of the options imufit.allan() takes by name (`imufit allan`'s).");
+
   BindNoiseTerms(m);
   m.def(
       "noise_terms", &NoiseTerms, py::arg("data"), py::arg("tau0_s") = py::none(), py::arg("taus") = "octave",
-      py::arg("min_clusters") = 8.0, py::arg("terms") = py::none(),
+      py::arg("min_clusters") = NoiseFitOptions().min_clusters, py::arg("terms") = py::none(),
       "The IEEE 952 noise terms (quantization, ARW, bias instability, RRW, ramp) with 1-sigma, fitted to the "
       "overlapping Allan deviation of rates `data` (shape (N,), every tau0_s seconds, at `taus`) or to an "
       "AllanResult (adev, oadev or totdev). `terms` limits the fit to the named terms.");
+  m.def(
+      "noise_terms_options", [] { return DescribeKeywords(NoiseFitOptionTable()); },
+      "{name: (default, description)} of the noise fit's options (min_clusters is noise_terms()'s).");
 }
 
 }  // namespace imufit::python

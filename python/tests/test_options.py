@@ -71,3 +71,39 @@ def test_the_command_offers_the_table_options(fixtures, tmp_path, run_imufit):
                      "-o", tmp_path / "cal.yaml", "--turn-margin", "-1", check=False)
     assert bad.returncode == 2
     assert "turn_margin_s = -1: must be >= 0" in bad.stderr, bad.stderr
+
+
+def stub_function_defaults(name):
+    tree = ast.parse(STUB.read_text())
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and node.name == name:
+            args = node.args.args
+            defaults = [None] * (len(args) - len(node.args.defaults)) + node.args.defaults
+            return {a.arg: d for a, d in zip(args, defaults)}
+    raise AssertionError(f"{name} is not in {STUB}")
+
+
+@pytest.mark.parametrize("function, described", [("allan", imufit.allan_options),
+                                                 ("noise_terms", imufit.noise_terms_options)])
+def test_noise_functions_take_their_defaults_from_the_tables(function, described):
+    # The defaults live in AllanOptions and NoiseFitOptions only: the stub says `...` for each
+    # keyword of the table, and the module's signature shows the table's default.
+    stub = stub_function_defaults(function)
+    signature = getattr(imufit, function).__doc__.splitlines()[0]
+    for key, (default, description) in described().items():
+        assert description, key
+        if key not in stub:
+            continue  # not a keyword of this function (the noise fit's iterations)
+        assert isinstance(stub[key], ast.Constant) and stub[key].value is Ellipsis, key
+        assert f"{key}: {type(default).__name__} = {default!r}" in signature, (key, signature)
+
+
+def test_allan_options_are_those_of_the_command(run_imufit):
+    help_text = run_imufit("allan", "--help").stdout
+    confidence = imufit.allan_options()["confidence"][0]
+    assert 0.68 < confidence < 0.69  # one sigma
+    assert f"--confidence FLOAT={confidence:g}" in help_text
+    with pytest.raises(imufit.InputError, match=r"confidence = 1.5: must lie in \(0, 1\)"):
+        imufit.allan(np.zeros(100), 0.01, confidence=1.5)
+    with pytest.raises(imufit.InputError, match=r"min_clusters = 1: must be >= 2"):
+        imufit.noise_terms(np.zeros(100), 0.01, min_clusters=1.0)

@@ -237,6 +237,17 @@ class OptionTable {
               std::function<std::string(const std::string&, Options*)> set, bool path = false) {
     return Add(key, flag, help, "", TextOption<Options>{std::move(get), std::move(set), path});
   }
+  // A text field taken as it is typed (a name, a path, a pattern).
+  Entry& String(const char* key, const char* flag, const std::string& help, std::string Options::*member,
+                bool path = false) {
+    return Text(
+        key, flag, help, [member](const Options& o) { return o.*member; },
+        [member](const std::string& text, Options* o) {
+          o->*member = text;
+          return std::string();
+        },
+        path);
+  }
 
   // Moves the entry of `key` to just after that of `after` (both must exist): a table that includes
   // another places its own entries among the included ones.

@@ -27,6 +27,7 @@
 
 #include <Eigen/Core>
 
+#include "imufit/base/option_table.h"
 #include "imufit/io/calibration.h"
 
 namespace imufit {
@@ -34,11 +35,15 @@ namespace imufit {
 enum class ExportFormat { kC, kBin, kPx4, kArduPilot, kKalibr, kImucal, kJson };
 
 const char* ToString(ExportFormat format);
-// nullopt for a name that is not a format.
+// The format of a name in any case ("PX4"); nullopt for a name that is not a format.
 std::optional<ExportFormat> ExportFormatFromString(std::string_view name);
 // "c, bin, px4, ardupilot, kalibr, imucal, json".
 std::string ExportFormatNames();
 
+// What an export is asked for. ExportOptionTable() describes each option (the command line of
+// `imufit export`, its help and validation messages); the defaults are these. An option that
+// serves only some formats says which (ExportOptionFormats()), and `imufit export` refuses it with
+// another.
 struct ExportOptions {
   ExportFormat format = ExportFormat::kJson;
   // The envelope the loss is measured over (with the calibration's fitted temperature range).
@@ -63,7 +68,16 @@ struct ExportOptions {
   std::string software;
   std::string calibration_file;
   std::string calibration_sha256;
+
+  // "" when valid, else a readable reason naming the option and its value.
+  std::string Validate() const;
 };
+// Every option but the provenance (software, calibration_file, calibration_sha256).
+const OptionTable<ExportOptions>& ExportOptionTable();
+// Whether the option `key` of ExportOptionTable() serves `format`.
+bool ExportOptionServes(const std::string& key, ExportFormat format);
+// The formats the option `key` serves, "kalibr, imucal"; "" when it serves every format.
+std::string ExportOptionFormats(const std::string& key);
 
 // The error of the consumer's correction against the full model over the envelope, per axis.
 struct ExportLoss {

@@ -36,6 +36,8 @@ struct BatchProgress {
   const UnitOutcome* last = nullptr;  // the unit that just finished
 };
 
+// The lot's options. BatchOptionTable() describes those a person gives (the command line of `imufit
+// batch`, its help and validation messages); the defaults are these.
 struct BatchOptions {
   std::string units_dir;   // a folder of unit folders; or:
   std::string units_list;  // a file listing the units: "serial, samples[, plan]" a line (CSV or blanks)
@@ -71,6 +73,9 @@ struct BatchOptions {
 
   std::string Validate() const;
 };
+// The folders and files, jobs, max_units and write_reports; not the fit (FitRunOptionTable()), the
+// shard (parsed from the environment too), the customer or the paper (shared with fit and report).
+const OptionTable<BatchOptions>& BatchOptionTable();
 
 struct BatchResult {
   std::vector<UnitOutcome> units;  // in folder-name order

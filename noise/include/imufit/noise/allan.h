@@ -42,6 +42,8 @@
 #include <string_view>
 #include <vector>
 
+#include "imufit/base/option_table.h"
+
 namespace imufit {
 
 enum class AllanEstimator { kAdev, kOadev, kMdev, kTdev, kHdev, kOhdev, kTotdev };
@@ -97,9 +99,12 @@ int64_t EstimatorTerms(AllanEstimator estimator, int64_t m, int64_t n_samples);
 std::string AveragingFactors(const TauSpec& spec, AllanEstimator estimator, int64_t n_samples, double tau0_s,
                              std::vector<int64_t>* factors);
 
+// The options of the computation. AllanOptionTable() describes each (the command line of `imufit
+// allan`, the Python keywords, the validation messages); the defaults are these.
 struct AllanOptions {
   AllanEstimator estimator = AllanEstimator::kOadev;
-  // Two-sided confidence of [dev_lo, dev_hi], 0 < confidence < 1; 0.683 is one sigma.
+  // Two-sided confidence of [dev_lo, dev_hi], 0 < confidence < 1; the default is one sigma (the
+  // probability of a normal variable within one standard deviation of its mean, 68.3 %).
   double confidence = 0.683;
   // Noise type behind the degrees of freedom; kIdentify identifies it per averaging factor.
   EdfNoise edf_noise = EdfNoise::kIdentify;
@@ -109,9 +114,11 @@ struct AllanOptions {
   // lag-1 autocorrelation is settled long before, and the cost stays bounded at m = 1.
   int64_t max_noise_id_points = int64_t{1} << 18;
 
-  // "" when valid, else a readable reason.
+  // "" when valid, else a readable reason naming the option and its value.
   std::string Validate() const;
 };
+// Every option of AllanOptions but max_noise_id_points (a bound on work, not a user's choice).
+const OptionTable<AllanOptions>& AllanOptionTable();
 
 struct AllanPoint {
   int64_t m = 0;        // averaging factor

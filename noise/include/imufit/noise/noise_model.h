@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "imufit/base/noise_terms.h"
+#include "imufit/base/option_table.h"
 #include "imufit/noise/allan.h"
 
 namespace imufit {
@@ -60,8 +61,10 @@ struct NoiseFitOptions {
   // Terms the fit may use; a disabled term stays zero.
   std::array<bool, kNoiseTerms> enabled = {true, true, true, true, true};
 
-  std::string Validate() const;
+  std::string Validate() const;  // from NoiseFitOptionTable()
 };
+// min_clusters (on the command line of `imufit allan`) and iterations.
+const OptionTable<NoiseFitOptions>& NoiseFitOptionTable();
 
 struct NoiseFitSummary {
   bool fitted = false;  // false: too few usable points (see message)

@@ -37,7 +37,7 @@ double ChiSquaredQuantile(double probability, double dof);
 // Standard normal quantile (inverse of Phi), used for starting values; about 1e-15 absolute.
 double NormalQuantile(double probability);
 
-// The interval [dev_lo, dev_hi] of confidence `confidence` (e.g. 0.683) for a deviation `dev`
+// The interval [dev_lo, dev_hi] of confidence `confidence` (e.g. one sigma) for a deviation `dev`
 // estimated with `edf` equivalent degrees of freedom (SP 1065 eq. 45).
 void ChiSquaredInterval(double dev, double edf, double confidence, double* dev_lo, double* dev_hi);
 

@@ -19,17 +19,24 @@
 #include <string>
 #include <vector>
 
+#include "imufit/base/option_table.h"
 #include "imufit/io/calibration.h"
 #include "imufit/pipeline/correct_file.h"
 
 namespace imufit {
 
+// How the time column is read. UniformSeriesOptionTable() describes each option (`imufit allan`'s
+// --time-tolerance and --gaps, the validation messages); the defaults are these.
 struct UniformSeriesOptions {
   // Largest |dt - dt_0| accepted, as a fraction of the nominal interval dt_0 (0 < t < 0.5).
   double time_tolerance = 0.1;
   // Join the data across gaps instead of failing.
   bool bridge_gaps = false;
+
+  // "" when valid, else a readable reason naming the option and its value.
+  std::string Validate() const;
 };
+const OptionTable<UniformSeriesOptions>& UniformSeriesOptionTable();
 
 struct UniformSeries {
   std::vector<std::string> names;            // the columns read, in the order asked
