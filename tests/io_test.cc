@@ -225,10 +225,10 @@ TEST_F(IoTest, CalibrationErrorsNameFileLineAndKey) {
 TEST_F(IoTest, CalibrationReaderIgnoresUnknownKeysAndHonoursReferenceTemperature) {
   std::string text = CalibrationToYaml(ExampleCalibration());
   text.replace(text.find("reference_temp_c: 25"), 20, "reference_temp_c: 20");
-  text += "noise:\n  gyro_arw_deg_per_sqrt_hr: 0.3\n";
+  text += "lab:\n  gyro_arw_deg_per_sqrt_hr: 0.3\n";
   const Calibration read = ReadCalibration(Write("cal.yaml", text));
   EXPECT_EQ(read.model.basis.center_c, 20.0);
-  EXPECT_EQ(read.extra["noise"]["gyro_arw_deg_per_sqrt_hr"].as<double>(), 0.3);
+  EXPECT_EQ(read.extra["lab"]["gyro_arw_deg_per_sqrt_hr"].as<double>(), 0.3);
 }
 
 // The fit's record: every key of the `fit:` and `check:` blocks round-trips through its typed
@@ -266,11 +266,10 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   fit.missing_segments = 2;
   calibration.check.emplace().samples = "check.csv";
   calibration.check->gyro_error_rms_radps = 1e-3;
-  calibration.extra = YAML::Node(YAML::NodeType::Map);
-  calibration.extra["noise"]["format"] = "imufit-noise";
+  calibration.noise.emplace().software = "imufit 0.1.0";
   const std::string text = CalibrationToYaml(calibration);
   for (const char* line : {"\nfit:\n  plan: plan.yaml\n  samples: runs/unit 1.csv.gz\n",
-                           "\n  distinct_temperatures_c:\n    - -40.000955338170442\n",
+                           "\n  distinct_temperatures_c:\n    - -40.00095533817044\n",
                            "\n  fitted: [gyro.bias, accel.bias]\n  held: []\n  held_values: prior\n",
                            "\n  gyro_reduced_chi2: .nan\n", "\n  g_sensitivity_fitted: false\n",
                            "\n  segments_without_windows: [3, 7]\n  missing_segments: 2\ncheck:\n",
@@ -291,7 +290,9 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   ASSERT_TRUE(read.check.has_value());
   EXPECT_EQ(read.check->gyro_error_rms_radps, 1e-3);
   EXPECT_FALSE(read.check->accel_error_rms_mps2.has_value());  // not written: not set
-  EXPECT_EQ(read.extra.size(), 1u);                            // noise
+  ASSERT_TRUE(read.noise.has_value());
+  EXPECT_EQ(read.noise->software, "imufit 0.1.0");
+  EXPECT_EQ(read.extra.size(), 0u);
   EXPECT_EQ(CalibrationToYaml(read), text);
 
   // A key of the block this reader does not know is kept, after the others.

@@ -29,36 +29,28 @@ void VisitCheckRecord(Record& record, Visit&& visit) {
 
 // ---------------------------------------------------------------- writing
 
-template <typename T>
-void Put(YAML::Node* node, const char* key, const T& value) {
-  (*node)[key] = value;
+MachineDoc ValueDoc(const std::string& value) { return MachineDoc::Text(value); }
+MachineDoc ValueDoc(long long value) { return MachineDoc::Integer(value); }
+MachineDoc ValueDoc(int value) { return MachineDoc::Integer(value); }
+MachineDoc ValueDoc(bool value) { return MachineDoc::Bool(value); }
+MachineDoc ValueDoc(double value) { return MachineDoc::Number(value); }
+// Temperatures one a line; names and ids on one line.
+MachineDoc ValueDoc(const std::vector<double>& values) {
+  return MachineDoc::Numbers(values, MachineDoc::Style::kBlock);
 }
-
-// Names and ids on one line.
-template <typename T>
-void PutFlowList(YAML::Node* node, const char* key, const std::vector<T>& values) {
-  YAML::Node list(YAML::NodeType::Sequence);
-  for (const T& value : values) list.push_back(value);
-  list.SetStyle(YAML::EmitterStyle::Flow);
-  (*node)[key] = list;
-}
-void Put(YAML::Node* node, const char* key, const std::vector<int>& values) {
-  PutFlowList(node, key, values);
-}
-void Put(YAML::Node* node, const char* key, const std::vector<std::string>& values) {
-  PutFlowList(node, key, values);
-}
+MachineDoc ValueDoc(const std::vector<int>& values) { return MachineDoc::Integers(values); }
+MachineDoc ValueDoc(const std::vector<std::string>& values) { return MachineDoc::Texts(values); }
 
 template <typename Record, typename VisitRecord>
-YAML::Node RecordNode(const Record& record, VisitRecord visit_record) {
-  YAML::Node node(YAML::NodeType::Map);
-  visit_record(record, [&node](const char* key, const auto& member) {
-    if (member) Put(&node, key, *member);
+MachineDoc RecordDoc(const Record& record, VisitRecord visit_record) {
+  MachineDoc doc = MachineDoc::Map();
+  visit_record(record, [&doc](const char* key, const auto& member) {
+    if (member) doc.Add(key, ValueDoc(*member));
   });
   if (record.extra.IsMap()) {
-    for (const auto& entry : record.extra) node.force_insert(entry.first, entry.second);
+    for (const auto& entry : record.extra) doc.Add(entry.first.Scalar(), MachineDocOfYaml(entry.second));
   }
-  return node;
+  return doc;
 }
 
 // ---------------------------------------------------------------- reading
@@ -126,12 +118,12 @@ Record ReadRecord(const yaml::Located& block, VisitRecord visit_record) {
 
 }  // namespace
 
-YAML::Node FitRecordNode(const FitRecord& record) {
-  return RecordNode(record, [](const FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+MachineDoc FitRecordDoc(const FitRecord& record) {
+  return RecordDoc(record, [](const FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
 }
 
-YAML::Node CheckRecordNode(const CheckRecord& record) {
-  return RecordNode(record, [](const CheckRecord& r, auto&& visit) { VisitCheckRecord(r, visit); });
+MachineDoc CheckRecordDoc(const CheckRecord& record) {
+  return RecordDoc(record, [](const CheckRecord& r, auto&& visit) { VisitCheckRecord(r, visit); });
 }
 
 FitRecord ReadFitRecord(const yaml::Located& block) {
