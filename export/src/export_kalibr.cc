@@ -62,32 +62,6 @@ double NoiseFigure(const KalibrNoiseRecord& figures, double KalibrNoiseRecord::*
   return value;
 }
 
-// A number as the file writes it (ExportError, naming `name`, when not finite).
-MachineDoc NumberDoc(double value, const std::string& name) {
-  DoubleText(value, name);
-  return MachineDoc::Number(value);
-}
-
-// A vector or matrix (rows) as the file writes it, and what a reader parses from it.
-MachineDoc VectorDoc(const Eigen::Vector3d& v, const std::string& name, Eigen::Vector3d* read_back) {
-  MachineDoc list = MachineDoc::List();
-  for (int i = 0; i < 3; ++i) {
-    list.Push(NumberDoc(v(i), name));
-    (*read_back)(i) = ReadDouble(YamlNumberText(v(i)));
-  }
-  return list;
-}
-
-MachineDoc MatrixDoc(const Eigen::Matrix3d& m, const std::string& name, Eigen::Matrix3d* read_back) {
-  MachineDoc rows = MachineDoc::List();
-  for (int row = 0; row < 3; ++row) {
-    Eigen::Vector3d values;
-    rows.Push(VectorDoc(m.row(row).transpose(), name, &values));
-    read_back->row(row) = values.transpose();
-  }
-  return rows;
-}
-
 // Kalibr's intrinsics as written and read back.
 struct KalibrImu {
   Eigen::Matrix3d m_accel, m_gyro, a_gyro, c_gyro_i, c_i_b;
@@ -130,14 +104,14 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
   KalibrImu imu;
   doc.Add("model", MachineDoc::Text("scale-misalignment"));
   MachineDoc accelerometers = MachineDoc::Map();
-  accelerometers.Add("M", MatrixDoc(m_accel, "M_accel", &imu.m_accel));
+  accelerometers.Add("M", MatrixDoc(m_accel, "M_accel", MachineDoc::Style::kFlow, &imu.m_accel));
   accelerometers.Add("b", VectorDoc(accel.bias / k_accel, "b_accel", &imu.b_accel),
                      "m/s^2 at the export temperature");
   doc.Add("accelerometers", std::move(accelerometers));
   MachineDoc gyroscopes = MachineDoc::Map();
-  gyroscopes.Add("M", MatrixDoc(m_gyro, "M_gyro", &imu.m_gyro));
-  gyroscopes.Add("A", MatrixDoc(a_gyro, "A", &imu.a_gyro), "(rad/s)/(m/s^2)");
-  gyroscopes.Add("C_gyro_i", MatrixDoc(c_gyro_i, "C_gyro_i", &imu.c_gyro_i));
+  gyroscopes.Add("M", MatrixDoc(m_gyro, "M_gyro", MachineDoc::Style::kFlow, &imu.m_gyro));
+  gyroscopes.Add("A", MatrixDoc(a_gyro, "A", MachineDoc::Style::kFlow, &imu.a_gyro), "(rad/s)/(m/s^2)");
+  gyroscopes.Add("C_gyro_i", MatrixDoc(c_gyro_i, "C_gyro_i", MachineDoc::Style::kFlow, &imu.c_gyro_i));
   gyroscopes.Add("b", VectorDoc(gyro.bias / k_gyro, "b_gyro", &imu.b_gyro),
                  "rad/s at the export temperature");
   doc.Add("gyroscopes", std::move(gyroscopes));

@@ -1,11 +1,16 @@
 #include "fit_record_yaml.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "imufit/base/robust_loss.h"
+#include "imufit/io/error.h"
+#include "imufit/model/sensor_model.h"
 
 namespace imufit {
 namespace {
@@ -116,6 +121,40 @@ Record ReadRecord(const yaml::Located& block, VisitRecord visit_record) {
   return record;
 }
 
+// The coefficient groups a fit estimates or holds, as the record names them: "gyro.bias", ...,
+// "accel.misalignment" (the model's groups of each sensor, model/sensor_model.h).
+std::vector<std::string> GroupNames() {
+  std::vector<std::string> names;
+  for (const bool gyro : {true, false}) {
+    const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
+    for (int c = 0; c < coefficients; ++c) {
+      const std::string name = std::string(gyro ? "gyro." : "accel.") + kCoefficientNames[c].group;
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  return names;
+}
+
+// Refuses a loss or a group the fit does not know, at its line and column.
+void CheckFitOptionNames(const yaml::Located& block, const FitRecord& record) {
+  if (record.loss) {
+    RobustLoss loss = RobustLoss::kHuber;
+    std::string error;
+    if (!ParseRobustLoss(*record.loss, &loss, &error)) block["loss"].Fail(error);
+  }
+  const std::vector<std::string> groups = GroupNames();
+  for (const auto& [key, names] : {std::pair{"fitted", &record.fitted}, {"held", &record.held}}) {
+    if (!*names) continue;
+    for (size_t i = 0; i < (*names)->size(); ++i) {
+      const std::string& name = (**names)[i];
+      if (std::find(groups.begin(), groups.end(), name) != groups.end()) continue;
+      std::string list;
+      for (const std::string& group : groups) list += (list.empty() ? "" : ", ") + group;
+      block[key].At(i).Fail(QuoteForMessage(name) + " is not a coefficient group (" + list + ")");
+    }
+  }
+}
+
 }  // namespace
 
 MachineDoc FitRecordDoc(const FitRecord& record) {
@@ -127,7 +166,10 @@ MachineDoc CheckRecordDoc(const CheckRecord& record) {
 }
 
 FitRecord ReadFitRecord(const yaml::Located& block) {
-  return ReadRecord<FitRecord>(block, [](FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+  FitRecord record =
+      ReadRecord<FitRecord>(block, [](FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+  CheckFitOptionNames(block, record);
+  return record;
 }
 
 CheckRecord ReadCheckRecord(const yaml::Located& block) {

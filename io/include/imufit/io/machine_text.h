@@ -11,10 +11,11 @@
 //  - booleans are true and false, null is null.
 //  - text is written plain only when no YAML 1.1 or 1.2 reader resolves it to anything else
 //    (YamlPlainSafe: a letter, _ or / first, then letters, digits, spaces and _ . / + - ^ ( ) *,
-//    no space last, and not a word such as yes, on, null or nan); otherwise double-quoted. Both syntaxes
-//    escape what is not printable (control characters, DEL, C1 controls, U+2028/9, U+FFFE/F) as \uXXXX, and a
-//    byte that is not part of valid UTF-8 as the code point of the same value (a Latin-1 byte 0xE9 becomes
-//    U+00E9, "é"): the text written is always valid UTF-8.
+//    no space last, and not a word such as yes, on, null or nan); otherwise double-quoted. Both
+//    syntaxes escape what is not printable (control characters, DEL, C1 controls, U+2028/9,
+//    U+FFFE/F) as \uXXXX (\n, \t, \r as such), and a byte that is not part of valid UTF-8 as the
+//    code point of the same value (a Latin-1 byte 0xE9 becomes U+00E9, "é"): the text written is
+//    always valid UTF-8.
 //
 // Styles: a list or map is written on one line (kFlow) or one item per line (kBlock), in YAML and
 // in JSON alike. Comments (YAML only; JSON has none) go before an entry or after it on its line.
