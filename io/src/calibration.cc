@@ -4,8 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <limits>
-#include <sstream>
+#include <vector>
 
 #include "fit_record_yaml.h"
 #include "imufit/io/error.h"
