@@ -285,10 +285,12 @@ NoiseColumnRecord NoiseColumn(const ColumnAnalysis& analysis) {
   column.value = fit.value;
   column.sigma = fit.sigma;
   for (int k = 0; k < kNoiseTerms; ++k) column.resolved[k] = IsResolved(fit, k);
-  column.readout_random_walk = fit.readout_random_walk;
-  column.readout_bias_instability = fit.readout_bias_instability;
+  // The read-outs in the units the file writes them (io/noise_file.h).
+  const auto written = [&](int term, double si) { return si * UnitsOf(analysis.kind, term).engineer_per_si; };
+  column.readout_random_walk = written(kRandomWalk, fit.readout_random_walk);
+  column.readout_bias_instability = written(kBiasInstability, fit.readout_bias_instability);
   column.readout_bias_tau_s = fit.readout_bias_tau_s;
-  column.readout_rate_random_walk = fit.readout_rate_random_walk;
+  column.readout_rate_random_walk = written(kRateRandomWalk, fit.readout_rate_random_walk);
   return column;
 }
 

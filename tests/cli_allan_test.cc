@@ -13,6 +13,7 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 
+#include "imufit/io/machine_text.h"
 #include "imufit/io/sha256.h"
 
 #include "cli_util.h"
@@ -70,8 +71,8 @@ TEST_F(CliTest, AllanWithCalibrationEqualsApplyThenAllanOnARawLog) {
   EXPECT_FALSE(YAML::Load(applied_yaml)["noise"]["calibration_sha256"]);
   EXPECT_EQ(direct_summary.find(Path("raw.csv.gz") + " corrected by " + truth + ": "), 0u) << direct_summary;
   EXPECT_EQ(r.out.find(Path("corrected.csv") + ": "), 0u) << r.out;
-  const std::string recorded =
-      "  calibration: \"" + truth + "\"\n  calibration_sha256: \"" + Sha256OfFile(truth) + "\"\n";
+  const std::string recorded = "  calibration: " + YamlStringText(truth) +
+                               "\n  calibration_sha256: " + YamlStringText(Sha256OfFile(truth)) + "\n";
   ASSERT_NE(direct_yaml.find(recorded), std::string::npos) << direct_yaml;
   direct_yaml.erase(direct_yaml.find(recorded), recorded.size());
   direct_yaml.replace(direct_yaml.find(Path("raw.csv.gz")), Path("raw.csv.gz").size(), Path("corrected.csv"));

@@ -36,10 +36,10 @@ std::vector<std::string> Args(std::vector<std::string> extra) {
 
 // The sigma of the row named `name` in the YAML output.
 double YamlSigma(const std::string& yaml, const std::string& name) {
-  const size_t at = yaml.find("name: \"" + name + "\"");
-  if (at == std::string::npos) return -1.0;
-  const size_t sigma = yaml.find("sigma: ", at);
-  return std::strtod(yaml.c_str() + sigma + 7, nullptr);
+  for (const YAML::Node& row : YAML::Load(yaml)["rows"]) {
+    if (row["name"].as<std::string>() == name) return row["sigma"].as<double>();
+  }
+  return -1.0;
 }
 
 TEST_F(CliPlanTest, PrintsEveryCoefficientAndTheLimitingOne) {

@@ -449,6 +449,69 @@ TEST_F(ExportTest, JsonReadsBackBitForBitAndAppliesIdentically) {
   EXPECT_EQ(again.find("\"export\""), again.rfind("\"export\""));
 }
 
+// A real fitted calibration (fit:, sigma:) with the noise block of `imufit allan` appended goes
+// YAML -> JSON -> read -> YAML bit for bit (the text of the writer, not only the numbers), and
+// `imufit apply -c unit.json` corrects as the YAML does. The fit's record keeps its types in JSON.
+TEST_F(ExportTest, AFittedCalibrationWithNoiseRoundTripsThroughJsonBitForBit) {
+  const std::string golden = kFixtures + "/golden/mems_6pos_soak.yaml";
+  const std::string fitted = ReadBytes(golden);
+  EXPECT_EQ(CalibrationToYaml(ReadCalibration(golden)), fitted) << "the writer's text is its own fixed point";
+  std::ofstream(Path("static.yaml"), std::ios::binary)
+      << "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n  - {id: 1, up: [0, 0, 1]}\n";
+  ASSERT_EQ(Run({"simulate",
+                 "-p",
+                 Path("static.yaml"),
+                 "-c",
+                 kFixtures + "/mems_truth.yaml",
+                 "-o",
+                 Path("static.csv"),
+                 "--rate",
+                 "100",
+                 "--dwell",
+                 "60",
+                 "--temps",
+                 "25",
+                 "--gyro-noise-density",
+                 "1e-4",
+                 "--accel-noise-density",
+                 "1e-3",
+                 "--seed",
+                 "5",
+                 "-q"})
+                .status,
+            0);
+  const RunResult allan =
+      Run({"allan", "-s", Path("static.csv"), "--calibration", kFixtures + "/mems_truth.yaml", "-o",
+           Path("adev.csv"), "--noise-yaml", Path("noise.yaml"), "-q"});
+  ASSERT_EQ(allan.status, 0) << allan.err;
+  std::ofstream(Path("unit.yaml"), std::ios::binary) << fitted << ReadBytes(Path("noise.yaml"));
+  const Calibration unit = ReadCalibration(Path("unit.yaml"));
+  ASSERT_TRUE(unit.fit && unit.sigma && unit.noise);
+  ASSERT_FALSE(unit.noise->columns.empty());
+  const std::string yaml = CalibrationToYaml(unit);
+
+  const RunResult exported = Run({"export", "-c", Path("unit.yaml"), "-f", "json", "-o", Path("unit.json")});
+  ASSERT_EQ(exported.status, 0) << exported.err;
+  const std::string json = ReadBytes(Path("unit.json"));
+  for (const char* typed : {"\"samples_read\": 26950,", "\"g_sensitivity_fitted\": true,",
+                            "\"fitted\": true,", "\"points_used\": "}) {
+    EXPECT_NE(json.find(typed), std::string::npos) << typed;
+  }
+  Calibration read = ReadCalibration(Path("unit.json"));
+  read.extra.remove("export");
+  EXPECT_EQ(CalibrationToYaml(read), yaml);
+  EXPECT_EQ(read.model.gyro, unit.model.gyro);
+  EXPECT_EQ(read.sigma->accel, unit.sigma->accel);
+  EXPECT_EQ(read.noise->columns[0].value, unit.noise->columns[0].value);
+
+  const std::string samples = kFixtures + "/mems_6pos_noiseless.csv.gz";
+  ASSERT_EQ(Run({"apply", "-q", "-c", Path("unit.yaml"), "-s", samples, "-o", Path("a.csv")}).status, 0);
+  const RunResult applied = Run({"apply", "-q", "-c", Path("unit.json"), "-s", samples, "-o", Path("b.csv")});
+  ASSERT_EQ(applied.status, 0) << applied.err;
+  const auto samples_of = [](const std::string& text) { return text.substr(text.find('\n') + 1); };
+  EXPECT_EQ(samples_of(ReadBytes(Path("a.csv"))), samples_of(ReadBytes(Path("b.csv"))));
+}
+
 TEST_F(ExportTest, RefusesALossyExportBeyondMaxLossSayingByHowMuch) {
   const std::vector<std::string> px4 = Plus({"export", "-c", kFixtures + "/mems_truth.yaml", "-f", "px4",
                                              "-o", Path("unit.params"), "--device-id", "7"},

@@ -191,15 +191,23 @@ TEST_F(FactoryTest, NoiseLimitsUseTheNoiseBlockWhenPresent) {
   Verdict verdict = EvaluateLimits(ReadLimits(limits_path), calibration);
   EXPECT_FALSE(verdict.criteria[0].pass);
   EXPECT_EQ(verdict.criteria[0].measured_text, "not in calibration");
-  // With one (the layout imufit allan --noise-yaml writes, docs/allan.md).
-  calibration.extra["noise"] = YAML::Load(
-      "{format: imufit-noise, version: 1, columns: {gyro_x: {arw_deg_per_sqrt_hr: [0.1498, 0.0002], "
-      "bias_instability_deg_per_hr: [0.94, 0.67]}}}");
+  // With one (the record imufit allan --noise-yaml writes, io/noise_file.h), in SI units.
+  NoiseColumnRecord gyro_x;
+  gyro_x.name = "gyro_x";
+  gyro_x.kind = ColumnKind::kGyro;
+  gyro_x.fitted = true;
+  const double arw = UnitsOf(ColumnKind::kGyro, kRandomWalk).engineer_per_si;
+  const double instability = UnitsOf(ColumnKind::kGyro, kBiasInstability).engineer_per_si;
+  gyro_x.value[kRandomWalk] = 0.1498 / arw;
+  gyro_x.sigma[kRandomWalk] = 0.0002 / arw;
+  gyro_x.value[kBiasInstability] = 0.94 / instability;
+  gyro_x.sigma[kBiasInstability] = 0.67 / instability;
+  calibration.noise.emplace().columns.push_back(gyro_x);
   verdict = EvaluateLimits(ReadLimits(limits_path), calibration);
   EXPECT_TRUE(verdict.criteria[0].pass);
-  EXPECT_EQ(verdict.criteria[0].measured, 0.1498);
+  EXPECT_DOUBLE_EQ(verdict.criteria[0].measured, 0.1498);
   EXPECT_FALSE(verdict.criteria[1].pass);  // 0.94 deg/h > 0.5 deg/h
-  EXPECT_EQ(FindFigure(KeyFigures(calibration), "noise.gyro_x.arw_deg_per_sqrt_hr")->sigma, 0.0002);
+  EXPECT_DOUBLE_EQ(FindFigure(KeyFigures(calibration), "noise.gyro_x.arw_deg_per_sqrt_hr")->sigma, 0.0002);
 }
 
 TEST_F(FactoryTest, StoreRecordsAndAnswers) {

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -22,6 +23,8 @@
 #include "imufit/io/error.h"
 #include "imufit/io/file_reads.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/machine_text.h"
+#include "imufit/io/noise_file.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/parallel_samples.h"
 #include "imufit/io/plan.h"
@@ -225,10 +228,10 @@ TEST_F(IoTest, CalibrationErrorsNameFileLineAndKey) {
 TEST_F(IoTest, CalibrationReaderIgnoresUnknownKeysAndHonoursReferenceTemperature) {
   std::string text = CalibrationToYaml(ExampleCalibration());
   text.replace(text.find("reference_temp_c: 25"), 20, "reference_temp_c: 20");
-  text += "noise:\n  gyro_arw_deg_per_sqrt_hr: 0.3\n";
+  text += "lab:\n  gyro_arw_deg_per_sqrt_hr: 0.3\n";
   const Calibration read = ReadCalibration(Write("cal.yaml", text));
   EXPECT_EQ(read.model.basis.center_c, 20.0);
-  EXPECT_EQ(read.extra["noise"]["gyro_arw_deg_per_sqrt_hr"].as<double>(), 0.3);
+  EXPECT_EQ(read.extra["lab"]["gyro_arw_deg_per_sqrt_hr"].as<double>(), 0.3);
 }
 
 // The fit's record: every key of the `fit:` and `check:` blocks round-trips through its typed
@@ -266,11 +269,10 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   fit.missing_segments = 2;
   calibration.check.emplace().samples = "check.csv";
   calibration.check->gyro_error_rms_radps = 1e-3;
-  calibration.extra = YAML::Node(YAML::NodeType::Map);
-  calibration.extra["noise"]["format"] = "imufit-noise";
+  calibration.noise.emplace().software = "imufit 0.1.0";
   const std::string text = CalibrationToYaml(calibration);
   for (const char* line : {"\nfit:\n  plan: plan.yaml\n  samples: runs/unit 1.csv.gz\n",
-                           "\n  distinct_temperatures_c:\n    - -40.000955338170442\n",
+                           "\n  distinct_temperatures_c:\n    - -40.00095533817044\n",
                            "\n  fitted: [gyro.bias, accel.bias]\n  held: []\n  held_values: prior\n",
                            "\n  gyro_reduced_chi2: .nan\n", "\n  g_sensitivity_fitted: false\n",
                            "\n  segments_without_windows: [3, 7]\n  missing_segments: 2\ncheck:\n",
@@ -291,7 +293,9 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   ASSERT_TRUE(read.check.has_value());
   EXPECT_EQ(read.check->gyro_error_rms_radps, 1e-3);
   EXPECT_FALSE(read.check->accel_error_rms_mps2.has_value());  // not written: not set
-  EXPECT_EQ(read.extra.size(), 1u);                            // noise
+  ASSERT_TRUE(read.noise.has_value());
+  EXPECT_EQ(read.noise->software, "imufit 0.1.0");
+  EXPECT_EQ(read.extra.size(), 0u);
   EXPECT_EQ(CalibrationToYaml(read), text);
 
   // A key of the block this reader does not know is kept, after the others.
@@ -307,6 +311,161 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   wrong.replace(wrong.find("iterations: 7"), 13, "iterations: seven");
   const InputError e = Catch([&] { ReadCalibration(Write("wrong.yaml", wrong)); });
   EXPECT_NE(e.message().find("fit.iterations: \"seven\" is not an integer"), std::string::npos) << e.what();
+}
+
+// ---------------------------------------------------------------- machine-readable text
+
+// The one writer: numbers a YAML 1.1 reader reads as numbers (a mantissa with a point, -0 as a
+// float), bit for bit; strings quoted when a YAML 1.1 or 1.2 reader would take them for something
+// else; valid UTF-8 always (a Latin-1 byte as its code point); the same document as JSON.
+TEST(MachineText, NumbersStringsAndBytesAreWrittenForEveryReader) {
+  EXPECT_EQ(YamlNumberText(2e-06), "2.0e-06");
+  EXPECT_EQ(YamlNumberText(1e+20), "1.0e+20");
+  EXPECT_EQ(YamlNumberText(2.5e-06), "2.5e-06");
+  EXPECT_EQ(YamlNumberText(25.0), "25");
+  EXPECT_EQ(YamlNumberText(-0.0), "-0.0");
+  EXPECT_EQ(YamlNumberText(std::numeric_limits<double>::quiet_NaN()), ".nan");
+  EXPECT_EQ(YamlNumberText(-std::numeric_limits<double>::infinity()), "-.inf");
+  EXPECT_EQ(JsonNumberText(std::numeric_limits<double>::infinity()), "null");
+  for (const double value :
+       {2e-06, 1e-300, 0.1, 1.0 / 3.0, -4.0316131030556947e-05, 5e-324, 1.7976931348623157e308}) {
+    const std::string text = YamlNumberText(value);
+    double read = 0.0;
+    ASSERT_EQ(std::from_chars(text.data(), text.data() + text.size(), read).ptr, text.data() + text.size());
+    EXPECT_EQ(read, value) << text;
+    EXPECT_NE(text.find_first_of(".e"), std::string::npos) << text;
+  }
+  for (const char* plain :
+       {"huber", "gyro.bias", "rad/s", "m/s^2", "imufit 0.1.0", "/imu0", "runs/unit 1.csv"}) {
+    EXPECT_EQ(YamlStringText(plain), plain);
+  }
+  for (const char* quoted :
+       {"",        "yes",  "No",       "on", "OFF",  "y",     "n",     "true",  "null",
+        "~",       "nan",  ".inf",     "12", "0123", "2e-06", "1_000", "14:03", "2026-11-20T14:03:60Z",
+        "0x1F",    "-1",   "<<",       "=",  "a: b", "a #b",  "[x]",   "x,y",   "*alias",
+        "&anchor", "!tag", "trailing "}) {
+    EXPECT_EQ(YamlStringText(quoted).front(), '"') << quoted;
+  }
+  EXPECT_EQ(YamlStringText("caf\xe9.csv"), "\"caf\xc3\xa9.csv\"") << "a Latin-1 byte as its code point";
+  EXPECT_EQ(ValidUtf8("caf\xe9"), "caf\xc3\xa9");
+  EXPECT_EQ(YamlStringText("caf\xc3\xa9"), "\"caf\xc3\xa9\"") << "valid UTF-8 kept as it is";
+  EXPECT_EQ(JsonStringText("a\"b\\c\n\x7f\xc2\x85"), "\"a\\\"b\\\\c\\n\\u007f\\u0085\"");
+
+  MachineDoc doc = MachineDoc::Map();
+  doc.Comment("made by a test");
+  doc.Add("n", MachineDoc::Integer(26950), "samples");
+  doc.Add("flag", MachineDoc::Bool(true));
+  doc.Add("list", MachineDoc::Numbers({2e-06, -0.0}));
+  MachineDoc rows = MachineDoc::List(MachineDoc::Style::kBlock);
+  rows.Push(
+      MachineDoc::Map(MachineDoc::Style::kFlow).Add("id", MachineDoc::Integer(1)).Add("on", MachineDoc()));
+  doc.Add("rows", rows);
+  doc.Add("empty", MachineDoc::Map());
+  EXPECT_EQ(YamlText(doc),
+            "# made by a test\n\"n\": 26950  # samples\nflag: true\nlist: [2.0e-06, -0.0]\nrows:\n"
+            "  - {id: 1, \"on\": null}\nempty: {}\n");
+  EXPECT_EQ(JsonText(doc),
+            "{\n  \"n\": 26950,\n  \"flag\": true,\n  \"list\": [2.0e-06, -0.0],\n  \"rows\": [\n"
+            "    {\"id\": 1, \"on\": null}\n  ],\n  \"empty\": {}\n}\n");
+}
+
+// docs/calibration.schema.json types every key of the `fit:` record as its table does (JSON: a
+// double may be null, for a value that is not finite).
+TEST(MachineText, TheJsonSchemaTypesTheFitRecordAsItsTable) {
+  const YAML::Node schema = YAML::LoadFile(IMUFIT_FIXTURES_DIR "/../docs/calibration.schema.json");
+  const YAML::Node properties = schema["properties"]["fit"]["properties"];
+  const std::map<std::string, std::string> json_types = {{"std::string", "string"},
+                                                         {"long long", "integer"},
+                                                         {"int", "integer"},
+                                                         {"double", "[number, null]"},
+                                                         {"bool", "boolean"},
+                                                         {"std::vector<double>", "array of number"},
+                                                         {"std::vector<int>", "array of integer"},
+                                                         {"std::vector<std::string>", "array of string"}};
+  const auto schema_type = [](const YAML::Node& property) {
+    if (!property || !property["type"]) return std::string("(none)");
+    const YAML::Node type = property["type"];
+    if (type.IsSequence()) return "[" + type[0].as<std::string>() + ", " + type[1].as<std::string>() + "]";
+    if (type.as<std::string>() == "array") return "array of " + property["items"]["type"].as<std::string>();
+    return type.as<std::string>();
+  };
+  size_t keys = 0;
+#define IMUFIT_EXPECT_SCHEMA_TYPE(type, key, description)                        \
+  EXPECT_EQ(schema_type(properties[#key]), json_types.at(#type)) << "fit." #key; \
+  ++keys;
+  IMUFIT_FIT_RECORD_FIELDS(IMUFIT_EXPECT_SCHEMA_TYPE)
+#undef IMUFIT_EXPECT_SCHEMA_TYPE
+  EXPECT_EQ(properties.size(), keys) << "a key in the schema that the record does not have";
+}
+
+// The noise block round-trips through its typed record; a value of the wrong type is located.
+TEST_F(IoTest, NoiseRecordRoundTripsThroughTheCalibration) {
+  Calibration calibration = ExampleCalibration();
+  NoiseRecord& noise = calibration.noise.emplace();
+  noise.software = "imufit 0.1.0";
+  noise.samples = "static \xe9t\xe9.csv";  // Latin-1 bytes in a file name
+  noise.sample_interval_s = 0.01;
+  noise.sample_count = 6000;
+  noise.duration_s = 60.0;
+  noise.columns.reserve(2);  // the references below stay valid
+  NoiseColumnRecord& gyro = noise.columns.emplace_back();
+  gyro.name = "gyro_x";
+  gyro.kind = ColumnKind::kGyro;
+  gyro.fitted = true;
+  gyro.points_used = 12;
+  gyro.reduced_chi_square = 1.0 / 3.0;
+  gyro.value = {2e-06, 1.0e-4, 3e-6, std::nan(""), 0.0};
+  gyro.sigma = {1e-7, 2e-6, 1e-6, std::nan(""), 1e-9};
+  gyro.resolved = {true, true, true, false, false};
+  gyro.readout_random_walk = 0.34377467707849391;
+  NoiseColumnRecord& other = noise.columns.emplace_back();
+  other.name = "yes";
+  other.reason = "too short";
+  const std::string text = CalibrationToYaml(calibration);
+  EXPECT_NE(text.find("  samples: \"static \xc3\xa9t\xc3\xa9.csv\"\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("    \"yes\":\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("quantization_rad: [2.0e-06, 1.0e-07]"), std::string::npos) << text;
+  const Calibration read = ReadCalibration(Write("noise.yaml", text));
+  ASSERT_TRUE(read.noise.has_value());
+  EXPECT_EQ(read.noise->samples, "static \xc3\xa9t\xc3\xa9.csv");
+  ASSERT_EQ(read.noise->columns.size(), 2u);
+  EXPECT_EQ(read.noise->columns[0].value[kRandomWalk], 1.0e-4);
+  EXPECT_FALSE(read.noise->columns[0].resolved[kRateRandomWalk]);
+  EXPECT_EQ(read.noise->columns[0].readout_random_walk, 0.34377467707849391);
+  EXPECT_EQ(read.noise->columns[1].name, "yes");
+  EXPECT_EQ(CalibrationToYaml(read), text);
+  const std::optional<std::array<double, 2>> arw = NoiseFigure(read.noise, "gyro_x", "arw_deg_per_sqrt_hr");
+  ASSERT_TRUE(arw.has_value());
+  EXPECT_EQ((*arw)[0], 1.0e-4 * UnitsOf(ColumnKind::kGyro, kRandomWalk).engineer_per_si);
+  EXPECT_FALSE(NoiseFigure(read.noise, "gyro_x", "rate_random_walk_radps_per_sqrt_s").has_value());
+
+  std::string wrong = text;
+  wrong.replace(wrong.find("points_used: 12"), 15, "points_used: many");
+  const InputError e = Catch([&] { ReadCalibration(Write("wrong_noise.yaml", wrong)); });
+  EXPECT_NE(e.message().find("noise.columns.gyro_x.points_used: \"many\" is not an integer"),
+            std::string::npos)
+      << e.what();
+}
+
+// The record's fit options name only losses and groups a fit knows: refused at their line.
+TEST_F(IoTest, FitRecordRefusesAnUnknownLossOrGroupAtItsLine) {
+  Calibration calibration = ExampleCalibration();
+  calibration.fit->loss = "huber";
+  calibration.fit->fitted = std::vector<std::string>{"gyro.bias", "accel.bias"};
+  const std::string text = CalibrationToYaml(calibration);
+  std::string loss = text;
+  loss.replace(loss.find("loss: huber"), 11, "loss: tukey");
+  InputError e = Catch([&] { ReadCalibration(Write("loss.yaml", loss)); });
+  EXPECT_NE(e.message().find("fit.loss: \"tukey\" is not a robust loss (none, huber, cauchy)"),
+            std::string::npos)
+      << e.what();
+  EXPECT_GT(e.line(), 0);
+  std::string group = text;
+  group.replace(group.find("accel.bias]"), 10, "accel.bais");
+  e = Catch([&] { ReadCalibration(Write("group.yaml", group)); });
+  EXPECT_NE(e.message().find("fit.fitted[1]: \"accel.bais\" is not a coefficient group"), std::string::npos)
+      << e.what();
+  EXPECT_GT(e.column(), 0);
 }
 
 // ---------------------------------------------------------------- plan
@@ -1215,9 +1374,11 @@ TEST(RunHeader, AcquiredIsAUtcTimeInOneForm) {
   EXPECT_EQ(NormalisedUtc("2026-11-20T14:03:07+00:00"), "2026-11-20T14:03:07Z");
   for (const char* bad :
        {"2026-11-20T14:03:00", "2026-11-20T14:03:00+01:00", "2026-02-30T10:00Z", "2026-11-20T24:00Z",
-        "2026-11-20T14:3Z", "20/11/2026 14:03", "2026-11-20T14:03:00.Z"}) {
+        "2026-11-20T14:3Z", "20/11/2026 14:03", "2026-11-20T14:03:00.Z", "2026-11-20T14:03:60Z"}) {
     EXPECT_EQ(NormalisedUtc(bad), "") << bad;
   }
+  // A leap second is 23:59:60 UTC; 14:03:60 is no time (PyYAML: "second must be in 0..59").
+  EXPECT_EQ(NormalisedUtc("2016-12-31T23:59:60Z"), "2016-12-31T23:59:60Z");
   const std::string path = "run.csv";
   const RunHeader header = RunHeaderOf(
       path, {{1, 3, "serial: SN1"}, {2, 3, "acquired: 2026-11-20T14:03Z"}, {3, 3, "firmware: 2.4.1"}});

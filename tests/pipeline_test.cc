@@ -109,6 +109,63 @@ INSTANTIATE_TEST_SUITE_P(
                                   "tactical_truth.yaml", 0.8, 3.2, 300.0}),
     [](const ::testing::TestParamInfo<FixtureCase>& info) { return std::string(info.param.name); });
 
+// The record's fit options read back as written, through the one table (fit_run.cc): every
+// combination of what a fit estimates, the temperature orders and the loss; a set of groups no fit
+// estimates, or a loss no fit knows, is refused at its key.
+TEST(FitOptionsOfRecord, ReadsBackWhatTheRecordWrites) {
+  const Calibration golden = ReadCalibration(IMUFIT_FIXTURES_DIR "/golden/mems_6pos_soak.yaml");
+  ASSERT_TRUE(golden.fit.has_value());
+  const FitOptions read = FitOptionsOfRecord(*golden.fit);
+  EXPECT_EQ(read.gyro_fit, SensorFit::kAll);
+  EXPECT_EQ(read.accel_fit, SensorFit::kAll);
+  EXPECT_TRUE(read.fit_g_sensitivity);
+  EXPECT_EQ(read.loss, RobustLoss::kHuber);
+  for (const SensorFit gyro : {SensorFit::kAll, SensorFit::kBias, SensorFit::kNone}) {
+    for (const SensorFit accel : {SensorFit::kAll, SensorFit::kBias, SensorFit::kNone}) {
+      for (const bool g_sensitivity : {true, false}) {
+        FitOptions options;
+        options.gyro_fit = gyro;
+        options.accel_fit = accel;
+        options.fit_g_sensitivity = g_sensitivity;
+        options.gyro_temp_order = 2;
+        options.accel_temp_order = 1;
+        options.loss = RobustLoss::kCauchy;
+        FitRecord record;  // as RecordOf() writes it
+        record.fitted = options.Groups(true);
+        record.held = options.Groups(false);
+        record.g_sensitivity_fitted = options.Fits(true, kGSensitivityCoefficient);
+        record.gyro_temp_order = options.gyro_temp_order;
+        record.accel_temp_order = options.accel_temp_order;
+        record.loss = RobustLossName(options.loss);
+        const FitOptions back = FitOptionsOfRecord(record);
+        EXPECT_EQ(back.Groups(true), options.Groups(true));
+        EXPECT_EQ(back.gyro_fit, gyro);
+        EXPECT_EQ(back.accel_fit, accel);
+        EXPECT_EQ(back.gyro_temp_order, 2);
+        EXPECT_EQ(back.accel_temp_order, 1);
+        EXPECT_EQ(back.loss, RobustLoss::kCauchy);
+      }
+    }
+  }
+  FitRecord bad;
+  bad.fitted = std::vector<std::string>{"gyro.scale"};  // a scale without its bias: no fit does that
+  try {
+    FitOptionsOfRecord(bad);
+    ADD_FAILURE() << "gyro.scale alone";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "fit.fitted") << e.what();
+  }
+  bad = FitRecord();
+  bad.loss = "tukey";
+  try {
+    FitOptionsOfRecord(bad);
+    ADD_FAILURE() << "tukey";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fit.loss: \"tukey\" is not a robust loss"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ReadRunWindows, RefusesASegmentThePlanDoesNotHave) {
   const Plan plan = ReadPlan(Fixture("plan_6pos.yaml"));
   Plan smaller = plan;

@@ -23,16 +23,6 @@ namespace {
 constexpr const char* kConsumer = "imucal (mad-lab-fau/imucal FerrarisCalibrationInfo, JSON format 2.0.0)";
 constexpr double kDegPerRad = kRadToDeg;
 
-// A JSON string of printable ASCII lines (CommentSafe): '"', '\\' and the line ends need escapes.
-std::string JsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c == '\n' ? std::string("\\n") : std::string(1, c);
-  }
-  return out + "\"";
-}
-
 // K (diagonal) and R (unit rows) with K R = forward.
 void ScaleAndRotation(const Eigen::Matrix3d& forward, Eigen::Matrix3d* k, Eigen::Matrix3d* r) {
   const Eigen::Vector3d norms = forward.rowwise().norm();
@@ -57,14 +47,18 @@ ExportResult ExportImucal(const Calibration& calibration, const ExportOptions& o
   ScaleAndRotation((gyro.scale / kDegPerRad).asDiagonal() * gyro.misalignment.inverse(), &k_g, &r_g);
 
   Ferraris f;
-  std::string body;
-  body += "    \"K_a\": " + MatrixText(k_a, "K_a", "    ", &f.k_a) + ",\n";
-  body += "    \"R_a\": " + MatrixText(r_a, "R_a", "    ", &f.r_a) + ",\n";
-  body += "    \"b_a\": " + VectorText(accel.bias, "b_a", &f.b_a) + ",\n";
-  body += "    \"K_g\": " + MatrixText(k_g, "K_g", "    ", &f.k_g) + ",\n";
-  body += "    \"R_g\": " + MatrixText(r_g, "R_g", "    ", &f.r_g) + ",\n";
-  body += "    \"K_ga\": " + MatrixText(gyro.g_sensitivity, "K_ga", "    ", &f.k_ga) + ",\n";
-  body += "    \"b_g\": " + VectorText(gyro.bias, "b_g", &f.b_g) + ",\n";
+  MachineDoc doc = MachineDoc::Map();
+  doc.Add("acc_unit", MachineDoc::Text("m/s^2")).Add("gyr_unit", MachineDoc::Text("deg/s"));
+  doc.Add("from_acc_unit", MachineDoc::Text("a.u.")).Add("from_gyr_unit", MachineDoc::Text("a.u."));
+  const auto matrix = [](const Eigen::Matrix3d& m, const char* name, Eigen::Matrix3d* read_back) {
+    return MatrixDoc(m, name, MachineDoc::Style::kBlock, read_back);
+  };
+  MachineDoc coefficients = MachineDoc::Map();
+  coefficients.Add("K_a", matrix(k_a, "K_a", &f.k_a)).Add("R_a", matrix(r_a, "R_a", &f.r_a));
+  coefficients.Add("b_a", VectorDoc(accel.bias, "b_a", &f.b_a));
+  coefficients.Add("K_g", matrix(k_g, "K_g", &f.k_g)).Add("R_g", matrix(r_g, "R_g", &f.r_g));
+  coefficients.Add("K_ga", matrix(gyro.g_sensitivity, "K_ga", &f.k_ga));
+  coefficients.Add("b_g", VectorDoc(gyro.bias, "b_g", &f.b_g));
 
   const ConsumerCorrection consumer = [f](double, const Eigen::Vector3d& gyro_raw,
                                           const Eigen::Vector3d& accel_raw, Eigen::Vector3d* omega_radps,
@@ -77,11 +71,12 @@ ExportResult ExportImucal(const Calibration& calibration, const ExportOptions& o
   ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
   const std::string comment = Commented(ProvenanceLines(calibration, options, result), "") + "taken at " +
                               FormatDouble(t0) + " degC; raw inputs in the unit's own numbers (a.u.)";
-  result.content =
-      "{\n    \"acc_unit\": \"m/s^2\",\n    \"gyr_unit\": \"deg/s\",\n    \"from_acc_unit\": \"a.u.\",\n"
-      "    \"from_gyr_unit\": \"a.u.\",\n    \"comment\": " +
-      JsonString(comment) + ",\n" + body +
-      "    \"cal_type\": \"Ferraris\",\n    \"_format_version\": \"2.0.0\"\n}\n";
+  doc.Add("comment", MachineDoc::Text(comment));
+  for (size_t i = 0; i < coefficients.items().size(); ++i) {
+    doc.Add(coefficients.keys()[i].name, coefficients.items()[i]);
+  }
+  doc.Add("cal_type", MachineDoc::Text("Ferraris")).Add("_format_version", MachineDoc::Text("2.0.0"));
+  result.content = JsonText(doc);
   return result;
 }
 

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "imufit/export/export.h"
+#include "imufit/io/machine_text.h"
 #include "imufit/model/constants.h"
 #include "imufit/model/sensor_model.h"
 
@@ -53,6 +54,14 @@ std::string VectorText(const Eigen::Vector3d& v, const std::string& name, Eigen:
 // indented by `indent` plus two spaces, the closing bracket by `indent`.
 std::string MatrixText(const Eigen::Matrix3d& m, const std::string& name, const std::string& indent,
                        Eigen::Matrix3d* read_back);
+
+// A number, vector or matrix (a list of rows, on one line or one row a line) as the one writer of
+// machine-readable text writes it (io/machine_text.h), and what a reader parses from it. Throws
+// ExportError, naming `name`, for a value that is not finite.
+MachineDoc NumberDoc(double value, const std::string& name);
+MachineDoc VectorDoc(const Eigen::Vector3d& v, const std::string& name, Eigen::Vector3d* read_back);
+MachineDoc MatrixDoc(const Eigen::Matrix3d& m, const std::string& name, MachineDoc::Style rows,
+                     Eigen::Matrix3d* read_back);
 
 // `text` with every character outside printable ASCII replaced by '?' and "*/" broken up: safe
 // inside any comment.

@@ -21,11 +21,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include <Eigen/Dense>
 
 #include "export_internal.h"
 #include "imufit/io/error.h"
+#include "imufit/io/machine_text.h"
 #include "imufit/io/output_file.h"
 #include "imufit/model/check.h"
 
@@ -51,17 +53,8 @@ void LowerTimesRotation(const Eigen::Matrix3d& g, Eigen::Matrix3d* lower, Eigen:
 }
 
 // The noise block's Kalibr figure, required and positive (Kalibr refuses a density that is not).
-double NoiseFigure(const Calibration& calibration, const char* key) {
-  YAML::Node node;
-  if (calibration.extra.IsMap() && calibration.extra["noise"] && calibration.extra["noise"]["kalibr"]) {
-    node = calibration.extra["noise"]["kalibr"][key];
-  }
-  double value = 0.0;
-  try {
-    if (node && node.IsScalar()) value = node.as<double>();
-  } catch (const YAML::Exception&) {
-    value = 0.0;
-  }
+double NoiseFigure(const KalibrNoiseRecord& figures, double KalibrNoiseRecord::*figure, const char* key) {
+  const double value = figures.*figure;
   if (!(value > 0.0) || !std::isfinite(value)) {
     throw ExportError(std::string("Kalibr needs noise.kalibr.") + key +
                       " > 0 in the calibration (append the noise block of `imufit allan --noise-yaml`)");
@@ -93,25 +86,35 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
   const Eigen::Matrix3d a_gyro = gyro.g_sensitivity / k_gyro * c_i_b.transpose() * c_gyro_i.transpose();
 
   // Kalibr's keys in its order, read one by one: a missing figure is named in that order too.
-  std::string noise;
-  for (const auto& [key, unit] : {std::pair{"accelerometer_noise_density", "m/s^2/sqrt(Hz)"},
-                                  {"accelerometer_random_walk", "m/s^3/sqrt(Hz)"},
-                                  {"gyroscope_noise_density", "rad/s/sqrt(Hz)"},
-                                  {"gyroscope_random_walk", "rad/s^2/sqrt(Hz)"}}) {
-    noise += std::string(key) + ": " + DoubleText(NoiseFigure(calibration, key), key) + "  # " + unit + "\n";
+  const KalibrNoiseRecord figures =
+      calibration.noise ? KalibrNoiseOf(*calibration.noise) : KalibrNoiseRecord();
+  MachineDoc doc = MachineDoc::Map();
+  for (const auto& [key, figure, unit] :
+       {std::tuple{"accelerometer_noise_density", &KalibrNoiseRecord::accelerometer_noise_density,
+                   "m/s^2/sqrt(Hz)"},
+        {"accelerometer_random_walk", &KalibrNoiseRecord::accelerometer_random_walk, "m/s^3/sqrt(Hz)"},
+        {"gyroscope_noise_density", &KalibrNoiseRecord::gyroscope_noise_density, "rad/s/sqrt(Hz)"},
+        {"gyroscope_random_walk", &KalibrNoiseRecord::gyroscope_random_walk, "rad/s^2/sqrt(Hz)"}}) {
+    doc.Add(key, NumberDoc(NoiseFigure(figures, figure, key), key), unit);
   }
-  noise += "rostopic: " + options.rostopic +
-           "\nupdate_rate: " + DoubleText(NoiseFigure(calibration, "update_rate"), "update_rate") +
-           "  # Hz\n";
+  doc.Add("rostopic", MachineDoc::Text(options.rostopic));
+  doc.Add("update_rate",
+          NumberDoc(NoiseFigure(figures, &KalibrNoiseRecord::update_rate, "update_rate"), "update_rate"),
+          "Hz");
   KalibrImu imu;
-  const std::string intrinsics =
-      "model: scale-misalignment\naccelerometers:\n  M: " + MatrixText(m_accel, "M_accel", "", &imu.m_accel) +
-      "\n  b: " + VectorText(accel.bias / k_accel, "b_accel", &imu.b_accel) +
-      "  # m/s^2 at the export temperature\ngyroscopes:\n  M: " +
-      MatrixText(m_gyro, "M_gyro", "", &imu.m_gyro) + "\n  A: " + MatrixText(a_gyro, "A", "", &imu.a_gyro) +
-      "  # (rad/s)/(m/s^2)\n  C_gyro_i: " + MatrixText(c_gyro_i, "C_gyro_i", "", &imu.c_gyro_i) +
-      "\n  b: " + VectorText(gyro.bias / k_gyro, "b_gyro", &imu.b_gyro) +
-      "  # rad/s at the export temperature\n";
+  doc.Add("model", MachineDoc::Text("scale-misalignment"));
+  MachineDoc accelerometers = MachineDoc::Map();
+  accelerometers.Add("M", MatrixDoc(m_accel, "M_accel", MachineDoc::Style::kFlow, &imu.m_accel));
+  accelerometers.Add("b", VectorDoc(accel.bias / k_accel, "b_accel", &imu.b_accel),
+                     "m/s^2 at the export temperature");
+  doc.Add("accelerometers", std::move(accelerometers));
+  MachineDoc gyroscopes = MachineDoc::Map();
+  gyroscopes.Add("M", MatrixDoc(m_gyro, "M_gyro", MachineDoc::Style::kFlow, &imu.m_gyro));
+  gyroscopes.Add("A", MatrixDoc(a_gyro, "A", MachineDoc::Style::kFlow, &imu.a_gyro), "(rad/s)/(m/s^2)");
+  gyroscopes.Add("C_gyro_i", MatrixDoc(c_gyro_i, "C_gyro_i", MachineDoc::Style::kFlow, &imu.c_gyro_i));
+  gyroscopes.Add("b", VectorDoc(gyro.bias / k_gyro, "b_gyro", &imu.b_gyro),
+                 "rad/s at the export temperature");
+  doc.Add("gyroscopes", std::move(gyroscopes));
   Eigen::Matrix3d c_i_b_read;
   const std::string frame = MatrixText(c_i_b, "C_i_b", "", &c_i_b_read);
   imu.c_i_b = c_i_b_read;
@@ -126,15 +129,16 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
         *omega_radps = imu.c_i_b.transpose() * (imu.c_gyro_i.transpose() * w_gyro);
       };
   ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
-  std::string out = Commented(ProvenanceLines(calibration, options, result), "# ");
+  std::vector<std::string> header = ProvenanceLines(calibration, options, result);
   const double angle_mrad = std::acos(std::clamp((c_i_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 1e3;
   char text[200];
   std::snprintf(text, sizeof text,
-                "# intrinsics at %s degC; Kalibr's IMU frame i = C_i_b * imufit's body frame (%.3g mrad):\n",
+                "intrinsics at %s degC; Kalibr's IMU frame i = C_i_b * imufit's body frame (%.3g mrad):",
                 FormatDouble(t0).c_str(), angle_mrad);
-  out += text;
-  out += "# C_i_b: " + frame + "\n";
-  result.content = out + noise + intrinsics;
+  header.push_back(text);
+  header.push_back("C_i_b: " + frame);
+  doc.CommentFirst(header);
+  result.content = YamlText(doc);
   return result;
 }
 

@@ -138,6 +138,31 @@ std::string MatrixText(const Eigen::Matrix3d& m, const std::string& name, const 
   return text + (indent.empty() ? "" : "\n" + indent) + "]";
 }
 
+MachineDoc NumberDoc(double value, const std::string& name) {
+  DoubleText(value, name);  // refuses a value that is not finite
+  return MachineDoc::Number(value);
+}
+
+MachineDoc VectorDoc(const Eigen::Vector3d& v, const std::string& name, Eigen::Vector3d* read_back) {
+  MachineDoc list = MachineDoc::List();
+  for (int i = 0; i < 3; ++i) {
+    list.Push(NumberDoc(v(i), name));
+    (*read_back)(i) = ReadDouble(YamlNumberText(v(i)));
+  }
+  return list;
+}
+
+MachineDoc MatrixDoc(const Eigen::Matrix3d& m, const std::string& name, MachineDoc::Style rows,
+                     Eigen::Matrix3d* read_back) {
+  MachineDoc list = MachineDoc::List(rows);
+  for (int row = 0; row < 3; ++row) {
+    Eigen::Vector3d values;
+    list.Push(VectorDoc(m.row(row).transpose(), name, &values));
+    read_back->row(row) = values.transpose();
+  }
+  return list;
+}
+
 std::string Commented(const std::vector<std::string>& lines, const std::string& marker) {
   std::string text;
   for (const std::string& line : lines) text += marker + line + "\n";

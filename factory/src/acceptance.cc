@@ -316,7 +316,7 @@ std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
   for (const auto& [name, key, unit] : noise_keys) {
     for (const char* axis : axes) {
       if (const std::optional<std::array<double, 2>> pair =
-              ReadNoiseFigure(calibration.extra, std::string("gyro_") + axis, key)) {
+              NoiseFigure(calibration.noise, std::string("gyro_") + axis, key)) {
         figures.push_back(MakeFigure(std::string(name) + "." + axis,
                                      std::string("noise.gyro_") + axis + "." + key, unit, (*pair)[0],
                                      (*pair)[1]));

@@ -8,9 +8,6 @@
 namespace imufit {
 namespace {
 
-constexpr EnumName<RobustLoss> kRobustLossNames[] = {
-    {RobustLoss::kNone, "none"}, {RobustLoss::kHuber, "huber"}, {RobustLoss::kCauchy, "cauchy"}};
-
 // The names of `imufit fit --fit`: what each names of the gyro and of the accelerometer (kNone:
 // nothing of that sensor).
 struct FitGroupName {
@@ -99,14 +96,6 @@ OptionTable<FitOptions> MakeFitOptionTable() {
 }
 
 }  // namespace
-
-std::string RobustLossName(RobustLoss loss) { return NameOf(kRobustLossNames, loss); }
-
-bool ParseRobustLoss(const std::string& name, RobustLoss* loss, std::string* error) {
-  if (ValueOf(kRobustLossNames, name, loss)) return true;
-  *error = "\"" + name + "\" is not a robust loss (" + AllNames(kRobustLossNames) + ")";
-  return false;
-}
 
 bool FitOptions::Fits(bool gyro, int coefficient) const {
   const SensorFit fit = gyro ? gyro_fit : accel_fit;

@@ -4,44 +4,43 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <limits>
-#include <sstream>
+#include <vector>
 
 #include "fit_record_yaml.h"
 #include "imufit/io/error.h"
+#include "imufit/io/machine_text.h"
 #include "imufit/io/output_file.h"
 #include "imufit/model/check.h"
 #include "imufit/model/rate_table.h"
+#include "noise_yaml.h"
 #include "yaml_util.h"
 
 namespace imufit {
 namespace {
 
 constexpr const char* kKnownKeys[] = {
-    "format",           "version", "serial", "created_utc", "software", "reference_temp_c",
-    "fit_temp_range_c", "gyro",    "accel",  "sigma",       "fit",      "check"};
+    "format", "version", "serial", "created_utc", "software", "reference_temp_c", "fit_temp_range_c", "gyro",
+    "accel",  "sigma",   "fit",    "check",       "noise"};
 
-std::string Quoted(const std::string& text) {
-  YAML::Emitter emitter;
-  emitter << YAML::DoubleQuoted << text;
-  return emitter.c_str();
-}
-
-// Appends one sensor's coefficient tree (bias, scale, misalignment[, g_sensitivity]).
-void AppendSensor(const double* params, int coefficients, const std::string& indent, std::string* out) {
+// One sensor's coefficient tree (bias, scale, misalignment[, g_sensitivity]), each coefficient a
+// list c0..c3 on one line.
+MachineDoc SensorDoc(const double* params, int coefficients, const char* unit) {
+  MachineDoc sensor = MachineDoc::Map();
+  if (unit != nullptr) sensor.Add("unit", MachineDoc::Text(unit));
+  MachineDoc group_doc = MachineDoc::Map();
   const char* group = nullptr;
   for (int i = 0; i < coefficients; ++i) {
     const CoefficientName& name = kCoefficientNames[i];
-    if (group == nullptr || std::string(group) != name.group) {
-      group = name.group;
-      *out += indent + group + ":\n";
+    if (group != nullptr && std::string(group) != name.group) {
+      sensor.Add(group, std::move(group_doc));
+      group_doc = MachineDoc::Map();
     }
-    *out += indent + "  " + name.axis + ": [";
-    for (int k = 0; k < kPolynomialTerms; ++k) {
-      *out += (k ? ", " : "") + FormatDouble(params[i * kPolynomialTerms + k]);
-    }
-    *out += "]\n";
+    group = name.group;
+    group_doc.Add(name.axis, MachineDoc::Numbers(std::vector<double>(params + i * kPolynomialTerms,
+                                                                     params + (i + 1) * kPolynomialTerms)));
   }
+  if (group != nullptr) sensor.Add(group, std::move(group_doc));
+  return sensor;
 }
 
 void ReadSensor(const yaml::Located& sensor, double* params, int coefficients) {
@@ -165,6 +164,7 @@ Calibration ReadCalibration(const std::string& path) {
   }
   if (root.Has("fit")) calibration.fit = ReadFitRecord(root["fit"]);
   if (root.Has("check")) calibration.check = ReadCheckRecord(root["check"]);
+  if (root.Has("noise")) calibration.noise = ReadNoiseRecord(root["noise"]);
   calibration.extra = YAML::Node(YAML::NodeType::Map);
   for (const auto& entry : root_node) {
     const std::string& key = entry.first.Scalar();
@@ -176,47 +176,43 @@ Calibration ReadCalibration(const std::string& path) {
   return calibration;
 }
 
-std::string CalibrationToYaml(const Calibration& calibration) {
+MachineDoc CalibrationDoc(const Calibration& calibration) {
   IMUFIT_CHECK(calibration.model.basis.half_range_c == 1.0, "a calibration is written in powers of dT");
-  std::string out;
-  out += "format: imufit-calibration\n";
-  out += "version: " + std::to_string(kCalibrationFormatVersion) + "\n";
-  out += "serial: " + Quoted(calibration.serial) + "\n";
-  out += "created_utc: " + Quoted(calibration.created_utc) + "\n";
-  out += "software: " + Quoted(calibration.software) + "\n";
-  out += "reference_temp_c: " + FormatDouble(calibration.model.basis.center_c) + "\n";
-  out += "fit_temp_range_c: [" + FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
-         FormatDouble(calibration.fit_temp_range_c[1]) + "]\n";
-  out += "gyro:\n  unit: rad/s\n";
-  AppendSensor(calibration.model.gyro.data(), kGyroCoefficients, "  ", &out);
-  out += "accel:\n  unit: m/s^2\n";
-  AppendSensor(calibration.model.accel.data(), kAccelCoefficients, "  ", &out);
+  MachineDoc doc = MachineDoc::Map();
+  doc.Add("format", MachineDoc::Text("imufit-calibration"));
+  doc.Add("version", MachineDoc::Integer(kCalibrationFormatVersion));
+  doc.Add("serial", MachineDoc::Text(calibration.serial));
+  doc.Add("created_utc", MachineDoc::Text(calibration.created_utc));
+  doc.Add("software", MachineDoc::Text(calibration.software));
+  doc.Add("reference_temp_c", MachineDoc::Number(calibration.model.basis.center_c));
+  doc.Add("fit_temp_range_c",
+          MachineDoc::Numbers({calibration.fit_temp_range_c[0], calibration.fit_temp_range_c[1]}));
+  doc.Add("gyro", SensorDoc(calibration.model.gyro.data(), kGyroCoefficients, "rad/s"));
+  doc.Add("accel", SensorDoc(calibration.model.accel.data(), kAccelCoefficients, "m/s^2"));
   if (calibration.sigma) {
-    out += "# 1-sigma uncertainty of every coefficient above, same layout and units\n";
-    out += "sigma:\n  gyro:\n";
-    AppendSensor(calibration.sigma->gyro.data(), kGyroCoefficients, "    ", &out);
-    out += "  accel:\n";
-    AppendSensor(calibration.sigma->accel.data(), kAccelCoefficients, "    ", &out);
+    doc.Comment("1-sigma uncertainty of every coefficient above, same layout and units");
+    MachineDoc sigma = MachineDoc::Map();
+    sigma.Add("gyro", SensorDoc(calibration.sigma->gyro.data(), kGyroCoefficients, nullptr));
+    sigma.Add("accel", SensorDoc(calibration.sigma->accel.data(), kAccelCoefficients, nullptr));
+    doc.Add("sigma", std::move(sigma));
   }
-  // The fit's record, then the further keys, in one YAML map.
-  YAML::Node tail(YAML::NodeType::Map);
-  if (calibration.fit) tail.force_insert("fit", FitRecordNode(*calibration.fit));
-  if (calibration.check) tail.force_insert("check", CheckRecordNode(*calibration.check));
+  // The fit's record, the noise record, then the further keys.
+  if (calibration.fit) doc.Add("fit", FitRecordDoc(*calibration.fit));
+  if (calibration.check) doc.Add("check", CheckRecordDoc(*calibration.check));
+  if (calibration.noise) doc.Add("noise", NoiseDoc(*calibration.noise));
   if (calibration.extra.IsMap()) {
     for (const auto& entry : calibration.extra) {
       const std::string& key = entry.first.Scalar();
-      IMUFIT_CHECK(key != "fit" && key != "check", "the fit's record is written from its typed members");
-      tail.force_insert(entry.first, entry.second);
+      IMUFIT_CHECK(key != "fit" && key != "check" && key != "noise",
+                   "the records are written from their typed members");
+      doc.Add(key, MachineDocOfYaml(entry.second));
     }
   }
-  if (tail.size() > 0) {
-    YAML::Emitter emitter;
-    emitter.SetDoublePrecision(17);
-    emitter << tail;
-    out += emitter.c_str();
-    out += "\n";
-  }
-  return out;
+  return doc;
+}
+
+std::string CalibrationToYaml(const Calibration& calibration) {
+  return YamlText(CalibrationDoc(calibration));
 }
 
 void WriteCalibration(const std::string& path, const Calibration& calibration,
@@ -231,22 +227,6 @@ std::string UtcNow() {
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
   return text;
-}
-
-YAML::Node CalibrationTree(const Calibration& calibration) {
-  // The coefficients as the file writes them; the records as nodes (their further keys keep how
-  // they were read); `extra` as read (an emitted and re-read YAML would lose the quotes).
-  Calibration coefficients = calibration;
-  coefficients.extra.reset(YAML::Node(YAML::NodeType::Map));  // rebinds; `=` would empty the shared node
-  coefficients.fit.reset();
-  coefficients.check.reset();
-  YAML::Node root = YAML::Load(CalibrationToYaml(coefficients));
-  if (calibration.fit) root.force_insert("fit", FitRecordNode(*calibration.fit));
-  if (calibration.check) root.force_insert("check", CheckRecordNode(*calibration.check));
-  if (calibration.extra.IsMap()) {
-    for (const auto& entry : calibration.extra) root.force_insert(entry.first.Scalar(), entry.second);
-  }
-  return root;
 }
 
 }  // namespace imufit

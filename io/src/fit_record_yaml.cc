@@ -1,11 +1,16 @@
 #include "fit_record_yaml.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "imufit/base/robust_loss.h"
+#include "imufit/io/error.h"
+#include "imufit/model/sensor_model.h"
 
 namespace imufit {
 namespace {
@@ -29,36 +34,28 @@ void VisitCheckRecord(Record& record, Visit&& visit) {
 
 // ---------------------------------------------------------------- writing
 
-template <typename T>
-void Put(YAML::Node* node, const char* key, const T& value) {
-  (*node)[key] = value;
+MachineDoc ValueDoc(const std::string& value) { return MachineDoc::Text(value); }
+MachineDoc ValueDoc(long long value) { return MachineDoc::Integer(value); }
+MachineDoc ValueDoc(int value) { return MachineDoc::Integer(value); }
+MachineDoc ValueDoc(bool value) { return MachineDoc::Bool(value); }
+MachineDoc ValueDoc(double value) { return MachineDoc::Number(value); }
+// Temperatures one a line; names and ids on one line.
+MachineDoc ValueDoc(const std::vector<double>& values) {
+  return MachineDoc::Numbers(values, MachineDoc::Style::kBlock);
 }
-
-// Names and ids on one line.
-template <typename T>
-void PutFlowList(YAML::Node* node, const char* key, const std::vector<T>& values) {
-  YAML::Node list(YAML::NodeType::Sequence);
-  for (const T& value : values) list.push_back(value);
-  list.SetStyle(YAML::EmitterStyle::Flow);
-  (*node)[key] = list;
-}
-void Put(YAML::Node* node, const char* key, const std::vector<int>& values) {
-  PutFlowList(node, key, values);
-}
-void Put(YAML::Node* node, const char* key, const std::vector<std::string>& values) {
-  PutFlowList(node, key, values);
-}
+MachineDoc ValueDoc(const std::vector<int>& values) { return MachineDoc::Integers(values); }
+MachineDoc ValueDoc(const std::vector<std::string>& values) { return MachineDoc::Texts(values); }
 
 template <typename Record, typename VisitRecord>
-YAML::Node RecordNode(const Record& record, VisitRecord visit_record) {
-  YAML::Node node(YAML::NodeType::Map);
-  visit_record(record, [&node](const char* key, const auto& member) {
-    if (member) Put(&node, key, *member);
+MachineDoc RecordDoc(const Record& record, VisitRecord visit_record) {
+  MachineDoc doc = MachineDoc::Map();
+  visit_record(record, [&doc](const char* key, const auto& member) {
+    if (member) doc.Add(key, ValueDoc(*member));
   });
   if (record.extra.IsMap()) {
-    for (const auto& entry : record.extra) node.force_insert(entry.first, entry.second);
+    for (const auto& entry : record.extra) doc.Add(entry.first.Scalar(), MachineDocOfYaml(entry.second));
   }
-  return node;
+  return doc;
 }
 
 // ---------------------------------------------------------------- reading
@@ -124,18 +121,55 @@ Record ReadRecord(const yaml::Located& block, VisitRecord visit_record) {
   return record;
 }
 
-}  // namespace
-
-YAML::Node FitRecordNode(const FitRecord& record) {
-  return RecordNode(record, [](const FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+// The coefficient groups a fit estimates or holds, as the record names them: "gyro.bias", ...,
+// "accel.misalignment" (the model's groups of each sensor, model/sensor_model.h).
+std::vector<std::string> GroupNames() {
+  std::vector<std::string> names;
+  for (const bool gyro : {true, false}) {
+    const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
+    for (int c = 0; c < coefficients; ++c) {
+      const std::string name = std::string(gyro ? "gyro." : "accel.") + kCoefficientNames[c].group;
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  return names;
 }
 
-YAML::Node CheckRecordNode(const CheckRecord& record) {
-  return RecordNode(record, [](const CheckRecord& r, auto&& visit) { VisitCheckRecord(r, visit); });
+// Refuses a loss or a group the fit does not know, at its line and column.
+void CheckFitOptionNames(const yaml::Located& block, const FitRecord& record) {
+  if (record.loss) {
+    RobustLoss loss = RobustLoss::kHuber;
+    std::string error;
+    if (!ParseRobustLoss(*record.loss, &loss, &error)) block["loss"].Fail(error);
+  }
+  const std::vector<std::string> groups = GroupNames();
+  for (const auto& [key, names] : {std::pair{"fitted", &record.fitted}, {"held", &record.held}}) {
+    if (!*names) continue;
+    for (size_t i = 0; i < (*names)->size(); ++i) {
+      const std::string& name = (**names)[i];
+      if (std::find(groups.begin(), groups.end(), name) != groups.end()) continue;
+      std::string list;
+      for (const std::string& group : groups) list += (list.empty() ? "" : ", ") + group;
+      block[key].At(i).Fail(QuoteForMessage(name) + " is not a coefficient group (" + list + ")");
+    }
+  }
+}
+
+}  // namespace
+
+MachineDoc FitRecordDoc(const FitRecord& record) {
+  return RecordDoc(record, [](const FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+}
+
+MachineDoc CheckRecordDoc(const CheckRecord& record) {
+  return RecordDoc(record, [](const CheckRecord& r, auto&& visit) { VisitCheckRecord(r, visit); });
 }
 
 FitRecord ReadFitRecord(const yaml::Located& block) {
-  return ReadRecord<FitRecord>(block, [](FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+  FitRecord record =
+      ReadRecord<FitRecord>(block, [](FitRecord& r, auto&& visit) { VisitFitRecord(r, visit); });
+  CheckFitOptionNames(block, record);
+  return record;
 }
 
 CheckRecord ReadCheckRecord(const yaml::Located& block) {

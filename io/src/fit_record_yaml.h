@@ -6,13 +6,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/io/fit_record.h"
+#include "imufit/io/machine_text.h"
 #include "yaml_util.h"
 
 namespace imufit {
 
-// The block as a YAML map, its keys in the table's order, then `extra`'s.
-YAML::Node FitRecordNode(const FitRecord& record);
-YAML::Node CheckRecordNode(const CheckRecord& record);
+// The block as a document, its keys in the table's order, then `extra`'s.
+MachineDoc FitRecordDoc(const FitRecord& record);
+MachineDoc CheckRecordDoc(const CheckRecord& record);
 
 // Reads a block; throws InputError located at a key whose value has the wrong type.
 FitRecord ReadFitRecord(const yaml::Located& block);

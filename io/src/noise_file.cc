@@ -2,43 +2,30 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <limits>
 
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/units.h"
 #include "imufit/model/check.h"
+#include "noise_yaml.h"
 #include "yaml_util.h"
 
 namespace imufit {
 namespace {
 
-// The file holds no non-finite number: a figure that is not finite is left out (docs/allan.md).
-std::string YamlNumber(double value) {
-  IMUFIT_CHECK(std::isfinite(value), "a noise file number is finite");
-  return FormatDouble(value);
+constexpr int kNoiseFormatVersion = 1;
+constexpr const char* kNoiseModel =
+    "sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2";
+
+// Adds `key: value` when `value` is finite (the file holds no non-finite number, docs/allan.md).
+void AddFinite(MachineDoc* map, const std::string& key, double value, std::string comment = "") {
+  if (std::isfinite(value)) map->Add(key, MachineDoc::Number(value), std::move(comment));
 }
 
-// "<indent><key>: <value><comment>\n", or nothing when `value` is not finite.
-void Scalar(std::ostream& yaml, const char* indent, const std::string& key, double value,
-            const char* comment = "") {
-  if (std::isfinite(value)) yaml << indent << key << ": " << YamlNumber(value) << comment << "\n";
-}
-
-// "<indent><key>: [value, sigma]\n", or nothing when either is not finite.
-void Pair(std::ostream& yaml, const char* indent, const std::string& key, double value, double sigma) {
-  if (std::isfinite(value) && std::isfinite(sigma)) {
-    yaml << indent << key << ": [" << YamlNumber(value) << ", " << YamlNumber(sigma) << "]\n";
-  }
-}
-
-std::string YamlString(const std::string& text) {
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') quoted += '\\';
-    quoted += c;
-  }
-  return quoted + "\"";
+// Adds `key: [value, sigma]` when both are finite.
+void AddPair(MachineDoc* map, const std::string& key, double value, double sigma) {
+  if (std::isfinite(value) && std::isfinite(sigma)) map->Add(key, MachineDoc::Numbers({value, sigma}));
 }
 
 // The largest fitted value of `term` over the columns of `kind` (Kalibr takes one number for all
@@ -120,131 +107,290 @@ void WriteAllanCsv(const std::string& path, const std::vector<AllanCurveRecord>&
   file.Commit();
 }
 
-std::string NoiseYaml(const NoiseRecord& record) {
-  std::ostringstream yaml;
-  yaml << "# Noise figures by imufit allan: the IEEE Std 952 model fitted to the overlapping Allan\n"
-       << "# variance. Every figure is [value, 1-sigma uncertainty]. Merge into a calibration by\n"
-       << "# appending this file: its only top-level key is `noise`.\n"
-       << "noise:\n"
-       << "  format: imufit-noise\n"
-       << "  version: 1\n"
-       << "  software: " << YamlString(record.software) << "\n"
-       << "  samples: " << YamlString(record.samples) << "\n";
-  if (!record.calibration.empty()) {
-    yaml << "  calibration: " << YamlString(record.calibration) << "\n"
-         << "  calibration_sha256: " << YamlString(record.calibration_sha256) << "\n";
-  }
-  Scalar(yaml, "  ", "sample_interval_s", record.sample_interval_s);
-  yaml << "  sample_count: " << record.sample_count << "\n";
-  Scalar(yaml, "  ", "duration_s", record.duration_s);
-  yaml << "  model: \"sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2\"\n"
-       << "  columns:\n";
-  for (const NoiseColumnRecord& fit : record.columns) {
-    yaml << "    " << fit.name << ":\n"
-         << "      kind: " << ToString(fit.kind) << "\n"
-         << "      unit: " << YamlString(SiUnit(fit.kind)) << "\n"
-         << "      fitted: " << (fit.fitted ? "true" : "false") << "\n";
-    if (!fit.fitted) {
-      yaml << "      reason: " << YamlString(fit.reason) << "\n";
-      continue;
-    }
-    yaml << "      points_used: " << fit.points_used << "\n";
-    Scalar(yaml, "      ", "reduced_chi_square", fit.reduced_chi_square);
+namespace {
+
+// The readouts' keys: engineer units where the kind has them, else SI (kRandomWalk,
+// kBiasInstability, kRateRandomWalk), and the bias instability's tau.
+std::array<std::string, 4> ReadoutKeys(ColumnKind kind) {
+  const auto key = [kind](int term) {
+    const NoiseTermUnits& units = UnitsOf(kind, term);
+    return std::string(*units.engineer_key != '\0' ? units.engineer_key : units.si_key);
+  };
+  return {key(kRandomWalk), key(kBiasInstability), "bias_instability_tau_s", key(kRateRandomWalk)};
+}
+
+MachineDoc NoiseColumnDoc(const NoiseColumnRecord& fit) {
+  MachineDoc column = MachineDoc::Map();
+  column.Add("kind", MachineDoc::Text(ToString(fit.kind)));
+  column.Add("unit", MachineDoc::Text(SiUnit(fit.kind)));
+  column.Add("fitted", MachineDoc::Bool(fit.fitted));
+  if (!fit.fitted) {
+    column.Add("reason", MachineDoc::Text(fit.reason));
+  } else {
+    column.Add("points_used", MachineDoc::Integer(fit.points_used));
+    AddFinite(&column, "reduced_chi_square", fit.reduced_chi_square);
     for (int k = 0; k < kNoiseTerms; ++k)
-      Pair(yaml, "      ", UnitsOf(fit.kind, k).si_key, fit.value[k], fit.sigma[k]);
+      AddPair(&column, UnitsOf(fit.kind, k).si_key, fit.value[k], fit.sigma[k]);
     for (int k = 0; k < kNoiseTerms; ++k) {
       const NoiseTermUnits& units = UnitsOf(fit.kind, k);
       if (*units.engineer_key == '\0') continue;
-      Pair(yaml, "      ", units.engineer_key, fit.value[k] * units.engineer_per_si,
-           fit.sigma[k] * units.engineer_per_si);
+      AddPair(&column, units.engineer_key, fit.value[k] * units.engineer_per_si,
+              fit.sigma[k] * units.engineer_per_si);
     }
     for (int k = 0; k < kNoiseTerms; ++k) {
       // A term without a finite value and sigma is unresolved, whatever the fit said.
       const bool finite = std::isfinite(fit.value[k]) && std::isfinite(fit.sigma[k]);
-      if (!fit.resolved[k] || !finite)
-        yaml << "      " << UnitsOf(fit.kind, k).si_key << "_resolved: false\n";
+      if (!fit.resolved[k] || !finite) {
+        column.Add(std::string(UnitsOf(fit.kind, k).si_key) + "_resolved", MachineDoc::Bool(false));
+      }
     }
-    const NoiseTermUnits& n = UnitsOf(fit.kind, kRandomWalk);
-    const NoiseTermUnits& b = UnitsOf(fit.kind, kBiasInstability);
-    const NoiseTermUnits& k = UnitsOf(fit.kind, kRateRandomWalk);
-    const bool engineer = *n.engineer_key != '\0';
-    std::ostringstream readout;
-    Scalar(readout, "        ", engineer ? n.engineer_key : n.si_key,
-           fit.readout_random_walk * n.engineer_per_si);
-    Scalar(readout, "        ", engineer ? b.engineer_key : b.si_key,
-           fit.readout_bias_instability * b.engineer_per_si);
-    Scalar(readout, "        ", "bias_instability_tau_s", fit.readout_bias_tau_s);
-    Scalar(readout, "        ", engineer ? k.engineer_key : k.si_key,
-           fit.readout_rate_random_walk * k.engineer_per_si);
-    if (!readout.str().empty()) {
-      yaml << "      readout:  # IEEE 952 graphical read-outs of the measured curve\n" << readout.str();
+    const std::array<std::string, 4> keys = ReadoutKeys(fit.kind);
+    const double readouts[4] = {fit.readout_random_walk, fit.readout_bias_instability, fit.readout_bias_tau_s,
+                                fit.readout_rate_random_walk};
+    MachineDoc readout = MachineDoc::Map();
+    for (int i = 0; i < 4; ++i) AddFinite(&readout, keys[i], readouts[i]);
+    if (!readout.items().empty()) {
+      column.Add("readout", std::move(readout), "IEEE 952 graphical read-outs of the measured curve");
     }
   }
-  const auto has = [&](ColumnKind kind) {
-    return std::any_of(record.columns.begin(), record.columns.end(),
-                       [&](const NoiseColumnRecord& c) { return c.kind == kind && c.fitted; });
-  };
-  const bool has_gyro = has(ColumnKind::kGyro), has_accel = has(ColumnKind::kAccel);
-  if (has_gyro || has_accel) {
-    yaml << "  kalibr:  # imu.yaml continuous-time values, the worst axis of each sensor (a term the log\n"
-            "           # does not resolve: its upper bound, value + 2 sigma)\n";
-    if (has_gyro) {
-      Scalar(yaml, "    ", "gyroscope_noise_density",
-             WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk), "  # rad/s/sqrt(Hz)");
-      Scalar(yaml, "    ", "gyroscope_random_walk",
-             WorstAxis(record.columns, ColumnKind::kGyro, kRateRandomWalk), "  # rad/s^2/sqrt(Hz)");
-    }
-    if (has_accel) {
-      Scalar(yaml, "    ", "accelerometer_noise_density",
-             WorstAxis(record.columns, ColumnKind::kAccel, kRandomWalk), "  # m/s^2/sqrt(Hz)");
-      Scalar(yaml, "    ", "accelerometer_random_walk",
-             WorstAxis(record.columns, ColumnKind::kAccel, kRateRandomWalk), "  # m/s^3/sqrt(Hz)");
-    }
-    Scalar(yaml, "    ", "update_rate", 1.0 / record.sample_interval_s, "  # Hz");
+  if (fit.extra.IsMap()) {
+    for (const auto& entry : fit.extra) column.Add(entry.first.Scalar(), MachineDocOfYaml(entry.second));
   }
-  return yaml.str();
+  return column;
+}
+
+bool HasFitted(const NoiseRecord& record, ColumnKind kind) {
+  return std::any_of(record.columns.begin(), record.columns.end(),
+                     [&](const NoiseColumnRecord& c) { return c.kind == kind && c.fitted; });
+}
+
+// ---------------------------------------------------------------- reading
+
+double NumberOr(const yaml::Located& block, const char* key, double otherwise) {
+  return block.Has(key) ? block[key].Double() : otherwise;
+}
+
+std::string TextOr(const yaml::Located& block, const char* key) {
+  return block.Has(key) ? block[key].String() : std::string();
+}
+
+// Unknown keys of `block` into `extra` (a map, or left null).
+void KeepUnknown(const yaml::Located& block, const std::vector<std::string>& known, YAML::Node* extra) {
+  for (const auto& entry : block.node) {
+    if (std::find(known.begin(), known.end(), entry.first.Scalar()) != known.end()) continue;
+    if (!extra->IsMap()) *extra = YAML::Node(YAML::NodeType::Map);
+    extra->force_insert(entry.first, entry.second);
+  }
+}
+
+NoiseColumnRecord ReadNoiseColumn(const std::string& name, const yaml::Located& block) {
+  block.RequireMap();
+  NoiseColumnRecord column;
+  column.name = name;
+  std::vector<std::string> known = {"kind",   "unit", "fitted", "reason", "points_used", "reduced_chi_square",
+                                    "readout"};
+  if (block.Has("kind")) {
+    const std::string kind = block["kind"].String();
+    if (kind == ToString(ColumnKind::kGyro)) {
+      column.kind = ColumnKind::kGyro;
+    } else if (kind == ToString(ColumnKind::kAccel)) {
+      column.kind = ColumnKind::kAccel;
+    } else if (kind != ToString(ColumnKind::kOther)) {
+      block["kind"].Fail(QuoteForMessage(kind) + " is not a kind of column (gyro, accel, other)");
+    }
+  }
+  column.fitted = block.Has("fitted") && block["fitted"].Bool();
+  column.reason = TextOr(block, "reason");
+  if (block.Has("points_used")) {
+    const long points = block["points_used"].Integer();
+    if (points < 0 || points > std::numeric_limits<int>::max()) block["points_used"].Fail("out of range");
+    column.points_used = static_cast<int>(points);
+  }
+  column.reduced_chi_square = NumberOr(block, "reduced_chi_square", std::nan(""));
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    const NoiseTermUnits& units = UnitsOf(column.kind, k);
+    const std::string resolved_key = std::string(units.si_key) + "_resolved";
+    known.push_back(units.si_key);
+    known.push_back(resolved_key);
+    if (*units.engineer_key != '\0') known.push_back(units.engineer_key);  // derived from the SI pair
+    column.value[k] = column.sigma[k] = std::nan("");
+    if (block.Has(units.si_key)) {
+      const std::vector<double> pair = block[units.si_key].Doubles(2);
+      column.value[k] = pair[0];
+      column.sigma[k] = pair[1];
+    }
+    column.resolved[k] = !(block.Has(resolved_key) && !block[resolved_key].Bool());
+  }
+  if (block.Has("readout")) {
+    const yaml::Located readout = block["readout"];
+    readout.RequireMap();
+    const std::array<std::string, 4> keys = ReadoutKeys(column.kind);
+    readout.RejectUnknownKeys({keys[0].c_str(), keys[1].c_str(), keys[2].c_str(), keys[3].c_str()});
+    double* readouts[4] = {&column.readout_random_walk, &column.readout_bias_instability,
+                           &column.readout_bias_tau_s, &column.readout_rate_random_walk};
+    for (int i = 0; i < 4; ++i) *readouts[i] = NumberOr(readout, keys[i].c_str(), std::nan(""));
+  }
+  KeepUnknown(block, known, &column.extra);
+  return column;
+}
+
+}  // namespace
+
+MachineDoc NoiseDoc(const NoiseRecord& record) {
+  MachineDoc noise = MachineDoc::Map();
+  noise.Add("format", MachineDoc::Text("imufit-noise"));
+  noise.Add("version", MachineDoc::Integer(kNoiseFormatVersion));
+  if (!record.software.empty()) noise.Add("software", MachineDoc::Text(record.software));
+  if (!record.samples.empty()) noise.Add("samples", MachineDoc::Text(record.samples));
+  if (!record.calibration.empty()) {
+    noise.Add("calibration", MachineDoc::Text(record.calibration));
+    noise.Add("calibration_sha256", MachineDoc::Text(record.calibration_sha256));
+  }
+  AddFinite(&noise, "sample_interval_s", record.sample_interval_s);
+  if (record.sample_count > 0) noise.Add("sample_count", MachineDoc::Integer(record.sample_count));
+  AddFinite(&noise, "duration_s", record.duration_s);
+  noise.Add("model", MachineDoc::Text(kNoiseModel));
+  MachineDoc columns = MachineDoc::Map();
+  for (const NoiseColumnRecord& column : record.columns) columns.Add(column.name, NoiseColumnDoc(column));
+  if (!record.columns.empty()) noise.Add("columns", std::move(columns));
+  const KalibrNoiseRecord k = KalibrNoiseOf(record);
+  MachineDoc kalibr = MachineDoc::Map();
+  AddFinite(&kalibr, "gyroscope_noise_density", k.gyroscope_noise_density, "rad/s/sqrt(Hz)");
+  AddFinite(&kalibr, "gyroscope_random_walk", k.gyroscope_random_walk, "rad/s^2/sqrt(Hz)");
+  AddFinite(&kalibr, "accelerometer_noise_density", k.accelerometer_noise_density, "m/s^2/sqrt(Hz)");
+  AddFinite(&kalibr, "accelerometer_random_walk", k.accelerometer_random_walk, "m/s^3/sqrt(Hz)");
+  AddFinite(&kalibr, "update_rate", k.update_rate, "Hz");
+  if (!kalibr.items().empty()) {
+    noise.Add("kalibr", std::move(kalibr),
+              "imu.yaml continuous-time values, the worst axis of each sensor (a term the log\n"
+              "does not resolve: its upper bound, value + 2 sigma)");
+  }
+  if (record.extra.IsMap()) {
+    for (const auto& entry : record.extra) noise.Add(entry.first.Scalar(), MachineDocOfYaml(entry.second));
+  }
+  return noise;
+}
+
+NoiseRecord ReadNoiseRecord(const yaml::Located& block) {
+  block.RequireMap();
+  if (block.Has("format") && block["format"].String() != "imufit-noise") {
+    block["format"].Fail(QuoteForMessage(block["format"].String()) + " is not \"imufit-noise\"");
+  }
+  if (block.Has("version")) {
+    const long version = block["version"].Integer();
+    if (version < 1 || version > kNoiseFormatVersion) {
+      block["version"].Fail("version " + std::to_string(version) +
+                            " is not supported (this imufit reads version " +
+                            std::to_string(kNoiseFormatVersion) + ")");
+    }
+  }
+  NoiseRecord record;
+  record.software = TextOr(block, "software");
+  record.samples = TextOr(block, "samples");
+  record.calibration = TextOr(block, "calibration");
+  record.calibration_sha256 = TextOr(block, "calibration_sha256");
+  record.sample_interval_s = NumberOr(block, "sample_interval_s", std::nan(""));
+  if (block.Has("sample_count")) record.sample_count = block["sample_count"].Integer();
+  record.duration_s = NumberOr(block, "duration_s", std::nan(""));
+  if (block.Has("columns")) {
+    const yaml::Located columns = block["columns"];
+    columns.RequireMap();
+    for (const auto& entry : columns.node) {
+      const std::string name = entry.first.Scalar();
+      record.columns.push_back(ReadNoiseColumn(name, columns[name]));
+    }
+  }
+  if (block.Has("kalibr")) {
+    const yaml::Located kalibr = block["kalibr"];
+    kalibr.RejectUnknownKeys({"gyroscope_noise_density", "gyroscope_random_walk",
+                              "accelerometer_noise_density", "accelerometer_random_walk", "update_rate"});
+    KalibrNoiseRecord k;
+    k.gyroscope_noise_density = NumberOr(kalibr, "gyroscope_noise_density", std::nan(""));
+    k.gyroscope_random_walk = NumberOr(kalibr, "gyroscope_random_walk", std::nan(""));
+    k.accelerometer_noise_density = NumberOr(kalibr, "accelerometer_noise_density", std::nan(""));
+    k.accelerometer_random_walk = NumberOr(kalibr, "accelerometer_random_walk", std::nan(""));
+    k.update_rate = NumberOr(kalibr, "update_rate", std::nan(""));
+    record.kalibr = k;
+  }
+  KeepUnknown(block,
+              {"format", "version", "software", "samples", "calibration", "calibration_sha256",
+               "sample_interval_s", "sample_count", "duration_s", "model", "columns", "kalibr"},
+              &record.extra);
+  return record;
+}
+
+KalibrNoiseRecord KalibrNoiseOf(const NoiseRecord& record) {
+  if (record.kalibr) return *record.kalibr;
+  KalibrNoiseRecord k;
+  if (HasFitted(record, ColumnKind::kGyro)) {
+    k.gyroscope_noise_density = WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk);
+    k.gyroscope_random_walk = WorstAxis(record.columns, ColumnKind::kGyro, kRateRandomWalk);
+  }
+  if (HasFitted(record, ColumnKind::kAccel)) {
+    k.accelerometer_noise_density = WorstAxis(record.columns, ColumnKind::kAccel, kRandomWalk);
+    k.accelerometer_random_walk = WorstAxis(record.columns, ColumnKind::kAccel, kRateRandomWalk);
+  }
+  if (HasFitted(record, ColumnKind::kGyro) || HasFitted(record, ColumnKind::kAccel)) {
+    k.update_rate = 1.0 / record.sample_interval_s;
+  }
+  return k;
+}
+
+std::string NoiseYaml(const NoiseRecord& record) {
+  MachineDoc doc = MachineDoc::Map();
+  doc.Comment("Noise figures by imufit allan: the IEEE Std 952 model fitted to the overlapping Allan");
+  doc.Comment("variance. Every figure is [value, 1-sigma uncertainty]. Merge into a calibration by");
+  doc.Comment("appending this file: its only top-level key is `noise`.");
+  doc.Add("noise", NoiseDoc(record));
+  return YamlText(doc);
 }
 
 void WriteNoiseYaml(const std::string& path, const NoiseRecord& record, OutputTransaction* transaction) {
   WriteFileAtomically(path, NoiseYaml(record), transaction);
 }
 
-std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& extra, const std::string& column,
-                                                     const std::string& key) {
-  if (!extra || !extra.IsMap()) return std::nullopt;
-  try {
-    const YAML::Node node = extra["noise"]["columns"][column][key];
-    if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
-    return std::array<double, 2>{node[0].as<double>(), node[1].as<double>()};
-  } catch (const YAML::Exception&) {
-    return std::nullopt;
+NoiseRecord ReadNoiseFile(const std::string& path) {
+  const YAML::Node root = yaml::LoadFile(path);
+  const yaml::Located located{&path, root, ""};
+  if (!root.IsMap() || !located.Has("noise")) {
+    throw InputError(path, "no noise block: give the noise YAML of `imufit allan --noise-yaml`");
   }
+  return ReadNoiseRecord(located["noise"]);
+}
+
+std::optional<std::array<double, 2>> NoiseFigure(const std::optional<NoiseRecord>& noise,
+                                                 const std::string& column, const std::string& key) {
+  if (!noise) return std::nullopt;
+  for (const NoiseColumnRecord& c : noise->columns) {
+    if (c.name != column || !c.fitted) continue;
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      const NoiseTermUnits& units = UnitsOf(c.kind, k);
+      const double factor = key == units.si_key                                        ? 1.0
+                            : *units.engineer_key != '\0' && key == units.engineer_key ? units.engineer_per_si
+                                                                                       : 0.0;
+      if (factor == 0.0 || !std::isfinite(c.value[k]) || !std::isfinite(c.sigma[k])) continue;
+      return std::array<double, 2>{c.value[k] * factor, c.sigma[k] * factor};
+    }
+  }
+  return std::nullopt;
 }
 
 SensorNoiseFigures ReadSensorNoise(const std::string& path) {
-  const YAML::Node root = yaml::LoadFile(path);
-  const YAML::Node columns = root.IsMap() && root["noise"] ? root["noise"]["columns"] : YAML::Node();
-  if (!columns || !columns.IsMap()) {
+  const NoiseRecord record = ReadNoiseFile(path);
+  if (record.columns.empty()) {
     throw InputError(path, "no noise.columns: give the noise YAML of `imufit allan --noise-yaml`");
   }
   SensorNoiseFigures figures;
-  for (const auto& entry : columns) {
-    const YAML::Node kind = entry.second["kind"];
-    if (!kind || !kind.IsScalar()) continue;
-    const bool gyro = kind.Scalar() == ToString(ColumnKind::kGyro);
-    if (!gyro && kind.Scalar() != ToString(ColumnKind::kAccel)) continue;
-    const ColumnKind column_kind = gyro ? ColumnKind::kGyro : ColumnKind::kAccel;
-    const std::string column = entry.first.Scalar();
+  for (const NoiseColumnRecord& column : record.columns) {
+    if (column.kind == ColumnKind::kOther) continue;
+    const bool gyro = column.kind == ColumnKind::kGyro;
     double& density = gyro ? figures.gyro_noise_density : figures.accel_noise_density;
     double& instability = gyro ? figures.gyro_bias_instability : figures.accel_bias_instability;
-    if (const auto white = ReadNoiseFigure(root, column, UnitsOf(column_kind, kRandomWalk).si_key);
-        white && std::isfinite((*white)[0])) {
-      density = std::max(density, (*white)[0]);
-    }
-    if (const auto flicker = ReadNoiseFigure(root, column, UnitsOf(column_kind, kBiasInstability).si_key);
-        flicker && std::isfinite((*flicker)[0])) {
-      instability = std::max(instability, (*flicker)[0]);
-    }
+    const auto finite = [&](int term) {
+      return std::isfinite(column.value[term]) && std::isfinite(column.sigma[term]);
+    };
+    if (finite(kRandomWalk)) density = std::max(density, column.value[kRandomWalk]);
+    if (finite(kBiasInstability)) instability = std::max(instability, column.value[kBiasInstability]);
   }
   if (!(figures.gyro_noise_density > 0.0) || !(figures.accel_noise_density > 0.0)) {
     throw InputError(path, std::string("no fitted white noise of the ") +

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "imufit/io/error.h"
+#include "imufit/io/machine_text.h"
 #include "imufit/io/output_file.h"
 #include "imufit/model/constants.h"
 #include "yaml_util.h"
@@ -142,36 +143,37 @@ Plan ReadPlanText(const std::string& text, const std::string& name) {
 
 namespace {
 
-std::string VectorYaml(const Eigen::Vector3d& v) {
-  return "[" + FormatDouble(v.x()) + ", " + FormatDouble(v.y()) + ", " + FormatDouble(v.z()) + "]";
-}
+MachineDoc VectorDoc(const Eigen::Vector3d& v) { return MachineDoc::Numbers({v.x(), v.y(), v.z()}); }
 
 }  // namespace
 
 std::string PlanYaml(const Plan& plan, const std::string& comment) {
-  std::string out;
+  MachineDoc doc = MachineDoc::Map();
   size_t start = 0;
   while (!comment.empty() && start < comment.size()) {
     const size_t end = std::min(comment.find('\n', start), comment.size());
-    out += "# " + comment.substr(start, end - start) + "\n";
+    doc.Comment(comment.substr(start, end - start));
     start = end + 1;
   }
-  out += "format: imufit-plan\nversion: " + std::to_string(kPlanFormatVersion) + "\n";
-  out += "gravity_mps2: " + FormatDouble(plan.site.gravity_mps2) + "\n";
+  doc.Add("format", MachineDoc::Text("imufit-plan"));
+  doc.Add("version", MachineDoc::Integer(kPlanFormatVersion));
+  doc.Add("gravity_mps2", MachineDoc::Number(plan.site.gravity_mps2));
   if (plan.site.latitude_rad)
-    out += "latitude_deg: " + FormatDouble(*plan.site.latitude_rad / kDegToRad) + "\n";
-  if (!plan.serial.empty()) out += "serial: \"" + plan.serial + "\"\n";
-  out += "segments:\n";
+    doc.Add("latitude_deg", MachineDoc::Number(*plan.site.latitude_rad / kDegToRad));
+  if (!plan.serial.empty()) doc.Add("serial", MachineDoc::Text(plan.serial));
+  MachineDoc segments = MachineDoc::List(MachineDoc::Style::kBlock);
   for (const TableSegment& s : plan.segments) {
-    out += "  - {id: " + std::to_string(s.id) + ", up: " + VectorYaml(s.up);
-    if (s.rate_radps != 0.0) out += ", rate_dps: " + FormatDouble(s.rate_radps / kDegToRad);
-    if (s.angle_rad) out += ", angle_deg: " + FormatDouble(*s.angle_rad / kDegToRad);
-    if (s.axis) out += ", axis: " + VectorYaml(*s.axis);
-    if (s.north) out += ", north: " + VectorYaml(*s.north);
-    if (s.lever_arm_m) out += ", lever_arm_m: " + VectorYaml(*s.lever_arm_m);
-    out += "}\n";
+    MachineDoc segment = MachineDoc::Map(MachineDoc::Style::kFlow);
+    segment.Add("id", MachineDoc::Integer(s.id)).Add("up", VectorDoc(s.up));
+    if (s.rate_radps != 0.0) segment.Add("rate_dps", MachineDoc::Number(s.rate_radps / kDegToRad));
+    if (s.angle_rad) segment.Add("angle_deg", MachineDoc::Number(*s.angle_rad / kDegToRad));
+    if (s.axis) segment.Add("axis", VectorDoc(*s.axis));
+    if (s.north) segment.Add("north", VectorDoc(*s.north));
+    if (s.lever_arm_m) segment.Add("lever_arm_m", VectorDoc(*s.lever_arm_m));
+    segments.Push(std::move(segment));
   }
-  return out;
+  doc.Add("segments", std::move(segments));
+  return YamlText(doc);
 }
 
 }  // namespace imufit

@@ -26,8 +26,10 @@ std::string TimeOfDay(const std::string& time) {
     if (!rest.empty() && (rest[0] != '.' || rest.size() == 1 || !AllDigits(rest, 1, rest.size() - 1)))
       return "";
   }
-  if (std::stoi(time.substr(0, 2)) > 23 || std::stoi(time.substr(3, 2)) > 59 || std::stoi(seconds) > 60)
-    return "";
+  const int hour = std::stoi(time.substr(0, 2)), minute = std::stoi(time.substr(3, 2));
+  const int second = std::stoi(seconds);
+  // A leap second is 23:59:60 UTC; any other :60 is not a time (PyYAML refuses it in a timestamp).
+  if (hour > 23 || minute > 59 || second > 60 || (second == 60 && (hour != 23 || minute != 59))) return "";
   return time.substr(0, 5) + ":" + seconds;
 }
 

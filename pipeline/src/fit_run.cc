@@ -6,6 +6,7 @@
 #include <set>
 
 #include "imufit/base/text.h"
+#include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 #include "imufit/pipeline/consistency.h"
@@ -17,6 +18,81 @@ namespace imufit {
 namespace {
 
 // The calibration's `fit:` block (io/fit_record.h), without the files' hashes.
+// ---------------------------------------------------------------- the fit options of the record
+
+// The FitOptions members a calibration's `fit:` record states, each described once: how RecordOf()
+// writes it and how FitOptionsOfRecord() reads it back (nullptr: written only, see there).
+struct RecordedOption {
+  const char* key;  // the record's member (fit_record.h)
+  void (*write)(const FitOptions& options, FitRecord* record);
+  void (*read)(const FitRecord& record, FitOptions* options);
+};
+
+// The groups the record names as fitted, as the sensors' SensorFit and the g-sensitivity: the one
+// combination whose Groups(true) they are. Throws InputError for any other set of names.
+void ReadFittedGroups(const FitRecord& record, FitOptions* options) {
+  if (!record.fitted) return;
+  std::vector<std::string> named = *record.fitted;
+  std::sort(named.begin(), named.end());
+  for (const SensorFit gyro : {SensorFit::kAll, SensorFit::kBias, SensorFit::kNone}) {
+    for (const SensorFit accel : {SensorFit::kAll, SensorFit::kBias, SensorFit::kNone}) {
+      for (const bool g_sensitivity : {true, false}) {
+        FitOptions candidate = *options;
+        candidate.gyro_fit = gyro;
+        candidate.accel_fit = accel;
+        if (gyro == SensorFit::kAll) candidate.fit_g_sensitivity = g_sensitivity;
+        std::vector<std::string> groups = candidate.Groups(true);
+        std::sort(groups.begin(), groups.end());
+        if (groups != named) continue;
+        *options = candidate;
+        return;
+      }
+    }
+  }
+  throw InputError("fit.fitted",
+                   "[" + Join(*record.fitted, ", ") +
+                       "] is not a set of groups a fit estimates (what imufit fit --fit names)");
+}
+
+const RecordedOption kRecordedOptions[] = {
+    {"gyro_temp_order", [](const FitOptions& o, FitRecord* r) { r->gyro_temp_order = o.gyro_temp_order; },
+     [](const FitRecord& r, FitOptions* o) {
+       o->gyro_temp_order = r.gyro_temp_order.value_or(o->gyro_temp_order);
+     }},
+    {"accel_temp_order", [](const FitOptions& o, FitRecord* r) { r->accel_temp_order = o.accel_temp_order; },
+     [](const FitRecord& r, FitOptions* o) {
+       o->accel_temp_order = r.accel_temp_order.value_or(o->accel_temp_order);
+     }},
+    {"g_sensitivity_fitted",
+     [](const FitOptions& o, FitRecord* r) {
+       r->g_sensitivity_fitted = o.Fits(true, kGSensitivityCoefficient);
+     },
+     [](const FitRecord& r, FitOptions* o) { o->fit_g_sensitivity = r.g_sensitivity_fitted.value_or(true); }},
+    // What the fit estimated; the held groups keep their stated values (a prior calibration's, or
+    // scale 1 and 0 otherwise) and a sigma of 0.
+    {"fitted",
+     [](const FitOptions& o, FitRecord* r) {
+       r->fitted = o.Groups(true);
+       r->held = o.Groups(false);
+       if (!r->held->empty()) r->held_values = o.held ? "prior" : "scale 1, others 0";
+     },
+     ReadFittedGroups},
+    {"loss", [](const FitOptions& o, FitRecord* r) { r->loss = RobustLossName(o.loss); },
+     [](const FitRecord& r, FitOptions* o) {
+       std::string error;
+       if (r.loss && !ParseRobustLoss(*r.loss, &o->loss, &error)) throw InputError("fit.loss", error);
+     }},
+    // Written only: the fit a record describes weights white noise alone (FitOptionsOfRecord).
+    {"gyro_bias_stability_radps",
+     [](const FitOptions& o, FitRecord* r) { r->gyro_bias_stability_radps = o.gyro_bias_stability_radps; },
+     nullptr},
+    {"accel_bias_stability_mps2",
+     [](const FitOptions& o, FitRecord* r) { r->accel_bias_stability_mps2 = o.accel_bias_stability_mps2; },
+     nullptr},
+    {"bias_correlation_s",
+     [](const FitOptions& o, FitRecord* r) { r->bias_correlation_s = o.bias_correlation_s; }, nullptr},
+};
+
 FitRecord RecordOf(const FitRunResult& result, const std::string& plan_path, const std::string& samples_path,
                    const FitOptions& options) {
   const FitSummary& fit = result.fit;
@@ -37,18 +113,7 @@ FitRecord RecordOf(const FitRunResult& result, const std::string& plan_path, con
   record.accel_residual_rms_mps2 = fit.accel_rms_mps2;
   record.gyro_reduced_chi2 = fit.gyro_reduced_chi2;
   record.accel_reduced_chi2 = fit.accel_reduced_chi2;
-  record.gyro_temp_order = options.gyro_temp_order;
-  record.accel_temp_order = options.accel_temp_order;
-  record.g_sensitivity_fitted = options.Fits(true, kGSensitivityCoefficient);
-  // What the fit estimated; the held groups keep their stated values (a prior calibration's, or
-  // scale 1 and 0 otherwise) and a sigma of 0.
-  record.fitted = options.Groups(true);
-  record.held = options.Groups(false);
-  if (!record.held->empty()) record.held_values = options.held ? "prior" : "scale 1, others 0";
-  record.loss = RobustLossName(options.loss);
-  record.gyro_bias_stability_radps = options.gyro_bias_stability_radps;
-  record.accel_bias_stability_mps2 = options.accel_bias_stability_mps2;
-  record.bias_correlation_s = options.bias_correlation_s;
+  for (const RecordedOption& option : kRecordedOptions) option.write(options, &record);
   // Plan segments without a single usable window (never visited, or every visit too short).
   std::set<int> visited;
   for (const Window& w : result.run.windows) visited.insert(w.segment);
@@ -228,23 +293,8 @@ std::string UndeterminedMessage(const std::string& samples, const FitRunOptions&
 
 FitOptions FitOptionsOfRecord(const FitRecord& record) {
   FitOptions options;
-  options.gyro_temp_order = record.gyro_temp_order.value_or(options.gyro_temp_order);
-  options.accel_temp_order = record.accel_temp_order.value_or(options.accel_temp_order);
-  options.fit_g_sensitivity = record.g_sensitivity_fitted.value_or(true);
-  if (record.loss) {
-    std::string error;
-    ParseRobustLoss(*record.loss, &options.loss, &error);
-  }
-  if (record.fitted) {
-    const auto has = [&](const char* group) {
-      return std::find(record.fitted->begin(), record.fitted->end(), group) != record.fitted->end();
-    };
-    options.gyro_fit = has("gyro.scale")  ? SensorFit::kAll
-                       : has("gyro.bias") ? SensorFit::kBias
-                                          : SensorFit::kNone;
-    options.accel_fit = has("accel.scale")  ? SensorFit::kAll
-                        : has("accel.bias") ? SensorFit::kBias
-                                            : SensorFit::kNone;
+  for (const RecordedOption& option : kRecordedOptions) {
+    if (option.read != nullptr) option.read(record, &options);
   }
   return options;
 }

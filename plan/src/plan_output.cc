@@ -1,4 +1,5 @@
-// `imufit plan check`'s outputs (plan_check.h): a table for people, YAML or JSON for machines.
+// `imufit plan check`'s outputs (plan_check.h): a table for people, YAML or JSON for machines (one
+// document, written by io's writer of machine-readable text: machine_text.h).
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -6,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "imufit/io/machine_text.h"
 #include "imufit/model/check.h"
 #include "imufit/plan/plan_check.h"
 #include "imufit/plan/plan_design.h"
@@ -29,174 +31,70 @@ std::string Ids(const std::vector<int>& ids) {
   return text.empty() ? "none" : text;
 }
 
-// The machines' document, built once and written as YAML or as JSON, so that both say the same.
-struct Doc {
-  enum class Kind { kNumber, kBool, kText, kList, kMap } kind = Kind::kMap;
-  double number = 0.0;
-  bool flag = false;
-  std::string text;
-  std::vector<Doc> list;
-  std::vector<std::pair<std::string, Doc>> map;
-
-  static Doc Number(double value) {
-    IMUFIT_CHECK(std::isfinite(value), "a plan check figure is finite");
-    Doc d;
-    d.kind = Kind::kNumber;
-    d.number = value;
-    return d;
-  }
-  static Doc Bool(bool value) {
-    Doc d;
-    d.kind = Kind::kBool;
-    d.flag = value;
-    return d;
-  }
-  static Doc Text(std::string value) {
-    Doc d;
-    d.kind = Kind::kText;
-    d.text = std::move(value);
-    return d;
-  }
-  static Doc List() {
-    Doc d;
-    d.kind = Kind::kList;
-    return d;
-  }
-  static Doc Numbers(const std::vector<double>& values) {
-    Doc d = List();
-    for (double v : values) d.list.push_back(Number(v));
-    return d;
-  }
-  static Doc Texts(const std::vector<std::string>& values) {
-    Doc d = List();
-    for (const std::string& v : values) d.list.push_back(Text(v));
-    return d;
-  }
-  Doc& Add(const std::string& key, Doc value) {
-    map.emplace_back(key, std::move(value));
-    return *this;
-  }
-};
-
-// A string quoted for YAML's double-quoted style and JSON alike (both read \" \\ \uXXXX).
-std::string Quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += Format("\\u%04x", static_cast<unsigned>(c));
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
+// A figure of the machines' document (finite: nothing non-finite is written).
+MachineDoc Figure(double value) {
+  IMUFIT_CHECK(std::isfinite(value), "a plan check figure is finite");
+  return MachineDoc::Number(value);
 }
 
-// One line of flow style: {a: 1, b: "x"} in YAML, {"a": 1, "b": "x"} in JSON.
-std::string Flow(const Doc& d, bool json) {
-  switch (d.kind) {
-    case Doc::Kind::kNumber:
-      return Format("%.9g", d.number);
-    case Doc::Kind::kBool:
-      return d.flag ? "true" : "false";
-    case Doc::Kind::kText:
-      return Quoted(d.text);
-    case Doc::Kind::kList: {
-      std::string out;
-      for (const Doc& e : d.list) out += (out.empty() ? "" : ", ") + Flow(e, json);
-      return "[" + out + "]";
-    }
-    case Doc::Kind::kMap:
-      break;
-  }
-  std::string out;
-  for (const auto& [key, value] : d.map) {
-    out += (out.empty() ? "" : ", ") + (json ? Quoted(key) : key) + ": " + Flow(value, json);
-  }
-  return "{" + out + "}";
+MachineDoc Figures(const std::vector<double>& values) {
+  MachineDoc list = MachineDoc::List();
+  for (const double value : values) list.Push(Figure(value));
+  return list;
 }
 
-// A list of maps or texts one element a line; everything else on the key's line.
-bool OneALine(const Doc& d) {
-  return d.kind == Doc::Kind::kList && !d.list.empty() && d.list.front().kind != Doc::Kind::kNumber;
+// Texts and records one a line.
+MachineDoc Lines(const std::vector<std::string>& values) {
+  return MachineDoc::Texts(values, MachineDoc::Style::kBlock);
 }
 
-std::string YamlOf(const Doc& top) {
-  std::string out;
-  for (const auto& [key, value] : top.map) {
-    if (!OneALine(value)) {
-      out += key + ": " + Flow(value, false) + "\n";
-      continue;
-    }
-    out += key + ":\n";
-    for (const Doc& e : value.list) out += "  - " + Flow(e, false) + "\n";
-  }
-  return out;
-}
-
-std::string JsonOf(const Doc& top) {
-  std::string out = "{";
-  for (size_t i = 0; i < top.map.size(); ++i) {
-    const auto& [key, value] = top.map[i];
-    out += std::string(i == 0 ? "\n" : ",\n") + "  " + Quoted(key) + ": ";
-    if (!OneALine(value)) {
-      out += Flow(value, true);
-      continue;
-    }
-    out += "[";
-    for (size_t j = 0; j < value.list.size(); ++j) {
-      out += std::string(j == 0 ? "\n" : ",\n") + "    " + Flow(value.list[j], true);
-    }
-    out += "\n  ]";
-  }
-  return out + "\n}\n";
-}
-
-Doc PlanCheckDoc(const PlanCheck& check) {
-  Doc doc;
-  doc.Add("format", Doc::Text("imufit-plan-check")).Add("version", Doc::Number(1));
-  doc.Add("undetermined", Doc::Texts(check.undetermined));
+MachineDoc PlanCheckDoc(const PlanCheck& check) {
+  MachineDoc doc = MachineDoc::Map();
+  doc.Add("format", MachineDoc::Text("imufit-plan-check")).Add("version", MachineDoc::Integer(1));
+  doc.Add("undetermined", Lines(check.undetermined));
   if (!check.undetermined.empty()) return doc;
-  doc.Add("plan_hours", Doc::Number(check.plan_hours)).Add("needed_hours", Doc::Number(check.needed_hours));
-  doc.Add("plan_range_c", Doc::Numbers({check.plan_range_c[0], check.plan_range_c[1]}));
-  doc.Add("extrapolation_factor", Doc::Number(check.extrapolation_factor));
-  doc.Add("tolerance_unmet", Doc::Bool(check.tolerance_unmet));
-  doc.Add("temperature_efficiency", Doc::Number(check.temperature_efficiency));
-  doc.Add("best_soaks_c", Doc::Numbers({check.best_soaks_c.begin(), check.best_soaks_c.end()}));
-  Doc rows = Doc::List();
+  doc.Add("plan_hours", Figure(check.plan_hours)).Add("needed_hours", Figure(check.needed_hours));
+  doc.Add("plan_range_c", Figures({check.plan_range_c[0], check.plan_range_c[1]}));
+  doc.Add("extrapolation_factor", Figure(check.extrapolation_factor));
+  doc.Add("tolerance_unmet", MachineDoc::Bool(check.tolerance_unmet));
+  doc.Add("temperature_efficiency", Figure(check.temperature_efficiency));
+  doc.Add("best_soaks_c", Figures({check.best_soaks_c.begin(), check.best_soaks_c.end()}));
+  MachineDoc rows = MachineDoc::List(MachineDoc::Style::kBlock);
   for (const PlanRow& r : check.rows) {
-    Doc row;
-    row.Add("name", Doc::Text(r.name)).Add("unit", Doc::Text(r.unit)).Add("sigma", Doc::Number(r.sigma));
-    row.Add("sigma_range", Doc::Number(r.sigma_range)).Add("sigma_spec", Doc::Number(r.sigma_spec));
-    row.Add("tolerance", Doc::Number(r.tolerance)).Add("ratio", Doc::Number(r.ratio));
-    row.Add("white_share", Doc::Number(r.white_share));
-    rows.list.push_back(row);
+    MachineDoc row = MachineDoc::Map(MachineDoc::Style::kFlow);
+    row.Add("name", MachineDoc::Text(r.name))
+        .Add("unit", MachineDoc::Text(r.unit))
+        .Add("sigma", Figure(r.sigma));
+    row.Add("sigma_range", Figure(r.sigma_range)).Add("sigma_spec", Figure(r.sigma_spec));
+    row.Add("tolerance", Figure(r.tolerance)).Add("ratio", Figure(r.ratio));
+    row.Add("white_share", Figure(r.white_share));
+    rows.Push(std::move(row));
   }
   doc.Add("rows", rows);
-  doc.Add("weak", Doc::Texts(check.weak));
-  Doc pairs = Doc::List();
+  doc.Add("weak", Lines(check.weak));
+  MachineDoc pairs = MachineDoc::List(MachineDoc::Style::kBlock);
   for (const PlanCheck::Pair& p : check.correlated) {
-    Doc pair;
-    pair.Add("a", Doc::Text(p.a)).Add("b", Doc::Text(p.b)).Add("correlation", Doc::Number(p.correlation));
-    pairs.list.push_back(pair);
+    MachineDoc pair = MachineDoc::Map(MachineDoc::Style::kFlow);
+    pair.Add("a", MachineDoc::Text(p.a))
+        .Add("b", MachineDoc::Text(p.b))
+        .Add("correlation", Figure(p.correlation));
+    pairs.Push(std::move(pair));
   }
   doc.Add("correlated", pairs);
-  Doc segments = Doc::List();
+  MachineDoc segments = MachineDoc::List(MachineDoc::Style::kBlock);
   for (const PlanSegmentEffect& e : check.segments) {
     // An essential segment's losses are infinite: written as -1 (nothing non-finite is written).
     const bool essential = !std::isfinite(e.worst_loss);
-    Doc segment;
-    segment.Add("id", Doc::Number(e.segment)).Add("essential", Doc::Bool(essential));
-    segment.Add("limiting_loss", Doc::Number(std::isfinite(e.limiting_loss) ? e.limiting_loss : -1.0));
-    segment.Add("worst_loss", Doc::Number(essential ? -1.0 : e.worst_loss));
-    segments.list.push_back(segment);
+    MachineDoc segment = MachineDoc::Map(MachineDoc::Style::kFlow);
+    segment.Add("id", MachineDoc::Integer(e.segment)).Add("essential", MachineDoc::Bool(essential));
+    segment.Add("limiting_loss", Figure(std::isfinite(e.limiting_loss) ? e.limiting_loss : -1.0));
+    segment.Add("worst_loss", Figure(essential ? -1.0 : e.worst_loss));
+    segments.Push(std::move(segment));
   }
   doc.Add("segments", segments);
-  doc.Add("carriers", Doc::Numbers({check.carriers.begin(), check.carriers.end()}));
-  doc.Add("cuttable", Doc::Numbers({check.cuttable.begin(), check.cuttable.end()}));
-  doc.Add("warnings", Doc::Texts(check.warnings));
+  doc.Add("carriers", MachineDoc::Integers(check.carriers));
+  doc.Add("cuttable", MachineDoc::Integers(check.cuttable));
+  doc.Add("warnings", Lines(check.warnings));
   return doc;
 }
 
@@ -266,8 +164,8 @@ std::string PlanDesignText(const PlanDesign& design, const PlanDesignOptions& op
   return out;
 }
 
-std::string PlanCheckYaml(const PlanCheck& check) { return YamlOf(PlanCheckDoc(check)); }
+std::string PlanCheckYaml(const PlanCheck& check) { return YamlText(PlanCheckDoc(check)); }
 
-std::string PlanCheckJson(const PlanCheck& check) { return JsonOf(PlanCheckDoc(check)); }
+std::string PlanCheckJson(const PlanCheck& check) { return JsonText(PlanCheckDoc(check)); }
 
 }  // namespace imufit

@@ -154,8 +154,8 @@ class FitResult:
     sigma: dict[str, dict[str, FloatArray]]  # 1-sigma, layout of Calibration.gyro / .accel
     diagnostics: dict[str, Any]
     """termination, iterations, initial_cost, final_cost, windows_used, windows_downweighted,
-    distinct_temps_c (degC), temp_range_c, gyro_residual_rms_radps, accel_residual_rms_mps2,
-    gyro_reduced_chi2, accel_reduced_chi2, samples, transition_samples, trimmed_samples,
+    distinct_temperatures_c (degC), temp_range_c, gyro_residual_rms_radps, accel_residual_rms_mps2,
+    gyro_reduced_chi2, accel_reduced_chi2, samples_read, transition_samples, trimmed_samples,
     short_windows, lost_samples, gaps, longest_gap_s (s), off_grid_samples, turns_dropped_for_gaps,
     turns_off_grid, time_stamp_note (what the time stamps showed, as `imufit fit` prints it),
     saturated_windows, saturation_note,

@@ -49,13 +49,13 @@ py::dict Diagnostics(const FitRunResult& result) {
   d["final_cost"] = fit.final_cost;
   d["windows_used"] = *record.windows_used;
   d["windows_downweighted"] = *record.windows_downweighted;
-  d["distinct_temps_c"] = ToArray(*record.distinct_temperatures_c);
+  d["distinct_temperatures_c"] = ToArray(*record.distinct_temperatures_c);
   d["temp_range_c"] = py::make_tuple(fit.temp_range_c[0], fit.temp_range_c[1]);
   d["gyro_residual_rms_radps"] = *record.gyro_residual_rms_radps;
   d["accel_residual_rms_mps2"] = *record.accel_residual_rms_mps2;
   d["gyro_reduced_chi2"] = *record.gyro_reduced_chi2;
   d["accel_reduced_chi2"] = *record.accel_reduced_chi2;
-  d["samples"] = *record.samples_read;
+  d["samples_read"] = *record.samples_read;
   d["transition_samples"] = stats.transition_samples;
   d["trimmed_samples"] = stats.trimmed_samples;
   d["short_windows"] = stats.short_windows;

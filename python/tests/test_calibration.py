@@ -144,9 +144,9 @@ def test_the_fit_record_is_typed_and_the_stub_names_every_key(fixtures, tmp_path
     path = tmp_path / "cal.yaml"
     result.calibration.save(path)
     record = imufit.Calibration.load(path).fit
-    assert record.samples_read == result.diagnostics["samples"] == 26950
+    assert record.samples_read == result.diagnostics["samples_read"] == 26950
     assert record.windows_used == result.diagnostics["windows_used"]
-    assert record.distinct_temperatures_c == result.diagnostics["distinct_temps_c"].tolist()
+    assert record.distinct_temperatures_c == result.diagnostics["distinct_temperatures_c"].tolist()
     assert record.termination == result.diagnostics["termination"]
     assert record.g_sensitivity_fitted is True and record.held == [] and record.held_values is None
     assert len(record.samples_sha256) == 64 and record.missing_segments == 0

@@ -42,7 +42,7 @@ def test_fit_matches_imufit_fit(fixtures, tmp_path, run_imufit):
     d = result.diagnostics
     assert d["termination"] and d["iterations"] > 0
     assert d["windows_used"] == len(d["residuals"]["window"]) > 0
-    assert d["samples"] == 26950
+    assert d["samples_read"] == 26950
     assert d["residuals"]["gyro_radps"].shape == (d["windows_used"], 3)
     assert "converged" in d["brief_report"]
 

@@ -28,7 +28,7 @@ def test_arrays_are_fitted_without_a_file(fixtures, tmp_path, run, monkeypatch):
     cal = result.calibration
     # The same doubles through the same reader: the file's calibration.
     assert_parameters_close({"gyro": cal.gyro, "accel": cal.accel}, {"gyro": from_file.gyro, "accel": from_file.accel})
-    assert result.diagnostics["samples"] == len(run["time_s"])
+    assert result.diagnostics["samples_read"] == len(run["time_s"])
     assert cal.fit.samples == "imufit.fit samples"
     assert len(cal.fit.samples_sha256) == 64
     # Unlabelled arrays are segmented in memory, as the file is.

@@ -39,18 +39,14 @@
 #include <vector>
 
 #include "imufit/base/option_table.h"
+#include "imufit/base/robust_loss.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 #include "imufit/run/windows.h"
 
 namespace imufit {
 
-enum class RobustLoss { kNone, kHuber, kCauchy };
-
-// "none", "huber", "cauchy".
-std::string RobustLossName(RobustLoss loss);
-// Parses a name; on failure returns false and sets `error` to a message listing the names.
-bool ParseRobustLoss(const std::string& name, RobustLoss* loss, std::string* error);
+// RobustLoss, its names and parser: imufit/base/robust_loss.h.
 
 // How much of one sensor's model a fit estimates; the rest is held (FitOptions::held).
 enum class SensorFit {

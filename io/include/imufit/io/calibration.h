@@ -3,7 +3,9 @@
 // Coefficients are written as lists c0..c3 of powers of dT = T - 25 degC, each number in its
 // shortest round-trip form, so write -> read gives back the same doubles (==). An optional
 // `sigma` tree mirrors the coefficients with their 1-sigma uncertainties; the optional `fit:` and
-// `check:` blocks are the fit's typed record (fit_record.h). Keys the reader does not know are
+// `check:` blocks are the fit's typed record (fit_record.h), the optional `noise:` block the
+// unit's noise record (noise_file.h). Written through the one writer of machine-readable text
+// (machine_text.h). Keys the reader does not know are
 // kept in `extra` (and written back); a `format` other than imufit-calibration or a version above
 // kCalibrationFormatVersion is refused.
 #ifndef IMUFIT_IO_CALIBRATION_H_
@@ -16,6 +18,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "imufit/io/fit_record.h"
+#include "imufit/io/machine_text.h"
+#include "imufit/io/noise_file.h"
 #include "imufit/io/output_file.h"
 #include "imufit/model/sensor_model.h"
 
@@ -36,17 +40,19 @@ struct Calibration {
   // What the fit did and on which files (`fit:`), and its errors on a held-out run (`check:`).
   std::optional<FitRecord> fit;
   std::optional<CheckRecord> check;
-  // Further top-level keys (noise figures, ...): a YAML map, written after the fit's record; on
-  // reading, every key this reader does not know. Holds no `fit` or `check` key.
+  // The unit's noise figures (`noise:`, appended from `imufit allan --noise-yaml`: noise_file.h).
+  std::optional<NoiseRecord> noise;
+  // Further top-level keys: a YAML map, written after the records; on reading, every key this
+  // reader does not know. Holds no `fit`, `check` or `noise` key.
   YAML::Node extra;
 };
 
 Calibration ReadCalibration(const std::string& path);
 // The file's text; `calibration.model.basis.half_range_c` must be 1.
 std::string CalibrationToYaml(const Calibration& calibration);
-// The file's tree, as CalibrationToYaml() writes it, with `extra`'s keys as they were read (a quoted
-// "12" stays a string): what an exporter writes in another syntax (JSON).
-YAML::Node CalibrationTree(const Calibration& calibration);
+// The file as a document (machine_text.h), as CalibrationToYaml() writes it, with `extra`'s keys
+// as they were read (a quoted "12" stays a string): what an exporter writes as JSON.
+MachineDoc CalibrationDoc(const Calibration& calibration);
 // Writes atomically (OutputFile), in `transaction` when not null.
 void WriteCalibration(const std::string& path, const Calibration& calibration,
                       OutputTransaction* transaction = nullptr);

@@ -10,7 +10,8 @@
 //              read-outs; then Kalibr's continuous-time densities (the worst axis of each sensor).
 //
 // io owns the format: the records below are plain, and the caller fills them from its analysis
-// (app/allan_command.cc from noise/column_analysis.h), so io does not depend on noise.
+// (app/allan_command.cc from noise/column_analysis.h), so io does not depend on noise. Written
+// through the one writer of machine-readable text (machine_text.h).
 #ifndef IMUFIT_IO_NOISE_FILE_H_
 #define IMUFIT_IO_NOISE_FILE_H_
 
@@ -64,19 +65,35 @@ struct NoiseColumnRecord {
   bool fitted = false;
   std::string reason;  // why not fitted
   int points_used = 0;
-  double reduced_chi_square = std::nan("");
-  // Each term's value and 1-sigma, and whether the fit resolved it from zero.
+  double reduced_chi_square = std::nan("");  // not written when not finite
+  // Each term's value and 1-sigma (a pair not written unless both are finite), and whether the fit
+  // resolved it from zero.
   std::array<double, kNoiseTerms> value = {0, 0, 0, 0, 0};
   std::array<double, kNoiseTerms> sigma = {0, 0, 0, 0, 0};
   std::array<bool, kNoiseTerms> resolved = {false, false, false, false, false};
-  // The graphical read-outs of the measured curve (nan when it has no such region).
+  // The graphical read-outs of the measured curve, in the units the file writes them: engineer
+  // units (UnitsOf(kind, term).engineer_key) where the kind has them, else SI; the SI value times
+  // engineer_per_si. nan when the curve has no such region (then not written).
   double readout_random_walk = std::nan("");
   double readout_bias_instability = std::nan("");
   double readout_bias_tau_s = std::nan("");
   double readout_rate_random_walk = std::nan("");
+  YAML::Node extra;  // keys of the column this reader does not know (a map, or null)
 };
 
-// The noise block: what it says about the record the columns came from, and the columns.
+// Kalibr's imu.yaml continuous-time figures (nan: unknown, not written).
+struct KalibrNoiseRecord {
+  double gyroscope_noise_density = std::nan("");      // rad/s/sqrt(Hz)
+  double gyroscope_random_walk = std::nan("");        // rad/s^2/sqrt(Hz)
+  double accelerometer_noise_density = std::nan("");  // m/s^2/sqrt(Hz)
+  double accelerometer_random_walk = std::nan("");    // m/s^3/sqrt(Hz)
+  double update_rate = std::nan("");                  // Hz
+};
+
+// The noise block: what it says about the record the columns came from, and the columns. Written
+// and read by io (NoiseYaml, ReadNoiseFile, and a calibration's `noise:` key, Calibration::noise);
+// everyone else holds this struct. A member a file does not state reads as its default here (text
+// empty, numbers nan, sample_count 0) and is then not written.
 struct NoiseRecord {
   std::string software;
   std::string samples;
@@ -85,21 +102,31 @@ struct NoiseRecord {
   // to tell which correction. Both "" (and not written) for samples analysed as they are.
   std::string calibration;
   std::string calibration_sha256;
-  double sample_interval_s = 0.0;
+  double sample_interval_s = std::nan("");
   long long sample_count = 0;
-  double duration_s = 0.0;
+  double duration_s = std::nan("");
   std::vector<NoiseColumnRecord> columns;
+  // Kalibr's figures as a file states them; when not set, KalibrNoiseOf() derives them from the
+  // columns (what `imufit allan` writes).
+  std::optional<KalibrNoiseRecord> kalibr;
+  YAML::Node extra;  // keys of the block this reader does not know (a map, or null)
 };
-// The text of the noise block (top-level key `noise:`).
+// The block's Kalibr figures: `record.kalibr` when set, else the worst fitted axis of each sensor
+// (an unresolved term: its upper bound, value + 2 sigma) and 1 / sample_interval_s.
+KalibrNoiseRecord KalibrNoiseOf(const NoiseRecord& record);
+// The text of the noise block (top-level key `noise:`), with a comment saying what it is.
 std::string NoiseYaml(const NoiseRecord& record);
 // Writes it atomically, in `transaction` when not null.
 void WriteNoiseYaml(const std::string& path, const NoiseRecord& record,
                     OutputTransaction* transaction = nullptr);
+// Reads the `noise:` block of a file `imufit allan --noise-yaml` wrote (alone, or appended to a
+// calibration). Throws InputError naming the file, and the key where a value has the wrong type.
+NoiseRecord ReadNoiseFile(const std::string& path);
 
-// [value, 1-sigma] of noise.columns.<column>.<key> in a calibration's further keys (Calibration::
-// extra), when there and a pair of numbers.
-std::optional<std::array<double, 2>> ReadNoiseFigure(const YAML::Node& calibration_extra,
-                                                     const std::string& column, const std::string& key);
+// [value, 1-sigma] of a fitted column's term, in the units of `key` (any term's SI key or engineer
+// key of UnitsOf(column's kind, term)), when `noise` has that column and the pair is finite.
+std::optional<std::array<double, 2>> NoiseFigure(const std::optional<NoiseRecord>& noise,
+                                                 const std::string& column, const std::string& key);
 
 // What a noise file says about each sensor, for a plan judged with the unit's measured noise
 // (`imufit plan check --noise-yaml`): the worst axis of the fitted columns of each kind, SI.

@@ -112,8 +112,11 @@ FitRunResult FitRun(Plan plan, std::string plan_sha256, const std::string& sampl
                     const FitRunOptions& options);
 
 // The fit a calibration's `fit:` record describes, as FitRun records it: the temperature orders,
-// the groups fitted (the rest held) and the robust loss. Everything else, the weighting by bias
-// stability included, is FitOptions' default.
+// the groups fitted (the rest held) and the robust loss, read back by the one table that writes
+// them (fit_run.cc). Everything else, the weighting by bias stability included, is FitOptions'
+// default. Throws InputError, located at the record's key (fit.fitted, fit.loss), for a set of
+// groups no fit estimates or a loss no fit knows (ReadCalibration refuses an unknown group or loss
+// name already, at its line and column).
 FitOptions FitOptionsOfRecord(const FitRecord& record);
 
 // Why a run does not determine the model, as one line (the CLI's error, Python's exception):
