@@ -1,26 +1,24 @@
 #include "imufit/io/limits.h"
 
-#include <sstream>
-
 #include "imufit/io/error.h"
 #include "yaml_util.h"
 
 namespace imufit {
-namespace {
 
-std::vector<std::string> Words(const char* text) {
-  std::istringstream stream(text);
-  std::vector<std::string> words;
-  for (std::string word; stream >> word;) words.push_back(word);
-  return words;
+const KeyFigure* FindLimitQuantity(const std::string& quantity) {
+  const KeyFigure* figure = FindKeyFigure(quantity);
+  return figure != nullptr && figure->in_limits && quantity == figure->name ? figure : nullptr;
 }
 
-const LimitQuantity* FindQuantity(const std::string& name) {
-  for (const LimitQuantity& q : kLimitQuantities) {
-    if (name == q.name) return &q;
+std::string LimitQuantityNames() {
+  std::string names;
+  for (const KeyFigure& figure : kKeyFigures) {
+    if (figure.in_limits) names += (names.empty() ? "" : ", ") + std::string(figure.name);
   }
-  return nullptr;
+  return names;
 }
+
+namespace {
 
 double PositiveNumber(const yaml::Located& value) {
   const double number = value.Double();
@@ -35,8 +33,7 @@ void ReadStatistic(const yaml::Located& entry, LimitCriterion* criterion) {
     const std::string text = statistic.String();
     const bool coefficient = criterion->kind == LimitKind::kCoefficient;
     // The noise figures are measured at one temperature: they have no curve to take a range of.
-    const bool has_curve = coefficient && criterion->quantity.find("_arw_") == std::string::npos &&
-                           criterion->quantity.find("_bias_instability_") == std::string::npos;
+    const bool has_curve = HasTemperatureCurve(*FindLimitQuantity(criterion->quantity));
     if (text == "sigma") {
       if (!coefficient) statistic.Fail(criterion->quantity + " has no 1-sigma");
       criterion->statistic = LimitStatistic::kSigma;
@@ -64,17 +61,16 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
   LimitCriterion criterion;
   const yaml::Located quantity = entry["quantity"];
   criterion.quantity = quantity.String();
-  const LimitQuantity* known = FindQuantity(criterion.quantity);
+  const KeyFigure* known = FindLimitQuantity(criterion.quantity);
   if (known == nullptr) {
-    std::string list;
-    for (const LimitQuantity& q : kLimitQuantities) list += (list.empty() ? "" : ", ") + std::string(q.name);
-    quantity.Fail("unknown quantity " + QuoteForMessage(criterion.quantity) + " (known: " + list + ")");
+    quantity.Fail("unknown quantity " + QuoteForMessage(criterion.quantity) +
+                  " (known: " + LimitQuantityNames() + ")");
   }
-  criterion.kind = known->kind;
+  criterion.kind = LimitKindOf(*known);
   criterion.unit = known->unit;
-  const std::vector<std::string> all_axes = Words(known->axes);
-  if (criterion.quantity.find("_scale_error_") != std::string::npos) {
-    const bool gyro = criterion.quantity.rfind("gyro", 0) == 0;
+  const std::vector<std::string> all_axes = KeyFigureAxes(*known);
+  if (known->source == FigureSource::kScaleError) {
+    const bool gyro = IsGyroFigure(*known);
     if ((gyro ? limits.nominal_gyro_scale : limits.nominal_accel_scale) == 0.0) {
       quantity.Fail(std::string("needs nominal.") + (gyro ? "gyro_scale" : "accel_scale") +
                     " (raw per rad/s or per m/s^2) in the limits file");
