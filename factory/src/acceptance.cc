@@ -236,20 +236,6 @@ std::string FigureTitle(const std::string& name) {
   return title;
 }
 
-const char* OutcomeName(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::kPass:
-      return "PASS";
-    case Outcome::kConditionalPass:
-      return "conditional pass";
-    case Outcome::kConditionalFail:
-      return "conditional fail";
-    case Outcome::kFail:
-      return "FAIL";
-  }
-  return "FAIL";
-}
-
 namespace {
 
 // The figures of a coefficient group (FigureSource::kCoefficient) at `temp_c`, one per coefficient of
@@ -358,7 +344,7 @@ std::string Verdict::Table() const {
   std::string text;
   char line[256];
   std::snprintf(line, sizeof line, "  acceptance%s%s: %s (%d of %zu criteria failed)\n",
-                limits_name.empty() ? "" : " ", limits_name.c_str(), pass ? "PASS" : "FAIL", Failed(),
+                limits_name.empty() ? "" : " ", limits_name.c_str(), VerdictName(pass), Failed(),
                 criteria.size());
   text += line;
   std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", "criterion", "measured", "limit",

@@ -52,9 +52,8 @@ void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
   unit->figures = KeyFigures(calibration);
   unit->calibrated_utc = calibration.created_utc;
   if (!settings.limits) return;
-  unit->verdict_detail = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
-  unit->verdict = unit->verdict_detail.pass ? "PASS" : "FAIL";
-  unit->message = unit->verdict_detail.FailedSummary();
+  unit->verdict = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
+  unit->message = unit->verdict->FailedSummary();
 }
 
 void ReadLimitsAndStation(const std::string& limits_path, const std::string& station_path,
@@ -72,7 +71,7 @@ void ReadLimitsAndStation(const std::string& limits_path, const std::string& sta
 bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit) {
   IMUFIT_CHECK(unit->fit && unit->fit->calibration, "CertifyUnit() certifies a fitted unit");
   const Calibration& calibration = *unit->fit->calibration;
-  unit->status = "fitted";
+  unit->status = UnitStatus::kFitted;
   unit->calibration_yaml = CalibrationToYaml(calibration);
   std::optional<Certificate> certificate;
   if (!files.report.empty()) certificate = MakeUnitCertificate(settings, files, *unit);
@@ -124,14 +123,14 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.unit = unit->unit.empty() ? unit->samples_path : unit->unit;
   row.serial = unit->serial.empty() ? row.unit : unit->serial;
   row.lot = settings.lot;
-  const bool fitted = unit->fit && unit->fit->calibration && unit->status == "fitted";
+  const bool fitted = unit->fit && unit->fit->calibration && unit->status == UnitStatus::kFitted;
   row.time_utc = fitted ? unit->fit->calibration->created_utc : UtcNow();
   row.software = settings.software;
   row.plan_sha256 = unit->plan_sha256;
   row.samples_sha256 = unit->samples_sha256;
   row.limits_sha256 = settings.limits_sha256;
-  row.status = unit->status;
-  row.verdict = unit->verdict;
+  row.status = unit->StatusText();
+  row.verdict = unit->VerdictText();
   row.message = unit->message;
   row.calibration_yaml = unit->calibration_yaml;
   if (settings.station)
@@ -141,12 +140,14 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.acquired_utc =
       header && !header->acquired_utc.empty() ? header->acquired_utc : FileTimeUtc(unit->samples_path);
   if (header) row.part_number = header->model;
+  const std::vector<CriterionResult> not_judged;
+  const std::vector<CriterionResult>& criteria = unit->verdict ? unit->verdict->criteria : not_judged;
   for (const Figure& figure : unit->figures) {
     StoredFigure g = StoredFigureOf(figure);
-    for (const CriterionResult& c : unit->verdict_detail.criteria) {
+    for (const CriterionResult& c : criteria) {
       if (c.name != "|" + g.name + "|") continue;
       g.limit_abs = c.limit;
-      g.outcome = c.pass ? "pass" : "fail";
+      g.outcome = NameOf(kCriterionAcceptanceNames, c.pass);
       g.judgement = OutcomeName(c.outcome);
     }
     if (!figure.unresolved.empty()) g.judgement = kNotResolved;
@@ -166,8 +167,8 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
     settings.store->Record(row, commit_outputs);
   } catch (const std::exception& e) {
     if (output_error) std::rethrow_exception(output_error);
-    unit->status = "error";
-    unit->verdict.clear();
+    unit->status = UnitStatus::kError;
+    unit->verdict.reset();
     unit->message = std::string(e.what()) + ": the fit is not recorded in the results store";
     return false;
   }

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "imufit/base/verdict.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/key_figures.h"
 #include "imufit/io/limits.h"
@@ -63,11 +64,8 @@ std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c = k
 // The figure called `name` (or with that `coefficient` path); nullptr when there is none.
 const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name);
 
-// Where a value lies against its limit with its expanded uncertainty U (ILAC-G8): clear of the
-// limit by more than U on either side, or within U of it.
-enum class Outcome { kPass, kConditionalPass, kConditionalFail, kFail };
-// "PASS", "conditional pass", "conditional fail", "FAIL".
-const char* OutcomeName(Outcome outcome);
+// "PASS", "conditional pass", "conditional fail", "FAIL" (Outcome: base/verdict.h).
+inline const char* OutcomeName(Outcome outcome) { return NameOf(kOutcomeNames, outcome); }
 // The judgement of a figure the run does not measure (Figure::unresolved), as stored.
 inline constexpr const char* kNotResolved = "not resolved";
 
