@@ -31,14 +31,18 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
   sources.folds = fit.folds;
   sources.warnings = unit.warnings;
   sources.limits = settings.limits;  // judged with the noise the certificate measures
-  // The calibration is not in place yet (it is committed with the certificate): hash its text.
-  sources.inputs = {{"calibration", files.calibration, Sha256Hex(unit.calibration_yaml)},
-                    {"plan", unit.plan_path, unit.plan_sha256},
-                    {"samples", unit.samples_path, unit.samples_sha256},
-                    {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
-                    {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
+  // A calibration just fitted is not in place yet (it is committed with the certificate): hash
+  // its text; an input is hashed from its file.
+  sources.inputs = {
+      {"calibration", files.calibration, files.calibration_is_input ? "" : Sha256Hex(unit.calibration_yaml)},
+      {"plan", unit.plan_path, unit.plan_sha256},
+      {"samples", unit.samples_path, unit.samples_sha256},
+      {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
+      {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
   sources.station = settings.station;
-  sources.header = RunHeader();  // the fit recorded what the samples header says
+  // A fit recorded what the samples header says; a calibration read from a file may not have.
+  sources.header = files.calibration_is_input ? fit.run.header : RunHeader();
+  sources.noise_stretch = settings.noise_stretch;
   sources.customer = settings.customer;
   sources.order = settings.order;
   ReadCertificateFiles(&sources);  // only what is not known yet: the run kept its static stretch
@@ -72,13 +76,13 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
   IMUFIT_CHECK(unit->fit && unit->fit->calibration, "CertifyUnit() certifies a fitted unit");
   const Calibration& calibration = *unit->fit->calibration;
   unit->status = UnitStatus::kFitted;
-  unit->calibration_yaml = CalibrationToYaml(calibration);
+  if (!files.calibration_is_input) unit->calibration_yaml = CalibrationToYaml(calibration);
   std::optional<Certificate> certificate;
   if (!files.report.empty()) certificate = MakeUnitCertificate(settings, files, *unit);
   JudgeUnit(settings, calibration, certificate ? certificate->verdict : std::nullopt, unit);
   // The calibration, the certificate, the caller's further outputs and the store's row: all or none.
   OutputTransaction outputs;
-  WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
+  if (!files.calibration_is_input) WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
   if (certificate) {
     const std::string html = CertificateHtml(*certificate);
     WriteFileAtomically(files.report, html, &outputs);

@@ -28,6 +28,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/station.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/pipeline/static_stretch.h"
 #include "imufit/report/pdf.h"
 #include "imufit/store/store.h"
 
@@ -82,6 +83,9 @@ struct CertifySettings {
   // ("" for a single fit).
   ResultsStore* store = nullptr;
   std::string lot;
+  // The static stretch the noise section is measured on when the run's reading kept none
+  // (imufit report's --noise-segment).
+  NoiseStretchOptions noise_stretch;
 };
 
 // Reads the limits and the station file into `settings` (either path may be empty), with their
@@ -91,16 +95,24 @@ void ReadLimitsAndStation(const std::string& limits_path, const std::string& sta
 
 // Where a unit's outputs go.
 struct UnitFiles {
+  // Where the calibration is written; with calibration_is_input, the file it was read from.
   std::string calibration;
   std::string report;  // the certificate; "" for none
   std::string pdf;     // the certificate printed (pdf.h), with `report`; "" for none
   Paper paper = Paper::kA4;
   // Further outputs written into the unit's transaction once it is judged (a batch's manifest).
   std::function<void(const UnitOutcome&, OutputTransaction*)> more;
+  // The calibration is an input certified as it is (imufit report: unit->fit holds it with the
+  // run read again, not a fit): its file is hashed, not written, and the certificate takes the
+  // samples header's run details where its record lacks them (a calibration of an older imufit).
+  bool calibration_is_input = false;
 };
 
 // Certifies, judges, commits and records `unit`: unit->fit holds FitRun's result with a calibration
-// (the serial it is to carry set), and unit->plan_path, samples_path and their hashes are filled.
+// (the serial it is to carry set), or for a calibration that is an input (UnitFiles::
+// calibration_is_input) that calibration with its plan and run; unit->plan_path, samples_path and
+// their hashes are filled (a hash may be "": then the file is hashed).
+// `imufit fit`, `imufit report` and every unit of `imufit batch` are certified here.
 // Sets the unit's status (fitted), figures, verdict and calibration text. Throws InputError when
 // an output cannot be written (then none is, and nothing is recorded). Returns RecordUnit()'s
 // answer (false: the store refused the row; then no output was written either).
