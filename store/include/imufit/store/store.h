@@ -53,7 +53,7 @@ enum class StoreAccess { kRecord, kRead };
 // A key figure as stored: its value, its expanded uncertainty and how it was judged. A plain row:
 // the store knows no documents; factory fills it from its judged figures.
 struct StoredFigure {
-  std::string name;         // quantity.axis, e.g. "gyro_bias_dps.x", "gyro_residual_rms_dps"
+  std::string name;         // quantity.axis of kKeyFigures (io/key_figures.h), e.g. "gyro_bias_dps.x"
   std::string coefficient;  // the calibration's path, e.g. "gyro.bias.x"; "fit.gyro_residual_rms"
   std::string unit;         // "deg/s", "mg", ...
   double value = 0.0;
