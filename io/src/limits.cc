@@ -1,5 +1,6 @@
 #include "imufit/io/limits.h"
 
+#include "imufit/base/enum_names.h"
 #include "imufit/io/error.h"
 #include "yaml_util.h"
 
@@ -20,6 +21,14 @@ std::string LimitQuantityNames() {
 
 namespace {
 
+// The limits file's words for what is judged and by which rule.
+constexpr EnumName<LimitStatistic> kLimitStatisticNames[] = {{LimitStatistic::kValue, "value"},
+                                                             {LimitStatistic::kSigma, "sigma"},
+                                                             {LimitStatistic::kLargest, "largest"},
+                                                             {LimitStatistic::kVariation, "variation"}};
+constexpr EnumName<DecisionRule> kDecisionRuleNames[] = {{DecisionRule::kSimple, "simple"},
+                                                         {DecisionRule::kGuarded, "guarded"}};
+
 double PositiveNumber(const yaml::Located& value) {
   const double number = value.Double();
   if (!(number > 0.0)) value.Fail(QuoteForMessage(value.String()) + " must be greater than 0");
@@ -34,15 +43,16 @@ void ReadStatistic(const yaml::Located& entry, LimitCriterion* criterion) {
     const bool coefficient = criterion->kind == LimitKind::kCoefficient;
     // The noise figures are measured at one temperature: they have no curve to take a range of.
     const bool has_curve = HasTemperatureCurve(*FindLimitQuantity(criterion->quantity));
-    if (text == "sigma") {
-      if (!coefficient) statistic.Fail(criterion->quantity + " has no 1-sigma");
-      criterion->statistic = LimitStatistic::kSigma;
-    } else if (text == "largest" || text == "variation") {
-      if (!has_curve) statistic.Fail(criterion->quantity + " does not vary with temperature in the model");
-      criterion->statistic = text == "largest" ? LimitStatistic::kLargest : LimitStatistic::kVariation;
-    } else if (text != "value") {
-      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: value, sigma, largest, variation)");
+    if (!ValueOf(kLimitStatisticNames, text, &criterion->statistic)) {
+      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: " + AllNames(kLimitStatisticNames) +
+                     ")");
     }
+    if (criterion->statistic == LimitStatistic::kSigma && !coefficient)
+      statistic.Fail(criterion->quantity + " has no 1-sigma");
+    if ((criterion->statistic == LimitStatistic::kLargest ||
+         criterion->statistic == LimitStatistic::kVariation) &&
+        !has_curve)
+      statistic.Fail(criterion->quantity + " does not vary with temperature in the model");
   }
   if (entry.Has("over")) {
     const yaml::Located over = entry["over"];
@@ -127,9 +137,7 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
 
 }  // namespace
 
-const char* DecisionRuleName(DecisionRule rule) {
-  return rule == DecisionRule::kGuarded ? "guarded" : "simple";
-}
+const char* DecisionRuleName(DecisionRule rule) { return NameOf(kDecisionRuleNames, rule); }
 
 Limits ReadLimits(const std::string& path) {
   const YAML::Node root_node = yaml::LoadFile(path);
@@ -148,11 +156,9 @@ Limits ReadLimits(const std::string& path) {
   if (root.Has("decision_rule")) {
     const yaml::Located rule = root["decision_rule"];
     const std::string text = rule.String();
-    if (text == "guarded") {
-      limits.decision_rule = DecisionRule::kGuarded;
-    } else if (text != "simple") {
-      rule.Fail(QuoteForMessage(text) + " is not a decision rule (known: simple, guarded)");
-    }
+    if (!ValueOf(kDecisionRuleNames, text, &limits.decision_rule))
+      rule.Fail(QuoteForMessage(text) + " is not a decision rule (known: " + AllNames(kDecisionRuleNames) +
+                ")");
   }
   if (root.Has("guard_band")) {
     if (limits.decision_rule != DecisionRule::kGuarded) {
