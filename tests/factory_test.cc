@@ -19,6 +19,7 @@
 #include "imufit/factory/batch.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certify.h"
+#include "imufit/factory/lot_history.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
@@ -245,6 +246,10 @@ TEST_F(FactoryTest, KeyFiguresFollowTheKeyFigureTable) {
   EXPECT_EQ(names, expected);
   // Every quantity a limits file may name has a title, the certificate's own ones too.
   for (const KeyFigure& quantity : kKeyFigures) EXPECT_NE(FigureTitle(quantity.name), quantity.name);
+  // The figures the lot summary and the lot trend pick are the table's.
+  for (const std::vector<std::string>* picked : {&kSummaryFigures, &kLotTrendFigures}) {
+    for (const std::string& name : *picked) EXPECT_NE(FindKeyFigure(name), nullptr) << name;
+  }
   EXPECT_EQ(FigureTitle("gyro_residual_max_dps"), "Gyro largest window error");
   EXPECT_EQ(FigureTitle("gyro_g_sensitivity_dpsg.xy"), "Gyro g-sensitivity X from Y");
 }
