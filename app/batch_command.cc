@@ -30,7 +30,8 @@ void ShowProgress(const BatchProgress& p, bool terminal) {
   const double left_s = rate > 0.0 ? (p.total - p.done) / rate : 0.0;
   const UnitOutcome& u = *p.last;
   const std::string outcome =
-      u.skipped ? "unchanged, skipped" : u.status + (u.verdict.empty() ? "" : " " + u.verdict);
+      u.skipped ? "unchanged, skipped"
+                : std::string(u.StatusText()) + (u.verdict ? std::string(" ") + u.VerdictText() : "");
   if (terminal) {
     std::fprintf(stderr, "\r\033[K[%d/%d] %.2f units/s, %.0f s left; %s: %s", p.done, p.total, rate, left_s,
                  u.unit.c_str(), outcome.c_str());
@@ -74,9 +75,9 @@ int RunBatchCommand(const BatchArguments& args) {
         "skipped\n",
         result.units.size(), result.passed, result.failed, result.not_fitted, result.errors, result.skipped);
     for (const UnitOutcome& u : result.units) {
-      if (u.verdict == "PASS" || (u.verdict.empty() && u.status == "fitted")) continue;
+      if (u.verdict ? u.verdict->pass : u.status == UnitStatus::kFitted) continue;
       std::printf("  %s (%s): %s%s%s\n", u.unit.c_str(), u.serial.c_str(),
-                  u.verdict.empty() ? u.status.c_str() : u.verdict.c_str(), u.message.empty() ? "" : ": ",
+                  u.verdict ? u.VerdictText() : u.StatusText(), u.message.empty() ? "" : ": ",
                   u.message.c_str());
     }
     if (result.complete) std::printf("  wrote %s/lot_summary.csv\n", options.output_dir.c_str());

@@ -224,13 +224,12 @@ int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool reco
     return kExitBadInput;
   }
   if (!args.report.empty()) WarnIfNoSerial(unit.fit->calibration->serial, args.samples);
-  const bool judged = !unit.verdict.empty();
-  if (judged && (!args.quiet || !unit.verdict_detail.pass))
-    std::printf("%s", unit.verdict_detail.Table().c_str());
+  const bool judged = unit.verdict.has_value();
+  if (judged && (!args.quiet || !unit.verdict->pass)) std::printf("%s", unit.verdict->Table().c_str());
   if (!args.quiet) std::printf("  wrote %s\n", args.output.c_str());
   if (!args.report.empty() && !args.quiet) std::printf("  wrote %s\n", args.report.c_str());
   if (!args.store.empty() && !args.quiet) std::printf("  recorded in %s\n", args.store.c_str());
-  return judged && !unit.verdict_detail.pass ? kExitFailedLimits : 0;
+  return judged && !unit.verdict->pass ? kExitFailedLimits : 0;
 }
 
 int RunFit(const FitArguments& args) {

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "imufit/factory/certificate.h"
+#include "imufit/factory/certify.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
@@ -46,61 +47,57 @@ int RunReport(const ReportArguments& args) {
   const SamplesInput input = args.run.input.Get();
   if (std::string problem = windows.Validate(); !problem.empty()) throw InputError("imufit report", problem);
   if (std::string problem = input.Validate(); !problem.empty()) throw InputError("imufit report", problem);
-  CertificateSources sources;
-  sources.software = SoftwareVersion();
-  sources.calibration = ReadCalibration(args.calibration);
-  sources.plan = ReadPlan(args.plan);
+  // Certified as `imufit fit` and `imufit batch` certify (CertifyUnit), the calibration an input.
+  CertifySettings settings;
+  settings.software = SoftwareVersion();
+  settings.windows = windows;
+  settings.samples_input = input;
+  settings.customer = args.customer.customer;
+  settings.order = args.customer.order;
+  settings.noise_stretch = args.run.NoiseStretch();
+  UnitOutcome unit;
+  FitRunResult& fit = unit.fit.emplace();
+  Calibration calibration = ReadCalibration(args.calibration);
+  fit.plan = ReadPlan(args.plan);
   // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
   // the unit's own log's, then the plan's. Sources that disagree are warned about (unit_serial.h).
-  SerialSource stated, calibration, plan;
+  SerialSource stated, stated_by_calibration, plan;
   stated.kind = SerialSource::Kind::kStated;
   stated.name = "--serial";
   stated.serial = args.serial;
-  calibration.name = "the calibration " + args.calibration;
-  calibration.serial = sources.calibration.serial;
+  stated_by_calibration.name = "the calibration " + args.calibration;
+  stated_by_calibration.serial = calibration.serial;
   plan.name = "the plan " + args.plan;
-  plan.serial = sources.plan.serial;
-  UnitSerial serial =
-      ResolveSerial({stated, calibration, SamplesHeaderSerial(args.samples), plan}, args.allow_mismatch);
-  sources.calibration.serial = serial.serial;
+  plan.serial = fit.plan.serial;
+  UnitSerial serial = ResolveSerial({stated, stated_by_calibration, SamplesHeaderSerial(args.samples), plan},
+                                    args.allow_mismatch);
+  calibration.serial = serial.serial;
   for (const std::string& w : serial.warnings) {
-    sources.warnings.push_back(w);
+    unit.warnings.push_back(w);
     std::fprintf(stderr, "imufit: warning: %s\n", w.c_str());
   }
-  if (!args.limits.empty()) sources.limits = ReadLimits(args.limits);
-  if (!args.station.empty()) sources.station = ReadStation(args.station);
+  ReadLimitsAndStation(args.limits, args.station, &settings);
   // A certificate of a calibration for another run's data would certify nothing.
-  const std::vector<std::string> mismatches = InputMismatches(sources.calibration, args.plan, args.samples);
+  const std::vector<std::string> mismatches = InputMismatches(calibration, args.plan, args.samples);
   if (!mismatches.empty() && !args.allow_mismatch) {
     throw InputError(args.calibration, mismatches.front() + "; give --allow-mismatch to certify it anyway");
   }
   for (const std::string& m : mismatches) {
-    sources.warnings.push_back(m + " (certified with --allow-mismatch)");
+    unit.warnings.push_back(m + " (certified with --allow-mismatch)");
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
-  sources.samples_input = input;
-  sources.customer = args.customer.customer;
-  sources.order = args.customer.order;
   // Read once for the windows, the hash and the noise section's static stretch.
-  RunReader reader(sources.plan, args.samples, input);
-  sources.header = reader.run_header();  // where the calibration's record does not say it
-  sources.noise_stretch = args.run.NoiseStretch();
-  sources.run = reader.Read(windows, sources.noise_stretch);
-  sources.windows = windows;
-  sources.inputs = {{"calibration", args.calibration, ""},
-                    {"plan", args.plan, ""},
-                    {"samples", args.samples, sources.run.samples_sha256},
-                    {"limits", args.limits, ""},
-                    {"station", args.station, ""}};
-  ReadCertificateFiles(&sources);
-  const Certificate certificate = MakeCertificate(sources);
-  WarnIfNoSerial(certificate.serial, args.calibration);
-  const std::string html = CertificateHtml(certificate);
-  OutputTransaction outputs;  // the page and its PDF, both or neither
-  WriteFileAtomically(args.output, html, &outputs);
-  if (!pdf.empty()) WritePdf(html, pdf, paper, &outputs);
-  outputs.Commit();
-  const std::optional<Verdict>& verdict = certificate.verdict;
+  RunReader reader(fit.plan, args.samples, input);
+  fit.run = reader.Read(windows, settings.noise_stretch);
+  fit.calibration = std::move(calibration);
+  unit.serial = fit.calibration->serial;
+  unit.plan_path = args.plan;
+  unit.samples_path = args.samples;
+  unit.samples_sha256 = fit.run.samples_sha256;
+  WarnIfNoSerial(unit.serial, args.calibration);
+  UnitFiles files{args.calibration, args.output, pdf, paper, {}, /*calibration_is_input=*/true};
+  CertifyUnit(settings, files, &unit);  // the page and its PDF, both or neither
+  const std::optional<Verdict>& verdict = unit.verdict;
   std::printf("imufit report: wrote %s%s%s\n", args.output.c_str(),
               pdf.empty() ? "" : (" and " + pdf).c_str(),
               verdict ? (verdict->pass ? " (acceptance PASS)" : " (acceptance FAIL)") : "");

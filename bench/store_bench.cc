@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "imufit/base/verdict.h"
 #include "imufit/factory/lot_history.h"
 #include "imufit/store/store.h"
 
@@ -141,8 +142,8 @@ imufit::StoredFit NewFit(int i) {
   fit.software = "imufit bench";
   fit.plan_sha256 = std::string(64, 'a');
   fit.samples_sha256 = std::to_string(i) + std::string(60, 'b');
-  fit.status = "fitted";
-  fit.verdict = "PASS";
+  fit.status = imufit::NameOf(imufit::kUnitStatusNames, imufit::UnitStatus::kFitted);
+  fit.verdict = imufit::VerdictName(true);
   fit.calibration_yaml = std::string(4000, 'y');  // about a calibration file's size
   for (int k = 0; k < kFiguresPerFit; ++k) {
     imufit::StoredFigure g;

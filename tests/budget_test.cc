@@ -252,11 +252,9 @@ TEST_F(BudgetTest, DecisionRuleJudgesWithU) {
   for (double limit : {value + 2.0 * u, value + 0.5 * u, value - 0.5 * u}) {
     UnitOutcome unit;
     unit.unit = "unit-" + std::to_string(batch.units.size());
-    unit.status = "fitted";
-    unit.verdict_detail = judge(limit, DecisionRule::kSimple);
-    unit.verdict = unit.verdict_detail.pass ? "PASS" : "FAIL";
-    (unit.verdict_detail.pass ? batch.passed : batch.failed) += 1;
-    batch.units.push_back(unit);
+    unit.status = UnitStatus::kFitted;
+    unit.verdict = judge(limit, DecisionRule::kSimple);
+    batch.Add(unit);
   }
   const LotSummary lot = MakeLotSummary("lot", batch, "imufit test", std::nullopt);
   EXPECT_EQ(lot.passed, 2);

@@ -146,7 +146,7 @@ TEST_F(CertificateLotTest, EveryVerdictItsReasonTheRuleAndTheBudgetOnStructsAndP
   const std::string bias_title = "Gyro bias X", arw_title = "Gyro angle random walk X";
   std::vector<Certificate> certificates;
   for (const UnitOutcome& unit : batch.units) {
-    ASSERT_EQ(unit.status, "fitted") << unit.unit << ": " << unit.message;
+    ASSERT_EQ(unit.status, UnitStatus::kFitted) << unit.unit << ": " << unit.message;
     certificates.push_back(CertificateOf(unit, options, limits));
   }
   const Verdict& a = *certificates[0].verdict;
@@ -154,13 +154,13 @@ TEST_F(CertificateLotTest, EveryVerdictItsReasonTheRuleAndTheBudgetOnStructsAndP
   const Verdict& c = *certificates[2].verdict;
   const Verdict& d = *certificates[3].verdict;
   EXPECT_TRUE(a.pass) << a.Table();
-  EXPECT_EQ(batch.units[0].verdict, "PASS");
+  EXPECT_EQ(batch.units[0].VerdictText(), std::string("PASS"));
   ASSERT_NE(Find(a, bias_title), nullptr) << a.Table();
   EXPECT_EQ(Find(a, bias_title)->outcome, Outcome::kPass);
   EXPECT_EQ(Find(a, arw_title)->outcome, Outcome::kPass) << a.Table();
 
   EXPECT_FALSE(b.pass);
-  EXPECT_EQ(batch.units[1].verdict, "FAIL");
+  EXPECT_EQ(batch.units[1].VerdictText(), std::string("FAIL"));
   EXPECT_EQ(Find(b, bias_title)->outcome, Outcome::kFail);
   EXPECT_NE(batch.units[1].message.find("gyro_bias_dps.x"), std::string::npos) << batch.units[1].message;
 

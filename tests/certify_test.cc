@@ -150,7 +150,7 @@ TEST_P(CertifyTest, FitReportAndStoreReadTheSamplesAtMostTwice) {
   EXPECT_NE(report.str().find(std::string("data-key=\"software\">") + kFittingSoftware + "<"),
             std::string::npos);
   EXPECT_NE(report.str().find(std::string("<td>") + kCertifyingSoftware + ", git "), std::string::npos);
-  EXPECT_EQ(unit.verdict, "PASS");
+  EXPECT_EQ(unit.VerdictText(), std::string("PASS"));
 }
 
 // The certificate measures the noise on the stretch the fit kept while it read the run: the same

@@ -103,8 +103,8 @@ BatchResult FiveUnits() {
     UnitOutcome u;
     u.unit = "unit-0" + std::to_string(i + 1);
     u.serial = "SN" + std::to_string(i + 1);
-    u.status = i == 3 ? "error" : "fitted";
-    u.verdict = i == 3 ? "" : (i == 2 || i == 4) ? "FAIL" : "PASS";
+    u.status = i == 3 ? UnitStatus::kError : UnitStatus::kFitted;
+    if (i != 3) u.verdict.emplace().pass = i != 2 && i != 4;
     if (i != 3) {
       u.figures = {MakeFigure("gyro_bias_dps.x", "", "deg/s", bias[i], 0.001),
                    MakeFigure("accel_bias_mg.x", "", "mg", 10.0 + 0.1 * i, 0.01)};
@@ -201,15 +201,15 @@ TEST_F(LotTest, LotSummaryMarksFailedAndOutlyingUnitsAndChoosesWhatAStripPlotSho
 TEST_F(LotTest, LotSummaryHidesNoFigureAndPlotsEveryFigureAUnitFailedOn) {
   BatchResult batch = FiveUnits();
   for (UnitOutcome& u : batch.units) {
-    if (u.status != "fitted") continue;
+    if (u.status != UnitStatus::kFitted) continue;
     u.calibrated_utc = "2026-11-2" + u.unit.substr(6) + "T06:00:00Z";
     u.figures.push_back(MakeFigure("accel_misalignment_mrad.xy", "", "mrad", 0.5, 0.02));
     u.figures.push_back(MakeFigure("accel_residual_rms_mg", "", "mg", 0.8, -1.0));
   }
   CriterionResult failed;
   failed.name = "sigma(accel_misalignment_mrad.xy)";
-  batch.units[2].verdict_detail.criteria.push_back(failed);
-  batch.units[2].verdict_detail.pass = false;
+  batch.units[2].verdict->criteria.push_back(failed);
+  batch.units[2].verdict->pass = false;
   batch.units[2].message = "sigma(accel_misalignment_mrad.xy) 0.02 > 0.01 mrad, badly";
 
   const Limits limits = WriteLimits("criteria:\n  - {quantity: gyro_bias_dps, max_abs: 0.3}\n");
@@ -224,7 +224,7 @@ TEST_F(LotTest, LotSummaryHidesNoFigureAndPlotsEveryFigureAUnitFailedOn) {
   EXPECT_TRUE(s.figures[3].plotted);  // a main figure
   EXPECT_EQ(LotPlots(s).size(), 4u);
   BatchResult passing = batch;
-  passing.units[2].verdict_detail = Verdict();
+  passing.units[2].verdict = Verdict();
   EXPECT_FALSE(MakeLotSummary("LOT-1", passing, "imufit test", limits).figures[2].plotted);
   EXPECT_EQ(LotPlots(MakeLotSummary("LOT-1", passing, "imufit test", limits)).size(), 3u);
 

@@ -16,8 +16,10 @@
 #include <gtest/gtest.h>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/batch.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certify.h"
+#include "imufit/factory/lot_history.h"
 #include "imufit/factory/report.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
@@ -208,6 +210,82 @@ TEST_F(FactoryTest, NoiseLimitsUseTheNoiseBlockWhenPresent) {
   EXPECT_DOUBLE_EQ(verdict.criteria[0].measured, 0.1498);
   EXPECT_FALSE(verdict.criteria[1].pass);  // 0.94 deg/h > 0.5 deg/h
   EXPECT_DOUBLE_EQ(FindFigure(KeyFigures(calibration), "noise.gyro_x.arw_deg_per_sqrt_hr")->sigma, 0.0002);
+}
+
+// KeyFigures() lists the table's figures of a calibration in the table's order, each with the
+// table's unit (the one engineering_units.h states it in) and a title in words.
+TEST_F(FactoryTest, KeyFiguresFollowTheKeyFigureTable) {
+  Calibration calibration = ReadCalibration(kFixtures + "/mems_truth.yaml");
+  FitRecord record;
+  record.gyro_residual_rms_radps = 1e-4;
+  record.accel_residual_rms_mps2 = 2e-3;
+  record.missing_segments = 0;
+  calibration.fit = record;
+  calibration.extra["noise"] = YAML::Load(
+      "{format: imufit-noise, version: 1, columns: {gyro_x: {arw_deg_per_sqrt_hr: [0.1498, 0.0002], "
+      "bias_instability_deg_per_hr: [0.94, 0.67]}}}");
+  const std::vector<Figure> figures = KeyFigures(calibration);
+  std::vector<std::string> expected;
+  for (const KeyFigure& quantity : kKeyFigures) {
+    if (quantity.source == FigureSource::kNoise) {
+      expected.push_back(std::string(quantity.name) + ".x");
+    } else if (quantity.source == FigureSource::kCoefficient) {
+      for (const std::string& axis : KeyFigureAxes(quantity))
+        expected.push_back(std::string(quantity.name) + "." + axis);
+    } else if (quantity.source == FigureSource::kFitRecord) {
+      expected.push_back(quantity.name);
+    }
+  }
+  std::vector<std::string> names;
+  for (const Figure& f : figures) {
+    names.push_back(f.name);
+    const KeyFigure* quantity = FindKeyFigure(f.name);
+    ASSERT_NE(quantity, nullptr) << f.name;
+    EXPECT_EQ(f.unit, quantity->unit) << f.name;
+    EXPECT_NE(FigureTitle(f.name), f.name);
+    if (quantity->source != FigureSource::kCoefficient) continue;
+    int coefficient = 0;  // the model's coefficient of the figure's path ("gyro.bias.x")
+    const std::string path = f.coefficient.substr(f.coefficient.find('.') + 1);
+    while (path !=
+           std::string(kCoefficientNames[coefficient].group) + "." + kCoefficientNames[coefficient].axis)
+      ++coefficient;
+    EXPECT_EQ(f.unit, EngineeringUnit(IsGyroFigure(*quantity) ? Sensor::kGyro : Sensor::kAccel, coefficient));
+  }
+  EXPECT_EQ(names, expected);
+  // Every quantity a limits file may name has a title, the certificate's own ones too.
+  for (const KeyFigure& quantity : kKeyFigures) EXPECT_NE(FigureTitle(quantity.name), quantity.name);
+  // The figures the lot summary and the lot trend pick are the table's.
+  for (const std::vector<std::string>* picked : {&kSummaryFigures, &kLotTrendFigures}) {
+    for (const std::string& name : *picked) EXPECT_NE(FindKeyFigure(name), nullptr) << name;
+  }
+  EXPECT_EQ(FigureTitle("gyro_residual_max_dps"), "Gyro largest window error");
+  EXPECT_EQ(FigureTitle("gyro_g_sensitivity_dpsg.xy"), "Gyro g-sensitivity X from Y");
+}
+
+// The verdict vocabulary as the store, the manifest and lot_summary.csv write it (docs/spec.md
+// section 5): these texts are a file format.
+TEST(VerdictNamesTest, AreTheSerialisedTexts) {
+  EXPECT_EQ(AllNames(kUnitStatusNames), "fitted, not-fitted, error");
+  EXPECT_EQ(AllNames(kOutcomeNames), "PASS, conditional pass, conditional fail, FAIL");
+  EXPECT_EQ(AllNames(kVerdictNames), "PASS, FAIL");
+  EXPECT_EQ(AllNames(kCriterionAcceptanceNames), "pass, fail");
+  UnitOutcome unit;
+  unit.status = UnitStatus::kNotFitted;
+  EXPECT_EQ(std::string(unit.StatusText()), "not-fitted");
+  EXPECT_EQ(std::string(unit.VerdictText()), "");
+  unit.status = UnitStatus::kFitted;
+  unit.verdict.emplace().pass = false;
+  EXPECT_EQ(std::string(unit.VerdictText()), "FAIL");
+  BatchResult batch;
+  batch.Add(unit);
+  unit.verdict.reset();
+  batch.Add(unit);
+  unit.status = UnitStatus::kError;
+  batch.Add(unit);
+  EXPECT_EQ(batch.failed, 1);
+  EXPECT_EQ(batch.passed, 0);
+  EXPECT_EQ(batch.errors, 1);
+  EXPECT_EQ(batch.not_fitted, 0);
 }
 
 TEST_F(FactoryTest, StoreRecordsAndAnswers) {

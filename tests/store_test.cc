@@ -409,11 +409,12 @@ TEST(StoreTest, AFiguresJudgementIsKeptAndTheStoredLotCountsConditionalUnitsAsTh
   EXPECT_EQ(fits[3].figures[1].judgement, kNotResolved);
   const BatchResult lot = StoredLot(&store, "lot-j");
   ASSERT_EQ(lot.units.size(), 4u);
-  EXPECT_EQ(lot.units[0].verdict_detail.Conditional(), 1);
-  EXPECT_EQ(lot.units[0].verdict_detail.criteria[0].outcome, Outcome::kConditionalPass);
-  EXPECT_TRUE(lot.units[0].verdict_detail.criteria[0].pass);
-  EXPECT_EQ(lot.units[1].verdict_detail.criteria[0].outcome, Outcome::kConditionalFail);
-  EXPECT_EQ(lot.units[2].verdict_detail.Conditional(), 0);
+  ASSERT_TRUE(lot.units[0].verdict && lot.units[1].verdict && lot.units[2].verdict);
+  EXPECT_EQ(lot.units[0].verdict->Conditional(), 1);
+  EXPECT_EQ(lot.units[0].verdict->criteria[0].outcome, Outcome::kConditionalPass);
+  EXPECT_TRUE(lot.units[0].verdict->criteria[0].pass);
+  EXPECT_EQ(lot.units[1].verdict->criteria[0].outcome, Outcome::kConditionalFail);
+  EXPECT_EQ(lot.units[2].verdict->Conditional(), 0);
   // and a merge carries it
   const std::string copy = FreshSqliteStore("judgement_copy");
   MergeStores({target}, copy);

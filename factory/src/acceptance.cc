@@ -17,15 +17,6 @@ std::string Number(double value) {
   return text;
 }
 
-// A figure of the fit's record, when the calibration has one and it says (>= 0: "not run" values
-// are negative).
-std::optional<double> FitFigure(const Calibration& calibration, std::optional<double> FitRecord::*member) {
-  if (!calibration.fit) return std::nullopt;
-  const std::optional<double>& value = (*calibration.fit).*member;
-  if (!value || !(*value >= 0.0)) return std::nullopt;
-  return value;
-}
-
 // The outcome of a criterion with U `expanded` under the verdict's rule.
 // (The margin is the distance inside the nearest limit, negative outside.)
 void Decide(const Verdict& verdict, CriterionResult* r) {
@@ -75,13 +66,13 @@ Reading Read(const Context& context, const std::string& name, bool sigma, const 
   };
   Reading reading;
   // Scale errors are relative to the nominal scale the limits file gives.
-  if (name.find("_scale_error_") != std::string::npos) {
-    const bool gyro = name.rfind("gyro", 0) == 0;
+  if (const KeyFigure* quantity = FindKeyFigure(name);
+      quantity != nullptr && quantity->source == FigureSource::kScaleError) {
+    const bool gyro = IsGyroFigure(*quantity);
     const std::string axis = name.substr(name.rfind('.') + 1);
-    const Figure* scale = FindFigure(figures, std::string(gyro ? "gyro" : "accel") + ".scale." + axis);
-    const double nominal = gyro ? context.limits.nominal_gyro_scale / kRadToDeg
-                                : context.limits.nominal_accel_scale * kStandardGravityMps2;
-    const double factor = name.find("_ppm") != std::string::npos ? 1e6 : 1e2;
+    const Figure* scale = FindFigure(figures, std::string(quantity->path) + "." + axis);
+    const double nominal = context.limits.NominalScaleFigure(gyro);
+    const double factor = quantity->per_unit;
     reading.value = sigma ? scale->sigma / nominal * factor : (scale->value / nominal - 1.0) * factor;
     if (!sigma && expanded(*scale) >= 0.0) reading.expanded = expanded(*scale) / nominal * factor;
     reading.extrapolated = scale->extrapolated;
@@ -191,7 +182,8 @@ CriterionResult Judge(const LimitCriterion& criterion, const std::string& name,
   if (!reading.found) {
     r.measured_text = reading.unresolved.empty() ? "not in calibration" : "not resolved by this run";
     r.reason = reading.unresolved;
-    if (reading.unresolved.empty() && name.find("_residual_max_") != std::string::npos)
+    const KeyFigure* quantity = FindKeyFigure(name);
+    if (reading.unresolved.empty() && quantity != nullptr && quantity->source == FigureSource::kCertificate)
       r.reason = "measured on the certificate's windows (give --report)";
     r.margin = -r.limit;
     r.margin_text = "none";
@@ -232,107 +224,74 @@ CriterionResult Judge(const LimitCriterion& criterion, const std::string& name,
 }  // namespace
 
 std::string FigureTitle(const std::string& name) {
-  struct Words {
-    const char* quantity;
-    const char* title;
-    bool pair;  // two-letter axes: "xy" reads "X from Y"
-  };
-  static constexpr Words kWords[] = {{"gyro_bias_dps", "Gyro bias", false},
-                                     {"accel_bias_mg", "Accel bias", false},
-                                     {"gyro_scale_per_dps", "Gyro scale factor", false},
-                                     {"accel_scale_per_g", "Accel scale factor", false},
-                                     {"gyro_scale_error_ppm", "Gyro scale-factor error", false},
-                                     {"gyro_scale_error_pct", "Gyro scale-factor error", false},
-                                     {"accel_scale_error_ppm", "Accel scale-factor error", false},
-                                     {"accel_scale_error_pct", "Accel scale-factor error", false},
-                                     {"gyro_misalignment_mrad", "Gyro misalignment", true},
-                                     {"accel_misalignment_mrad", "Accel misalignment", true},
-                                     {"gyro_g_sensitivity_dpsg", "Gyro g-sensitivity", true},
-                                     {"gyro_residual_rms_dps", "Gyro residual RMS", false},
-                                     {"accel_residual_rms_mg", "Accel residual RMS", false},
-                                     {"fit_temp_range_c", "Fitted temperature range", false},
-                                     {"coverage", "Plan segments without a window", false},
-                                     {"gyro_arw_deg_per_sqrt_hr", "Gyro angle random walk", false},
-                                     {"gyro_bias_instability_dph", "Gyro bias instability", false}};
+  const KeyFigure* quantity = FindKeyFigure(name);
+  if (quantity == nullptr) return name;
   const size_t dot = name.find('.');
-  const std::string quantity = name.substr(0, dot),
-                    axis = dot == std::string::npos ? "" : name.substr(dot + 1);
-  for (const Words& w : kWords) {
-    if (quantity != w.quantity) continue;
-    std::string title = w.title;
-    const auto upper = [](char c) { return std::string(1, static_cast<char>(c - 'a' + 'A')); };
-    if (w.pair && axis.size() == 2) return title + " " + upper(axis[0]) + " from " + upper(axis[1]);
-    if (axis.size() == 1) return title + " " + upper(axis[0]);
-    return title;
-  }
-  return name;
+  const std::string axis = dot == std::string::npos ? "" : name.substr(dot + 1);
+  const std::string title = quantity->title;
+  const auto upper = [](char c) { return std::string(1, static_cast<char>(c - 'a' + 'A')); };
+  if (quantity->pair_axes && axis.size() == 2)
+    return title + " " + upper(axis[0]) + " from " + upper(axis[1]);
+  if (axis.size() == 1) return title + " " + upper(axis[0]);
+  return title;
 }
 
-const char* OutcomeName(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::kPass:
-      return "PASS";
-    case Outcome::kConditionalPass:
-      return "conditional pass";
-    case Outcome::kConditionalFail:
-      return "conditional fail";
-    case Outcome::kFail:
-      return "FAIL";
+namespace {
+
+// The figures of a coefficient group (FigureSource::kCoefficient) at `temp_c`, one per coefficient of
+// the group, in the model's layout.
+void CoefficientFigures(const KeyFigure& quantity, const Calibration& calibration, double temp_c,
+                        std::vector<Figure>* figures) {
+  const SensorModel* sigma = calibration.sigma ? &*calibration.sigma : nullptr;
+  const bool gyro = IsGyroFigure(quantity);
+  const Sensor sensor = gyro ? Sensor::kGyro : Sensor::kAccel;
+  const std::string group = std::string(quantity.path).substr(std::string(quantity.path).find('.') + 1);
+  const auto& range = calibration.fit_temp_range_c;
+  for (int coefficient = 0; coefficient < (gyro ? kGyroCoefficients : kAccelCoefficients); ++coefficient) {
+    const CoefficientName& n = kCoefficientNames[coefficient];
+    if (group != n.group) continue;
+    const EngineeringValue v = EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, temp_c);
+    Figure figure = MakeFigure(std::string(quantity.name) + "." + n.axis,
+                               std::string(quantity.path) + "." + n.axis, quantity.unit, v.value, v.sigma);
+    figure.extrapolated = range[1] > range[0] && (temp_c < range[0] || temp_c > range[1]);
+    figures->push_back(std::move(figure));
   }
-  return "FAIL";
 }
+
+}  // namespace
 
 std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
-  const SensorModel* sigma = calibration.sigma ? &*calibration.sigma : nullptr;
   std::vector<Figure> figures;
-  const auto add = [&](const std::string& quantity, Sensor sensor, int coefficient) {
-    const CoefficientName& n = kCoefficientNames[coefficient];
-    const EngineeringValue v = EngineeringCoefficient(calibration.model, sigma, sensor, coefficient, temp_c);
-    const auto& range = calibration.fit_temp_range_c;
-    Figure figure =
-        MakeFigure(quantity + "." + n.axis,
-                   std::string(sensor == Sensor::kGyro ? "gyro." : "accel.") + n.group + "." + n.axis,
-                   EngineeringUnit(sensor, coefficient), v.value, v.sigma);
-    figure.extrapolated = range[1] > range[0] && (temp_c < range[0] || temp_c > range[1]);
-    figures.push_back(std::move(figure));
-  };
-  for (int i = 0; i < 3; ++i) add("gyro_bias_dps", Sensor::kGyro, kBiasCoefficient + i);
-  for (int i = 0; i < 3; ++i) add("accel_bias_mg", Sensor::kAccel, kBiasCoefficient + i);
-  for (int i = 0; i < 3; ++i) add("gyro_scale_per_dps", Sensor::kGyro, kScaleCoefficient + i);
-  for (int i = 0; i < 3; ++i) add("accel_scale_per_g", Sensor::kAccel, kScaleCoefficient + i);
-  for (int m = 0; m < 6; ++m) add("gyro_misalignment_mrad", Sensor::kGyro, kMisalignmentCoefficient + m);
-  for (int m = 0; m < 6; ++m) add("accel_misalignment_mrad", Sensor::kAccel, kMisalignmentCoefficient + m);
-  for (int h = 0; h < 9; ++h) add("gyro_g_sensitivity_dpsg", Sensor::kGyro, kGSensitivityCoefficient + h);
-  // Noise figures, when the calibration carries a `noise:` block (imufit allan --noise-yaml,
-  // docs/allan.md): [value, 1-sigma] per gyro column.
-  const char* axes[] = {"x", "y", "z"};
-  struct NoiseKey {
-    const char* name;
-    const char* key;
-    const char* unit;
-  };
-  const NoiseKey noise_keys[] = {{"gyro_arw_deg_per_sqrt_hr", "arw_deg_per_sqrt_hr", "deg/sqrt(h)"},
-                                 {"gyro_bias_instability_dph", "bias_instability_deg_per_hr", "deg/h"}};
-  for (const auto& [name, key, unit] : noise_keys) {
-    for (const char* axis : axes) {
-      if (const std::optional<std::array<double, 2>> pair =
-              NoiseFigure(calibration.noise, std::string("gyro_") + axis, key)) {
-        figures.push_back(MakeFigure(std::string(name) + "." + axis,
-                                     std::string("noise.gyro_") + axis + "." + key, unit, (*pair)[0],
-                                     (*pair)[1]));
-      }
+  for (const KeyFigure& quantity : kKeyFigures) {
+    switch (quantity.source) {
+      case FigureSource::kCoefficient:
+        CoefficientFigures(quantity, calibration, temp_c, &figures);
+        break;
+      case FigureSource::kNoise:
+        // When the calibration carries a `noise:` block (imufit allan --noise-yaml, docs/allan.md):
+        // [value, 1-sigma] per gyro column.
+        for (const std::string& axis : KeyFigureAxes(quantity)) {
+          if (const std::optional<std::array<double, 2>> pair =
+                  NoiseFigure(calibration.noise, "gyro_" + axis, quantity.path)) {
+            figures.push_back(MakeFigure(std::string(quantity.name) + "." + axis,
+                                         "noise.gyro_" + axis + "." + quantity.path, quantity.unit,
+                                         (*pair)[0], (*pair)[1]));
+          }
+        }
+        break;
+      case FigureSource::kFitRecord:
+        // "Not run" values are negative.
+        if (const std::optional<double> value =
+                calibration.fit ? quantity.record(*calibration.fit) : std::nullopt;
+            value && *value >= 0.0) {
+          figures.push_back(MakeFigure(quantity.name, quantity.path, quantity.unit, *value));
+        }
+        break;
+      case FigureSource::kScaleError:   // judged from the scale figures
+      case FigureSource::kCertificate:  // measured by the certificate (MeasuredFigures)
+      case FigureSource::kFitRange:     // judged as a range
+        break;
     }
-  }
-  if (const std::optional<double> rms = FitFigure(calibration, &FitRecord::gyro_residual_rms_radps)) {
-    figures.push_back(
-        MakeFigure("gyro_residual_rms_dps", "fit.gyro_residual_rms", "deg/s", DpsFromRadps(*rms)));
-  }
-  if (calibration.fit && calibration.fit->missing_segments && *calibration.fit->missing_segments >= 0) {
-    figures.push_back(MakeFigure("coverage", "fit.missing_segments", "segments missing",
-                                 static_cast<double>(*calibration.fit->missing_segments)));
-  }
-  if (const std::optional<double> rms = FitFigure(calibration, &FitRecord::accel_residual_rms_mps2)) {
-    figures.push_back(MakeFigure("accel_residual_rms_mg", "fit.accel_residual_rms", "mg", MgFromMps2(*rms)));
   }
   return figures;
 }
@@ -385,7 +344,7 @@ std::string Verdict::Table() const {
   std::string text;
   char line[256];
   std::snprintf(line, sizeof line, "  acceptance%s%s: %s (%d of %zu criteria failed)\n",
-                limits_name.empty() ? "" : " ", limits_name.c_str(), pass ? "PASS" : "FAIL", Failed(),
+                limits_name.empty() ? "" : " ", limits_name.c_str(), VerdictName(pass), Failed(),
                 criteria.size());
   text += line;
   std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s\n", "criterion", "measured", "limit",

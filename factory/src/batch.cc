@@ -286,17 +286,19 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
       previous->issued_to != manifest.issued_to) {
     return false;
   }
-  if (previous->status == "fitted" &&
+  UnitStatus status = UnitStatus::kError;
+  if (!ValueOf(kUnitStatusNames, previous->status, &status)) return false;  // not ours: done again
+  if (status == UnitStatus::kFitted &&
       !(fs::exists(paths.calibration) && (!shared.options->write_reports || fs::exists(paths.report)) &&
         (paths.pdf.empty() || fs::exists(paths.pdf)))) {
     return false;
   }
   unit->skipped = true;
   unit->serial = previous->serial;
-  unit->status = previous->status;
-  unit->verdict = previous->verdict;
+  unit->status = status;
   unit->message = previous->message;
-  if (unit->status == "fitted")
+  // The verdict is judged again (it is the manifest's, from the same calibration and limits).
+  if (unit->status == UnitStatus::kFitted)
     JudgeUnit(shared.certify, ReadCalibration(paths.calibration), std::nullopt, unit);
   return true;
 }
@@ -305,7 +307,7 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
 // from its manifest and calibration, so that the store holds every unit of the lot.
 void RecordSkippedUnit(const Shared& shared, const UnitPaths& paths, UnitOutcome* unit) {
   if (shared.store == nullptr || shared.store->HasUnit(shared.certify.lot, unit->unit)) return;
-  if (unit->status == "fitted") {
+  if (unit->status == UnitStatus::kFitted) {
     std::ifstream stream(paths.calibration, std::ios::binary);
     unit->calibration_yaml.assign(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
   }
@@ -335,10 +337,10 @@ void FitUnit(const Shared& shared, const UnitInput& input, const UnitPaths& path
   unit->warnings.insert(unit->warnings.end(), result.run_warnings.begin(), result.run_warnings.end());
   if (result.serial.empty()) unit->warnings.push_back(kSerialNotStated);
   if (result.fit.status == FitStatus::kUndetermined) {
-    unit->status = "not-fitted";
+    unit->status = UnitStatus::kNotFitted;
     unit->message = "the run does not determine the model: " + Join(result.fit.undetermined, "; ");
   } else if (!result.calibration) {
-    unit->status = "not-fitted";
+    unit->status = UnitStatus::kNotFitted;
     unit->message = result.fit.BriefReport();
   } else if (result.calibration->serial.empty()) {
     result.calibration->serial = unit->serial;
@@ -349,8 +351,8 @@ void FitUnit(const Shared& shared, const UnitInput& input, const UnitPaths& path
 void WriteUnitManifest(const UnitPaths& paths, const UnitOutcome& unit, Manifest manifest,
                        OutputTransaction* transaction) {
   manifest.serial = unit.serial;
-  manifest.status = unit.status;
-  manifest.verdict = unit.verdict;
+  manifest.status = unit.StatusText();
+  manifest.verdict = unit.VerdictText();
   manifest.message = unit.message;
   if (!unit.calibration_yaml.empty()) manifest.calibration_sha256 = Sha256Hex(unit.calibration_yaml);
   fs::create_directories(paths.folder);
@@ -400,7 +402,7 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
   UnitOutcome unit;
   unit.unit = input.name;
   unit.serial = unit.unit;
-  unit.status = "error";
+  unit.status = UnitStatus::kError;
   const UnitPaths paths = PathsOf(*shared.options, unit.unit);
   Manifest manifest;
   bool done = false;     // certified: outputs, manifest and store row committed together
@@ -414,11 +416,11 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
     }
     FitUnit(shared, input, paths, &unit);
   } catch (const InputError& e) {
-    unit.status = "error";
+    unit.status = UnitStatus::kError;
     unit.message = e.what();
     outside = OutsideTheUnit(e);
   } catch (const std::exception& e) {
-    unit.status = "error";
+    unit.status = UnitStatus::kError;
     unit.message = std::string("error: ") + e.what();
     outside = true;
   }
@@ -444,8 +446,8 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
       RecordUnit(shared.certify, &unit, &outputs);
     }
   } catch (const std::exception& e) {  // an output could not be written: nothing was
-    unit.status = "error";
-    unit.verdict.clear();
+    unit.status = UnitStatus::kError;
+    unit.verdict.reset();
     unit.message = std::string("not written (the unit is done again on the next run): ") + e.what();
   }
   unit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -642,13 +644,7 @@ BatchResult Tally(std::vector<std::optional<UnitOutcome>> outcomes) {
       result.complete = false;
       continue;
     }
-    const UnitOutcome& u = *outcome;
-    result.skipped += u.skipped ? 1 : 0;
-    if (u.status == "error") ++result.errors;
-    if (u.status == "not-fitted") ++result.not_fitted;
-    if (u.verdict == "PASS") ++result.passed;
-    if (u.verdict == "FAIL") ++result.failed;
-    result.units.push_back(std::move(*outcome));
+    result.Add(std::move(*outcome));
   }
   return result;
 }

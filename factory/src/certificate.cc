@@ -158,9 +158,10 @@ void Identify(const CertificateSources& sources, Certificate* c) {
 std::vector<KeyFigureRow> FigureRows(const Calibration& cal, const UncertaintyBudget& budget) {
   std::vector<KeyFigureRow> rows;
   for (const Figure& f : KeyFigures(cal)) {
-    // Coefficients have a path in the model ("gyro.bias.x"); the others are the fit's diagnostics
-    // ("fit.gyro_residual_rms", "fit.missing_segments") and noise figures ("noise.gyro_x.arw...").
-    const bool is_coefficient = f.coefficient.rfind("gyro.", 0) == 0 || f.coefficient.rfind("accel.", 0) == 0;
+    // Coefficients of the model, signed; the others are the fit's diagnostics (residual RMS,
+    // segments missing) and noise figures.
+    const KeyFigure* quantity = FindKeyFigure(f.name);
+    const bool is_coefficient = quantity != nullptr && quantity->source == FigureSource::kCoefficient;
     const FigureBudget* b = budget.Find(f.name);
     rows.push_back({f.name, f.unit, is_coefficient, f.value, f.sigma,
                     b != nullptr && f.sigma >= 0.0 ? b->expanded
@@ -303,7 +304,8 @@ std::string CertificateNumber(const std::string& serial, const std::string& date
 namespace {
 
 // Why this run does not resolve a noise term, and how to supply it (Figure::unresolved).
-std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, bool arw) {
+std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, const KeyFigure& quantity) {
+  const bool arw = quantity.noise_term == kRandomWalk;
   const double needed_s = arw ? kMinAllanStretchS : kBiasInstabilityStretchS;
   std::string text =
       "not resolved by this run (needs a static stretch of " + FormatNumber("%g", needed_s) + " s";
@@ -313,8 +315,8 @@ std::string Unresolved(const NoiseSection& noise, const NoiseAxis* axis, bool ar
     text += "; the stretch measured is " + FormatNumber("%.0f", noise.duration_s) + " s";
     if (axis != nullptr && !axis->why_not.empty()) text += ", " + axis->why_not;
     if (axis != nullptr && axis->fitted) {
-      text += "; " + TermFigureText(arw ? axis->arw_deg_per_sqrt_hr : axis->bias_instability_dph,
-                                    arw ? "deg/sqrt(h)" : "deg/h");
+      text +=
+          "; " + TermFigureText(arw ? axis->arw_deg_per_sqrt_hr : axis->bias_instability_dph, quantity.unit);
     }
     text += ")";
   }
@@ -334,10 +336,12 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
       if (axis.axis == axis_name) a = &axis;
     }
     const std::string axis = axis_name;
-    const auto noise_figure = [&](bool arw) {
-      Figure f = MakeFigure(arw ? "gyro_arw_deg_per_sqrt_hr." + axis : "gyro_bias_instability_dph." + axis,
-                            "certificate.gyro_" + axis + (arw ? ".arw" : ".bias_instability"),
-                            arw ? "deg/sqrt(h)" : "deg/h");
+    // Every noise figure of the key figures, from this certificate's own Allan deviation.
+    for (const KeyFigure& quantity : kKeyFigures) {
+      if (quantity.source != FigureSource::kNoise) continue;
+      const bool arw = quantity.noise_term == kRandomWalk;
+      Figure f = MakeFigure(std::string(quantity.name) + "." + axis,
+                            "certificate.gyro_" + axis + (arw ? ".arw" : ".bias_instability"), quantity.unit);
       const NoiseTermFigure* term = a == nullptr || !a->fitted ? nullptr
                                     : arw                      ? &a->arw_deg_per_sqrt_hr
                                                                : &a->bias_instability_dph;
@@ -345,21 +349,20 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
         f.value = term->value;
         f.sigma = term->sigma;
       } else {
-        f.unresolved = Unresolved(noise, a, arw);
+        f.unresolved = Unresolved(noise, a, quantity);
       }
       figures.push_back(f);
-    };
-    noise_figure(true);
-    noise_figure(false);
+    }
   }
   // The worst window after correction, at any temperature of the run (the per-segment table's "all").
   if (!certificate.residual_table.empty()) {
     const ResidualRow& all = certificate.residual_table.back();
-    figures.push_back(
-        MakeFigure("gyro_residual_max_dps", "certificate.gyro_residual_max", "deg/s", all.gyro_max_dps));
-    if (all.accel_windows > 0) {
-      figures.push_back(
-          MakeFigure("accel_residual_max_mg", "certificate.accel_residual_max", "mg", all.accel_max_mg));
+    for (const KeyFigure& quantity : kKeyFigures) {
+      if (quantity.source != FigureSource::kCertificate) continue;
+      const bool gyro = IsGyroFigure(quantity);
+      if (!gyro && all.accel_windows <= 0) continue;
+      figures.push_back(MakeFigure(quantity.name, quantity.path, quantity.unit,
+                                   gyro ? all.gyro_max_dps : all.accel_max_mg));
     }
   }
   return figures;

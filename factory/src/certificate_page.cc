@@ -204,7 +204,7 @@ void Identification(Html* h, const Certificate& c) {
       .Element("span", serial, {{"data-key", "serial"}});
   h->Close("h1");
   if (c.verdict) {
-    const char* v = c.verdict->pass ? "PASS" : "FAIL";
+    const char* v = VerdictName(c.verdict->pass);
     h->Open("p").Element("span", v, {{"class", std::string("badge ") + v}, {"data-key", "verdict"}});
     const std::string criteria = Count(static_cast<long long>(c.verdict->criteria.size()));
     h->Text(" " + c.verdict->limits_name + " \xe2\x80\x94 " +
@@ -214,7 +214,7 @@ void Identification(Html* h, const Certificate& c) {
     // What failed, where the signer looks first (the table below has every criterion).
     if (!c.verdict->pass) {
       h->Element("p", "Failed: " + c.verdict->FailedSummary(/*in_words=*/true) + ".",
-                 {{"class", "FAIL"}, {"data-key", "failed_criteria"}});
+                 {{"class", VerdictName(false)}, {"data-key", "failed_criteria"}});
     }
   } else {
     h->Element("p",
@@ -376,7 +376,7 @@ void Acceptance(Html* h, const Verdict& verdict) {
       Num(h, cr.margin_text);
     }
     h->Element("td", OutcomeName(cr.outcome) + (cr.reason.empty() ? std::string() : ": " + cr.reason),
-               {{"class", cr.pass ? "PASS" : "FAIL"}, {"data-outcome", OutcomeName(cr.outcome)}})
+               {{"class", VerdictName(cr.pass)}, {"data-outcome", OutcomeName(cr.outcome)}})
         .Close("tr");
   }
   h->Close("tbody").Close("table");
@@ -670,7 +670,7 @@ std::string CertificateHtml(const Certificate& c) {
   Html h;
   internal::OpenPage(
       &h, "Calibration certificate " + serial, "IMU calibration certificate " + serial,
-      (c.verdict ? std::string(c.verdict->pass ? "PASS" : "FAIL") + " \xe2\x80\x94 " : std::string()) +
+      (c.verdict ? std::string(VerdictName(c.verdict->pass)) + " \xe2\x80\x94 " : std::string()) +
           "certificate " + c.number + ", " + (c.acquired_utc.empty() ? c.calibrated_utc : c.acquired_utc));
   Identification(&h, c);
   RunAndSettings(&h, c);

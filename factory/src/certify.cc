@@ -31,14 +31,18 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
   sources.folds = fit.folds;
   sources.warnings = unit.warnings;
   sources.limits = settings.limits;  // judged with the noise the certificate measures
-  // The calibration is not in place yet (it is committed with the certificate): hash its text.
-  sources.inputs = {{"calibration", files.calibration, Sha256Hex(unit.calibration_yaml)},
-                    {"plan", unit.plan_path, unit.plan_sha256},
-                    {"samples", unit.samples_path, unit.samples_sha256},
-                    {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
-                    {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
+  // A calibration just fitted is not in place yet (it is committed with the certificate): hash
+  // its text; an input is hashed from its file.
+  sources.inputs = {
+      {"calibration", files.calibration, files.calibration_is_input ? "" : Sha256Hex(unit.calibration_yaml)},
+      {"plan", unit.plan_path, unit.plan_sha256},
+      {"samples", unit.samples_path, unit.samples_sha256},
+      {"limits", settings.limits ? settings.limits->path : "", settings.limits_sha256},
+      {"station", settings.station ? settings.station->path : "", settings.station_sha256}};
   sources.station = settings.station;
-  sources.header = RunHeader();  // the fit recorded what the samples header says
+  // A fit recorded what the samples header says; a calibration read from a file may not have.
+  sources.header = files.calibration_is_input ? fit.run.header : RunHeader();
+  sources.noise_stretch = settings.noise_stretch;
   sources.customer = settings.customer;
   sources.order = settings.order;
   ReadCertificateFiles(&sources);  // only what is not known yet: the run kept its static stretch
@@ -52,9 +56,8 @@ void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
   unit->figures = KeyFigures(calibration);
   unit->calibrated_utc = calibration.created_utc;
   if (!settings.limits) return;
-  unit->verdict_detail = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
-  unit->verdict = unit->verdict_detail.pass ? "PASS" : "FAIL";
-  unit->message = unit->verdict_detail.FailedSummary();
+  unit->verdict = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
+  unit->message = unit->verdict->FailedSummary();
 }
 
 void ReadLimitsAndStation(const std::string& limits_path, const std::string& station_path,
@@ -72,14 +75,14 @@ void ReadLimitsAndStation(const std::string& limits_path, const std::string& sta
 bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit) {
   IMUFIT_CHECK(unit->fit && unit->fit->calibration, "CertifyUnit() certifies a fitted unit");
   const Calibration& calibration = *unit->fit->calibration;
-  unit->status = "fitted";
-  unit->calibration_yaml = CalibrationToYaml(calibration);
+  unit->status = UnitStatus::kFitted;
+  if (!files.calibration_is_input) unit->calibration_yaml = CalibrationToYaml(calibration);
   std::optional<Certificate> certificate;
   if (!files.report.empty()) certificate = MakeUnitCertificate(settings, files, *unit);
   JudgeUnit(settings, calibration, certificate ? certificate->verdict : std::nullopt, unit);
   // The calibration, the certificate, the caller's further outputs and the store's row: all or none.
   OutputTransaction outputs;
-  WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
+  if (!files.calibration_is_input) WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
   if (certificate) {
     const std::string html = CertificateHtml(*certificate);
     WriteFileAtomically(files.report, html, &outputs);
@@ -124,14 +127,14 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.unit = unit->unit.empty() ? unit->samples_path : unit->unit;
   row.serial = unit->serial.empty() ? row.unit : unit->serial;
   row.lot = settings.lot;
-  const bool fitted = unit->fit && unit->fit->calibration && unit->status == "fitted";
+  const bool fitted = unit->fit && unit->fit->calibration && unit->status == UnitStatus::kFitted;
   row.time_utc = fitted ? unit->fit->calibration->created_utc : UtcNow();
   row.software = settings.software;
   row.plan_sha256 = unit->plan_sha256;
   row.samples_sha256 = unit->samples_sha256;
   row.limits_sha256 = settings.limits_sha256;
-  row.status = unit->status;
-  row.verdict = unit->verdict;
+  row.status = unit->StatusText();
+  row.verdict = unit->VerdictText();
   row.message = unit->message;
   row.calibration_yaml = unit->calibration_yaml;
   if (settings.station)
@@ -141,12 +144,14 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.acquired_utc =
       header && !header->acquired_utc.empty() ? header->acquired_utc : FileTimeUtc(unit->samples_path);
   if (header) row.part_number = header->model;
+  const std::vector<CriterionResult> not_judged;
+  const std::vector<CriterionResult>& criteria = unit->verdict ? unit->verdict->criteria : not_judged;
   for (const Figure& figure : unit->figures) {
     StoredFigure g = StoredFigureOf(figure);
-    for (const CriterionResult& c : unit->verdict_detail.criteria) {
+    for (const CriterionResult& c : criteria) {
       if (c.name != "|" + g.name + "|") continue;
       g.limit_abs = c.limit;
-      g.outcome = c.pass ? "pass" : "fail";
+      g.outcome = NameOf(kCriterionAcceptanceNames, c.pass);
       g.judgement = OutcomeName(c.outcome);
     }
     if (!figure.unresolved.empty()) g.judgement = kNotResolved;
@@ -166,8 +171,8 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
     settings.store->Record(row, commit_outputs);
   } catch (const std::exception& e) {
     if (output_error) std::rethrow_exception(output_error);
-    unit->status = "error";
-    unit->verdict.clear();
+    unit->status = UnitStatus::kError;
+    unit->verdict.reset();
     unit->message = std::string(e.what()) + ": the fit is not recorded in the results store";
     return false;
   }

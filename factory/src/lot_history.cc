@@ -4,7 +4,7 @@
 #include <cmath>
 #include <map>
 
-#include "imufit/io/units.h"
+#include "imufit/io/key_figures.h"
 
 namespace imufit {
 namespace {
@@ -21,13 +21,6 @@ LimitInterval Intersect(const LimitInterval& a, const LimitInterval& b) {
   return both;
 }
 
-// The nominal scale of a scale figure in the figure's unit (raw/(deg/s), raw/g); 0 without one.
-double NominalScale(const std::string& quantity, const Limits& limits) {
-  if (quantity == "gyro_scale_per_dps") return limits.nominal_gyro_scale / kRadToDeg;
-  if (quantity == "accel_scale_per_g") return limits.nominal_accel_scale * kStandardGravityMps2;
-  return 0.0;
-}
-
 }  // namespace
 
 const std::vector<std::string> kLotTrendFigures = {
@@ -38,11 +31,11 @@ std::optional<LimitInterval> FigureLimits(const std::string& figure, const Limit
   const size_t dot = figure.find('.');
   const std::string quantity = figure.substr(0, dot);
   const std::string axis = dot == std::string::npos ? "" : figure.substr(dot + 1);
-  // "gyro_scale_per_dps" is judged by "gyro_scale_error_ppm" and "_pct": |S / nominal - 1| < limit.
-  const size_t scale_at = quantity.find("_scale_per_");
-  const std::string scale_error =
-      scale_at == std::string::npos ? "" : quantity.substr(0, scale_at) + "_scale_error_";
-  const double nominal = NominalScale(quantity, limits);
+  // A scale figure ("gyro_scale_per_dps") is judged by the scale errors of its group
+  // ("gyro_scale_error_ppm", "_pct"): |S / nominal - 1| < limit.
+  const KeyFigure* figure_quantity = FindKeyFigure(quantity);
+  const bool coefficient =
+      figure_quantity != nullptr && figure_quantity->source == FigureSource::kCoefficient;
   std::optional<LimitInterval> interval;
   for (const LimitCriterion& criterion : limits.criteria) {
     if (criterion.kind == LimitKind::kCoverage || criterion.statistic == LimitStatistic::kSigma) continue;
@@ -54,10 +47,12 @@ std::optional<LimitInterval> FigureLimits(const std::string& figure, const Limit
       allowed.upper = criterion.max_abs;  // a residual RMS: one-sided
     } else if (criterion.quantity == quantity) {
       allowed = {-criterion.max_abs, criterion.max_abs, true};
-    } else if (!scale_error.empty() && nominal > 0.0 && criterion.quantity.rfind(scale_error, 0) == 0) {
-      const bool ppm =
-          criterion.quantity.size() > 4 && criterion.quantity.substr(criterion.quantity.size() - 4) == "_ppm";
-      const double fraction = criterion.max_abs * (ppm ? 1e-6 : 1e-2);
+    } else if (const KeyFigure* error = FindLimitQuantity(criterion.quantity);
+               coefficient && error != nullptr && error->source == FigureSource::kScaleError &&
+               std::string(error->path) == figure_quantity->path) {
+      const double nominal = limits.NominalScaleFigure(IsGyroFigure(*error));
+      if (!(nominal > 0.0)) continue;
+      const double fraction = criterion.max_abs * (1.0 / error->per_unit);  // 1e-6 per ppm, 1e-2 per %
       allowed = {nominal * (1.0 - fraction), nominal * (1.0 + fraction), false};
     } else {
       continue;

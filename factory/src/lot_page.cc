@@ -105,9 +105,13 @@ void Summary(Html* h, const LotSummary& lot) {
   h->Open("tr").Element("td", "units").Open("td").Element("span", Count(lot.units), {{"data-key", "units"}});
   h->Close("td").Close("tr");
   h->Open("tr").Element("td", "passed").Open("td");
-  h->Element("span", Count(lot.passed), {{"class", "PASS"}, {"data-key", "passed"}}).Close("td").Close("tr");
+  h->Element("span", Count(lot.passed), {{"class", VerdictName(true)}, {"data-key", "passed"}})
+      .Close("td")
+      .Close("tr");
   h->Open("tr").Element("td", "failed limits").Open("td");
-  h->Element("span", Count(lot.failed), {{"class", "FAIL"}, {"data-key", "failed"}}).Close("td").Close("tr");
+  h->Element("span", Count(lot.failed), {{"class", VerdictName(false)}, {"data-key", "failed"}})
+      .Close("td")
+      .Close("tr");
   Row(h, {"not fitted / errors", Count(lot.not_fitted) + " / " + Count(lot.errors)});
   h->Open("tr").Element("td", "yield").Open("td");
   if (std::isfinite(lot.yield_pct)) {

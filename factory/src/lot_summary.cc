@@ -65,8 +65,8 @@ std::string LotSummaryCsv(const BatchResult& batch) {
   for (const std::string& name : names) csv += "," + name + "," + name + ".sigma," + name + ".U";
   csv += "\n";
   for (const UnitOutcome& u : batch.units) {
-    csv += CsvCell(u.unit) + "," + CsvCell(u.serial) + "," + CsvCell(u.status) + "," + CsvCell(u.verdict) +
-           "," + CsvCell(u.message) + "," + CsvCell(u.calibrated_utc);
+    csv += CsvCell(u.unit) + "," + CsvCell(u.serial) + "," + CsvCell(u.StatusText()) + "," +
+           CsvCell(u.VerdictText()) + "," + CsvCell(u.message) + "," + CsvCell(u.calibrated_utc);
     for (const std::string& name : names) {
       const Figure* f = FindFigure(u.figures, name);
       if (f == nullptr) {
@@ -85,7 +85,8 @@ namespace {
 
 // Whether `unit` failed a criterion about the figure `name`: "|name|", "sigma(name)" or "name".
 bool FailedOn(const UnitOutcome& unit, const std::string& name) {
-  for (const CriterionResult& c : unit.verdict_detail.criteria) {
+  if (!unit.verdict) return false;
+  for (const CriterionResult& c : unit.verdict->criteria) {
     if (c.pass) continue;
     if (c.name == name || c.name == "|" + name + "|" || c.name == "sigma(" + name + ")") return true;
   }
@@ -132,7 +133,7 @@ LotFigure FigureOverLot(const std::string& name, const BatchResult& batch,
     f.row.push_back(static_cast<int>(row));
     f.value.push_back(figure->value);
     f.sigma.push_back(figure->sigma);
-    f.failed.push_back(u.verdict == "FAIL");
+    f.failed.push_back(u.verdict && !u.verdict->pass);
     f.outside_limits.push_back(f.limits && ((f.limits->lower && !(figure->value > *f.limits->lower)) ||
                                             (f.limits->upper && !(figure->value < *f.limits->upper))));
     f.plotted = f.plotted || f.outside_limits.back() || FailedOn(u, name);
@@ -179,12 +180,12 @@ LotSummary MakeLotSummary(const std::string& lot, const BatchResult& batch, cons
   std::vector<std::string> names;
   for (const UnitOutcome& u : batch.units) {
     names.push_back(u.unit);
-    s.conditional += !u.verdict.empty() && u.verdict_detail.Conditional() > 0 ? 1 : 0;
+    s.conditional += u.verdict && u.verdict->Conditional() > 0 ? 1 : 0;
   }
   s.unit_prefix = SharedPrefix(names);
   for (const UnitOutcome& u : batch.units) {
-    s.rows.push_back({u.unit, u.serial, u.status, u.verdict, u.message, u.status == "fitted",
-                      u.unit.substr(s.unit_prefix.size())});
+    s.rows.push_back({u.unit, u.serial, u.StatusText(), u.VerdictText(), u.message,
+                      u.status == UnitStatus::kFitted, u.unit.substr(s.unit_prefix.size())});
   }
   s.figure_names = LotFigureNames(batch);
   for (const std::string& name : s.figure_names) {

@@ -126,16 +126,19 @@ BatchResult StoredLot(ResultsStore* store, const std::string& lot) {
     UnitOutcome u;
     u.unit = f.unit;
     u.serial = f.serial;
-    u.status = f.status;
-    u.verdict = f.verdict;
+    ValueOf(kUnitStatusNames, f.status, &u.status);
+    bool pass = false;
+    if (ValueOf(kVerdictNames, f.verdict, &pass)) u.verdict.emplace().pass = pass;
     u.message = f.message;
     u.plan_sha256 = f.plan_sha256;
     u.samples_sha256 = f.samples_sha256;
-    if (f.status == "fitted") u.calibrated_utc = f.time_utc;  // a batch's: the calibration's created_utc
+    if (u.status == UnitStatus::kFitted)
+      u.calibrated_utc = f.time_utc;  // a batch's: the calibration's created_utc
     u.calibration_yaml = std::move(f.calibration_yaml);
     for (const StoredFigure& g : f.figures) {
       u.figures.push_back(MakeFigure(g.name, g.coefficient, g.unit, g.value, g.sigma));
-      if (g.outcome.empty()) continue;
+      bool accepted = false;
+      if (!u.verdict || !ValueOf(kCriterionAcceptanceNames, g.outcome, &accepted)) continue;
       CriterionResult c;
       c.name = "|" + g.name + "|";
       c.unit = g.unit;
@@ -143,20 +146,12 @@ BatchResult StoredLot(ResultsStore* store, const std::string& lot) {
       c.limit = g.limit_abs;
       c.margin = g.limit_abs - c.measured;
       c.expanded = g.expanded_u;
-      c.pass = g.outcome == "pass";
+      c.pass = accepted;
       c.outcome = c.pass ? Outcome::kPass : Outcome::kFail;  // a store of version 3 knows no more
-      for (Outcome o :
-           {Outcome::kPass, Outcome::kConditionalPass, Outcome::kConditionalFail, Outcome::kFail}) {
-        if (g.judgement == OutcomeName(o)) c.outcome = o;
-      }
-      u.verdict_detail.criteria.push_back(c);
+      ValueOf(kOutcomeNames, g.judgement, &c.outcome);
+      u.verdict->criteria.push_back(c);
     }
-    u.verdict_detail.pass = u.verdict == "PASS";
-    if (u.status == "error") ++result.errors;
-    if (u.status == "not-fitted") ++result.not_fitted;
-    if (u.verdict == "PASS") ++result.passed;
-    if (u.verdict == "FAIL") ++result.failed;
-    result.units.push_back(std::move(u));
+    result.Add(std::move(u));
   }
   return result;
 }

@@ -1,26 +1,33 @@
 #include "imufit/io/limits.h"
 
-#include <sstream>
-
+#include "imufit/base/enum_names.h"
 #include "imufit/io/error.h"
 #include "yaml_util.h"
 
 namespace imufit {
+
+const KeyFigure* FindLimitQuantity(const std::string& quantity) {
+  const KeyFigure* figure = FindKeyFigure(quantity);
+  return figure != nullptr && figure->in_limits && quantity == figure->name ? figure : nullptr;
+}
+
+std::string LimitQuantityNames() {
+  std::string names;
+  for (const KeyFigure& figure : kKeyFigures) {
+    if (figure.in_limits) names += (names.empty() ? "" : ", ") + std::string(figure.name);
+  }
+  return names;
+}
+
 namespace {
 
-std::vector<std::string> Words(const char* text) {
-  std::istringstream stream(text);
-  std::vector<std::string> words;
-  for (std::string word; stream >> word;) words.push_back(word);
-  return words;
-}
-
-const LimitQuantity* FindQuantity(const std::string& name) {
-  for (const LimitQuantity& q : kLimitQuantities) {
-    if (name == q.name) return &q;
-  }
-  return nullptr;
-}
+// The limits file's words for what is judged and by which rule.
+constexpr EnumName<LimitStatistic> kLimitStatisticNames[] = {{LimitStatistic::kValue, "value"},
+                                                             {LimitStatistic::kSigma, "sigma"},
+                                                             {LimitStatistic::kLargest, "largest"},
+                                                             {LimitStatistic::kVariation, "variation"}};
+constexpr EnumName<DecisionRule> kDecisionRuleNames[] = {{DecisionRule::kSimple, "simple"},
+                                                         {DecisionRule::kGuarded, "guarded"}};
 
 double PositiveNumber(const yaml::Located& value) {
   const double number = value.Double();
@@ -35,17 +42,17 @@ void ReadStatistic(const yaml::Located& entry, LimitCriterion* criterion) {
     const std::string text = statistic.String();
     const bool coefficient = criterion->kind == LimitKind::kCoefficient;
     // The noise figures are measured at one temperature: they have no curve to take a range of.
-    const bool has_curve = coefficient && criterion->quantity.find("_arw_") == std::string::npos &&
-                           criterion->quantity.find("_bias_instability_") == std::string::npos;
-    if (text == "sigma") {
-      if (!coefficient) statistic.Fail(criterion->quantity + " has no 1-sigma");
-      criterion->statistic = LimitStatistic::kSigma;
-    } else if (text == "largest" || text == "variation") {
-      if (!has_curve) statistic.Fail(criterion->quantity + " does not vary with temperature in the model");
-      criterion->statistic = text == "largest" ? LimitStatistic::kLargest : LimitStatistic::kVariation;
-    } else if (text != "value") {
-      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: value, sigma, largest, variation)");
+    const bool has_curve = HasTemperatureCurve(*FindLimitQuantity(criterion->quantity));
+    if (!ValueOf(kLimitStatisticNames, text, &criterion->statistic)) {
+      statistic.Fail(QuoteForMessage(text) + " is not a statistic (known: " + AllNames(kLimitStatisticNames) +
+                     ")");
     }
+    if (criterion->statistic == LimitStatistic::kSigma && !coefficient)
+      statistic.Fail(criterion->quantity + " has no 1-sigma");
+    if ((criterion->statistic == LimitStatistic::kLargest ||
+         criterion->statistic == LimitStatistic::kVariation) &&
+        !has_curve)
+      statistic.Fail(criterion->quantity + " does not vary with temperature in the model");
   }
   if (entry.Has("over")) {
     const yaml::Located over = entry["over"];
@@ -64,17 +71,16 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
   LimitCriterion criterion;
   const yaml::Located quantity = entry["quantity"];
   criterion.quantity = quantity.String();
-  const LimitQuantity* known = FindQuantity(criterion.quantity);
+  const KeyFigure* known = FindLimitQuantity(criterion.quantity);
   if (known == nullptr) {
-    std::string list;
-    for (const LimitQuantity& q : kLimitQuantities) list += (list.empty() ? "" : ", ") + std::string(q.name);
-    quantity.Fail("unknown quantity " + QuoteForMessage(criterion.quantity) + " (known: " + list + ")");
+    quantity.Fail("unknown quantity " + QuoteForMessage(criterion.quantity) +
+                  " (known: " + LimitQuantityNames() + ")");
   }
-  criterion.kind = known->kind;
+  criterion.kind = LimitKindOf(*known);
   criterion.unit = known->unit;
-  const std::vector<std::string> all_axes = Words(known->axes);
-  if (criterion.quantity.find("_scale_error_") != std::string::npos) {
-    const bool gyro = criterion.quantity.rfind("gyro", 0) == 0;
+  const std::vector<std::string> all_axes = KeyFigureAxes(*known);
+  if (known->source == FigureSource::kScaleError) {
+    const bool gyro = IsGyroFigure(*known);
     if ((gyro ? limits.nominal_gyro_scale : limits.nominal_accel_scale) == 0.0) {
       quantity.Fail(std::string("needs nominal.") + (gyro ? "gyro_scale" : "accel_scale") +
                     " (raw per rad/s or per m/s^2) in the limits file");
@@ -131,9 +137,7 @@ LimitCriterion ReadCriterion(const yaml::Located& entry, const Limits& limits) {
 
 }  // namespace
 
-const char* DecisionRuleName(DecisionRule rule) {
-  return rule == DecisionRule::kGuarded ? "guarded" : "simple";
-}
+const char* DecisionRuleName(DecisionRule rule) { return NameOf(kDecisionRuleNames, rule); }
 
 Limits ReadLimits(const std::string& path) {
   const YAML::Node root_node = yaml::LoadFile(path);
@@ -152,11 +156,9 @@ Limits ReadLimits(const std::string& path) {
   if (root.Has("decision_rule")) {
     const yaml::Located rule = root["decision_rule"];
     const std::string text = rule.String();
-    if (text == "guarded") {
-      limits.decision_rule = DecisionRule::kGuarded;
-    } else if (text != "simple") {
-      rule.Fail(QuoteForMessage(text) + " is not a decision rule (known: simple, guarded)");
-    }
+    if (!ValueOf(kDecisionRuleNames, text, &limits.decision_rule))
+      rule.Fail(QuoteForMessage(text) + " is not a decision rule (known: " + AllNames(kDecisionRuleNames) +
+                ")");
   }
   if (root.Has("guard_band")) {
     if (limits.decision_rule != DecisionRule::kGuarded) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "imufit/io/key_figures.h"
 #include "imufit/model/constants.h"
 #include "imufit/pipeline/fit_run.h"
 
@@ -47,49 +48,32 @@ double AchievedSigma(const Calibration& calibration, const PlanRow& row) {
   return divisor > 0.0 ? sigma * PlanGroupFactor(row.group) / divisor : -1.0;
 }
 
-// The key figure (acceptance.h's KeyFigures names) of a 25 degC coefficient.
+// The key figure (io/key_figures.h) of a 25 degC coefficient: its group's.
 std::string FigureOf(const PlanRow& row) {
-  static const std::map<std::string, std::string> kQuantities = {
-      {"gyro.bias", "gyro_bias_dps"},
-      {"accel.bias", "accel_bias_mg"},
-      {"gyro.scale", "gyro_scale_per_dps"},
-      {"accel.scale", "accel_scale_per_g"},
-      {"gyro.misalignment", "gyro_misalignment_mrad"},
-      {"accel.misalignment", "accel_misalignment_mrad"},
-      {"gyro.g_sensitivity", "gyro_g_sensitivity_dpsg"}};
-  const auto quantity = kQuantities.find(row.group);
-  if (row.term != 0 || quantity == kQuantities.end()) return "";
-  return quantity->second + "." + kCoefficientNames[row.coefficient].axis;
+  if (row.term != 0) return "";
+  for (const KeyFigure& quantity : kKeyFigures) {
+    if (quantity.source == FigureSource::kCoefficient && row.group == quantity.path)
+      return std::string(quantity.name) + "." + kCoefficientNames[row.coefficient].axis;
+  }
+  return "";
 }
 
 }  // namespace
 
 void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances) {
-  struct Map {
-    const char* quantity;
-    const char* group;
-    double factor;
-  };
-  static const Map kMaps[] = {{"gyro_bias_dps", "gyro.bias", 1.0},
-                              {"accel_bias_mg", "accel.bias", 1.0},
-                              {"gyro_scale_error_ppm", "gyro.scale", 1.0},
-                              {"gyro_scale_error_pct", "gyro.scale", 1e4},
-                              {"accel_scale_error_ppm", "accel.scale", 1.0},
-                              {"accel_scale_error_pct", "accel.scale", 1e4},
-                              {"gyro_misalignment_mrad", "gyro.misalignment", 1.0},
-                              {"accel_misalignment_mrad", "accel.misalignment", 1.0},
-                              {"gyro_g_sensitivity_dpsg", "gyro.g_sensitivity", 1.0}};
   for (const LimitCriterion& criterion : limits.criteria) {
     const double half_width = criterion.max_abs > 0.0          ? criterion.max_abs
                               : criterion.min && criterion.max ? 0.5 * (*criterion.max - *criterion.min)
                                                                : 0.0;
     if (!(half_width > 0.0)) continue;
-    for (const Map& m : kMaps) {
-      if (criterion.quantity != m.quantity) continue;
-      const double tolerance = half_width * m.factor;
-      auto [it, inserted] = tolerances->emplace(m.group, tolerance);
-      if (!inserted) it->second = std::min(it->second, tolerance);
-    }
+    // A coefficient's limit in its group's display unit: the figure's own, except a scale error's
+    // (PlanGroupUnit: ppm).
+    const KeyFigure* quantity = FindLimitQuantity(criterion.quantity);
+    if (quantity == nullptr || !HasTemperatureCurve(*quantity)) continue;
+    const double factor = quantity->source == FigureSource::kScaleError ? 1e6 / quantity->per_unit : 1.0;
+    const double tolerance = half_width * factor;
+    auto [it, inserted] = tolerances->emplace(quantity->path, tolerance);
+    if (!inserted) it->second = std::min(it->second, tolerance);
   }
 }
 

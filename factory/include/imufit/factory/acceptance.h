@@ -1,10 +1,11 @@
 // imufit — a unit's key figures and its acceptance verdict against a limits file.
 //
-// Key figures are the calibration's coefficients at 25 degC, evaluated through the model's
-// polynomial (whatever the calibration's reference_temp_c), in the units a test engineer reads
-// (engineering_units.h: deg/s, mg, raw/(deg/s), raw/g, mrad, deg/s/g), each with its 1-sigma from the
-// `sigma` tree; plus the fit's residual RMS (deg/s, mg) from the calibration's `fit:` block and
-// the gyro noise figures of a `noise:` block (io/noise_file.h).
+// Key figures (their table, names, units and sources: io/key_figures.h) are the calibration's
+// coefficients at 25 degC, evaluated through the model's polynomial (whatever the calibration's
+// reference_temp_c), in the units a test engineer reads (engineering_units.h: deg/s, mg,
+// raw/(deg/s), raw/g, mrad, deg/s/g), each with its 1-sigma from the `sigma` tree; plus the fit's
+// residual RMS (deg/s, mg) and segments missing from the calibration's `fit:` block and the gyro
+// noise figures of a `noise:` block (io/noise_file.h).
 #ifndef IMUFIT_FACTORY_ACCEPTANCE_H_
 #define IMUFIT_FACTORY_ACCEPTANCE_H_
 
@@ -12,7 +13,9 @@
 #include <utility>
 #include <vector>
 
+#include "imufit/base/verdict.h"
 #include "imufit/io/calibration.h"
+#include "imufit/io/key_figures.h"
 #include "imufit/io/limits.h"
 #include "imufit/report/engineering_units.h"
 
@@ -48,23 +51,21 @@ inline Figure MakeFigure(std::string name, std::string coefficient, std::string 
   return figure;
 }
 
-// A figure or limit quantity in words, for a reader: "gyro_bias_dps.x" -> "Gyro bias X",
-// "gyro_g_sensitivity_dpsg.xy" -> "Gyro g-sensitivity X from Y", "gyro_misalignment_mrad.xy" ->
-// "Gyro misalignment X from Y", "fit_temp_range_c" -> "Fitted temperature range"; a name it does
-// not know is returned as it is.
+// A figure or limit quantity in words (its KeyFigure::title with the axis), for a reader:
+// "gyro_bias_dps.x" -> "Gyro bias X", "gyro_g_sensitivity_dpsg.xy" -> "Gyro g-sensitivity X from Y",
+// "gyro_misalignment_mrad.xy" -> "Gyro misalignment X from Y", "fit_temp_range_c" -> "Fitted
+// temperature range"; a name it does not know is returned as it is.
 std::string FigureTitle(const std::string& name);
 
-// Every coefficient at 25 degC and the residual RMS values, in a fixed order.
+// Every figure of the calibration at 25 degC (coefficients, noise figures, the fit record's), in
+// the order of kKeyFigures.
 // `temp_c`: the coefficients at another temperature (the statistics over a range of a limits file).
 std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c = kFigureTempC);
 // The figure called `name` (or with that `coefficient` path); nullptr when there is none.
 const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name);
 
-// Where a value lies against its limit with its expanded uncertainty U (ILAC-G8): clear of the
-// limit by more than U on either side, or within U of it.
-enum class Outcome { kPass, kConditionalPass, kConditionalFail, kFail };
-// "PASS", "conditional pass", "conditional fail", "FAIL".
-const char* OutcomeName(Outcome outcome);
+// "PASS", "conditional pass", "conditional fail", "FAIL" (Outcome: base/verdict.h).
+inline const char* OutcomeName(Outcome outcome) { return NameOf(kOutcomeNames, outcome); }
 // The judgement of a figure the run does not measure (Figure::unresolved), as stored.
 inline constexpr const char* kNotResolved = "not resolved";
 

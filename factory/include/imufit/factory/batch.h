@@ -81,10 +81,20 @@ struct BatchResult {
   std::vector<UnitOutcome> units;  // in folder-name order
   int passed = 0, failed = 0, not_fitted = 0, errors = 0, skipped = 0;
   bool complete = true;  // false when max_units stopped the batch early
+
+  // Appends `unit` and counts it.
+  void Add(UnitOutcome unit) {
+    skipped += unit.skipped ? 1 : 0;
+    errors += unit.status == UnitStatus::kError ? 1 : 0;
+    not_fitted += unit.status == UnitStatus::kNotFitted ? 1 : 0;
+    passed += unit.verdict && unit.verdict->pass ? 1 : 0;
+    failed += unit.verdict && !unit.verdict->pass ? 1 : 0;
+    units.push_back(std::move(unit));
+  }
 };
 
 // Throws InputError for a bad units folder, output folder, limits file or store; never for one
-// unit's bad input (that unit's status is "error").
+// unit's bad input (that unit's status is UnitStatus::kError).
 BatchResult RunBatch(const BatchOptions& options);
 
 // The unit's key figures in the lot summary, in column order.

@@ -22,11 +22,13 @@
 #include <string>
 #include <vector>
 
+#include "imufit/base/verdict.h"
 #include "imufit/factory/acceptance.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/station.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/pipeline/static_stretch.h"
 #include "imufit/report/pdf.h"
 #include "imufit/store/store.h"
 
@@ -39,8 +41,10 @@ struct UnitOutcome {
   // Sources of the serial that disagree (unit_serial.h); shown on the certificate. Not kept for a
   // skipped unit.
   std::vector<std::string> warnings;
-  std::string status;   // "fitted", "not-fitted" (the run does not determine the model), "error" (bad input)
-  std::string verdict;  // "PASS", "FAIL", "" (not fitted, or no limits)
+  UnitStatus status = UnitStatus::kNotFitted;
+  // The verdict against the acceptance limits, criterion by criterion; nullopt when the unit was
+  // not fitted, or without limits.
+  std::optional<Verdict> verdict;
   std::string message;  // the failed criteria, or why it was not fitted
   std::vector<Figure> figures;
   std::string calibrated_utc;  // when the calibration was made (its created_utc); fitted units
@@ -53,7 +57,11 @@ struct UnitOutcome {
   // The fit's result and the calibration (not filled for skipped units).
   std::optional<FitRunResult> fit;
   std::string calibration_yaml;  // the calibration file's text (fitted units)
-  Verdict verdict_detail;
+
+  // As the manifest, the store and lot_summary.csv write them (base/verdict.h): "fitted",
+  // "not-fitted", "error"; "PASS", "FAIL", "" (no verdict).
+  const char* StatusText() const { return NameOf(kUnitStatusNames, status); }
+  const char* VerdictText() const { return verdict ? VerdictName(verdict->pass) : ""; }
 };
 
 // What every unit is certified with: the one unit of `imufit fit`, or each unit of a batch.
@@ -75,6 +83,9 @@ struct CertifySettings {
   // ("" for a single fit).
   ResultsStore* store = nullptr;
   std::string lot;
+  // The static stretch the noise section is measured on when the run's reading kept none
+  // (imufit report's --noise-segment).
+  NoiseStretchOptions noise_stretch;
 };
 
 // Reads the limits and the station file into `settings` (either path may be empty), with their
@@ -84,17 +95,25 @@ void ReadLimitsAndStation(const std::string& limits_path, const std::string& sta
 
 // Where a unit's outputs go.
 struct UnitFiles {
+  // Where the calibration is written; with calibration_is_input, the file it was read from.
   std::string calibration;
   std::string report;  // the certificate; "" for none
   std::string pdf;     // the certificate printed (pdf.h), with `report`; "" for none
   Paper paper = Paper::kA4;
   // Further outputs written into the unit's transaction once it is judged (a batch's manifest).
   std::function<void(const UnitOutcome&, OutputTransaction*)> more;
+  // The calibration is an input certified as it is (imufit report: unit->fit holds it with the
+  // run read again, not a fit): its file is hashed, not written, and the certificate takes the
+  // samples header's run details where its record lacks them (a calibration of an older imufit).
+  bool calibration_is_input = false;
 };
 
 // Certifies, judges, commits and records `unit`: unit->fit holds FitRun's result with a calibration
-// (the serial it is to carry set), and unit->plan_path, samples_path and their hashes are filled.
-// Sets the unit's status ("fitted"), figures, verdict and calibration text. Throws InputError when
+// (the serial it is to carry set), or for a calibration that is an input (UnitFiles::
+// calibration_is_input) that calibration with its plan and run; unit->plan_path, samples_path and
+// their hashes are filled (a hash may be "": then the file is hashed).
+// `imufit fit`, `imufit report` and every unit of `imufit batch` are certified here.
+// Sets the unit's status (fitted), figures, verdict and calibration text. Throws InputError when
 // an output cannot be written (then none is, and nothing is recorded). Returns RecordUnit()'s
 // answer (false: the store refused the row; then no output was written either).
 bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit);
@@ -109,7 +128,7 @@ StoredFigure StoredFigureOf(const Figure& figure);
 
 // Records `unit`, whatever its status, in settings.store when there is one (safe from several
 // threads at once), committing `outputs` (may be null) with the row: both or neither. Returns
-// false when the store refuses it: then the unit is an "error" whose message says why, and no
+// false when the store refuses it: then the unit is an error whose message says why, and no
 // output is written. An output that cannot be written throws (InputError); then nothing is recorded.
 bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransaction* outputs = nullptr);
 

@@ -22,9 +22,10 @@
 // "conditional pass" (inside the limit) or a "conditional fail" (outside). Simple acceptance passes
 // the value inside its limit; guarded acceptance passes it only inside the limit less w = guard_band x U.
 //
-// Quantities are the 25 degC values of coefficients in familiar units (kLimitQuantities), fit
-// residual RMS values, and the fitted temperature range. The reader checks every name, axis and
-// number and throws InputError at file:line:column; evaluation is imufit::factory's.
+// Quantities are the key figures of kKeyFigures (key_figures.h) a limits file may name: the 25 degC
+// values of coefficients in familiar units, fit residual RMS values, the noise figures, the
+// certificate's largest window errors, and the fitted temperature range. The reader checks every name, axis
+// and number and throws InputError at file:line:column; evaluation is imufit::factory's.
 #ifndef IMUFIT_IO_LIMITS_H_
 #define IMUFIT_IO_LIMITS_H_
 
@@ -32,6 +33,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "imufit/io/key_figures.h"
 
 namespace imufit {
 
@@ -41,43 +44,11 @@ inline constexpr int kLimitsFormatVersion = 1;
 // limits are judged with, that certificates print and that the results store keeps.
 inline constexpr double kCoverageFactor = 2.0;
 
-enum class LimitKind {
-  kCoefficient,  // a 25 degC coefficient value per axis: |value| (or its 1-sigma) < max_abs
-  kFigure,       // one number without axes (residual RMS): value < max_abs
-  kCoverage,     // fit_temp_range_c must cover [lo, hi]
-};
-
-struct LimitQuantity {
-  const char* name;  // as written in the file, unit in the name
-  LimitKind kind;
-  const char* axes;  // space-separated axis names of a coefficient quantity, "" otherwise
-  const char* unit;  // for tables: "deg/s", "ppm", ...
-};
-
-inline constexpr LimitQuantity kLimitQuantities[] = {
-    {"gyro_bias_dps", LimitKind::kCoefficient, "x y z", "deg/s"},
-    {"accel_bias_mg", LimitKind::kCoefficient, "x y z", "mg"},
-    {"gyro_scale_error_ppm", LimitKind::kCoefficient, "x y z", "ppm"},
-    {"gyro_scale_error_pct", LimitKind::kCoefficient, "x y z", "%"},
-    {"accel_scale_error_ppm", LimitKind::kCoefficient, "x y z", "ppm"},
-    {"accel_scale_error_pct", LimitKind::kCoefficient, "x y z", "%"},
-    {"gyro_misalignment_mrad", LimitKind::kCoefficient, "xy xz yx yz zx zy", "mrad"},
-    {"accel_misalignment_mrad", LimitKind::kCoefficient, "xy xz yx yz zx zy", "mrad"},
-    {"gyro_g_sensitivity_dpsg", LimitKind::kCoefficient, "xx xy xz yx yy yz zx zy zz", "deg/s/g"},
-    {"gyro_residual_rms_dps", LimitKind::kFigure, "", "deg/s"},
-    {"accel_residual_rms_mg", LimitKind::kFigure, "", "mg"},
-    {"fit_temp_range_c", LimitKind::kCoverage, "", "degC"},
-    // Plan segments without a usable window in the run (`fit:` block): {quantity: coverage,
-    // max_abs: 1} passes when every segment of the plan was measured.
-    {"coverage", LimitKind::kFigure, "", "segments missing"},
-    // The largest error of any window after correction, at any temperature of the run: measured by
-    // the certificate (its per-segment table), not in the calibration.
-    {"gyro_residual_max_dps", LimitKind::kFigure, "", "deg/s"},
-    {"accel_residual_max_mg", LimitKind::kFigure, "", "mg"},
-    // From a `noise:` block in the calibration (imufit allan --noise-yaml appended to it).
-    {"gyro_arw_deg_per_sqrt_hr", LimitKind::kCoefficient, "x y z", "deg/sqrt(h)"},
-    {"gyro_bias_instability_dph", LimitKind::kCoefficient, "x y z", "deg/h"},
-};
+// The quantities a limits file may name: the key figures with `in_limits` (key_figures.h); nullptr
+// for any other name.
+const KeyFigure* FindLimitQuantity(const std::string& quantity);
+// Their names, comma-separated, in table order: what a message about an unknown one lists.
+std::string LimitQuantityNames();
 
 // What of a coefficient is judged: its value at 25 degC, its 1-sigma there, or over a temperature
 // range (`over:`, else the calibration's fitted range) the largest |value| (with min/max: the
@@ -95,7 +66,7 @@ const char* DecisionRuleName(DecisionRule rule);
 inline constexpr double kDefaultCoversToleranceC = 0.5;
 
 struct LimitCriterion {
-  std::string quantity;  // a kLimitQuantities name
+  std::string quantity;  // a kKeyFigures name with in_limits
   LimitKind kind = LimitKind::kCoefficient;
   std::string unit;
   std::vector<std::string> axes;  // the axes checked (all of the quantity's when not given)
@@ -117,6 +88,12 @@ struct Limits {
   std::vector<LimitCriterion> criteria;
   DecisionRule decision_rule = DecisionRule::kSimple;
   double guard_band_u = 1.0;  // guarded acceptance: w = guard_band_u x U
+
+  // The nominal scale in the unit of the scale figures (key_figures.h): raw/(deg/s) for the gyro,
+  // raw/g for the accelerometer; 0: not given.
+  double NominalScaleFigure(bool gyro) const {
+    return gyro ? nominal_gyro_scale / kRadToDeg : nominal_accel_scale * kStandardGravityMps2;
+  }
 };
 
 Limits ReadLimits(const std::string& path);

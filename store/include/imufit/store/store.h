@@ -55,17 +55,19 @@ enum class StoreAccess { kRecord, kRead };
 // A key figure as stored: its value, its expanded uncertainty and how it was judged. A plain row:
 // the store knows no documents; factory fills it from its judged figures.
 struct StoredFigure {
-  std::string name;         // quantity.axis, e.g. "gyro_bias_dps.x", "gyro_residual_rms_dps"
+  std::string name;         // quantity.axis of kKeyFigures (io/key_figures.h), e.g. "gyro_bias_dps.x"
   std::string coefficient;  // the calibration's path, e.g. "gyro.bias.x"; "fit.gyro_residual_rms"
   std::string unit;         // "deg/s", "mg", ...
   double value = 0.0;
   double sigma = -1.0;       // 1-sigma; < 0 when the calibration has none
   double expanded_u = -1.0;  // U = k sigma (k = kCoverageFactor, io/limits.h); < 0 without sigma
   double limit_abs = -1.0;   // the acceptance limit on |value|; < 0 without one
-  std::string outcome;       // "pass", "fail" (accepted under the decision rule or not), "" (not judged)
-  // Where the value lies against its limit with U (ILAC-G8): "PASS", "conditional pass",
-  // "conditional fail", "FAIL", "not resolved" (the run does not measure it), or "" (not judged,
-  // or recorded before schema version 4: then `outcome` alone is known).
+  // "pass", "fail" (accepted under the decision rule or not: kCriterionAcceptanceNames,
+  // base/verdict.h), "" (not judged).
+  std::string outcome;
+  // Where the value lies against its limit with U (ILAC-G8; kOutcomeNames): "PASS", "conditional
+  // pass", "conditional fail", "FAIL", "not resolved" (the run does not measure it), or "" (not
+  // judged, or recorded before schema version 4: then `outcome` alone is known).
   std::string judgement;
 };
 
@@ -93,9 +95,11 @@ struct StoredFit {
   std::string plan_sha256;
   std::string samples_sha256;
   std::string limits_sha256;  // empty without limits
-  std::string status;         // "fitted", "not-fitted" (the run does not determine the model), "error"
-  std::string verdict;        // "PASS", "FAIL", "" (no limits, or not fitted)
-  std::string message;        // failed criteria, or why it was not fitted
+  // The names of base/verdict.h: UnitStatus's ("fitted", "not-fitted": the run does not determine
+  // the model, "error") and the unit's verdict ("PASS", "FAIL", "": no limits, or not fitted).
+  std::string status;
+  std::string verdict;
+  std::string message;  // failed criteria, or why it was not fitted
   std::string calibration_yaml;
   std::vector<StoredFigure> figures;
   std::vector<StoredAttachment> attachments;
