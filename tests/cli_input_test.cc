@@ -565,10 +565,12 @@ TEST_F(CliInputTest, ChannelsSwappedInvertedOrRotatedAreSaidSoNotDead) {
   std::ofstream(Path("inverted.csv")) << MapColumn(text, "gyro_y", Negated);
   r = Fit(Path("inverted.csv"));
   EXPECT_EQ(r.status, 1) << r.err;
-  ExpectOneLine(r,
-                "inverted.csv: gyro_y reads with its sign inverted (a left-handed frame: the logger's "
-                "channel signs?); fix the logger's channel map and signs (the accelerometer follows the "
-                "plan: not the mounting); nothing written");
+  ExpectOneLine(
+      r,
+      "inverted.csv: gyro_y reads with its sign inverted against the plan (the logger's channel "
+      "sign, or the plan's rates and turns about y of the wrong sign: the right-hand rule) (a "
+      "left-handed frame?); fix the logger's channel map and signs, or the plan's (the accelerometer "
+      "follows the plan: not the mounting); nothing written");
 
   // Mounted turned 90 deg about z: the unit's x is the plan's y, its y the plan's -x.
   std::string rotated = text;

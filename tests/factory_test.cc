@@ -221,9 +221,13 @@ TEST_F(FactoryTest, KeyFiguresFollowTheKeyFigureTable) {
   record.accel_residual_rms_mps2 = 2e-3;
   record.missing_segments = 0;
   calibration.fit = record;
-  calibration.extra["noise"] = YAML::Load(
-      "{format: imufit-noise, version: 1, columns: {gyro_x: {arw_deg_per_sqrt_hr: [0.1498, 0.0002], "
-      "bias_instability_deg_per_hr: [0.94, 0.67]}}}");
+  NoiseColumnRecord gyro_x;  // the noise record of one gyro column, both terms fitted
+  gyro_x.name = "gyro_x";
+  gyro_x.kind = ColumnKind::kGyro;
+  gyro_x.fitted = true;
+  gyro_x.value[kRandomWalk] = 0.1498 / UnitsOf(ColumnKind::kGyro, kRandomWalk).engineer_per_si;
+  gyro_x.value[kBiasInstability] = 0.94 / UnitsOf(ColumnKind::kGyro, kBiasInstability).engineer_per_si;
+  calibration.noise.emplace().columns.push_back(gyro_x);
   const std::vector<Figure> figures = KeyFigures(calibration);
   std::vector<std::string> expected;
   for (const KeyFigure& quantity : kKeyFigures) {

@@ -216,7 +216,10 @@ std::string MapInWords(const char* sensor, const Eigen::Matrix3d& map) {
     }
   }
   for (const int channel : inverted) {
-    words += (words.empty() ? "" : ", ") + name + "_" + "xyz"[channel] + " reads with its sign inverted";
+    words += (words.empty() ? "" : ", ") + name + "_" + "xyz"[channel] +
+             " reads with its sign inverted against the plan (the logger's channel sign, or the plan's " +
+             (name == "gyro" ? "rates and turns" : "up vectors") + " about " + "xyz"[channel] +
+             " of the wrong sign: the right-hand rule)";
   }
   return words;
 }
@@ -272,9 +275,8 @@ std::string AxisMapFinding(const std::vector<Window>& windows, const TableSite& 
   const auto in_words = [](const char* sensor, const Eigen::Matrix3d& map) {
     const std::string remedy = ColumnRemedy(sensor, map);
     return MapInWords(sensor, map) +
-           (map.determinant() < 0.0 && remedy.empty() ? " (a left-handed frame: the logger's channel signs?)"
-                                                      : "") +
-           (remedy.empty() ? "; fix the logger's channel map and signs"
+           (map.determinant() < 0.0 && remedy.empty() ? " (a left-handed frame?)" : "") +
+           (remedy.empty() ? "; fix the logger's channel map and signs, or the plan's"
                            : "; the logger's channel map? read them back with " + remedy);
   };
   std::string finding;
