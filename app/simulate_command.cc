@@ -31,6 +31,43 @@ struct SimulateArguments {
   CliOptions<FieldSessionOptions> field_options;  // FieldSessionOptionTable(), with --field
 };
 
+// The samples and the truth together, or neither: a samples file whose truth failed to write
+// would pass for a complete simulation. `truth_comment` heads the truth file (with --truth).
+class SimulationOutputs {
+ public:
+  SimulationOutputs(const SimulateArguments& args, SampleColumns columns, const std::string& comment,
+                    const std::string& truth_comment)
+      : samples_(args.output, columns, comment, &outputs_) {
+    if (!args.truth_output.empty()) {
+      truth_.emplace(args.truth_output, SampleColumns{true, true}, truth_comment, &outputs_);
+    }
+  }
+  // Writes a raw sample and, with --truth, its true rate and specific force in the same row layout.
+  void Write(const Sample& raw, const SegmentTruth& truth_of) {
+    samples_.Write(raw);
+    if (truth_) {
+      Sample true_sample = raw;
+      true_sample.gyro = truth_of.omega_radps;
+      true_sample.accel = truth_of.a_mps2;
+      truth_->Write(true_sample);
+    }
+    ++count_;
+  }
+  // Completes every file, then renames them together.
+  void Commit() {
+    samples_.Commit();
+    if (truth_) truth_->Commit();
+    outputs_.Commit();
+  }
+  long long count() const { return count_; }
+
+ private:
+  OutputTransaction outputs_;  // before the writers, which it outlives
+  SamplesWriter samples_;
+  std::optional<SamplesWriter> truth_;
+  long long count_ = 0;
+};
+
 // simulate --field: a session by hand, written without a segment column; --truth keeps the pose
 // index as its segment (-1 while turning).
 int RunFieldSimulate(const SimulateArguments& args, const SimulationOptions& options) {
@@ -41,34 +78,18 @@ int RunFieldSimulate(const SimulateArguments& args, const SimulationOptions& opt
   }
   const Calibration truth = ReadCalibration(args.calibration);
   const std::string serial_line = args.serial.empty() ? "" : "\n" + SerialComment(args.serial, "--serial");
-  OutputTransaction outputs;
   std::ostringstream comment;
   comment << "simulated by " << SoftwareVersion() << ": a session by hand (" << session.poses
           << " poses) from calibration " << args.calibration << ", seed " << options.seed << serial_line;
-  SamplesWriter samples(args.output, SampleColumns{false, !args.no_temp_column}, comment.str(), &outputs);
-  std::optional<SamplesWriter> truth_samples;
-  if (!args.truth_output.empty()) {
-    truth_samples.emplace(args.truth_output, SampleColumns{true, true},
-                          "true angular rate (rad/s) and specific force (m/s^2) of " + args.output +
-                              "; segment: the pose (-1 turning)" + serial_line,
-                          &outputs);
-  }
-  long long count = 0;
+  SimulationOutputs outputs(args, SampleColumns{false, !args.no_temp_column}, comment.str(),
+                            "true angular rate (rad/s) and specific force (m/s^2) of " + args.output +
+                                "; segment: the pose (-1 turning)" + serial_line);
   SimulateFieldSession(options, session, truth.model, [&](const Sample& raw, const SegmentTruth& truth_of) {
-    samples.Write(raw);
-    if (truth_samples) {
-      Sample true_sample = raw;
-      true_sample.gyro = truth_of.omega_radps;
-      true_sample.accel = truth_of.a_mps2;
-      truth_samples->Write(true_sample);
-    }
-    ++count;
+    outputs.Write(raw, truth_of);
   });
-  samples.Commit();
-  if (truth_samples) truth_samples->Commit();
   outputs.Commit();
   if (!args.quiet) {
-    std::printf("simulated %lld samples (%d poses by hand) -> %s\n", count, session.poses,
+    std::printf("simulated %lld samples (%d poses by hand) -> %s\n", outputs.count(), session.poses,
                 args.output.c_str());
   }
   return 0;
@@ -101,37 +122,17 @@ int RunSimulate(SimulateArguments args) {
 
   // The serial as a unit's logger states it, so that fit, report and batch find it (samples.h).
   const std::string serial_line = args.serial.empty() ? "" : "\n" + SerialComment(args.serial, "--serial");
-  // The samples and the truth together, or neither: a samples file whose truth failed to write
-  // would pass for a complete simulation.
-  OutputTransaction outputs;
   std::ostringstream comment;
   comment << "simulated by " << SoftwareVersion() << " from plan " << args.plan << " and calibration "
           << args.calibration << ", seed " << options.seed << serial_line;
-  SamplesWriter samples(args.output, SampleColumns{!args.no_segment_column, !args.no_temp_column},
-                        comment.str(), &outputs);
-  std::optional<SamplesWriter> truth_samples;
-  if (!args.truth_output.empty()) {
-    truth_samples.emplace(
-        args.truth_output, SampleColumns{true, true},
-        "true angular rate (rad/s) and specific force (m/s^2) of " + args.output + serial_line, &outputs);
-  }
-  long long count = 0;
+  SimulationOutputs outputs(
+      args, SampleColumns{!args.no_segment_column, !args.no_temp_column}, comment.str(),
+      "true angular rate (rad/s) and specific force (m/s^2) of " + args.output + serial_line);
   SimulateRun(options, plan.site, plan.segments, truth.model,
-              [&](const Sample& raw, const SegmentTruth& truth_of) {
-                samples.Write(raw);
-                if (truth_samples) {
-                  Sample true_sample = raw;
-                  true_sample.gyro = truth_of.omega_radps;
-                  true_sample.accel = truth_of.a_mps2;
-                  truth_samples->Write(true_sample);
-                }
-                ++count;
-              });
-  samples.Commit();
-  if (truth_samples) truth_samples->Commit();
+              [&](const Sample& raw, const SegmentTruth& truth_of) { outputs.Write(raw, truth_of); });
   outputs.Commit();
   if (!args.quiet) {
-    std::printf("simulated %lld samples (%zu segments, %s) -> %s\n", count, plan.segments.size(),
+    std::printf("simulated %lld samples (%zu segments, %s) -> %s\n", outputs.count(), plan.segments.size(),
                 options.ramp ? "temperature ramp" : "temperature soaks", args.output.c_str());
   }
   return 0;
