@@ -1,0 +1,84 @@
+// The field fit's step 1 (field_fit.h): the poses of a session by hand, the turns between them and
+// the log's noise floor. No Ceres.
+#include <algorithm>
+#include <cmath>
+
+#include "imufit/fit/field_fit.h"
+#include "imufit/model/check.h"
+
+namespace imufit {
+namespace {
+
+// The index of the first sample at or after `time_s` (samples in time order).
+long long FirstAtOrAfter(const std::vector<Sample>& samples, double time_s) {
+  const auto it = std::lower_bound(samples.begin(), samples.end(), time_s,
+                                   [](const Sample& s, double t) { return s.time_s < t; });
+  return static_cast<long long>(it - samples.begin());
+}
+
+// A pose over samples [first, last]: its means.
+FieldPose PoseOver(const std::vector<Sample>& samples, long long first, long long last) {
+  FieldPose pose;
+  pose.first = first;
+  pose.last = last;
+  pose.start_s = samples[first].time_s;
+  pose.end_s = samples[last].time_s;
+  for (long long i = first; i <= last; ++i) {
+    pose.gyro_mean += samples[i].gyro;
+    pose.accel_mean += samples[i].accel;
+    pose.temp_c += samples[i].temp_c;
+  }
+  const double n = static_cast<double>(last - first + 1);
+  pose.gyro_mean /= n;
+  pose.accel_mean /= n;
+  pose.temp_c /= n;
+  return pose;
+}
+
+}  // namespace
+
+void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& options,
+                    std::vector<FieldPose>* poses, std::vector<FieldTurn>* turns,
+                    Eigen::Vector3d* gyro_noise_raw, Eigen::Vector3d* accel_noise_raw) {
+  poses->clear();
+  turns->clear();
+  *gyro_noise_raw = Eigen::Vector3d::Zero();
+  *accel_noise_raw = Eigen::Vector3d::Zero();
+  if (samples.size() < 2) return;
+  MotionDetector detector(options.detection);
+  for (const Sample& sample : samples) detector.Add(sample);
+  const DetectedRun run = detector.Finish();
+  for (const MotionPiece& piece : run.pieces) {
+    if (piece.kind != PieceKind::kSteady || piece.end_s - piece.start_s < options.min_pose_s) continue;
+    const long long first = FirstAtOrAfter(samples, piece.start_s);
+    const long long last = FirstAtOrAfter(samples, piece.end_s);
+    if (last <= first || last >= static_cast<long long>(samples.size())) continue;
+    poses->push_back(PoseOver(samples, first, last));
+  }
+  // The noise of one sample, per axis, pooled over the poses (each about its own mean).
+  Eigen::Vector3d gyro_sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_sum = Eigen::Vector3d::Zero();
+  long long degrees_of_freedom = 0;
+  for (const FieldPose& pose : *poses) {
+    for (long long i = pose.first; i <= pose.last; ++i) {
+      gyro_sum += (samples[i].gyro - pose.gyro_mean).cwiseAbs2();
+      accel_sum += (samples[i].accel - pose.accel_mean).cwiseAbs2();
+    }
+    degrees_of_freedom += pose.last - pose.first;
+  }
+  if (degrees_of_freedom > 0) {
+    *gyro_noise_raw = (gyro_sum / static_cast<double>(degrees_of_freedom)).cwiseSqrt();
+    *accel_noise_raw = (accel_sum / static_cast<double>(degrees_of_freedom)).cwiseSqrt();
+  }
+  for (size_t p = 1; p < poses->size(); ++p) {
+    FieldTurn turn;
+    turn.from = static_cast<int>(p - 1);
+    turn.to = static_cast<int>(p);
+    turn.first = (*poses)[p - 1].last;
+    turn.last = (*poses)[p].first;
+    IMUFIT_CHECK(turn.last > turn.first, "successive poses overlap");
+    turns->push_back(turn);
+  }
+}
+
+}  // namespace imufit
