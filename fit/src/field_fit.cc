@@ -334,24 +334,6 @@ PoseDirection::PoseDirection(const Eigen::Vector3d& up) : u0(up.normalized()) {
   e2 = u0.cross(e1);
 }
 
-std::string FieldFitOptions::Validate() const {
-  if (!(gravity_mps2 >= 9.7 && gravity_mps2 <= 9.9)) {
-    return "gravity_mps2 = " + OptionNumberText(gravity_mps2) + ": local gravity lies in [9.7, 9.9] m/s^2";
-  }
-  if (std::string problem = detection.Validate(); !problem.empty()) return problem;
-  if (!(min_pose_s > 0.0 && std::isfinite(min_pose_s))) return "min_pose_s must be finite and > 0";
-  if (min_poses < 9)
-    return "min_poses = " + std::to_string(min_poses) + ": the accelerometer alone has 9 unknowns";
-  if (!(near_direction_deg > 0.0 && near_direction_deg < 90.0))
-    return "near_direction_deg must lie in (0, 90)";
-  if (!(min_turn_about_axis_rad >= 0.0 && max_relative_scale_sigma > 0.0 &&
-        max_misalignment_sigma_rad > 0.0)) {
-    return "the observability thresholds must be > 0";
-  }
-  if (max_iterations < 1) return "max_iterations must be >= 1";
-  return "";
-}
-
 std::string FieldFitSummary::BriefReport() const {
   const std::string counts =
       std::to_string(poses.size()) + " poses, " + std::to_string(turns.size()) + " turns";

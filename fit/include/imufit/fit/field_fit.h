@@ -44,6 +44,7 @@
 
 #include <Eigen/Core>
 
+#include "imufit/base/option_table.h"
 #include "imufit/model/constants.h"
 #include "imufit/model/sample.h"
 #include "imufit/model/sensor_model.h"
@@ -81,6 +82,10 @@ struct FieldFitOptions {
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
 };
+
+// The options a user sets (gravity_mps2, min_pose_s), described once (base/option_table.h;
+// field_fit_options.cc): `imufit fit --field` takes them from here.
+const OptionTable<FieldFitOptions>& FieldFitOptionTable();
 
 // A rest found in the session: its samples [first, last] (indices into the samples given) and means.
 struct FieldPose {
