@@ -182,20 +182,24 @@ struct TurnSample {
 };
 
 // The attitude at a turn's end relative to its start (attitude_integration.h): the corrected gyro
-// (CorrectWith, each sample with its own corrected specific force) integrated over the samples.
+// (CorrectWith, each sample with its own corrected specific force) integrated over the samples on
+// their times `times_s`.
 template <typename T>
-Quaternion4<T> IntegrateTurn(const UnitCoefficients<T>& c, const std::vector<TurnSample>& samples) {
-  Quaternion4<T> q(T(1.0), T(0.0), T(0.0), T(0.0));
-  Vector3<T> omega_before;
+Quaternion4<T> IntegrateTurn(const UnitCoefficients<T>& c, const std::vector<TurnSample>& samples,
+                             const std::vector<double>& times_s) {
+  std::vector<Vector3<T>> omega(samples.size());
   Vector3<T> a_hat;
-  CorrectWith(c, samples[0].gyro.cast<T>().eval(), samples[0].accel.cast<T>().eval(), &omega_before, &a_hat);
-  for (size_t k = 1; k < samples.size(); ++k) {
-    Vector3<T> omega;
-    CorrectWith(c, samples[k].gyro.cast<T>().eval(), samples[k].accel.cast<T>().eval(), &omega, &a_hat);
-    q = IntegrateAttitudeStep(q, omega_before, omega, T(samples[k].step_s));
-    omega_before = omega;
+  for (size_t k = 0; k < samples.size(); ++k) {
+    CorrectWith(c, samples[k].gyro.cast<T>().eval(), samples[k].accel.cast<T>().eval(), &omega[k], &a_hat);
   }
-  return q;
+  return IntegrateAttitude(times_s.data(), omega.data(), samples.size());
+}
+
+// The times of a turn's samples from its first, s.
+inline std::vector<double> TurnTimes(const std::vector<TurnSample>& samples) {
+  std::vector<double> times_s(samples.size(), 0.0);
+  for (size_t k = 1; k < samples.size(); ++k) times_s[k] = times_s[k - 1] + samples[k].step_s;
+  return times_s;
 }
 
 // Gravity's direction after a turn: integrate the corrected gyro over the turn's samples (their
@@ -211,6 +215,7 @@ class FieldTurnCost {
         from_(from),
         to_(to),
         samples_(std::move(samples)),
+        times_s_(TurnTimes(samples_)),
         x_(x),
         inverse_sigma_(1.0 / sigma_rad) {}
 
@@ -225,7 +230,8 @@ class FieldTurnCost {
   template <typename T>
   bool operator()(const T* gyro_q, const T* accel_q, const T* from_q, const T* to_q, T* residual) const {
     const UnitCoefficients<T> c = layout_->CoefficientsAtArgument(gyro_q, accel_q, T(x_));
-    const Vector3<T> predicted = RotateIntoCurrentFrame(IntegrateTurn(c, samples_), from_->At(from_q));
+    const Vector3<T> predicted =
+        RotateIntoCurrentFrame(IntegrateTurn(c, samples_, times_s_), from_->At(from_q));
     const Vector3<T> error = predicted - to_->At(to_q);
     residual[0] = error.dot(to_->e1.cast<T>()) * T(inverse_sigma_);
     residual[1] = error.dot(to_->e2.cast<T>()) * T(inverse_sigma_);
@@ -237,6 +243,7 @@ class FieldTurnCost {
   const PoseDirection* from_;
   const PoseDirection* to_;
   std::vector<TurnSample> samples_;
+  std::vector<double> times_s_;  // of samples_, from the first
   double x_;
   double inverse_sigma_;
 };

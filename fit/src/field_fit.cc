@@ -314,7 +314,8 @@ void Residuals(const FieldProblem& fp, const std::vector<std::vector<TurnSample>
     };
     const Eigen::Vector3d from = up_of(turn.from);
     const Eigen::Vector3d to = up_of(turn.to);
-    const Eigen::Vector3d predicted = RotateIntoCurrentFrame(IntegrateTurn(c, turn_samples[t]), from);
+    const Eigen::Vector3d predicted =
+        RotateIntoCurrentFrame(IntegrateTurn(c, turn_samples[t], TurnTimes(turn_samples[t])), from);
     turn.angle_rad = std::atan2(from.cross(to).norm(), from.dot(to));
     turn.direction_error_rad = std::atan2(predicted.cross(to).norm(), predicted.dot(to));
     direction_sum += turn.direction_error_rad * turn.direction_error_rad;

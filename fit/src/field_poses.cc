@@ -70,6 +70,17 @@ void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& o
     *gyro_noise_raw = (gyro_sum / static_cast<double>(degrees_of_freedom)).cwiseSqrt();
     *accel_noise_raw = (accel_sum / static_cast<double>(degrees_of_freedom)).cwiseSqrt();
   }
+  // A noiseless log (a simulation without noise, a stuck converter) still weighs its residuals:
+  // its floor is a relative rounding of its largest reading.
+  double gyro_largest = 0.0;
+  double accel_largest = 0.0;
+  for (const Sample& s : samples) {
+    gyro_largest = std::max(gyro_largest, s.gyro.cwiseAbs().maxCoeff());
+    accel_largest = std::max(accel_largest, s.accel.cwiseAbs().maxCoeff());
+  }
+  constexpr double kNoiseFloorRelative = 1e-9;
+  *gyro_noise_raw = gyro_noise_raw->cwiseMax(kNoiseFloorRelative * std::max(gyro_largest, 1e-300));
+  *accel_noise_raw = accel_noise_raw->cwiseMax(kNoiseFloorRelative * std::max(accel_largest, 1e-300));
   for (size_t p = 1; p < poses->size(); ++p) {
     FieldTurn turn;
     turn.from = static_cast<int>(p - 1);

@@ -71,8 +71,8 @@ double TurnMismatch(const SensorModel& model, const std::vector<FieldPose>& pose
     const auto up = [&](int pose) {
       return CorrectSensor(c.accel, poses[pose].accel_mean, Eigen::Vector3d::Zero().eval()).normalized();
     };
-    const Eigen::Vector3d predicted =
-        RotateIntoCurrentFrame(IntegrateTurn(c, turn_samples[t]), up(turns[t].from));
+    const Eigen::Vector3d predicted = RotateIntoCurrentFrame(
+        IntegrateTurn(c, turn_samples[t], TurnTimes(turn_samples[t])), up(turns[t].from));
     sum += (predicted - up(turns[t].to)).squaredNorm();
   }
   return sum;
