@@ -23,6 +23,7 @@
 #include <cstddef>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross
 
 #include "imufit/model/sensor_model.h"
 
