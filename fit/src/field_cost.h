@@ -44,6 +44,13 @@ struct FieldLayout {
   std::array<double, kAccelParameters> accel0{};
   std::array<double, kGyroBlock> gyro_step{};
   std::array<double, kAccelBlock> accel_step{};
+  // Each residual group's noise as a multiple of the log's white noise (1 until the fit finds the
+  // group's residuals larger than that noise explains: field_fit.cc, NoiseScales()). Indexed by
+  // kAccelGroup, kGyroGroup, kTurnGroup; a residual is divided by its group's.
+  static constexpr int kAccelGroup = 0;
+  static constexpr int kGyroGroup = 1;
+  static constexpr int kTurnGroup = 2;
+  std::array<double, 3> noise_scale{1.0, 1.0, 1.0};
 
   template <typename T>
   void Gyro(const T* q, T* p) const {
@@ -122,7 +129,8 @@ class FieldPoseAccelCost {
     const SensorCoefficients<T> c = CoefficientsAt(accel, kAccelCoefficients, T(x_));
     const Vector3<T> a_hat = CorrectSensor(c, accel_mean_.cast<T>().eval(), Vector3<T>::Zero().eval());
     const Vector3<T> raw_error = InRawUnits(c, (a_hat - T(gravity_mps2_) * pose_->At(pose_q)).eval());
-    for (int axis = 0; axis < 3; ++axis) residual[axis] = raw_error(axis) * T(inverse_sigma_(axis));
+    const double scale = layout_->noise_scale[FieldLayout::kAccelGroup];
+    for (int axis = 0; axis < 3; ++axis) residual[axis] = raw_error(axis) * T(inverse_sigma_(axis) / scale);
     return true;
   }
 
@@ -162,7 +170,8 @@ class FieldPoseGyroCost {
     Vector3<T> a_hat;
     CorrectWith(c, gyro_mean_.cast<T>().eval(), accel_mean_.cast<T>().eval(), &omega_hat, &a_hat);
     const Vector3<T> raw_error = InRawUnits(c.gyro, omega_hat);
-    for (int axis = 0; axis < 3; ++axis) residual[axis] = raw_error(axis) * T(inverse_sigma_(axis));
+    const double scale = layout_->noise_scale[FieldLayout::kGyroGroup];
+    for (int axis = 0; axis < 3; ++axis) residual[axis] = raw_error(axis) * T(inverse_sigma_(axis) / scale);
     return true;
   }
 
@@ -233,8 +242,9 @@ class FieldTurnCost {
     const Vector3<T> predicted =
         RotateIntoCurrentFrame(IntegrateTurn(c, samples_, times_s_), from_->At(from_q));
     const Vector3<T> error = predicted - to_->At(to_q);
-    residual[0] = error.dot(to_->e1.cast<T>()) * T(inverse_sigma_);
-    residual[1] = error.dot(to_->e2.cast<T>()) * T(inverse_sigma_);
+    const double scale = layout_->noise_scale[FieldLayout::kTurnGroup];
+    residual[0] = error.dot(to_->e1.cast<T>()) * T(inverse_sigma_ / scale);
+    residual[1] = error.dot(to_->e2.cast<T>()) * T(inverse_sigma_ / scale);
     return true;
   }
 

@@ -85,6 +85,8 @@ struct FieldProblem {
   std::array<double, FieldLayout::kAccelBlock> accel_q{};
   std::vector<std::array<double, 2>> pose_q;
   ceres::Problem problem;
+  // The residual blocks of each group (FieldLayout::kAccelGroup, kGyroGroup, kTurnGroup).
+  std::array<std::vector<ceres::ResidualBlockId>, 3> groups;
 
   // The model at the current q.
   SensorModel Model() const {
@@ -137,14 +139,14 @@ void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTu
     const double n = static_cast<double>(poses[p].last - poses[p].first + 1);
     fp->directions.emplace_back(CorrectSensor(c.accel, poses[p].accel_mean, Eigen::Vector3d::Zero().eval()));
     const double x = basis.Argument(poses[p].temp_c);
-    fp->problem.AddResidualBlock(
+    fp->groups[FieldLayout::kAccelGroup].push_back(fp->problem.AddResidualBlock(
         FieldPoseAccelCost::Create(&fp->layout, &fp->directions[p], poses[p].accel_mean, x,
                                    options.gravity_mps2, summary.accel_noise_raw / std::sqrt(n)),
-        nullptr, fp->accel_q.data(), fp->pose_q[p].data());
-    fp->problem.AddResidualBlock(
+        nullptr, fp->accel_q.data(), fp->pose_q[p].data()));
+    fp->groups[FieldLayout::kGyroGroup].push_back(fp->problem.AddResidualBlock(
         FieldPoseGyroCost::Create(&fp->layout, poses[p].gyro_mean, poses[p].accel_mean, x,
                                   summary.gyro_noise_raw / std::sqrt(n)),
-        nullptr, fp->gyro_q.data(), fp->accel_q.data());
+        nullptr, fp->gyro_q.data(), fp->accel_q.data()));
   }
   // The gyro's white noise in rad/s (at the start's scales), integrated over a turn: the angle's
   // random walk, per axis perpendicular to gravity.
@@ -160,11 +162,11 @@ void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTu
       weight_sum += 0.25 * (before + after) * (before + after);
     }
     const double sigma_rad = noise_radps * std::sqrt(weight_sum);
-    fp->problem.AddResidualBlock(
+    fp->groups[FieldLayout::kTurnGroup].push_back(fp->problem.AddResidualBlock(
         FieldTurnCost::Create(&fp->layout, &fp->directions[turns[t].from], &fp->directions[turns[t].to],
                               std::move(turn_samples[t]), basis.Argument(temp_c), std::max(sigma_rad, 1e-12)),
         nullptr, fp->gyro_q.data(), fp->accel_q.data(), fp->pose_q[turns[t].from].data(),
-        fp->pose_q[turns[t].to].data());
+        fp->pose_q[turns[t].to].data()));
   }
   if (!options.fit_g_sensitivity) {
     std::vector<int> held;
@@ -194,17 +196,57 @@ std::string ColumnName(int column, bool fit_g_sensitivity) {
   return "the direction of pose " + std::to_string((column - FieldLayout::kAccelBlock) / 2 + 1);
 }
 
-// The Jacobian of every residual at the solution, dense, in the solver's q (tangent) columns.
-Eigen::MatrixXd Jacobian(FieldProblem* fp) {
+// The residuals and their Jacobian at the current q, dense, rows in group order (accel, gyro,
+// turns), columns in the solver's q (tangent) order; `group_rows` the first row of each group and
+// the end.
+Eigen::MatrixXd Jacobian(FieldProblem* fp, Eigen::VectorXd* residuals, std::array<int, 4>* group_rows) {
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = fp->Blocks();
+  (*group_rows)[0] = 0;
+  for (int g = 0; g < 3; ++g) {
+    evaluate.residual_blocks.insert(evaluate.residual_blocks.end(), fp->groups[g].begin(),
+                                    fp->groups[g].end());
+    int rows = 0;
+    for (const ceres::ResidualBlockId id : fp->groups[g])
+      rows += fp->problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+    (*group_rows)[g + 1] = (*group_rows)[g] + rows;
+  }
+  std::vector<double> r;
   ceres::CRSMatrix crs;
-  fp->problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  fp->problem.Evaluate(evaluate, nullptr, &r, nullptr, &crs);
+  IMUFIT_CHECK(crs.num_rows == (*group_rows)[3], "one Jacobian row per residual");
+  *residuals = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
   for (int row = 0; row < crs.num_rows; ++row) {
     for (int i = crs.rows[row]; i < crs.rows[row + 1]; ++i) jacobian(row, crs.cols[i]) = crs.values[i];
   }
   return jacobian;
+}
+
+// Each group's residuals against its share of the redundancy: s^2 = sum r^2 / sum (1 - h_ii), h_ii
+// the leverage of residual i (J C J^T), which is the variance-component estimate of the group's
+// noise as a multiple of the one assumed. Multiplies layout->noise_scale of every group whose s^2
+// exceeds 1 beyond chance (1 + 3 sqrt(2 / its redundancy)) by s; returns whether any did. A hand
+// session's rests hold tremor and its turns more than white noise; a simulated one holds neither.
+bool NoiseScales(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
+                 const Eigen::MatrixXd& covariance, const std::array<int, 4>& group_rows,
+                 FieldLayout* layout) {
+  bool changed = false;
+  for (int g = 0; g < 3; ++g) {
+    double sum_r2 = 0.0;
+    double redundancy = 0.0;
+    for (int i = group_rows[g]; i < group_rows[g + 1]; ++i) {
+      sum_r2 += residuals(i) * residuals(i);
+      redundancy += 1.0 - jacobian.row(i).dot(covariance * jacobian.row(i).transpose());
+    }
+    if (!(redundancy > 0.5)) continue;  // a group its parameters fit exactly tells nothing
+    const double s2 = sum_r2 / redundancy;
+    if (s2 > 1.0 + 3.0 * std::sqrt(2.0 / redundancy)) {
+      layout->noise_scale[g] *= std::sqrt(s2);
+      changed = true;
+    }
+  }
+  return changed;
 }
 
 // Step 5: the covariance (J^T J)^-1 in q, or the parameter a direction without information moves
@@ -262,13 +304,14 @@ std::vector<std::string> LooseCoefficients(const SensorModel& model, const Senso
   for (int axis = 0; axis < 3; ++axis) {
     const int i = (kScaleCoefficient + axis) * kPolynomialTerms;
     if (sigma.gyro[i] > options.max_relative_scale_sigma * std::abs(model.gyro[i])) {
-      loose.push_back(Format("turns about %c too small to fix the gyro's %c scale", axes[axis], axes[axis]) +
+      loose.push_back(std::string("turns about ") + axes[axis] + " too small to fix the gyro's " +
+                      axes[axis] + " scale" +
                       Format(" (1 sigma %.2g %%)", 100.0 * sigma.gyro[i] / std::abs(model.gyro[i])));
     }
     if (sigma.accel[i] > options.max_relative_scale_sigma * std::abs(model.accel[i])) {
-      loose.push_back(
-          Format("poses too few or too close together to fix the accelerometer's %c scale", axes[axis]) +
-          Format(" (1 sigma %.2g %%)", 100.0 * sigma.accel[i] / std::abs(model.accel[i])));
+      loose.push_back(std::string("poses too few or too close together to fix the accelerometer's ") +
+                      axes[axis] + " scale" +
+                      Format(" (1 sigma %.2g %%)", 100.0 * sigma.accel[i] / std::abs(model.accel[i])));
     }
   }
   for (int m = 0; m < 6; ++m) {
@@ -304,6 +347,7 @@ void Residuals(const FieldProblem& fp, const std::vector<std::vector<TurnSample>
     gyro_sum += omega_hat.squaredNorm();
   }
   double direction_sum = 0.0;
+  int fitted_turns = 0;
   for (size_t t = 0; t < summary->turns.size(); ++t) {
     FieldTurn& turn = summary->turns[t];
     const auto up_of = [&](int pose) {
@@ -318,13 +362,14 @@ void Residuals(const FieldProblem& fp, const std::vector<std::vector<TurnSample>
         RotateIntoCurrentFrame(IntegrateTurn(c, turn_samples[t], TurnTimes(turn_samples[t])), from);
     turn.angle_rad = std::atan2(from.cross(to).norm(), from.dot(to));
     turn.direction_error_rad = std::atan2(predicted.cross(to).norm(), predicted.dot(to));
+    if (turn.saturated) continue;
     direction_sum += turn.direction_error_rad * turn.direction_error_rad;
+    ++fitted_turns;
   }
   const double poses = static_cast<double>(summary->poses.size());
   summary->accel_norm_rms_mps2 = std::sqrt(accel_sum / poses);
   summary->gyro_static_rms_radps = std::sqrt(gyro_sum / (3.0 * poses));
-  summary->direction_rms_rad =
-      summary->turns.empty() ? 0.0 : std::sqrt(direction_sum / static_cast<double>(summary->turns.size()));
+  summary->direction_rms_rad = fitted_turns == 0 ? 0.0 : std::sqrt(direction_sum / fitted_turns);
 }
 
 }  // namespace
@@ -336,8 +381,11 @@ PoseDirection::PoseDirection(const Eigen::Vector3d& up) : u0(up.normalized()) {
 }
 
 std::string FieldFitSummary::BriefReport() const {
+  const int saturated = static_cast<int>(
+      std::count_if(turns.begin(), turns.end(), [](const FieldTurn& t) { return t.saturated; }));
   const std::string counts =
-      std::to_string(poses.size()) + " poses, " + std::to_string(turns.size()) + " turns";
+      std::to_string(poses.size()) + " poses, " + std::to_string(turns.size()) + " turns" +
+      (saturated > 0 ? " (" + std::to_string(saturated) + " saturated, left out)" : "");
   switch (status) {
     case FieldFitStatus::kNotRun:
       return "not run";
@@ -354,7 +402,12 @@ std::string FieldFitSummary::BriefReport() const {
   return "converged (" + counts + ", " + std::to_string(iterations) + " iterations): |a| - g RMS " +
          Format("%.3g mg", accel_norm_rms_mps2 / kStandardGravityMps2 * 1e3) + ", gravity after the turns " +
          Format("%.3g deg RMS", direction_rms_rad * kRadToDeg) +
-         Format(", reduced chi-square %.3g", reduced_chi2);
+         Format(", reduced chi-square %.3g", reduced_chi2) +
+         (noise_scale[0] > 1.0 || noise_scale[1] > 1.0 || noise_scale[2] > 1.0
+              ? Format("; noise beyond the log's white noise: rests x%.3g accel, ", noise_scale[0],
+                       noise_scale[1]) +
+                    Format("x%.3g gyro, turns x%.3g", noise_scale[1], noise_scale[2])
+              : "");
 }
 
 FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options) {
@@ -375,17 +428,24 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
         Format(" (rest %.3g s or longer in each)", options.min_pose_s + options.detection.window_s));
     return summary;
   }
-  std::vector<std::vector<TurnSample>> turn_samples;
-  for (const FieldTurn& turn : summary.turns) turn_samples.push_back(TurnSamples(samples, turn));
-  const SensorModel start = FieldStart(summary.poses, summary.turns, turn_samples, options);
-  summary.undetermined = CoverageProblems(summary.poses, summary.turns, turn_samples, start, options);
+  std::vector<std::vector<TurnSample>> turn_samples;  // of every turn
+  std::vector<FieldTurn> fitted;                      // the turns not saturated, and their samples
+  std::vector<std::vector<TurnSample>> fitted_samples;
+  for (const FieldTurn& turn : summary.turns) {
+    turn_samples.push_back(TurnSamples(samples, turn));
+    if (turn.saturated) continue;
+    fitted.push_back(turn);
+    fitted_samples.push_back(turn_samples.back());
+  }
+  const SensorModel start = FieldStart(summary.poses, fitted, fitted_samples, options);
+  summary.undetermined = CoverageProblems(summary.poses, fitted, fitted_samples, start, options);
   if (!summary.undetermined.empty()) {
     summary.status = FieldFitStatus::kUndetermined;
     return summary;
   }
 
   FieldProblem fp;
-  BuildProblem(summary.poses, summary.turns, turn_samples, summary, start, options, &fp);
+  BuildProblem(summary.poses, fitted, std::move(fitted_samples), summary, start, options, &fp);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.max_num_iterations = options.max_iterations;
@@ -393,27 +453,40 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
   solver.parameter_tolerance = 1e-12;
   solver.gradient_tolerance = 1e-14;
   solver.num_threads = 1;
-  ceres::Solver::Summary solved;
-  ceres::Solve(solver, &fp.problem, &solved);
-  summary.iterations = static_cast<int>(solved.iterations.size());
-  summary.termination = solved.message;
-  if (!solved.IsSolutionUsable()) {
-    summary.status = FieldFitStatus::kFailed;
-    return summary;
+  // Solve; while a group's residuals exceed its noise beyond chance, scale that noise and solve
+  // again (NoiseScales), so that the covariance describes the session's actual scatter.
+  constexpr int kMaxNoisePasses = 4;
+  Eigen::MatrixXd covariance;
+  Eigen::MatrixXd jacobian;
+  double final_cost = 0.0;
+  summary.iterations = 0;
+  for (int pass = 0; pass < kMaxNoisePasses; ++pass) {
+    ceres::Solver::Summary solved;
+    ceres::Solve(solver, &fp.problem, &solved);
+    summary.iterations += static_cast<int>(solved.iterations.size());
+    summary.termination = solved.message;
+    if (!solved.IsSolutionUsable()) {
+      summary.status = FieldFitStatus::kFailed;
+      return summary;
+    }
+    final_cost = solved.final_cost;
+    Eigen::VectorXd residuals;
+    std::array<int, 4> group_rows{};
+    jacobian = Jacobian(&fp, &residuals, &group_rows);
+    if (const std::string missing = Covariance(jacobian, options.fit_g_sensitivity, &covariance);
+        !missing.empty()) {
+      summary.status = FieldFitStatus::kUndetermined;
+      summary.undetermined.push_back("the session holds no information on the " + missing);
+      return summary;
+    }
+    if (!NoiseScales(jacobian, residuals, covariance, group_rows, &fp.layout)) break;
   }
   summary.model = fp.Model();
   summary.model.basis = TemperatureBasis::Reference();
-  const Eigen::MatrixXd jacobian = Jacobian(&fp);
-  Eigen::MatrixXd covariance;
-  if (const std::string missing = Covariance(jacobian, options.fit_g_sensitivity, &covariance);
-      !missing.empty()) {
-    summary.status = FieldFitStatus::kUndetermined;
-    summary.undetermined.push_back("the session holds no information on the " + missing);
-    return summary;
-  }
-  summary.sigma = Sigmas(covariance, fp.layout, options.fit_g_sensitivity);
+  summary.noise_scale = fp.layout.noise_scale;
   const double dof = static_cast<double>(jacobian.rows() - jacobian.cols());
-  summary.reduced_chi2 = dof > 0 ? 2.0 * solved.final_cost / dof : 0.0;
+  summary.reduced_chi2 = dof > 0 ? 2.0 * final_cost / dof : 0.0;
+  summary.sigma = Sigmas(covariance, fp.layout, options.fit_g_sensitivity);
   Residuals(fp, turn_samples, options, &summary);
   summary.undetermined = LooseCoefficients(summary.model, summary.sigma, options);
   summary.status = summary.undetermined.empty() ? FieldFitStatus::kConverged : FieldFitStatus::kUndetermined;

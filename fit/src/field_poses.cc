@@ -2,9 +2,11 @@
 // the log's noise floor. No Ceres.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "imufit/fit/field_fit.h"
 #include "imufit/model/check.h"
+#include "imufit/run/channel_check.h"
 
 namespace imufit {
 namespace {
@@ -33,6 +35,33 @@ FieldPose PoseOver(const std::vector<Sample>& samples, long long first, long lon
   pose.accel_mean /= n;
   pose.temp_c /= n;
   return pose;
+}
+
+// Each gyro axis's rails: its largest and smallest reading over the log when that reading is a
+// converter's limit (run/channel_check.h) reached more than once (a clipped converter); NaN, which
+// no reading equals, when not.
+struct GyroRails {
+  Eigen::Vector3d high = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+GyroRails GyroRailsOf(const std::vector<Sample>& samples) {
+  GyroRails rails;
+  for (int axis = 0; axis < 3; ++axis) {
+    double high = -std::numeric_limits<double>::infinity();
+    double low = std::numeric_limits<double>::infinity();
+    int at_high = 0;
+    int at_low = 0;
+    for (const Sample& s : samples) {
+      const double v = s.gyro(axis);
+      if (v > high) high = v, at_high = 0;
+      if (v == high) ++at_high;
+      if (v < low) low = v, at_low = 0;
+      if (v == low) ++at_low;
+    }
+    if (ConverterLimit(high) && at_high > 1) rails.high(axis) = high;
+    if (ConverterLimit(low) && at_low > 1) rails.low(axis) = low;
+  }
+  return rails;
 }
 
 }  // namespace
@@ -81,6 +110,7 @@ void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& o
   constexpr double kNoiseFloorRelative = 1e-9;
   *gyro_noise_raw = gyro_noise_raw->cwiseMax(kNoiseFloorRelative * std::max(gyro_largest, 1e-300));
   *accel_noise_raw = accel_noise_raw->cwiseMax(kNoiseFloorRelative * std::max(accel_largest, 1e-300));
+  const GyroRails rails = GyroRailsOf(samples);
   for (size_t p = 1; p < poses->size(); ++p) {
     FieldTurn turn;
     turn.from = static_cast<int>(p - 1);
@@ -88,6 +118,12 @@ void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& o
     turn.first = (*poses)[p - 1].last;
     turn.last = (*poses)[p].first;
     IMUFIT_CHECK(turn.last > turn.first, "successive poses overlap");
+    for (long long i = turn.first; i <= turn.last && !turn.saturated; ++i) {
+      for (int axis = 0; axis < 3; ++axis) {
+        turn.saturated = turn.saturated || samples[i].gyro(axis) == rails.high(axis) ||
+                         samples[i].gyro(axis) == rails.low(axis);
+      }
+    }
     turns->push_back(turn);
   }
 }

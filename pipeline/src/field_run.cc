@@ -17,6 +17,13 @@ YAML::Node FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& optio
   field["gyro_static_rms_radps"] = fit.gyro_static_rms_radps;
   field["gravity_direction_rms_rad"] = fit.direction_rms_rad;
   field["reduced_chi2"] = fit.reduced_chi2;
+  // The noise of the rests (accelerometer, gyro) and the turns as multiples of the log's white noise.
+  field["noise_scale_accel_rests"] = fit.noise_scale[0];
+  field["noise_scale_gyro_rests"] = fit.noise_scale[1];
+  field["noise_scale_turns"] = fit.noise_scale[2];
+  int saturated = 0;
+  for (const FieldTurn& turn : fit.turns) saturated += turn.saturated ? 1 : 0;
+  field["saturated_turns"] = saturated;
   return field;
 }
 

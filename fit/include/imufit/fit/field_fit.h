@@ -29,10 +29,12 @@
 //     accelerometer's misalignment xy, xz and yz are held at 0 (kBodyFrameConvention).
 //  5. Uncertainty. Every residual is normalised by its noise, so the covariance of the
 //     coefficients is (J^T J)^-1 at the solution; `sigma` holds its square roots (0 for a held
-//     term). A session that cannot determine a coefficient is refused, saying what it lacks in
-//     plain words (`undetermined`): no pose near some direction, too few poses, turns too small
-//     about an axis, or a direction of the problem with no information (named by the coefficient
-//     it moves most).
+//     term). Where a group of residuals (accelerometer at rest, gyro at rest, turns) is larger than
+//     the white noise can explain (a real hand session: tremor, drift), its noise is scaled by its
+//     variance-component estimate and the problem solved again, so that the sigmas stay honest. A session
+//     that cannot determine a coefficient is refused, saying what it lacks in plain words (`undetermined`):
+//     no pose near some direction, too few poses, turns too small about an axis, or a direction of the
+//     problem with no information (named by the coefficient it moves most).
 //
 // Frames and units: raw inputs as the unit gives them; SI inside; the body frame above.
 #ifndef IMUFIT_FIT_FIELD_FIT_H_
@@ -108,6 +110,9 @@ struct FieldTurn {
   int to = 0;
   long long first = 0;
   long long last = 0;
+  // A gyro sample at a converter's limit (run/channel_check.h): the integrated rate is wrong, so the
+  // turn is left out of the fit (its poses stay).
+  bool saturated = false;
   double angle_rad = 0.0;  // after the fit: the angle gravity turned through
   // After the fit: the angle between gravity's direction at `to` and the one the turn predicts, rad.
   double direction_error_rad = 0.0;
@@ -136,12 +141,17 @@ struct FieldFitSummary {
   Eigen::Vector3d gyro_noise_raw = Eigen::Vector3d::Constant(-1.0);
   Eigen::Vector3d accel_noise_raw = Eigen::Vector3d::Constant(-1.0);
   // Residuals after the fit: | |a_hat| - g | over the poses (RMS, m/s^2), the corrected static gyro
-  // (RMS over poses and axes, rad/s), gravity's direction after each turn (RMS, rad), and the
-  // reduced chi-square of the whole problem.
+  // (RMS over poses and axes, rad/s), gravity's direction after each turn fitted (RMS, rad), and
+  // the reduced chi-square of the whole problem.
   double accel_norm_rms_mps2 = -1.0;
   double gyro_static_rms_radps = -1.0;
   double direction_rms_rad = -1.0;
   double reduced_chi2 = -1.0;
+  // The noise of each residual group as a multiple of the log's white noise: the accelerometer at
+  // rest, the gyro at rest, the turns. 1 unless the group's residuals exceed that noise beyond
+  // chance (hand tremor, drift, correlated noise); then its variance-component estimate, by which
+  // the group is weighted and its sigmas grow (field_fit.cc, NoiseScales()).
+  std::array<double, 3> noise_scale{1.0, 1.0, 1.0};
 
   bool IsSolutionUsable() const { return status == FieldFitStatus::kConverged; }
   // One line: the outcome, poses, turns and residuals.
