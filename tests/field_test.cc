@@ -397,6 +397,40 @@ TEST(FieldFitTest, RefusesTurnsTooSmallAboutAnAxis) {
   EXPECT_EQ(fit.BriefReport().find("about x too small"), std::string::npos) << fit.BriefReport();
 }
 
+// A converter that clips: turns whose gyro touches the rail are left out, the rest still fit.
+TEST(FieldFitTest, LeavesOutTurnsAtTheRail) {
+  const SensorModel truth = FieldTruth(10);
+  SimulationOptions options = ShortSession(10);
+  options.quantize = true;
+  options.gyro_full_scale_raw = 2047.0;  // 2^11 - 1 counts: about 2.2 rad/s of this unit
+  FieldSessionOptions field;
+  field.poses = 16;
+  const FieldFitSummary fit = FitField(Simulate(truth, options, field).samples, FieldFitOptions{});
+  int saturated = 0;
+  for (const FieldTurn& turn : fit.turns) saturated += turn.saturated ? 1 : 0;
+  EXPECT_GT(saturated, 0);
+  EXPECT_LT(saturated, static_cast<int>(fit.turns.size()));
+  ASSERT_TRUE(fit.IsSolutionUsable()) << fit.BriefReport();
+  EXPECT_NE(fit.BriefReport().find("saturated, left out"), std::string::npos) << fit.BriefReport();
+  ExpectRecovered(fit, truth);
+}
+
+// A gyro whose bias wanders (a Gauss-Markov process): the rests and turns scatter beyond the white
+// noise, the fit says so (noise_scale) and its widened sigmas still cover the truth.
+TEST(FieldFitTest, ScalesTheNoiseOfAWanderingBias) {
+  const SensorModel truth = FieldTruth(11);
+  SimulationOptions options = ShortSession(11);
+  options.gyro_bias_instability = 2e-3;  // rad/s
+  options.bias_correlation_s = 5.0;
+  const FieldFitSummary fit =
+      FitField(Simulate(truth, options, FieldSessionOptions{}).samples, FieldFitOptions{});
+  ASSERT_TRUE(fit.IsSolutionUsable()) << fit.BriefReport();
+  EXPECT_GT(fit.noise_scale[1], 2.0);
+  EXPECT_NE(fit.BriefReport().find("noise beyond the log's white noise"), std::string::npos)
+      << fit.BriefReport();
+  ExpectRecovered(fit, truth);
+}
+
 // The sigmas are honest: over 50 sessions (each its own unit and seed) the z-scores of every class
 // have an RMS near 1.
 TEST(FieldFitTest, MonteCarloSigmasMatchTheSpread) {

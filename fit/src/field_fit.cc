@@ -487,6 +487,15 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
   const double dof = static_cast<double>(jacobian.rows() - jacobian.cols());
   summary.reduced_chi2 = dof > 0 ? 2.0 * final_cost / dof : 0.0;
   summary.sigma = Sigmas(covariance, fp.layout, options.fit_g_sensitivity);
+  const auto finite = [](const SensorModel& m) {
+    return std::all_of(m.gyro.begin(), m.gyro.end(), [](double v) { return std::isfinite(v); }) &&
+           std::all_of(m.accel.begin(), m.accel.end(), [](double v) { return std::isfinite(v); });
+  };
+  if (!finite(summary.model) || !finite(summary.sigma)) {  // never written: docs/spec.md section 4
+    summary.status = FieldFitStatus::kFailed;
+    summary.termination = "the solution or its covariance is not finite";
+    return summary;
+  }
   Residuals(fp, turn_samples, options, &summary);
   summary.undetermined = LooseCoefficients(summary.model, summary.sigma, options);
   summary.status = summary.undetermined.empty() ? FieldFitStatus::kConverged : FieldFitStatus::kUndetermined;
