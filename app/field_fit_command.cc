@@ -86,9 +86,10 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
                 result.samples_read, fit.temp_range_c[0], fit.temp_range_c[1], kBodyFrameConvention);
     std::printf("  static gyro RMS %.5f deg/s over the poses\n", DpsFromRadps(fit.gyro_static_rms_radps));
     PrintFieldCoefficients(fit);
-    std::printf(
-        "  note: the sigmas reflect the session's white noise; Earth's rotation (up to 0.004 deg/s) is not "
-        "modelled\n");
+    const bool scaled = fit.noise_scale[0] > 1.0 || fit.noise_scale[1] > 1.0 || fit.noise_scale[2] > 1.0;
+    std::printf("  note: the sigmas reflect %s; Earth's rotation (up to 0.004 deg/s) is not modelled\n",
+                scaled ? "the session's scatter, beyond its white noise (tremor, drift)"
+                       : "the session's white noise");
   }
   WriteCalibration(output, *result.calibration);
   if (!quiet) std::printf("  wrote %s\n", output.c_str());

@@ -128,7 +128,8 @@ void SetSteps(const SensorModel& start, FieldLayout* layout) {
 
 // The residuals of field_fit.h step 3, one block each per pose and per turn.
 void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTurn>& turns,
-                  std::vector<std::vector<TurnSample>> turn_samples, const FieldFitSummary& summary,
+                  std::vector<std::vector<TurnSample>> turn_samples,
+                  const std::vector<double>& turn_noise_weight_s, const FieldFitSummary& summary,
                   const SensorModel& start, const FieldFitOptions& options, FieldProblem* fp) {
   SetSteps(start, &fp->layout);
   const UnitCoefficients<double> c = start.CoefficientsAtTemperature(25.0);
@@ -153,15 +154,8 @@ void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTu
   const Eigen::Vector3d gyro_noise_radps = summary.gyro_noise_raw.cwiseQuotient(c.gyro.scale.cwiseAbs());
   const double noise_radps = std::sqrt(gyro_noise_radps.squaredNorm() / 3.0);
   for (size_t t = 0; t < turns.size(); ++t) {
-    const std::vector<TurnSample>& samples = turn_samples[t];
-    double weight_sum = 0.0;  // sum of the trapezoid weights squared, s^2
-    double temp_c = 0.5 * (poses[turns[t].from].temp_c + poses[turns[t].to].temp_c);
-    for (size_t k = 0; k < samples.size(); ++k) {
-      const double before = k > 0 ? samples[k].step_s : 0.0;
-      const double after = k + 1 < samples.size() ? samples[k + 1].step_s : 0.0;
-      weight_sum += 0.25 * (before + after) * (before + after);
-    }
-    const double sigma_rad = noise_radps * std::sqrt(weight_sum);
+    const double temp_c = 0.5 * (poses[turns[t].from].temp_c + poses[turns[t].to].temp_c);
+    const double sigma_rad = noise_radps * turn_noise_weight_s[t];
     fp->groups[FieldLayout::kTurnGroup].push_back(fp->problem.AddResidualBlock(
         FieldTurnCost::Create(&fp->layout, &fp->directions[turns[t].from], &fp->directions[turns[t].to],
                               std::move(turn_samples[t]), basis.Argument(temp_c), std::max(sigma_rad, 1e-12)),
@@ -428,14 +422,16 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
         Format(" (rest %.3g s or longer in each)", options.min_pose_s + options.detection.window_s));
     return summary;
   }
-  std::vector<std::vector<TurnSample>> turn_samples;  // of every turn
-  std::vector<FieldTurn> fitted;                      // the turns not saturated, and their samples
-  std::vector<std::vector<TurnSample>> fitted_samples;
+  std::vector<std::vector<TurnSample>> turn_samples;    // of every turn
+  std::vector<FieldTurn> fitted;                        // the turns not saturated, and their samples
+  std::vector<std::vector<TurnSample>> fitted_samples;  // at most kTurnFitRateHz
+  std::vector<double> fitted_noise_weight_s;            // from every sample
   for (const FieldTurn& turn : summary.turns) {
     turn_samples.push_back(TurnSamples(samples, turn));
     if (turn.saturated) continue;
     fitted.push_back(turn);
-    fitted_samples.push_back(turn_samples.back());
+    fitted_samples.push_back(DecimatedTurn(turn_samples.back(), kTurnFitRateHz));
+    fitted_noise_weight_s.push_back(TurnNoiseWeightS(turn_samples.back()));
   }
   const SensorModel start = FieldStart(summary.poses, fitted, fitted_samples, options);
   summary.undetermined = CoverageProblems(summary.poses, fitted, fitted_samples, start, options);
@@ -445,7 +441,8 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
   }
 
   FieldProblem fp;
-  BuildProblem(summary.poses, fitted, std::move(fitted_samples), summary, start, options, &fp);
+  BuildProblem(summary.poses, fitted, std::move(fitted_samples), fitted_noise_weight_s, summary, start,
+               options, &fp);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.max_num_iterations = options.max_iterations;

@@ -136,6 +136,48 @@ std::vector<TurnSample> TurnSamples(const std::vector<Sample>& samples, const Fi
   return out;
 }
 
+std::vector<TurnSample> DecimatedTurn(const std::vector<TurnSample>& samples, double max_rate_hz) {
+  const std::vector<double> times_s = TurnTimes(samples);
+  const double duration_s = times_s.back();
+  const size_t count = samples.size();
+  const size_t block = count > 2 && duration_s > 0.0
+                           ? static_cast<size_t>(static_cast<double>(count - 1) / duration_s / max_rate_hz)
+                           : 1;
+  if (block <= 1) return samples;
+  std::vector<TurnSample> out = {samples.front()};
+  double last_time_s = 0.0;
+  for (size_t first = 1; first + 1 < count; first += block) {
+    const size_t end = std::min(first + block, count - 1);
+    TurnSample mean;
+    double time_s = 0.0;
+    for (size_t k = first; k < end; ++k) {
+      mean.gyro += samples[k].gyro;
+      mean.accel += samples[k].accel;
+      time_s += times_s[k];
+    }
+    const double n = static_cast<double>(end - first);
+    mean.gyro /= n;
+    mean.accel /= n;
+    mean.step_s = time_s / n - last_time_s;
+    last_time_s = time_s / n;
+    out.push_back(mean);
+  }
+  TurnSample last = samples.back();
+  last.step_s = duration_s - last_time_s;
+  out.push_back(last);
+  return out;
+}
+
+double TurnNoiseWeightS(const std::vector<TurnSample>& samples) {
+  double sum = 0.0;
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const double before = k > 0 ? samples[k].step_s : 0.0;
+    const double after = k + 1 < samples.size() ? samples[k + 1].step_s : 0.0;
+    sum += 0.25 * (before + after) * (before + after);
+  }
+  return std::sqrt(sum);
+}
+
 SensorModel FieldStart(const std::vector<FieldPose>& poses, const std::vector<FieldTurn>& turns,
                        const std::vector<std::vector<TurnSample>>& turn_samples,
                        const FieldFitOptions& options) {

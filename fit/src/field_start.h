@@ -23,6 +23,18 @@ namespace imufit {
 // The samples of `turn` as the turn cost integrates them.
 std::vector<TurnSample> TurnSamples(const std::vector<Sample>& samples, const FieldTurn& turn);
 
+// A turn's samples for the fit at no more than max_rate_hz: beyond it, the samples between the
+// first and the last are averaged in blocks (the raw values are linear in the model, so the mean of
+// the corrected rates is the corrected mean), each block at its mean time. The integral of the rate
+// is kept; what changes is an O(h^2) coning term of the block length h (1e-5 rad per hand turn at
+// 200 Hz). A 1 kHz log then costs the solver what a 200 Hz one does.
+inline constexpr double kTurnFitRateHz = 200.0;
+std::vector<TurnSample> DecimatedTurn(const std::vector<TurnSample>& samples, double max_rate_hz);
+
+// sqrt(sum of the squared trapezoid weights) of a turn's samples, s: times the white noise of one
+// sample (rad/s) it is the 1-sigma of the integrated angle about an axis.
+double TurnNoiseWeightS(const std::vector<TurnSample>& samples);
+
 // The starting model (temperature terms 0) from the poses and the turns' samples.
 SensorModel FieldStart(const std::vector<FieldPose>& poses, const std::vector<FieldTurn>& turns,
                        const std::vector<std::vector<TurnSample>>& turn_samples,
