@@ -70,8 +70,11 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   options.fit_g_sensitivity = run.fit.Fits(true, kGSensitivityCoefficient);
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit --field", problem);
-  const FieldRunResult result = FieldFitRun(samples, run.input, options, SoftwareVersion(), serial);
+  const FieldRunResult result =
+      FieldFitRun(samples, run.input, options, SoftwareVersion(), serial, run.allow_serial_mismatch);
   const FieldFitSummary& fit = result.fit;
+  for (const std::string& warning : result.serial_warnings)
+    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
   if (!fit.IsSolutionUsable()) {
     std::fprintf(stderr, "imufit: %s: %s, nothing written\n", samples.c_str(), fit.BriefReport().c_str());
     return 1;

@@ -174,5 +174,24 @@ TEST_F(CliTest, FieldOptionsAreChecked) {
   EXPECT_NE(r.out.find("every sample at 25 degC (--temp-c)"), std::string::npos) << r.out;
 }
 
+// The unit's serial as for a table fit: the samples header's, and a stated one that contradicts it
+// refused unless --allow-mismatch.
+TEST_F(CliTest, FieldFitTakesTheSerialOfTheSamples) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--serial", "SN0001"})).status, 0);
+  const std::string out = Path("cal.yaml");
+  RunResult r = Run({"fit", "--field", "--samples", raw, "-o", out, "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(YAML::LoadFile(out)["serial"].as<std::string>(), "SN0001");
+  const std::string other = Path("other.yaml");
+  r = Run({"fit", "--field", "--samples", raw, "-o", other, "--serial", "SN0002", "-q"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(other));
+  r = Run({"fit", "--field", "--samples", raw, "-o", other, "--serial", "SN0002", "--allow-mismatch", "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_EQ(YAML::LoadFile(other)["serial"].as<std::string>(), "SN0002");
+}
+
 }  // namespace
 }  // namespace imufit::testing

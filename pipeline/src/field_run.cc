@@ -3,6 +3,7 @@
 #include "imufit/io/run_header.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
+#include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
 namespace {
@@ -59,7 +60,7 @@ Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& 
 
 FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& input,
                            const FieldFitOptions& options, const std::string& software,
-                           const std::string& serial) {
+                           const std::string& serial, bool allow_serial_mismatch) {
   FieldRunResult result;
   Sha256 digest;
   SamplesReader reader(samples_path, /*require_segment=*/false, input.Format(), &digest);
@@ -68,7 +69,11 @@ FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& 
   while (reader.Next(&sample)) samples.push_back(sample);
   result.samples_read = static_cast<long long>(samples.size());
   result.samples_sha256 = digest.HexDigest();
-  result.serial = serial.empty() ? reader.serial() : serial;
+  const UnitSerial unit = ResolveSerial(
+      {SerialSource{SerialSource::Kind::kStated, "--serial", serial, "", 0, 0}, SamplesHeaderSerial(reader)},
+      allow_serial_mismatch);
+  result.serial = unit.serial;
+  result.serial_warnings = unit.warnings;
   result.fit = FitField(samples, options);
   if (!result.fit.IsSolutionUsable()) return result;
   Calibration calibration = FieldCalibration(result.fit, options);

@@ -24,14 +24,17 @@ struct FieldRunResult {
   std::optional<Calibration> calibration;  // when fit.IsSolutionUsable()
   long long samples_read = 0;
   std::string samples_sha256;
-  std::string serial;  // `serial` given, else the samples header's
+  std::string serial;  // `serial` given, else the samples header's (unit_serial.h)
+  std::vector<std::string> serial_warnings;
 };
 
 // Reads `samples_path` as `input` says (its segment column, if any, is not used) and fits it.
-// `software` and `serial` go into the calibration. Throws InputError for bad input.
+// `software` and the unit's serial go into the calibration: `serial` as stated (--serial), else the
+// samples header's; a stated serial that contradicts the header is refused (InputError at the
+// header) unless `allow_serial_mismatch`, as for a table fit. Throws InputError for bad input.
 FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& input,
                            const FieldFitOptions& options, const std::string& software,
-                           const std::string& serial);
+                           const std::string& serial, bool allow_serial_mismatch);
 
 // The calibration of a usable field fit (what FieldFitRun writes), without the record's file names.
 Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& options);
