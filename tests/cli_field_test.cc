@@ -12,12 +12,18 @@
 #include <Eigen/Core>
 
 #include "cli_util.h"
+#include "imufit/io/calibration.h"
 #include "imufit/model/attitude_integration.h"
 
 namespace imufit::testing {
 namespace {
 
 constexpr double kGravityMps2 = 9.80665;
+// A refit of the golden session: every coefficient within this fraction of its sigma of the golden
+// file's, every sigma within this relative difference (worst case; the same session and program
+// give the same numbers up to the solver's last iterations).
+constexpr double kGoldenSigmaFraction = 1e-3;
+constexpr double kGoldenSigmaRelative = 1e-6;
 // Issue 32's bars, RMS over the poses and over the turns.
 constexpr double kMaxAccelNormRmsMps2 = 1e-3 * kGravityMps2;
 constexpr double kMaxDirectionRmsRad = 0.3 * kDegToRad;
@@ -172,6 +178,29 @@ TEST_F(CliTest, FieldOptionsAreChecked) {
   const RunResult r = Run({"fit", "--field", "--samples", raw, "-o", out, "--temp-c", "25"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("every sample at 25 degC (--temp-c)"), std::string::npos) << r.out;
+}
+
+// The fixture's session by hand refitted gives its golden calibration (fixtures/README.md).
+TEST_F(CliTest, FieldFitOfTheFixtureMatchesItsGolden) {
+  const std::string out = Path("cal.yaml");
+  const RunResult r =
+      Run({"fit", "--field", "--samples", Fixture("mems_field_session.csv.gz"), "-o", out, "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Calibration fit = ReadCalibration(out);
+  const Calibration golden = ReadCalibration(Fixture("golden/mems_field_session.yaml"));
+  ASSERT_TRUE(fit.sigma && golden.sigma);
+  const auto compare = [](const double* value, const double* sigma, const double* golden_value,
+                          const double* golden_sigma, int count, const char* sensor) {
+    for (int i = 0; i < count; ++i) {
+      EXPECT_NEAR(value[i], golden_value[i], kGoldenSigmaFraction * golden_sigma[i]) << sensor << " " << i;
+      EXPECT_NEAR(sigma[i], golden_sigma[i], kGoldenSigmaRelative * golden_sigma[i])
+          << sensor << " sigma " << i;
+    }
+  };
+  compare(fit.model.gyro.data(), fit.sigma->gyro.data(), golden.model.gyro.data(), golden.sigma->gyro.data(),
+          kGyroParameters, "gyro");
+  compare(fit.model.accel.data(), fit.sigma->accel.data(), golden.model.accel.data(),
+          golden.sigma->accel.data(), kAccelParameters, "accel");
 }
 
 // The unit's serial as for a table fit: the samples header's, and a stated one that contradicts it
