@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "field_cost.h"
+#include "field_start.h"
 #include "imufit/fit/field_fit.h"
 #include "imufit/model/attitude_integration.h"
 #include "imufit/sim/field_session.h"
@@ -67,6 +68,8 @@ constexpr double kMaxDirectionRmsRad = 0.3 * kDegToRad;
 // of stamp jitter and bursts of 3 lost samples (5e-5 rad measured: a 40 ms gap mid-turn).
 constexpr double kMaxIntegrationErrorRad = 5e-6;
 constexpr double kMaxIntegrationErrorWithLossesRad = 1.5e-4;
+// Worst-case angle between a 1 kHz turn integrated whole and at kTurnFitRateHz (field_start.h).
+constexpr double kMaxDecimationErrorRad = 2e-5;
 
 // A short session at a low rate: 12 poses of about 3 s, MEMS-like noise.
 SimulationOptions ShortSession(std::uint64_t seed) {
@@ -266,6 +269,35 @@ TEST(FieldCostTest, AutodiffAgreesWithCentralDifferencesAndCallsTheModel) {
   const Eigen::Vector3d expected =
       InRawUnits(truth.CoefficientsAtTemperature(25.0).gyro, omega_hat).cwiseQuotient(gyro_noise);
   for (int axis = 0; axis < 3; ++axis) EXPECT_DOUBLE_EQ(residual[axis], expected(axis));
+}
+
+// A 1 kHz turn fitted at kTurnFitRateHz: block means keep the attitude (to the O(h^2) coning term)
+// and the trapezoid noise weight of the full series is what the fit's angle noise uses.
+TEST(FieldCostTest, DecimatedTurnsKeepTheAttitude) {
+  SimulationOptions options;
+  options.rate_hz = 1000.0;
+  options.dwell_s = 2.0;
+  std::vector<Sample> samples;
+  SimulateFieldSession(options, FieldSessionOptions{}, SensorModel::Identity(),
+                       [&](const Sample& raw, const SegmentTruth&) { samples.push_back(raw); });
+  const UnitCoefficients<double> identity = SensorModel::Identity().CoefficientsAtTemperature(25.0);
+  int turns = 0;
+  for (size_t k = 0; k + 1 < samples.size(); ++k) {
+    if (samples[k].segment < 0 || samples[k + 1].segment >= 0) continue;
+    FieldTurn turn;
+    turn.first = static_cast<long long>(k);
+    turn.last = turn.first + 1;
+    while (samples[turn.last].segment < 0) ++turn.last;
+    const std::vector<TurnSample> full = TurnSamples(samples, turn);
+    const std::vector<TurnSample> decimated = DecimatedTurn(full, kTurnFitRateHz);
+    EXPECT_LT(decimated.size(), full.size() / 4);
+    const Quaternion4<double> q_full = IntegrateTurn(identity, full, TurnTimes(full));
+    const Quaternion4<double> q_decimated = IntegrateTurn(identity, decimated, TurnTimes(decimated));
+    EXPECT_LT(2.0 * std::acos(std::min(1.0, std::abs(q_full.dot(q_decimated)))), kMaxDecimationErrorRad);
+    EXPECT_NEAR(TurnTimes(decimated).back(), TurnTimes(full).back(), 1e-12);
+    ++turns;
+  }
+  EXPECT_EQ(turns, 11);
 }
 
 TEST(FieldFitTest, RecoversTruthWithinItsSigmas) {

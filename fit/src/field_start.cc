@@ -140,9 +140,10 @@ std::vector<TurnSample> DecimatedTurn(const std::vector<TurnSample>& samples, do
   const std::vector<double> times_s = TurnTimes(samples);
   const double duration_s = times_s.back();
   const size_t count = samples.size();
-  const size_t block = count > 2 && duration_s > 0.0
-                           ? static_cast<size_t>(static_cast<double>(count - 1) / duration_s / max_rate_hz)
-                           : 1;
+  const size_t block =
+      count > 2 && duration_s > 0.0
+          ? static_cast<size_t>(std::ceil(static_cast<double>(count - 1) / duration_s / max_rate_hz))
+          : 1;
   if (block <= 1) return samples;
   std::vector<TurnSample> out = {samples.front()};
   double last_time_s = 0.0;
