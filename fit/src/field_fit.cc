@@ -366,6 +366,72 @@ void Residuals(const FieldProblem& fp, const std::vector<std::vector<TurnSample>
   summary->direction_rms_rad = fitted_turns == 0 ? 0.0 : std::sqrt(direction_sum / fitted_turns);
 }
 
+// The turns' samples: of every turn (for the residuals), and of the turns the fit uses (not
+// saturated) at most kTurnFitRateHz, with their angle noise weights from every sample.
+struct TurnSets {
+  std::vector<std::vector<TurnSample>> all_samples;
+  std::vector<FieldTurn> fitted;
+  std::vector<std::vector<TurnSample>> fitted_samples;
+  std::vector<double> fitted_noise_weight_s;
+};
+TurnSets SplitTurns(const std::vector<Sample>& samples, const std::vector<FieldTurn>& turns) {
+  TurnSets sets;
+  for (const FieldTurn& turn : turns) {
+    sets.all_samples.push_back(TurnSamples(samples, turn));
+    if (turn.saturated) continue;
+    sets.fitted.push_back(turn);
+    sets.fitted_samples.push_back(DecimatedTurn(sets.all_samples.back(), kTurnFitRateHz));
+    sets.fitted_noise_weight_s.push_back(TurnNoiseWeightS(sets.all_samples.back()));
+  }
+  return sets;
+}
+
+// Solves; while a group's residuals exceed its noise beyond chance, scales that noise and solves
+// again (NoiseScales), so that the covariance describes the session's actual scatter. Sets the
+// summary's iterations, termination, noise scales and reduced chi-square; false (with the status
+// set) when the solver fails or the problem has a direction without information.
+bool Solve(const FieldFitOptions& options, FieldProblem* fp, FieldFitSummary* summary,
+           Eigen::MatrixXd* covariance) {
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = 1e-12;
+  solver.parameter_tolerance = 1e-12;
+  solver.gradient_tolerance = 1e-14;
+  solver.num_threads = 1;
+  constexpr int kMaxNoisePasses = 4;
+  summary->iterations = 0;
+  for (int pass = 0; pass < kMaxNoisePasses; ++pass) {
+    ceres::Solver::Summary solved;
+    ceres::Solve(solver, &fp->problem, &solved);
+    summary->iterations += static_cast<int>(solved.iterations.size());
+    summary->termination = solved.message;
+    if (!solved.IsSolutionUsable()) {
+      summary->status = FieldFitStatus::kFailed;
+      return false;
+    }
+    Eigen::VectorXd residuals;
+    std::array<int, 4> group_rows{};
+    const Eigen::MatrixXd jacobian = Jacobian(fp, &residuals, &group_rows);
+    if (const std::string missing = Covariance(jacobian, options.fit_g_sensitivity, covariance);
+        !missing.empty()) {
+      summary->status = FieldFitStatus::kUndetermined;
+      summary->undetermined.push_back("the session holds no information on the " + missing);
+      return false;
+    }
+    const double dof = static_cast<double>(jacobian.rows() - jacobian.cols());
+    summary->reduced_chi2 = dof > 0 ? 2.0 * solved.final_cost / dof : 0.0;
+    summary->noise_scale = fp->layout.noise_scale;
+    if (!NoiseScales(jacobian, residuals, *covariance, group_rows, &fp->layout)) break;
+  }
+  return true;
+}
+
+bool AllFinite(const SensorModel& m) {
+  return std::all_of(m.gyro.begin(), m.gyro.end(), [](double v) { return std::isfinite(v); }) &&
+         std::all_of(m.accel.begin(), m.accel.end(), [](double v) { return std::isfinite(v); });
+}
+
 }  // namespace
 
 PoseDirection::PoseDirection(const Eigen::Vector3d& up) : u0(up.normalized()) {
@@ -422,78 +488,27 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
         Format(" (rest %.3g s or longer in each)", options.min_pose_s + options.detection.window_s));
     return summary;
   }
-  std::vector<std::vector<TurnSample>> turn_samples;    // of every turn
-  std::vector<FieldTurn> fitted;                        // the turns not saturated, and their samples
-  std::vector<std::vector<TurnSample>> fitted_samples;  // at most kTurnFitRateHz
-  std::vector<double> fitted_noise_weight_s;            // from every sample
-  for (const FieldTurn& turn : summary.turns) {
-    turn_samples.push_back(TurnSamples(samples, turn));
-    if (turn.saturated) continue;
-    fitted.push_back(turn);
-    fitted_samples.push_back(DecimatedTurn(turn_samples.back(), kTurnFitRateHz));
-    fitted_noise_weight_s.push_back(TurnNoiseWeightS(turn_samples.back()));
-  }
-  const SensorModel start = FieldStart(summary.poses, fitted, fitted_samples, options);
-  summary.undetermined = CoverageProblems(summary.poses, fitted, fitted_samples, start, options);
+  TurnSets turns = SplitTurns(samples, summary.turns);
+  const SensorModel start = FieldStart(summary.poses, turns.fitted, turns.fitted_samples, options);
+  summary.undetermined = CoverageProblems(summary.poses, turns.fitted, turns.fitted_samples, start, options);
   if (!summary.undetermined.empty()) {
     summary.status = FieldFitStatus::kUndetermined;
     return summary;
   }
-
   FieldProblem fp;
-  BuildProblem(summary.poses, fitted, std::move(fitted_samples), fitted_noise_weight_s, summary, start,
-               options, &fp);
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-12;
-  solver.parameter_tolerance = 1e-12;
-  solver.gradient_tolerance = 1e-14;
-  solver.num_threads = 1;
-  // Solve; while a group's residuals exceed its noise beyond chance, scale that noise and solve
-  // again (NoiseScales), so that the covariance describes the session's actual scatter.
-  constexpr int kMaxNoisePasses = 4;
+  BuildProblem(summary.poses, turns.fitted, std::move(turns.fitted_samples), turns.fitted_noise_weight_s,
+               summary, start, options, &fp);
   Eigen::MatrixXd covariance;
-  Eigen::MatrixXd jacobian;
-  double final_cost = 0.0;
-  summary.iterations = 0;
-  for (int pass = 0; pass < kMaxNoisePasses; ++pass) {
-    ceres::Solver::Summary solved;
-    ceres::Solve(solver, &fp.problem, &solved);
-    summary.iterations += static_cast<int>(solved.iterations.size());
-    summary.termination = solved.message;
-    if (!solved.IsSolutionUsable()) {
-      summary.status = FieldFitStatus::kFailed;
-      return summary;
-    }
-    final_cost = solved.final_cost;
-    Eigen::VectorXd residuals;
-    std::array<int, 4> group_rows{};
-    jacobian = Jacobian(&fp, &residuals, &group_rows);
-    if (const std::string missing = Covariance(jacobian, options.fit_g_sensitivity, &covariance);
-        !missing.empty()) {
-      summary.status = FieldFitStatus::kUndetermined;
-      summary.undetermined.push_back("the session holds no information on the " + missing);
-      return summary;
-    }
-    if (!NoiseScales(jacobian, residuals, covariance, group_rows, &fp.layout)) break;
-  }
+  if (!Solve(options, &fp, &summary, &covariance)) return summary;
   summary.model = fp.Model();
   summary.model.basis = TemperatureBasis::Reference();
-  summary.noise_scale = fp.layout.noise_scale;
-  const double dof = static_cast<double>(jacobian.rows() - jacobian.cols());
-  summary.reduced_chi2 = dof > 0 ? 2.0 * final_cost / dof : 0.0;
   summary.sigma = Sigmas(covariance, fp.layout, options.fit_g_sensitivity);
-  const auto finite = [](const SensorModel& m) {
-    return std::all_of(m.gyro.begin(), m.gyro.end(), [](double v) { return std::isfinite(v); }) &&
-           std::all_of(m.accel.begin(), m.accel.end(), [](double v) { return std::isfinite(v); });
-  };
-  if (!finite(summary.model) || !finite(summary.sigma)) {  // never written: docs/spec.md section 4
+  if (!AllFinite(summary.model) || !AllFinite(summary.sigma)) {  // never written: docs/spec.md section 4
     summary.status = FieldFitStatus::kFailed;
     summary.termination = "the solution or its covariance is not finite";
     return summary;
   }
-  Residuals(fp, turn_samples, options, &summary);
+  Residuals(fp, turns.all_samples, options, &summary);
   summary.undetermined = LooseCoefficients(summary.model, summary.sigma, options);
   summary.status = summary.undetermined.empty() ? FieldFitStatus::kConverged : FieldFitStatus::kUndetermined;
   return summary;
