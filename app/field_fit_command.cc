@@ -1,8 +1,10 @@
 // imufit fit --field (field_fit_command.h).
 #include "field_fit_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 
 #include "commands.h"
 #include "imufit/io/error.h"
@@ -59,6 +61,32 @@ void AddFieldFitOptions(CLI::App* command, FieldFitArguments* args) {
       "was turned by hand between them (docs/field.md)");
   args->options.Add(command, FieldFitOptionTable());
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key)->needs(field);
+}
+
+// The options of a table fit that also mean something to a session by hand: how the samples are
+// read, the serial, the g-sensitivity, and how rests are told from motion.
+bool AppliesToAFieldFit(const std::string& key) {
+  static const char* const kKeys[] = {"temp_c",
+                                      "time_unit",
+                                      "delimiter",
+                                      "decimal_comma",
+                                      "column",
+                                      "allow_serial_mismatch",
+                                      "fit_g_sensitivity",
+                                      "segment_window_s",
+                                      "segment_noise_quantile",
+                                      "segment_threshold_factor",
+                                      "min_steady_s"};
+  return std::find(std::begin(kKeys), std::end(kKeys), key) != std::end(kKeys);
+}
+
+void RefuseTableOptions(const FitRunArguments& run) {
+  for (const auto& entry : FitRunOptionTable().entries()) {
+    if (!entry.flag.empty() && run.options.Given(entry.key) && !AppliesToAFieldFit(entry.key)) {
+      throw InputError(entry.flag.substr(0, entry.flag.find(',')),
+                       "is an option of a table fit, not of --field");
+    }
+  }
 }
 
 int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,

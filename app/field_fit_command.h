@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_options.h"
+#include "commands.h"
 #include "imufit/fit/field_fit.h"
 #include "imufit/pipeline/fit_run.h"
 
@@ -20,6 +21,10 @@ struct FieldFitArguments {
 
 // Adds --field and the field fit's own options (which need it) to `command`.
 void AddFieldFitOptions(CLI::App* command, FieldFitArguments* args);
+
+// Refuses (InputError, exit 2) a table fit's option given with --field that has no meaning for a
+// session by hand (--validate, --prior, --fit, ...).
+void RefuseTableOptions(const FitRunArguments& run);
 
 // The field fit of `samples` written to `output`; `run` gives how the samples are read (--temp-c,
 // --time-unit, columns, rest detection) and whether the g-sensitivity is fitted (--no-g-sensitivity).

@@ -242,6 +242,7 @@ int RunFit(const FitArguments& args) {
       if (!factory->empty())
         throw InputError("--field", "limits, certificates and the store take table runs only");
     }
+    RefuseTableOptions(args.run);
     return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, ResolveOptions(args));
   }
   if (args.plan.empty()) throw InputError("imufit fit", "--plan is required (or --field)");

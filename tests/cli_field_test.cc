@@ -166,6 +166,8 @@ TEST_F(CliTest, FieldOptionsAreChecked) {
       "--field");
   expect_bad({"fit", "--field", "--samples", raw, "-o", out, "--temp-c", "25", "--gravity-mps2", "12"},
              "gravity_mps2");
+  expect_bad({"fit", "--field", "--samples", raw, "-o", out, "--temp-c", "25", "--validate"},
+             "--validate: is an option of a table fit, not of --field");
   expect_bad({"simulate", "--field", "--calibration", Fixture("mems_truth.yaml"), "-o", Path("s.csv"),
               "--poses", "5"},
              "poses");
