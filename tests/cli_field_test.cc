@@ -205,6 +205,16 @@ TEST_F(CliTest, FieldFitOfTheFixtureMatchesItsGolden) {
           golden.sigma->accel.data(), kAccelParameters, "accel");
 }
 
+// A unit warming up during the session: fitted all the same, with a warning that the calibration
+// is constant in temperature.
+TEST_F(CliTest, FieldFitWarnsOfAWarmUp) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--warmup-c", "8", "--warmup-tau-s", "30"})).status, 0);
+  const RunResult r = Run({"fit", "--field", "--samples", raw, "-o", Path("cal.yaml"), "-q"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: the session spans 17"), std::string::npos) << r.err;
+}
+
 // The unit's serial as for a table fit: the samples header's, and a stated one that contradicts it
 // refused unless --allow-mismatch.
 TEST_F(CliTest, FieldFitTakesTheSerialOfTheSamples) {
