@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "field_fit_command.h"
 #include "imufit/base/text.h"
 #include "imufit/factory/certify.h"
 #include "imufit/fit/thermal_fit.h"
@@ -30,6 +31,7 @@ struct FitArguments {
   PdfArguments pdf;            // the certificate printed too (with --report)
   CustomerArguments customer;  // printed on the certificate (with --report)
   FitRunArguments run;         // the fit options, shared with imufit batch
+  FieldFitArguments field;     // --field: a session by hand, no plan (field_fit_command.h)
 };
 
 // A value and its 1-sigma: the sigma goes through the same unit conversion as the value, whose
@@ -233,6 +235,16 @@ int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool reco
 }
 
 int RunFit(const FitArguments& args) {
+  if (args.field.field) {
+    if (!args.plan.empty()) throw InputError("--plan", "a session by hand (--field) has no plan");
+    for (const std::string* factory : {&args.limits, &args.report, &args.store, &args.station}) {
+      if (!factory->empty())
+        throw InputError("--field", "limits, certificates and the store take table runs only");
+    }
+    RefuseTableOptions(args.run);
+    return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, ResolveOptions(args));
+  }
+  if (args.plan.empty()) throw InputError("imufit fit", "--plan is required (or --field)");
   const std::string check_plan = args.run.options.GivenText("check_plan");
   const std::string check_samples = args.run.options.GivenText("check_samples");
   RefuseToOverwriteInputs(args.output, {args.plan, args.samples, check_plan, check_samples, args.limits,
@@ -302,7 +314,7 @@ int RunFit(const FitArguments& args) {
 
 CommandRunner AddFitCommand(CliCommand command) {
   auto args = std::make_shared<FitArguments>();
-  command.Option("--plan,-p", &args->plan, "plan YAML of the run").Required();
+  command.Option("--plan,-p", &args->plan, "plan YAML of the run (required, but with --field)");
   command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
   command.Option("--output,-o", &args->output, "calibration YAML to write").Required();
   AddFitRunOptions(command, &args->run);
@@ -323,6 +335,7 @@ CommandRunner AddFitCommand(CliCommand command) {
   command.Option(
       "--store", &args->store,
       "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");
+  AddFieldFitOptions(command, &args->field);
   return [args] { return RunFit(*args); };
 }
 

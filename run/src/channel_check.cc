@@ -24,15 +24,6 @@ const char* ChannelName(int channel) {
   return kNames[channel];
 }
 
-// A converter's limit: +-(2^k - 1) or -2^k.
-bool ConverterLimit(double value) {
-  for (int k = 7; k <= 31; ++k) {
-    const double limit = std::ldexp(1.0, k);
-    if (value == limit - 1.0 || value == -(limit - 1.0) || value == -limit) return true;
-  }
-  return false;
-}
-
 std::string Stuck(int channel, double value, const WindowOptions& options) {
   const double full_scale = channel < 3 ? options.gyro_full_scale_raw : options.accel_full_scale_raw;
   const std::string reads =
@@ -291,6 +282,14 @@ std::string AxisMapFinding(const std::vector<Window>& windows, const TableSite& 
 }
 
 }  // namespace
+
+bool ConverterLimit(double value) {
+  for (int k = 7; k <= 31; ++k) {
+    const double limit = std::ldexp(1.0, k);
+    if (value == limit - 1.0 || value == -(limit - 1.0) || value == -limit) return true;
+  }
+  return false;
+}
 
 std::string CheckChannels(const std::vector<Window>& windows, const WindowStats& stats, const TableSite& site,
                           const std::vector<TableSegment>& segments, const WindowOptions& options) {

@@ -34,6 +34,10 @@ inline constexpr double kResponseShare = 0.5;
 // A response smaller than this many scatters of the window means is none.
 inline constexpr double kResponseSigmas = 6.0;
 
+// Whether a raw value is a converter's limit, +-(2^k - 1) or -2^k for k = 7 .. 31 (a saturated
+// integer channel; the field fit drops a turn that touches one).
+bool ConverterLimit(double value);
+
 // The dead, stuck or railed channels of a run (raw units; `stats` over every sample, `windows` those
 // the fit gets), one line ("" when every channel is live).
 std::string CheckChannels(const std::vector<Window>& windows, const WindowStats& stats, const TableSite& site,

@@ -1,0 +1,36 @@
+// imufit fit --field — a calibration from a session by hand, without a table or a plan
+// (pipeline/field_run.h, docs/field.md). `fit` declares the options and hands the run over here.
+#ifndef IMUFIT_APP_FIELD_FIT_COMMAND_H_
+#define IMUFIT_APP_FIELD_FIT_COMMAND_H_
+
+#include <string>
+
+#include "cli_options.h"
+#include "commands.h"
+#include "imufit/fit/field_fit.h"
+#include "imufit/pipeline/fit_run.h"
+
+namespace imufit {
+
+struct FieldFitArguments {
+  bool field = false;                   // --field: a session by hand
+  CliOptions<FieldFitOptions> options;  // FieldFitOptionTable()
+};
+
+// Adds --field and the field fit's own options (which need it) to `command`.
+void AddFieldFitOptions(CliCommand command, FieldFitArguments* args);
+
+// Refuses (InputError, exit 2) a table fit's option given with --field that has no meaning for a
+// session by hand (--validate, --prior, --fit, ...).
+void RefuseTableOptions(const FitRunArguments& run);
+
+// The field fit of `samples` written to `output`; `run` gives how the samples are read (--temp-c,
+// --time-unit, columns, rest detection) and whether the g-sensitivity is fitted (--no-g-sensitivity).
+// Returns the exit status: 0, or 1 when the session does not determine the model (the message says
+// what it lacks) or the fit does not converge; nothing is written then.
+int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
+                const std::string& serial, bool quiet, const FitRunOptions& run);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_APP_FIELD_FIT_COMMAND_H_

@@ -1,0 +1,172 @@
+// imufit — the field fit: a calibration from a session by hand, without a table or a plan
+// (`imufit fit --field`, docs/field.md). The model is the shared one (model/sensor_model.h,
+// docs/spec.md section 1), its coefficients here constant in temperature (order 0; the parameter
+// blocks hold kTerms terms per coefficient so that the cubic is a change of kTerms).
+//
+// The session: the unit rests in N >= 9 arbitrary poses and is turned by hand between them.
+//
+//  1. Poses. The rests are found on both sensors at once (run/segmentation.h's MotionDetector: a
+//     noise floor from the whole log, gyro and accelerometer variance over a sliding window); a
+//     steady piece of at least min_pose_s is a pose. Each pose is reduced to its raw means; the
+//     white noise of a sample, per axis, is pooled over every pose (the noise floor of the log).
+//  2. Turns. Between two successive poses the corrected gyro is integrated on the samples' own
+//     time stamps (model/attitude_integration.h: quaternion, Runge-Kutta 4, rate linear between
+//     samples), from the last sample of one pose to the first of the next.
+//  3. The Ceres problem (fit/src/field_cost.h), every residual through the shared model's
+//     CorrectWith(); the unknowns are the coefficients and, per pose, gravity's direction u_p
+//     (two tangent parameters about its starting value):
+//       accelerometer at pose p:  K_a (a_hat_p - g u_p) / sigma_a            3 residuals
+//       gyro at pose p:           K_g omega_hat_p / sigma_g (at rest: zero)  3 residuals
+//       turn from p to q:         E_q^T (R_pq^T u_p - u_q) / sigma_turn      2 residuals
+//     with K = diag(S) inv(M) (errors in raw units, where the noise lives, as the table fit's
+//     window_cost.h), sigma the noise of a pose's mean, R_pq the integrated turn, E_q two unit
+//     vectors perpendicular to u_q, and sigma_turn the gyro's white noise integrated over the turn
+//     (angle random walk). So |a_hat| = g fixes the accelerometer, the turns fix the gyro's scale
+//     and misalignment, the static gyro means its bias and, through a_hat_p, its g-sensitivity H.
+//     Earth's rotation (at most 7.3e-5 rad/s) is not modelled: the session has no north.
+//  4. The body frame. Without a table it is a convention (docs/spec.md section 1, "field
+//     calibration"): x along the accelerometer's x axis, y in the plane of its x and y axes, so the
+//     accelerometer's misalignment xy, xz and yz are held at 0 (kBodyFrameConvention).
+//  5. Uncertainty. Every residual is normalised by its noise, so the covariance of the
+//     coefficients is (J^T J)^-1 at the solution; `sigma` holds its square roots (0 for a held
+//     term). Where a group of residuals (accelerometer at rest, gyro at rest, turns) is larger than
+//     the white noise can explain (a real hand session: tremor, drift), its noise is scaled by its
+//     variance-component estimate and the problem solved again, so that the sigmas stay honest. A session
+//     that cannot determine a coefficient is refused, saying what it lacks in plain words (`undetermined`):
+//     no pose near some direction, too few poses, turns too small about an axis, or a direction of the
+//     problem with no information (named by the coefficient it moves most).
+//
+// Frames and units: raw inputs as the unit gives them; SI inside; the body frame above.
+#ifndef IMUFIT_FIT_FIELD_FIT_H_
+#define IMUFIT_FIT_FIELD_FIT_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "imufit/base/option_table.h"
+#include "imufit/model/constants.h"
+#include "imufit/model/sample.h"
+#include "imufit/model/sensor_model.h"
+#include "imufit/run/segmentation.h"
+
+namespace imufit {
+
+// The body frame of a field calibration, as the calibration file's `body_frame:` key states it.
+inline constexpr const char* kBodyFrameConvention = "accelerometer_xy";
+// The accelerometer's misalignment terms the convention holds at 0 (indices into its 6).
+inline constexpr int kFieldHeldAccelMisalignment[3] = {0, 1, 3};  // xy, xz, yz
+
+struct FieldFitOptions {
+  // Local gravity, m/s^2: the length every pose's corrected specific force must have.
+  double gravity_mps2 = kStandardGravityMps2;
+  // How rests are told from motion (window, noise quantile, threshold): the segmentation's.
+  SegmentationOptions detection;
+  // A steady stretch shorter than this is not a pose, s.
+  double min_pose_s = 1.0;
+  // Fewer poses than this is refused (9 accelerometer unknowns need 9 poses, and more are better).
+  int min_poses = 9;
+  // Whether the gyro g-sensitivity H is fitted (else held at 0).
+  bool fit_g_sensitivity = true;
+  // A pose is "near" a direction (+x, -x, ...) within this angle, degrees: every one of the six must
+  // have one, or the accelerometer's scale and bias of that axis rest on one side only.
+  double near_direction_deg = 50.0;
+  // The turns must move gravity by at least this much about each gyro axis, rad (summed over the
+  // turns: the rotation about the axis times the sine of gravity's angle to it).
+  double min_turn_about_axis_rad = 0.5;
+  // Refused beyond these 1-sigma: relative gyro and accelerometer scale, misalignment (rad).
+  double max_relative_scale_sigma = 0.01;
+  double max_misalignment_sigma_rad = 0.01;
+  int max_iterations = 100;
+
+  // An empty string when usable, else what is wrong.
+  std::string Validate() const;
+};
+
+// The options a user sets (gravity_mps2, min_pose_s), described once (base/option_table.h;
+// field_fit_options.cc): `imufit fit --field` takes them from here.
+const OptionTable<FieldFitOptions>& FieldFitOptionTable();
+
+// A rest found in the session: its samples [first, last] (indices into the samples given) and means.
+struct FieldPose {
+  long long first = 0;
+  long long last = 0;
+  double start_s = 0.0;
+  double end_s = 0.0;
+  double temp_c = 0.0;                                   // mean reading
+  Eigen::Vector3d gyro_mean = Eigen::Vector3d::Zero();   // raw
+  Eigen::Vector3d accel_mean = Eigen::Vector3d::Zero();  // raw
+  // After the fit: gravity's direction (up, body frame) and | |a_hat| - g |, m/s^2.
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  double accel_norm_error_mps2 = 0.0;
+};
+
+// The motion between two successive poses: the samples [first, last] integrated (the last of pose
+// `from` to the first of pose `to`).
+struct FieldTurn {
+  int from = 0;
+  int to = 0;
+  long long first = 0;
+  long long last = 0;
+  // A gyro sample at a converter's limit (run/channel_check.h): the integrated rate is wrong, so the
+  // turn is left out of the fit (its poses stay).
+  bool saturated = false;
+  double angle_rad = 0.0;  // after the fit: the angle gravity turned through
+  // After the fit: the angle between gravity's direction at `to` and the one the turn predicts, rad.
+  double direction_error_rad = 0.0;
+};
+
+enum class FieldFitStatus {
+  kNotRun,
+  kConverged,     // solved; the calibration is usable
+  kUndetermined,  // the session does not determine the model; see `undetermined`
+  kFailed,        // the solver did not converge; see `termination`
+};
+
+struct FieldFitSummary {
+  FieldFitStatus status = FieldFitStatus::kNotRun;
+  // What the session cannot determine, in plain words ("no pose with gravity near -y (the y axis
+  // up)", "turns about z too small to fix the gyro's z scale").
+  std::vector<std::string> undetermined;
+  std::vector<FieldPose> poses;
+  std::vector<FieldTurn> turns;
+  SensorModel model = SensorModel::Identity();  // basis: TemperatureBasis::Reference()
+  SensorModel sigma{};                          // 1-sigma, same layout; 0 for a held term
+  std::array<double, 2> temp_range_c{0.0, 0.0};
+  int iterations = -1;
+  std::string termination;
+  // Noise of one sample, raw, per axis (the log's floor, pooled over the poses).
+  Eigen::Vector3d gyro_noise_raw = Eigen::Vector3d::Constant(-1.0);
+  Eigen::Vector3d accel_noise_raw = Eigen::Vector3d::Constant(-1.0);
+  // Residuals after the fit: | |a_hat| - g | over the poses (RMS, m/s^2), the corrected static gyro
+  // (RMS over poses and axes, rad/s), gravity's direction after each turn fitted (RMS, rad), and
+  // the reduced chi-square of the whole problem.
+  double accel_norm_rms_mps2 = -1.0;
+  double gyro_static_rms_radps = -1.0;
+  double direction_rms_rad = -1.0;
+  double reduced_chi2 = -1.0;
+  // The noise of each residual group as a multiple of the log's white noise: the accelerometer at
+  // rest, the gyro at rest, the turns. 1 unless the group's residuals exceed that noise beyond
+  // chance (hand tremor, drift, correlated noise); then its variance-component estimate, by which
+  // the group is weighted and its sigmas grow (field_fit.cc, NoiseScales()).
+  std::array<double, 3> noise_scale{1.0, 1.0, 1.0};
+
+  bool IsSolutionUsable() const { return status == FieldFitStatus::kConverged; }
+  // One line: the outcome, poses, turns and residuals.
+  std::string BriefReport() const;
+};
+
+// Fits the model to a session by hand, `samples` in time order (raw; temp_c as read).
+FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options);
+
+// Step 1 alone: the poses and turns of a session (their means; `up` and the errors not set) and the
+// noise floor. Poses the session lacks are reported by FitField, not here.
+void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& options,
+                    std::vector<FieldPose>* poses, std::vector<FieldTurn>* turns,
+                    Eigen::Vector3d* gyro_noise_raw, Eigen::Vector3d* accel_noise_raw);
+
+}  // namespace imufit
+
+#endif  // IMUFIT_FIT_FIELD_FIT_H_

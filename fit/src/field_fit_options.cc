@@ -1,0 +1,41 @@
+// FieldFitOptions: its option table (base/option_table.h) and its checks.
+#include <cmath>
+
+#include "imufit/fit/field_fit.h"
+
+namespace imufit {
+namespace {
+
+OptionTable<FieldFitOptions> MakeFieldFitOptionTable() {
+  using O = FieldFitOptions;
+  OptionTable<O> t;
+  t.Number("gravity_mps2", "--gravity-mps2", "local gravity: the length of every pose's specific force",
+           "m/s^2", &O::gravity_mps2, Between(9.7, 9.9));
+  t.Number("min_pose_s", "--min-pose-s", "a rest shorter than this is not a pose", "s", &O::min_pose_s,
+           PositiveFinite());
+  return t;
+}
+
+}  // namespace
+
+const OptionTable<FieldFitOptions>& FieldFitOptionTable() {
+  static const OptionTable<FieldFitOptions> table = MakeFieldFitOptionTable();
+  return table;
+}
+
+std::string FieldFitOptions::Validate() const {
+  if (std::string problem = ValidateOptions(FieldFitOptionTable(), *this); !problem.empty()) return problem;
+  if (std::string problem = detection.Validate(); !problem.empty()) return problem;
+  if (min_poses < 9)
+    return "min_poses = " + std::to_string(min_poses) + ": the accelerometer alone has 9 unknowns";
+  if (!(near_direction_deg > 0.0 && near_direction_deg < 90.0))
+    return "near_direction_deg must lie in (0, 90)";
+  if (!(min_turn_about_axis_rad >= 0.0 && max_relative_scale_sigma > 0.0 &&
+        max_misalignment_sigma_rad > 0.0)) {
+    return "the observability thresholds must be > 0";
+  }
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  return "";
+}
+
+}  // namespace imufit
