@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "file_open_counter.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certify.h"
 #include "imufit/io/calibration.h"

@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include "file_open_counter.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"

@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/inotify.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -48,39 +47,6 @@ RunResult Finish(pid_t pid, const std::string& out_path, const std::string& err_
 }
 
 }  // namespace
-
-FileOpenCounter::FileOpenCounter(const std::string& path) : path_(path) {
-  inotify_ = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
-  if (inotify_ < 0) {
-    ADD_FAILURE() << "inotify: " << std::strerror(errno);
-    return;
-  }
-  // The closings are watched too, so that two openings one after the other are two events: the
-  // kernel merges an event into an identical one still unread just before it.
-  if (::inotify_add_watch(inotify_, path.c_str(), IN_OPEN | IN_CLOSE) < 0) {
-    ADD_FAILURE() << path << ": cannot watch: " << std::strerror(errno);
-  }
-}
-
-FileOpenCounter::~FileOpenCounter() {
-  if (inotify_ >= 0) ::close(inotify_);
-}
-
-long long FileOpenCounter::count() const {
-  // The events queued since the last call (an opening is queued when it happens).
-  alignas(struct inotify_event) char buffer[1 << 14];
-  for (;;) {
-    const ssize_t got = inotify_ < 0 ? -1 : ::read(inotify_, buffer, sizeof buffer);
-    if (got <= 0) break;
-    for (ssize_t at = 0; at < got;) {
-      const auto* event = reinterpret_cast<const struct inotify_event*>(buffer + at);
-      if (event->mask & IN_Q_OVERFLOW) ADD_FAILURE() << path_ << ": inotify queue overflow";
-      if (event->mask & IN_OPEN) ++count_;
-      at += static_cast<ssize_t>(sizeof(struct inotify_event) + event->len);
-    }
-  }
-  return count_;
-}
 
 std::string Fixture(const std::string& name) { return std::string(IMUFIT_FIXTURES_DIR) + "/" + name; }
 

@@ -47,28 +47,6 @@ RunResult RunProgramWithFileSizeLimit(const std::string& program, const std::vec
                                       const std::string& out_path, const std::string& err_path,
                                       rlim_t max_file_bytes);
 
-// Counts, while it lives, the openings of the file `path` names, by any code of this process or
-// another (the kernel's inotify IN_OPEN events on its inode: two spellings of a path are one file,
-// and an opening no reader reports is counted too). A test holds a command to how often it reads a
-// large input this way (`imufit fit --report --store`: the samples at most twice). Two openings that
-// overlap in time may count as one (the kernel merges identical events); io's readers open a file
-// one after another. A file that does not exist, or a kernel without inotify, fails the test.
-class FileOpenCounter {
- public:
-  explicit FileOpenCounter(const std::string& path);
-  ~FileOpenCounter();
-  FileOpenCounter(const FileOpenCounter&) = delete;
-  FileOpenCounter& operator=(const FileOpenCounter&) = delete;
-
-  // The openings since this counter was made.
-  long long count() const;
-
- private:
-  std::string path_;
-  int inotify_ = -1;
-  mutable long long count_ = 0;
-};
-
 // A test that works in a fresh, empty folder of its own, dir_, under the system's temporary
 // folder, named after the test and the process. The folder is removed after a test that passed and
 // kept after one that failed, to look at. Programs run through RunProgram() leave their captured
