@@ -157,7 +157,9 @@ TEST(Simulator, LostSamplesJitterQuantisationAndSaturationAsAStationHasThem) {
     const Sample& s = run.raw[i];
     const double nominal_time = std::round(s.time_s * options.rate_hz) / options.rate_hz;
     worst_jitter = std::max(worst_jitter, std::abs(s.time_s - nominal_time));
-    if (i > 0) ASSERT_GT(s.time_s, run.raw[i - 1].time_s) << "sample " << i;
+    if (i > 0) {
+      ASSERT_GT(s.time_s, run.raw[i - 1].time_s) << "sample " << i;
+    }
     for (int axis = 0; axis < 3; ++axis) {
       ASSERT_EQ(s.gyro[axis], std::round(s.gyro[axis])) << "sample " << i;
       ASSERT_EQ(s.accel[axis], std::round(s.accel[axis])) << "sample " << i;

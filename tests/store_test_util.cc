@@ -71,9 +71,18 @@ StoredFit MakeFit(const std::string& serial, const std::string& lot, const std::
   fit.status = "fitted";
   fit.verdict = verdict;
   fit.calibration_yaml = "calibration of " + serial + "\n";
-  StoredFigure x{"gyro_bias_dps.x", "gyro.bias.x", "deg/s", bias_dps, 0.01};
+  const auto figure = [](const std::string& name, const std::string& coefficient, double value) {
+    StoredFigure f;
+    f.name = name;
+    f.coefficient = coefficient;
+    f.unit = "deg/s";
+    f.value = value;
+    f.sigma = 0.01;
+    return f;
+  };
+  StoredFigure x = figure("gyro_bias_dps.x", "gyro.bias.x", bias_dps);
   x.expanded_u = 0.02;
-  fit.figures = {x, StoredFigure{"gyro_bias_dps.y", "gyro.bias.y", "deg/s", 0.0, 0.01}};
+  fit.figures = {x, figure("gyro_bias_dps.y", "gyro.bias.y", 0.0)};
   return fit;
 }
 
