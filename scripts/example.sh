@@ -9,10 +9,10 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-imufit_install_deps
+imufit_install_deps "${IMUFIT_APT_PACKAGES[@]}"  # what the build and the example need, nothing for the tests
 imufit_say "building imufit (Release, build-release/)"
 build=$IMUFIT_ROOT/build-release
-imufit_build "$build" imufit
+imufit_build "$build" imufit -- "${IMUFIT_EXAMPLE_CMAKE_ARGS[@]}"
 imufit=$build/app/imufit
 fixtures=$IMUFIT_ROOT/fixtures
 out=$build/example

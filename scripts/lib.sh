@@ -5,13 +5,25 @@
 
 IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
-# Everything the build, the tests and the Allan plots need, as Debian packages.
-IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libgtest-dev
-                     libcli11-dev zlib1g-dev libbenchmark-dev gnuplot-nox libsqlite3-dev
-                     pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-yaml
-                     python3-matplotlib python3-setuptools python3-wheel python3-pip clang clang-format
-                     libfuzzer-14-dev chromium poppler-utils ccache gcc-arm-none-eabi libnewlib-arm-none-eabi
-                     python3-jsonschema libssl-dev libisal-dev libpq-dev postgresql)
+# What building imufit (the command, tests, benchmarks and Python module left out) and running
+# scripts/example.sh need, as Debian packages: the compiler and build tools, and every library the
+# build's CMake requires (Eigen and Ceres, yaml-cpp, CLI11, zlib, OpenSSL's libcrypto, ISA-L,
+# SQLite and PostgreSQL's libpq for the results store). scripts/example.sh configures with
+# IMUFIT_EXAMPLE_CMAKE_ARGS, so that GoogleTest, Google Benchmark and pybind11 are not needed;
+# scripts/test.sh turns them on again in the same build folder (IMUFIT_TEST_CMAKE_ARGS).
+IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libcli11-dev
+                     zlib1g-dev libssl-dev libisal-dev libsqlite3-dev libpq-dev)
+IMUFIT_EXAMPLE_CMAKE_ARGS=(-DIMUFIT_BUILD_TESTS=OFF -DIMUFIT_BUILD_BENCH=OFF -DIMUFIT_BUILD_PYTHON=OFF)
+
+# What the whole suite needs besides (scripts/test.sh): GoogleTest and Google Benchmark, the
+# Python module's build and tests, gnuplot for the plots, Chromium and poppler-utils for the
+# printed certificates, a PostgreSQL server for the store's tests, the ARM cross-compiler for the
+# C runtime's Cortex-M4 build, clang with libFuzzer and clang-format, ccache, JSON Schema.
+IMUFIT_TEST_CMAKE_ARGS=(-DIMUFIT_BUILD_TESTS=ON -DIMUFIT_BUILD_BENCH=ON -UIMUFIT_BUILD_PYTHON -DIMUFIT_WERROR=ON)
+IMUFIT_TEST_APT_PACKAGES=(libgtest-dev libbenchmark-dev gnuplot-nox pybind11-dev python3-pybind11 python3-dev
+                          python3-numpy python3-pytest python3-yaml python3-matplotlib python3-setuptools
+                          python3-wheel python3-pip clang clang-format libfuzzer-14-dev chromium poppler-utils
+                          ccache gcc-arm-none-eabi libnewlib-arm-none-eabi python3-jsonschema postgresql)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {
@@ -29,15 +41,15 @@ imufit_fuzz_available() {
 imufit_say() { printf '== %s\n' "$*"; }
 imufit_die() { printf 'error: %s\n' "$*" >&2; exit 1; }
 
-# Installs the packages of IMUFIT_APT_PACKAGES that are not installed yet (apt-get update first;
-# sudo only when not root).
+# imufit_install_deps PACKAGE...: installs those of the Debian packages named that are not
+# installed yet (apt-get update first; sudo only when not root).
 imufit_install_deps() {
   if ! command -v dpkg-query >/dev/null 2>&1; then
-    imufit_say "not a Debian system: make sure these are installed: ${IMUFIT_APT_PACKAGES[*]}"
+    imufit_say "not a Debian system: make sure these are installed: $*"
     return 0
   fi
   local missing=() package
-  for package in "${IMUFIT_APT_PACKAGES[@]}"; do
+  for package in "$@"; do
     if [[ $(dpkg-query -W -f='${db:Status-Status}' "$package" 2>/dev/null) != installed ]]; then
       missing+=("$package")
     fi

@@ -40,12 +40,14 @@ check_format() {
   fi
 }
 
-imufit_install_deps
+imufit_install_deps "${IMUFIT_APT_PACKAGES[@]}" "${IMUFIT_TEST_APT_PACKAGES[@]}"
 check_format
 
 imufit_say "Release build (build-release/)"
 started=$SECONDS
-imufit_build "$IMUFIT_ROOT/build-release"
+# Tests, benchmarks and the Python module on (scripts/example.sh builds without them), and every
+# warning of the project's own code an error (IMUFIT_WERROR).
+imufit_build "$IMUFIT_ROOT/build-release" -- "${IMUFIT_TEST_CMAKE_ARGS[@]}"
 run_suite Release "$IMUFIT_ROOT/build-release"
 
 # The Python module (python/), when this build has it: pytest against the Release build's module and
@@ -65,7 +67,7 @@ started=$SECONDS
 # -O1: the sanitizers need no more, and the Ceres-heavy sources compile in about half the time.
 # No Python module: an ASan-built extension cannot be loaded into an uninstrumented interpreter.
 imufit_build "$IMUFIT_ROOT/build-sanitize" -- -DIMUFIT_SANITIZE=ON -DIMUFIT_BUILD_BENCH=OFF -DIMUFIT_BUILD_PYTHON=OFF \
-  "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"
+  -DIMUFIT_WERROR=ON "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"
 run_suite "ASan+UBSan" "$IMUFIT_ROOT/build-sanitize"
 
 # The readers under libFuzzer, briefly (scripts/fuzz.sh --seconds N for a campaign).

@@ -12,10 +12,10 @@
 
 #include <gtest/gtest.h>
 
+#include "file_open_counter.h"
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certify.h"
 #include "imufit/io/calibration.h"
-#include "imufit/io/file_reads.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
@@ -24,6 +24,7 @@
 #include "imufit/pipeline/static_stretch.h"
 #include "imufit/sim/simulator.h"
 #include "imufit/store/store.h"
+#include "test_util.h"
 
 namespace imufit {
 namespace {
@@ -98,7 +99,7 @@ class CertifyTest : public ::testing::TestWithParam<bool> {
 TEST_P(CertifyTest, FitReportAndStoreReadTheSamplesAtMostTwice) {
   const std::string limits_path = Path("limits.yaml");
   std::ofstream(limits_path) << kLimits;
-  const FileReadCounter reads(samples_);
+  const testing::FileOpenCounter reads(samples_);
 
   // What `imufit fit -p PLAN -s SAMPLES -o CAL --limits L --report R --store S` does.
   const FitRunOptions options = FitOptions();
@@ -175,14 +176,14 @@ TEST_P(CertifyTest, TheStretchHandedOnIsTheOneInTheFile) {
   sources.run = fit.run;
   sources.inputs = {{"samples", samples_, fit.run.samples_sha256}};
   {
-    const FileReadCounter reads(samples_);
+    const testing::FileOpenCounter reads(samples_);
     ReadCertificateFiles(&sources);
     EXPECT_EQ(reads.count(), 0) << "the stretch handed on: the file is not read";
   }
   const Certificate handed_on = MakeCertificate(sources);
   sources.run.static_stretch.reset();
   sources.noise.reset();
-  const FileReadCounter reads(samples_);
+  const testing::FileOpenCounter reads(samples_);
   ReadCertificateFiles(&sources);
   EXPECT_EQ(reads.count(), 1) << "without the stretch, it is read";
   const Certificate read_again = MakeCertificate(sources);
@@ -201,7 +202,7 @@ TEST_P(CertifyTest, TheStretchHandedOnIsTheOneInTheFile) {
 // A run read into windows alone (imufit report, the benchmarks) is read as often, and its hash is
 // the file's.
 TEST_P(CertifyTest, ReadingARunHashesItOnTheWay) {
-  const FileReadCounter reads(samples_);
+  const testing::FileOpenCounter reads(samples_);
   const RunWindows run = ReadRunWindows(plan_, samples_, WindowOptions());
   EXPECT_EQ(reads.count(), Reads());
   EXPECT_EQ(run.samples_sha256, Sha256OfFile(samples_));

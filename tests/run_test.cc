@@ -1,4 +1,4 @@
-// Tests of fit/segmentation.h: a plan's segments found in unlabelled runs with a known truth.
+// Tests of run/segmentation.h: a plan's segments found in unlabelled runs with a known truth.
 //
 // Simulated runs (soaks, a ramp, rate segments, noise, quantised counts, jittered time stamps,
 // raw axes of either sign) and hand sessions made here (rests, moves and turns through a known

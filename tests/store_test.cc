@@ -450,19 +450,6 @@ TEST(StoreTest, AVersion2StoreGainsItsLatestFitsKeepingEveryRowAndEveryAnswer) {
   EXPECT_EQ(Answers(&store, kShuffledLots), RecomputedAnswers(&store, kShuffledLots));
 }
 
-// Two stations' SQLite stores, one with a fit the other has too (the same run uploaded twice).
-std::vector<std::string> TwoStationStores() {
-  const std::string a = FreshSqliteStore("station_a"), b = FreshSqliteStore("station_b");
-  ResultsStore station_a(a), station_b(b);
-  station_a.Record(MakeFit("SN1", "lot-m", "2026-04-01T00:00:00Z", 1.0, "PASS"));
-  station_a.Record(MakeFit("SN2", "lot-m", "2026-04-01T00:01:00Z", 2.0, "FAIL"));
-  station_b.Record(MakeFit("SN2", "lot-m", "2026-04-01T00:01:00Z", 2.0, "FAIL"));
-  StoredFit other = MakeFit("SN3", "lot-m", "2026-04-02T00:00:00Z", 3.0, "PASS");
-  other.station = "station-2";
-  station_b.Record(other);
-  return {a, b};
-}
-
 TEST(StoreTest, MergeIsIdempotent) {
   const std::string into = FreshStore("merge_into");
   const std::vector<std::string> sources = TwoStationStores();
@@ -483,29 +470,6 @@ TEST(StoreTest, MergeIsIdempotent) {
     EXPECT_EQ(after[i].figures.size(), before[i].figures.size());
   }
   EXPECT_EQ(ResultsStore(into).Yield("lot-m")[0].units, 3);
-}
-
-testing::RunResult Imufit(const std::vector<std::string>& args) {
-  const std::string base = FreshSqliteStore("imufit_output");
-  return testing::RunProgram(IMUFIT_EXE, args, base + ".out", base + ".err");
-}
-
-TEST(StoreTest, MergeCommandRunTwiceChangesNothing) {
-  const std::string into = FreshStore("merge_cli");
-  std::vector<std::string> args = {"store", "merge"};
-  for (const std::string& source : TwoStationStores()) args.push_back(source);
-  args.insert(args.end(), {"--into", into});
-  const testing::RunResult first = Imufit(args);
-  ASSERT_EQ(first.status, 0) << first.out;
-  EXPECT_NE(first.out.find(": 2 fits, 1 new"), std::string::npos) << first.out;
-  const testing::RunResult second = Imufit(args);
-  ASSERT_EQ(second.status, 0) << second.out;
-  EXPECT_NE(second.out.find(": 2 fits, 0 new"), std::string::npos) << second.out;
-  EXPECT_EQ(second.out.find(", 1 new"), std::string::npos) << second.out;
-  EXPECT_EQ(second.out.find(", 2 new"), std::string::npos) << second.out;
-  const testing::RunResult missing = Imufit({"store", "merge", "no_such.db", "--into", into});
-  EXPECT_EQ(missing.status, 2) << missing.err;
-  EXPECT_NE(missing.err.find("no_such.db: no such results store to merge"), std::string::npos) << missing.err;
 }
 
 }  // namespace

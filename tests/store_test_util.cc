@@ -71,10 +71,53 @@ StoredFit MakeFit(const std::string& serial, const std::string& lot, const std::
   fit.status = "fitted";
   fit.verdict = verdict;
   fit.calibration_yaml = "calibration of " + serial + "\n";
-  StoredFigure x{"gyro_bias_dps.x", "gyro.bias.x", "deg/s", bias_dps, 0.01};
+  const auto figure = [](const std::string& name, const std::string& coefficient, double value) {
+    StoredFigure f;
+    f.name = name;
+    f.coefficient = coefficient;
+    f.unit = "deg/s";
+    f.value = value;
+    f.sigma = 0.01;
+    return f;
+  };
+  StoredFigure x = figure("gyro_bias_dps.x", "gyro.bias.x", bias_dps);
   x.expanded_u = 0.02;
-  fit.figures = {x, StoredFigure{"gyro_bias_dps.y", "gyro.bias.y", "deg/s", 0.0, 0.01}};
+  fit.figures = {x, figure("gyro_bias_dps.y", "gyro.bias.y", 0.0)};
   return fit;
+}
+
+StoredFit AtStation(StoredFit fit, const std::string& station) {
+  fit.station = station;
+  return fit;
+}
+
+std::string KnownStore(const std::string& name) {
+  const std::string target = FreshStore(name);
+  ResultsStore store(target);
+  store.Record(AtStation(MakeFit("SN1", "lot-a", "2026-01-05T08:00:00Z", 1.0, "PASS"), "station-1"));
+  store.Record(AtStation(MakeFit("SN2", "lot-a", "2026-01-06T08:00:00Z", 3.0, "FAIL"), "station-1"));
+  store.Record(AtStation(MakeFit("SN3", "lot-a", "2026-02-01T08:00:00Z", 1.5, "PASS"), "station-2"));
+  store.Record(AtStation(MakeFit("SN4", "lot-b", "2026-02-10T08:00:00Z", 2.0, "PASS"), "station-2"));
+  StoredFit not_fitted = AtStation(MakeFit("SN5", "lot-b", "2026-03-01T08:00:00Z", 0.0, ""), "station-2");
+  not_fitted.status = "not-fitted";
+  not_fitted.figures.clear();
+  store.Record(not_fitted);
+  StoredFit rerun = AtStation(MakeFit("SN2", "lot-a", "2026-03-02T08:00:00Z", 1.2, "PASS"), "station-2");
+  rerun.samples_sha256 = std::string(64, '9');  // a new run of the unit
+  store.Record(rerun);
+  return target;
+}
+
+std::vector<std::string> TwoStationStores() {
+  const std::string a = FreshSqliteStore("station_a"), b = FreshSqliteStore("station_b");
+  ResultsStore station_a(a), station_b(b);
+  station_a.Record(MakeFit("SN1", "lot-m", "2026-04-01T00:00:00Z", 1.0, "PASS"));
+  station_a.Record(MakeFit("SN2", "lot-m", "2026-04-01T00:01:00Z", 2.0, "FAIL"));
+  station_b.Record(MakeFit("SN2", "lot-m", "2026-04-01T00:01:00Z", 2.0, "FAIL"));
+  StoredFit other = MakeFit("SN3", "lot-m", "2026-04-02T00:00:00Z", 3.0, "PASS");
+  other.station = "station-2";
+  station_b.Record(other);
+  return {a, b};
 }
 
 void WriteVersion1Store(const std::string& path) {

@@ -1,5 +1,5 @@
 // The solving stages of the thermal fit (thermal_fit_state.h): the Ceres problem, the least-squares
-// pass, the robust pass, the solver's verdict and the rank backstop.
+// pass, the robust pass, the solver's verdict and the rank backstop (its SVD in thermal_fit_rank.cc).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -7,11 +7,10 @@
 #include <vector>
 
 #include <glog/logging.h>
-#include <Eigen/SVD>
 
 #include "imufit/model/check.h"
 #include "thermal_fit_state.h"
-#include "window_cost.h"
+#include "window_cost_create.h"
 
 namespace imufit::internal {
 namespace {
@@ -20,8 +19,6 @@ namespace {
 constexpr double kMadToSigma = 1.4826;
 // The robust spread of the normalised residuals is never taken below one measured noise.
 constexpr double kMinRobustSpread = 1.0;
-// A direction of the Jacobian names the parameters whose share of it is at least this.
-constexpr double kDirectionShare = 0.3;
 
 // The solver's own log (glog: a warning per residual block that does not evaluate, an error on
 // termination) never reaches a terminal or a notebook: what it says comes back through the
@@ -50,17 +47,6 @@ ceres::Solver::Options SolverOptions(const FitOptions& options) {
   return solver_options;
 }
 
-// "gyro scale x (linear term)"
-std::string ParameterName(const SensorProblem& sensor, int parameter) {
-  const CoefficientName& name = kCoefficientNames[parameter / kPolynomialTerms];
-  const int k = parameter % kPolynomialTerms;
-  return std::string(sensor.name) + " " + name.group + " " + name.axis +
-         (k == 0   ? ""
-          : k == 1 ? " (linear term)"
-          : k == 2 ? " (quadratic term)"
-                   : " (cubic term)");
-}
-
 // The Jacobian of the sensor's normalised residuals (no loss) in its free q at the solution, kept
 // in `sensor->jacobian` (the bias-stability covariance uses it) with its column -> parameter map
 // in `sensor->free`.
@@ -86,33 +72,6 @@ void EvaluateJacobian(const FitOptions& options, ceres::Problem* problem, Sensor
 
 }  // namespace
 
-// The directions of q the residuals do not see: right singular vectors of the column-normalised
-// Jacobian (each column scaled to unit norm, so that units and steps do not decide the rank)
-// whose singular value is below rank_tolerance times the largest, each named by the parameters
-// that make it up.
-std::vector<std::string> UndeterminedDirections(const FitOptions& options, const SensorProblem& sensor) {
-  Eigen::MatrixXd jacobian = sensor.jacobian;
-  const Eigen::VectorXd column_norm = jacobian.colwise().norm().transpose();
-  for (int c = 0; c < jacobian.cols(); ++c) {
-    if (column_norm(c) > 0.0) jacobian.col(c) /= column_norm(c);
-  }
-  const Eigen::BDCSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
-  const Eigen::VectorXd& singular = svd.singularValues();
-  std::vector<std::string> findings;
-  for (int d = 0; d < singular.size(); ++d) {
-    if (singular(d) > options.rank_tolerance * singular(0)) continue;
-    const Eigen::VectorXd direction = svd.matrixV().col(d);
-    std::string names;
-    for (int c = 0; c < direction.size(); ++c) {
-      if (std::abs(direction(c)) < kDirectionShare) continue;
-      names += (names.empty() ? "" : ", ") + ParameterName(sensor, sensor.free[c]);
-    }
-    findings.push_back("the run cannot separate " + names +
-                       " (a combination of them does not change any residual)");
-  }
-  return findings;
-}
-
 std::vector<double> NormalisedResidualNorms(const ceres::Problem& problem, const SensorProblem& sensor) {
   std::vector<double> norms;
   for (ceres::ResidualBlockId block : sensor.blocks) {
@@ -131,7 +90,7 @@ void BuildProblem(ThermalFitState* fit) {
   for (SensorProblem* sensor : fit->Sensors()) {
     sensor->loss = new ceres::LossFunctionWrapper(nullptr, ceres::TAKE_OWNERSHIP);
     const bool gyro = sensor->is_gyro;
-    const auto create = gyro ? &WindowCost<kGyroParameters>::Create : &WindowCost<kAccelParameters>::Create;
+    const auto create = gyro ? &CreateGyroWindowCost : &CreateAccelWindowCost;
     for (size_t w = 0; w < sensor->windows.size(); ++w) {
       const FitWindow& fw = sensor->windows[w];
       ceres::CostFunction* cost = create(RawFor(fw, gyro), TruthFor(fw, gyro), fw.truth.a_mps2, fw.x,

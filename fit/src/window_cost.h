@@ -18,7 +18,10 @@
 // with p the model's parameters in the fit's temperature basis (layout of sensor_model.h), p0
 // the closed-form start and `step` a per-parameter magnitude, so every q is O(1).
 // Header-only so that tests can instantiate it with ceres::Jet and with double; Create() gives
-// the fit its autodiff cost, the way Ceres's examples build theirs.
+// the fit its autodiff cost, the way Ceres's examples build theirs. The fit itself instantiates it
+// only through window_cost_create.h: each sensor's autodiff cost in a translation unit of its own
+// (window_cost_gyro.cc, window_cost_accel.cc), so that no object of the build takes long to
+// compile.
 #ifndef IMUFIT_FIT_SRC_WINDOW_COST_H_
 #define IMUFIT_FIT_SRC_WINDOW_COST_H_
 

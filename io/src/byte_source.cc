@@ -10,7 +10,6 @@
 #include <string_view>
 
 #include "imufit/io/error.h"
-#include "imufit/io/file_reads.h"
 #include "imufit/io/path.h"
 #include "imufit/io/sha256.h"
 
@@ -59,7 +58,6 @@ struct ByteSource::Inflater {
 ByteSource::ByteSource(std::string path, Sha256* digest) : path_(std::move(path)), digest_(digest) {
   fd_ = ::open(path_.c_str(), O_RDONLY);
   if (fd_ < 0) throw InputError(path_, std::string("cannot open: ") + std::strerror(errno));
-  CountOpenedForReading(path_);
   raw_.resize(kRawBytes);
   // Close the descriptor if the first read throws: the destructor does not run for a constructor
   // that throws.

@@ -1,13 +1,13 @@
 #include "imufit/io/sha256.h"
 
+#include <fcntl.h>
 #include <openssl/evp.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 
 #include "imufit/io/error.h"
-#include "imufit/io/file_reads.h"
 #include "imufit/model/check.h"
 
 namespace imufit {
@@ -51,14 +51,21 @@ std::string Sha256Hex(std::string_view data) {
 }
 
 std::string Sha256OfFile(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
-  CountOpenedForReading(path);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
   Sha256 hash;
   char block[1 << 16];
-  while (stream.read(block, sizeof block) || stream.gcount() > 0)
-    hash.Update(std::string_view(block, stream.gcount()));
-  if (stream.bad()) throw InputError(path, "read error");
+  for (;;) {
+    const ssize_t got = ::read(fd, block, sizeof block);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) {
+      ::close(fd);
+      throw InputError(path, "read error");
+    }
+    if (got == 0) break;
+    hash.Update(std::string_view(block, static_cast<size_t>(got)));
+  }
+  ::close(fd);
   return hash.HexDigest();
 }
 

@@ -1,5 +1,6 @@
-// `imufit batch --shard` into one store on the backend under test: four shards writing at once
-// give every unit exactly once and, through `imufit lot --store`, the lot summary and page of one
+// `imufit lot --store` end to end on the backend under test (cli_lot_test --backend sqlite|postgresql,
+// as store_test), on lots fitted with `imufit batch --shard` into one store: four shards writing at
+// once give every unit exactly once and, through `imufit lot`, the lot summary and page of one
 // unsharded batch; a shard stopped part way, or killed (SIGKILL) mid-batch, and run again completes
 // with every unit once and every output whole.
 #include <fcntl.h>
