@@ -183,7 +183,9 @@ void ExpectWellFormed(const OptionTable<Options>& table) {
     if (const auto* text = std::get_if<TextOption<Options>>(&entry.value)) {
       Options read = defaults;
       const std::string shown = text->Get(defaults);
-      if (!shown.empty()) EXPECT_EQ(text->set(shown, &read), "") << entry.key;
+      if (!shown.empty()) {
+        EXPECT_EQ(text->set(shown, &read), "") << entry.key;
+      }
       EXPECT_EQ(text->Get(read), shown) << entry.key;
     }
   }
@@ -237,7 +239,9 @@ TEST(OptionTables, ExportFormatsAndTheOptionsThatServeThem) {
   // The help of an option that serves some formats names them, from the same table.
   for (const OptionEntry<ExportOptions>& entry : ExportOptionTable().entries()) {
     const std::string formats = ExportOptionFormats(entry.key);
-    if (!formats.empty()) EXPECT_EQ(entry.help.rfind(formats + ": ", 0), 0u) << entry.key;
+    if (!formats.empty()) {
+      EXPECT_EQ(entry.help.rfind(formats + ": ", 0), 0u) << entry.key;
+    }
   }
 }
 

@@ -138,8 +138,9 @@ TEST_F(CliTest, ParseErrorsAreOneImufitLineNamingTheCommand) {
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_EQ(r.err.rfind("imufit: ", 0), 0u) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    if (!args.empty() && args[0] != "no-such-command")
+    if (!args.empty() && args[0] != "no-such-command") {
       EXPECT_EQ(r.err.rfind("imufit: " + args[0] + ": ", 0), 0u) << r.err;
+    }
   }
   EXPECT_EQ(Listing(), std::set<std::string>{});
 }
