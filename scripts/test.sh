@@ -66,8 +66,11 @@ imufit_say "AddressSanitizer + UndefinedBehaviorSanitizer build (build-sanitize/
 started=$SECONDS
 # -O1: the sanitizers need no more, and the Ceres-heavy sources compile in about half the time.
 # No Python module: an ASan-built extension cannot be loaded into an uninstrumented interpreter.
+# Warnings are gated by the Release build (IMUFIT_WERROR above); at -O1 under the sanitizers'
+# instrumentation GCC 12 warns of what it cannot prove (-Wformat-truncation, -Wmaybe-uninitialized),
+# so this build reports warnings without failing on them.
 imufit_build "$IMUFIT_ROOT/build-sanitize" -- -DIMUFIT_SANITIZE=ON -DIMUFIT_BUILD_BENCH=OFF -DIMUFIT_BUILD_PYTHON=OFF \
-  -DIMUFIT_WERROR=ON "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"
+  -DIMUFIT_WERROR=OFF "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"
 run_suite "ASan+UBSan" "$IMUFIT_ROOT/build-sanitize"
 
 # The readers under libFuzzer, briefly (scripts/fuzz.sh --seconds N for a campaign).

@@ -84,7 +84,7 @@ std::string DoubleQuoted(std::string_view text) {
     } else if (cp == '\n' || cp == '\t' || cp == '\r') {
       out += cp == '\n' ? "\\n" : cp == '\t' ? "\\t" : "\\r";
     } else if (!Printable(cp)) {
-      char escape[8];
+      char escape[16];  // "\u" and 4 hex digits: every code point Printable() refuses is below U+10000
       std::snprintf(escape, sizeof escape, "\\u%04x", static_cast<unsigned>(cp));
       out += escape;
     } else {
