@@ -76,7 +76,7 @@ const std::vector<Format>& Formats() {
       {"c", "mems_truth.yaml", "mems_truth.h", {}},
       {"bin", "mems_truth.yaml", "mems_truth.bin", {}},
       {"px4", "mems_truth.yaml", "mems_truth.params", Plus(kDriver, {"--device-id", "2621474", "--force"})},
-      {"ardupilot", "mems_truth.yaml", "mems_truth.parm", Plus(kDriver, {"--force"})},
+      {"ardupilot", "mems_truth.yaml", "mems_truth.parm", Plus(kDriver, {"--device-id", "2621474", "--force"})},
       {"kalibr", "mems_truth_noise.yaml", "mems_truth_noise_kalibr.yaml", Plus(kDriver, {"--force"})},
       {"imucal", "mems_truth.yaml", "mems_truth_imucal.json", {"--force"}},
       {"json", "mems_truth.yaml", "mems_truth.json", {}}};
