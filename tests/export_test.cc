@@ -25,6 +25,7 @@
 #include <Eigen/Dense>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/output_file.h"
 #include "imufit/io/samples.h"
 #include "imufit_runtime.h"
 #include "test_util.h"
@@ -47,9 +48,20 @@ constexpr double kLossReportMargin = 1.01;
 // worse than any of them: a few units of float32 rounding of the sample's own value are allowed.
 constexpr double kFloat32Rounding = 4 * 0x1p-24;
 
-// The driver's scale of the MEMS unit (fixtures/README.md): 16.4 LSB per deg/s, 2048 LSB per g.
-const std::vector<std::string> kDriver = {"--gyro-raw-per-radps", "939.65", "--accel-raw-per-mps2",
-                                          "208.838"};
+// What a consumer's driver divides the raw output by: raw per rad/s, raw per m/s^2.
+struct Driver {
+  double gyro_raw_per_radps;
+  double accel_raw_per_mps2;
+  std::vector<std::string> Args() const {
+    return {"--gyro-raw-per-radps", FormatDouble(gyro_raw_per_radps), "--accel-raw-per-mps2",
+            FormatDouble(accel_raw_per_mps2)};
+  }
+};
+// The MEMS unit in counts (fixtures/README.md): 16.4 LSB per deg/s, 2048 LSB per g.
+const Driver kMemsDriver = {939.65, 208.838};
+// The tactical unit in physical units: deg/s and g.
+const Driver kTacticalDriver = {180.0 / M_PI, 1.0 / 9.80665};
+const std::vector<std::string> kDriver = kMemsDriver.Args();
 
 // A noise block, as `imufit allan --noise-yaml` writes its Kalibr figures, appended to a unit.
 constexpr const char* kNoiseBlock = R"(noise:
@@ -147,16 +159,23 @@ class ExportTest : public ::testing::Test {
   }
 
   // The raw noiseless ramp of fixtures/ and `imufit apply`'s correction of it with `calibration`.
-  void ReadRun(const std::string& calibration, std::vector<Sample>* raw,
-               std::vector<Sample>* corrected) const {
-    const std::string samples = kFixtures + "/mems_6pos_noiseless.csv.gz";
-    const RunResult apply =
-        Run({"apply", "-q", "-c", calibration, "-s", samples, "-o", Path("corrected.csv")});
-    ASSERT_EQ(apply.status, 0) << apply.err;
-    for (const auto& [path, out] : {std::pair{samples, raw}, std::pair{Path("corrected.csv"), corrected}}) {
-      SamplesReader reader(path, false);
-      for (Sample s; reader.Next(&s);) out->push_back(s);
+  // The run of samples_ and `imufit apply`'s correction of it with `calibration` (kept for the
+  // test's next round trip of the same calibration and run).
+  void ReadRun(const std::string& calibration, std::vector<Sample>* raw, std::vector<Sample>* corrected) {
+    const std::string& samples = samples_;
+    auto& [cached_raw, cached_corrected] = runs_[{calibration, samples}];
+    if (cached_raw.empty()) {
+      const RunResult apply =
+          Run({"apply", "-q", "-c", calibration, "-s", samples, "-o", Path("corrected.csv")});
+      ASSERT_EQ(apply.status, 0) << apply.err;
+      for (const auto& [path, out] :
+           {std::pair{samples, &cached_raw}, std::pair{Path("corrected.csv"), &cached_corrected}}) {
+        SamplesReader reader(path, false);
+        for (Sample s; reader.Next(&s);) out->push_back(s);
+      }
     }
+    *raw = cached_raw;
+    *corrected = cached_corrected;
     ASSERT_EQ(raw->size(), corrected->size());
     ASSERT_GT(raw->size(), 1000u);
   }
@@ -164,16 +183,21 @@ class ExportTest : public ::testing::Test {
   // Exports `format` (of `calibration`, mems_truth.yaml by default), builds its consumer from the
   // file and checks it against `imufit apply` on the run within the loss the export reported;
   // returns that loss.
-  // `extra_args` are added to the format's; samples above `temp_high_c` are not compared.
+  // `extra_args` are added to the format's; samples outside [temp_low_c, temp_high_c] are not compared.
   ReportedLoss ExpectRoundTrip(const std::string& name,
                                const std::function<Consumer(const std::string& file)>& consumer_of,
                                std::string calibration = "", const std::vector<std::string>& extra_args = {},
-                               double temp_high_c = HUGE_VAL) {
+                               double temp_high_c = HUGE_VAL, double temp_low_c = -HUGE_VAL) {
     const Format& format = FormatNamed(name);
     if (calibration.empty()) calibration = CalibrationPath(format.calibration);
     const std::string output = Path("export." + name);
-    const RunResult result = Run(
-        Plus(Plus({"export", "-c", calibration, "-f", format.name, "-o", output}, format.args), extra_args));
+    std::vector<std::string> args = format.args;
+    for (size_t i = 0; i + 1 < args.size(); ++i) {  // the driver of the unit under test
+      if (args[i] == "--gyro-raw-per-radps") args[i + 1] = FormatDouble(driver_.gyro_raw_per_radps);
+      if (args[i] == "--accel-raw-per-mps2") args[i + 1] = FormatDouble(driver_.accel_raw_per_mps2);
+    }
+    const RunResult result =
+        Run(Plus(Plus({"export", "-c", calibration, "-f", format.name, "-o", output}, args), extra_args));
     EXPECT_EQ(result.status, 0) << result.err;
     const ReportedLoss loss = ParseLoss(result.out);
     const Consumer consumer = consumer_of(output);
@@ -182,7 +206,7 @@ class ExportTest : public ::testing::Test {
     int beyond = 0;
     std::string first;
     for (size_t i = 0; i < raw.size(); ++i) {
-      if (raw[i].temp_c > temp_high_c) continue;
+      if (raw[i].temp_c > temp_high_c || raw[i].temp_c < temp_low_c) continue;
       const Corrected c = consumer(raw[i]);
       const Eigen::Vector3d gyro_error = (c.omega_radps - corrected[i].gyro).cwiseAbs() * kDegPerRad;
       const Eigen::Vector3d accel_error = (c.a_mps2 - corrected[i].accel).cwiseAbs() / kGravity * 1e3;
@@ -206,6 +230,10 @@ class ExportTest : public ::testing::Test {
   }
 
   fs::path dir_;
+  // The run the round trips correct, and the driver of its unit.
+  std::string samples_ = kFixtures + "/mems_6pos_noiseless.csv.gz";
+  Driver driver_ = kMemsDriver;
+  std::map<std::pair<std::string, std::string>, std::pair<std::vector<Sample>, std::vector<Sample>>> runs_;
 };
 
 TEST_F(ExportTest, EveryFormatMatchesItsGoldenFile) {
@@ -269,7 +297,7 @@ std::map<std::string, float> ReadParameters(const std::string& path, bool px4,
 
 // PX4's correction with the parameters of instance `n`; `v112_set_scale`: CAL_ACCn_xSCALE loaded as
 // v1.12's Accelerometer::set_scale() loads it after boot (kept at 1 unless |scale - 1| > 0.01).
-Consumer Px4ConsumerOf(const std::string& file, int n, bool v112_set_scale) {
+Consumer Px4ConsumerOf(const std::string& file, int n, bool v112_set_scale, Driver driver = kMemsDriver) {
   std::map<std::string, float> p = ReadParameters(file, true);
   const std::string tc_g = "TC_G" + std::to_string(n) + "_", tc_a = "TC_A" + std::to_string(n) + "_",
                     cal_gyro = "CAL_GYRO" + std::to_string(n) + "_",
@@ -278,7 +306,7 @@ Consumer Px4ConsumerOf(const std::string& file, int n, bool v112_set_scale) {
   EXPECT_EQ(p[tc_a + "ID"], p[cal_acc + "ID"]);
   Eigen::Vector3f scale(p[cal_acc + "XSCALE"], p[cal_acc + "YSCALE"], p[cal_acc + "ZSCALE"]);
   if (v112_set_scale && !((scale - Eigen::Vector3f::Ones()).norm() > 0.01f)) scale = Eigen::Vector3f::Ones();
-  return [p, tc_g, tc_a, cal_gyro, cal_acc, scale](const Sample& raw) mutable {
+  return [p, tc_g, tc_a, cal_gyro, cal_acc, scale, driver](const Sample& raw) mutable {
     // TemperatureCompensation::calc_thermal_offsets_3D, then the calibration's Correct().
     const auto offsets = [&](const std::string& s) {
       const float t = static_cast<float>(raw.temp_c);
@@ -296,8 +324,8 @@ Consumer Px4ConsumerOf(const std::string& file, int n, bool v112_set_scale) {
     Corrected c;
     for (int i = 0; i < 3; ++i) {
       const std::string xyz(1, "XYZ"[i]);
-      const float gyro = static_cast<float>(raw.gyro(i) / 939.65),
-                  accel = static_cast<float>(raw.accel(i) / 208.838);
+      const float gyro = static_cast<float>(raw.gyro(i) / driver.gyro_raw_per_radps),
+                  accel = static_cast<float>(raw.accel(i) / driver.accel_raw_per_mps2);
       c.omega_radps(i) = gyro - gyro_offset(i) - p[cal_gyro + xyz + "OFF"];
       c.a_mps2(i) = (accel - accel_offset(i) - p[cal_acc + xyz + "OFF"]) * scale(i);
     }
@@ -314,7 +342,7 @@ Consumer Px4V112Consumer(const std::string& file) { return Px4ConsumerOf(file, 0
 
 // ArduPilot's correction with the parameters of instance `n` (1..3): INS_TCALn_*, and the n-th
 // sensor's INS_ACCOFFS / INS_ACC2OFFS, INS_ACC1_CALTEMP / INS_ACC2_CALTEMP, ...
-Consumer ArduPilotConsumerOf(const std::string& file, int n) {
+Consumer ArduPilotConsumerOf(const std::string& file, int n, Driver driver = kMemsDriver) {
   std::map<std::string, float> p = ReadParameters(file, false);
   const std::string tcal_prefix = "INS_TCAL" + std::to_string(n) + "_", number = std::to_string(n),
                     suffix = n == 1 ? "" : number;
@@ -326,7 +354,7 @@ Consumer ArduPilotConsumerOf(const std::string& file, int n) {
   }
   EXPECT_EQ(p.count("INS_ACC" + suffix + "_ID"), 1u) << "accel_calibrated_ok_all() needs the saved ID";
   EXPECT_EQ(p.count("INS_GYR" + suffix + "_ID"), 1u);
-  return [p, tcal_prefix, number, suffix](const Sample& raw) mutable {
+  return [p, tcal_prefix, number, suffix, driver](const Sample& raw) mutable {
     // AP_InertialSensor::TCal::correct_sensor: no constant term, 35 degC reference, x1e6.
     const float tmin = p[tcal_prefix + "TMIN"], tmax = p[tcal_prefix + "TMAX"];
     const auto clamp = [&](float t) { return std::min(std::max(t, tmin), tmax); };
@@ -341,8 +369,8 @@ Consumer ArduPilotConsumerOf(const std::string& file, int n) {
     Corrected c;
     for (int i = 0; i < 3; ++i) {
       const std::string xyz(1, "XYZ"[i]);
-      float accel = static_cast<float>(raw.accel(i) / 208.838),
-            gyro = static_cast<float>(raw.gyro(i) / 939.65);
+      float accel = static_cast<float>(raw.accel(i) / driver.accel_raw_per_mps2),
+            gyro = static_cast<float>(raw.gyro(i) / driver.gyro_raw_per_radps);
       accel -= tcal("ACC", i, t);
       accel += tcal("ACC", i, clamp(p["INS_ACC" + number + "_CALTEMP"]));
       gyro -= tcal("GYR", i, t);
@@ -368,7 +396,7 @@ Eigen::Vector3d Vector(const YAML::Node& node) {
   return {node[0].as<double>(), node[1].as<double>(), node[2].as<double>()};
 }
 
-Consumer KalibrConsumer(const std::string& file) {
+Consumer KalibrConsumerOf(const std::string& file, Driver driver) {
   const YAML::Node imu = YAML::LoadFile(file);
   EXPECT_EQ(imu["model"].as<std::string>(), "scale-misalignment");
   EXPECT_GT(imu["gyroscope_noise_density"].as<double>(), 0.0);
@@ -385,12 +413,15 @@ Consumer KalibrConsumer(const std::string& file) {
   EXPECT_EQ(m_g(1, 2), 0.0);
   return [=](const Sample& raw) {
     // IccScaledMisalignedImu: alpha = M_a a_i + b_a, omega = M_g C_gyro_i w_i + A C_gyro_i a_i + b_g.
-    const Eigen::Vector3d a_i = m_a.inverse() * (raw.accel / 208.838 - b_a);
+    const Eigen::Vector3d a_i = m_a.inverse() * (raw.accel / driver.accel_raw_per_mps2 - b_a);
     const Eigen::Vector3d w_i =
-        c_gyro_i.transpose() * (m_g.inverse() * (raw.gyro / 939.65 - b_g - a_g * c_gyro_i * a_i));
+        c_gyro_i.transpose() *
+        (m_g.inverse() * (raw.gyro / driver.gyro_raw_per_radps - b_g - a_g * c_gyro_i * a_i));
     return Corrected{c_i_b.transpose() * w_i, c_i_b.transpose() * a_i};
   };
 }
+
+Consumer KalibrConsumer(const std::string& file) { return KalibrConsumerOf(file, kMemsDriver); }
 
 Consumer ImucalConsumer(const std::string& file) {
   const YAML::Node cal = YAML::LoadFile(file);  // JSON is YAML
@@ -655,8 +686,46 @@ TEST_F(ExportTest, ArduPilotInstanceIdsAndTemperatureRange) {
   EXPECT_LT(parm.find("\nINS_TCAL2_ENABLE 1\n"), parm.find("\nINS_TCAL2_TMIN "));
   const ReportedLoss narrow = ExpectRoundTrip(
       "ardupilot", [](const std::string& file) { return ArduPilotConsumerOf(file, 2); }, "",
-      Plus(ids, {"--envelope-temp-c", "20,30"}), 30.0);
+      Plus(ids, {"--envelope-temp-c", "20,30"}), 30.0, 20.0);
   EXPECT_LT(narrow.accel_mg.maxCoeff(), full.accel_mg.maxCoeff());
+}
+
+// Real fitted units through the autopilots' and Kalibr's equations, on the runs they were fitted
+// from: the MEMS unit in counts (fixtures/golden/mems_6pos_soak.yaml) and the tactical unit in
+// physical units (deg/s and g: tactical_24pos_soak.yaml), over the whole fitted range (beyond
+// ArduPilot's 80 degC for the MEMS unit, which reaches 85) and over a narrow one (20..30 degC).
+TEST_F(ExportTest, RealFittedUnitsInCountsAndPhysicalUnitsStayWithinTheirLoss) {
+  struct Unit {
+    const char* calibration;
+    const char* samples;
+    Driver driver;
+  };
+  for (const Unit& unit : {Unit{"mems_6pos_soak.yaml", "mems_6pos_soak.csv.gz", kMemsDriver},
+                           Unit{"tactical_24pos_soak.yaml", "tactical_24pos_soak.csv.gz", kTacticalDriver}}) {
+    SCOPED_TRACE(unit.calibration);
+    samples_ = kFixtures + "/" + unit.samples;
+    driver_ = unit.driver;
+    const std::string calibration = kFixtures + "/golden/" + unit.calibration;
+    std::ofstream(Path("with_noise.yaml"), std::ios::binary) << ReadBytes(calibration) << kNoiseBlock;
+    const Driver d = unit.driver;
+    for (const auto& [range, temp_low_c, temp_high_c] :
+         {std::tuple{std::vector<std::string>{}, -HUGE_VAL, HUGE_VAL},
+          std::tuple{std::vector<std::string>{"--envelope-temp-c", "20,30"}, 20.0, 30.0}}) {
+      const auto px4 = [d](bool v112) {
+        return [d, v112](const std::string& file) { return Px4ConsumerOf(file, 0, v112, d); };
+      };
+      const ReportedLoss px4_loss =
+          ExpectRoundTrip("px4", px4(false), calibration, range, temp_high_c, temp_low_c);
+      ExpectRoundTrip("px4", px4(true), calibration, range, temp_high_c, temp_low_c);
+      ExpectRoundTrip(
+          "ardupilot", [d](const std::string& file) { return ArduPilotConsumerOf(file, 1, d); }, calibration,
+          range, temp_high_c, temp_low_c);
+      ExpectRoundTrip(
+          "kalibr", [d](const std::string& file) { return KalibrConsumerOf(file, d); },
+          Path("with_noise.yaml"), range, temp_high_c, temp_low_c);
+      EXPECT_GT(px4_loss.gyro_dps.maxCoeff(), 0.0);
+    }
+  }
 }
 
 }  // namespace
