@@ -29,8 +29,7 @@ std::vector<Eigen::Vector3d> Corners(double scale) {
 }  // namespace
 
 Envelope EnvelopeOf(const Calibration& calibration, const ExportOptions& options) {
-  // ExportOptions::Validate() has checked the full scale and g (positive, finite) and that a
-  // temperature range is two numbers.
+  // ExportOptions::Validate() has checked the full scale and g (positive, finite).
   const ExportOptions defaults;
   const auto given = [](bool is_default, const char* flag) {
     return std::string(flag) + (is_default ? ", the default" : "");
@@ -40,6 +39,8 @@ Envelope EnvelopeOf(const Calibration& calibration, const ExportOptions& options
   envelope.temp_high_c = calibration.fit_temp_range_c[1];
   envelope.temp_source = "the calibration's fitted range; --envelope-temp-c";
   if (!options.envelope_temp_c.empty()) {
+    if (options.envelope_temp_c.size() != 2)
+      throw InputError("--envelope-temp-c", "the envelope's temperatures are two numbers MIN,MAX");
     const double low = options.envelope_temp_c[0], high = options.envelope_temp_c[1];
     if (!(low <= high) || !(low >= envelope.temp_low_c) || !(high <= envelope.temp_high_c)) {
       throw InputError("--envelope-temp-c",

@@ -33,6 +33,13 @@ py::dict Export(const py::object& calibration, const std::string& format, const 
   py::dict keywords(kwargs);
   keywords["format"] = format;
   ApplyKeywords(ExportOptionTable(), where, keywords, &options);
+  for (const auto& [key, value] : kwargs) {  // as the command: an option of other formats is refused
+    const std::string name = py::str(key);
+    if (!ExportOptionServes(name, options.format)) {
+      ThrowBadArgument(
+          where, name + ": only " + ExportOptionFormats(name) + " use it, not " + ToString(options.format));
+    }
+  }
   Calibration unit;
   if (py::isinstance<Calibration>(calibration)) {
     // Provenance of a calibration in memory: the SHA-256 of its YAML text, as it would be written.

@@ -92,6 +92,10 @@ def test_export_refusals_name_the_option(fixtures):
         imufit.export(cal, "px4", device_id=1, instance="7", **DRIVER)
     with pytest.raises(imufit.InputError, match="is not a format"):
         imufit.export(cal, "mavlink")
+    with pytest.raises(imufit.InputError, match="device_id: only px4, ardupilot use it, not json"):
+        imufit.export(cal, "json", device_id=5)
+    with pytest.raises(imufit.InputError, match="temp_c: only kalibr, imucal use it, not px4"):
+        imufit.export(cal, "px4", device_id=5, temp_c=25, **DRIVER)
     with pytest.raises(TypeError, match="unexpected keyword argument 'device'"):
         imufit.export(cal, "px4", device=1)
     assert set(imufit.export_options()) >= {"device_id", "instance", "envelope_temp_c", "full_scale_dps"}

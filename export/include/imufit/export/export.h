@@ -2,10 +2,10 @@
 //
 //   c       a C header for the firmware runtime (model/c/imufit_runtime.h): an initializer macro
 //   bin     the runtime's packed little-endian blob (magic, version, length, CRC-32), for EEPROM
-//   px4     PX4 parameters in the ground station's tab-separated .params format: the TC_G0_* /
-//           TC_A0_* bias cubics, CAL_ACC0_xSCALE
-//   ardupilot  ArduPilot parameters (.parm): INS_TCAL1_* about its fixed 35 degC, offsets and
-//           accelerometer scale at the calibration temperature
+//   px4     PX4 parameters in the ground station's tab-separated .params format: the TC_Gn_* /
+//           TC_An_* bias cubics, CAL_ACCn_xSCALE, the device IDs (instance n = --instance)
+//   ardupilot  ArduPilot parameters (.parm): INS_TCALn_* about its fixed 35 degC, offsets and
+//           accelerometer scale at the calibration temperature, INS_ACC_ID / INS_GYR_ID
 //   kalibr  Kalibr's imu.yaml: the noise densities and its scale-misalignment intrinsics
 //   imucal  imucal's Ferraris JSON (K, R, b, K_ga) at one temperature
 //   json    the whole calibration in JSON (the calibration file's schema, docs/calibration.schema.json)
@@ -13,8 +13,9 @@
 // Every format that cannot hold the whole model measures its loss before anything is written: the
 // full model (`imufit apply`'s SensorModel::Correct) and the consumer's own equations, evaluated
 // with the consumer's arithmetic (float32 where it uses it) on the numbers exactly as the file
-// prints them, over the envelope: the calibration's fitted temperature range x every axis of the
-// angular rate in [-full_scale, full_scale] x every axis of the specific force in [-max_g, max_g] g.
+// prints them, over the envelope: the temperatures (the calibration's fitted range, or a range
+// inside it) x every axis of the angular rate in [-full_scale, full_scale] x every axis of the
+// specific force in [-max_g, max_g] g.
 // The loss (worst case and RMS per axis, deg/s and mg) and the provenance are written into the
 // exported file's comments (or its comment field).
 #ifndef IMUFIT_EXPORT_EXPORT_H_
