@@ -48,18 +48,26 @@ int RunExport(const ExportArguments& args) {
   options.software = SoftwareVersion();
   options.calibration_file = args.calibration;
   options.calibration_sha256 = Sha256OfFile(args.calibration);
+  // The output is opened (a temporary file beside it) before anything is measured or printed: a
+  // folder that is missing or not writable fails first. Not committed, it leaves nothing behind.
+  OutputFile output(args.output);
   const ExportResult result = ExportCalibration(calibration, options);
+  if (!result.warning.empty()) std::fprintf(stderr, "imufit: warning: %s\n", result.warning.c_str());
   if (!args.quiet) std::printf("%s", DescribeLoss(result, "").c_str());
   if (const std::optional<std::string> excess =
           LossBeyondBounds(result.loss, args.max_loss[0], args.max_loss[1])) {
     if (!args.force) {
-      std::fprintf(stderr, "imufit: %s export refused: %s (--max-loss, --force); nothing written\n",
+      std::fprintf(stderr,
+                   "imufit: %s export refused: %s (accept it: --max-loss GYRO_DPS,ACCEL_MG or --force; "
+                   "narrow the envelope: --envelope-temp-c MIN,MAX, --full-scale-dps, --max-g); nothing "
+                   "written\n",
                    ToString(options.format), excess->c_str());
       return kExitNotDone;
     }
     std::fprintf(stderr, "imufit: warning: %s (written anyway: --force)\n", excess->c_str());
   }
-  WriteFileAtomically(args.output, result.content);
+  output.Write(result.content);
+  output.Commit();
   if (!args.quiet) std::printf("wrote %s (%s)\n", args.output.c_str(), ToString(options.format));
   return kExitDone;
 }

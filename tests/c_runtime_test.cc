@@ -269,7 +269,7 @@ TEST(CRuntimeTest, ExportedHeaderReadsBackBitForBit) {
   for (int i = 0; i < IMUFIT_SHA256_BYTES; ++i) {
     EXPECT_EQ(header.sha256[i], std::stoi(sha.substr(2 * i, 2), nullptr, 16)) << "byte " << i;
   }
-  const imufit_calibration_f header_f = IMUFIT_UNIT_INITIALIZER;
+  const imufit_calibration_f header_f = IMUFIT_UNIT_INITIALIZER_F;
   ExpectCoefficientsOf(calibration, header_f);
 }
 

@@ -37,6 +37,13 @@ TEST_F(CliTest, ExportRefusesALossyExportBeyondMaxLossSayingByHowMuch) {
   EXPECT_NE(refused.err.find("px4 export refused: the gyro's worst-case loss"), std::string::npos)
       << refused.err;
   EXPECT_NE(refused.err.find("exceeds the bound 0.5 deg/s by "), std::string::npos) << refused.err;
+  // The refusal names every option that changes it: the bound, the envelope, --force.
+  for (const char* option : {"--max-loss", "--force", "--envelope-temp-c", "--full-scale-dps", "--max-g"}) {
+    EXPECT_NE(refused.err.find(option), std::string::npos) << option << ": " << refused.err;
+  }
+  // The loss printed names where each bound of the envelope comes from.
+  EXPECT_NE(refused.out.find("(the calibration's fitted range; --envelope-temp-c)"), std::string::npos)
+      << refused.out;
   EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
   EXPECT_FALSE(fs::exists(Path("unit.params")));
   // Within a looser bound, it is written.
@@ -53,31 +60,98 @@ TEST_F(CliTest, ExportRefusesALossyExportBeyondMaxLossSayingByHowMuch) {
 
 TEST_F(CliTest, ExportBadInvocationsAndUnexportableCalibrations) {
   const std::string cal = Fixture("mems_truth.yaml");
-  RunResult r = Run({"export", "-c", cal, "-f", "px4", "-o", Path("x.params")});
+  const std::vector<std::string> driver = {"--gyro-raw-per-radps", "939.65", "--accel-raw-per-mps2",
+                                           "208.838"};
+  const auto run = [&](std::vector<std::string> args, const std::vector<std::string>& more = {}) {
+    args.insert(args.end(), more.begin(), more.end());
+    return Run(args);
+  };
+  RunResult r = run({"export", "-c", cal, "-f", "px4", "-o", Path("x.params")}, driver);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--device-id"), std::string::npos) << r.err;
-  r = Run({"export", "-c", cal, "-f", "mavlink", "-o", Path("x")});
+  r = run({"export", "-c", cal, "-f", "mavlink", "-o", Path("x")});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("c, bin, px4, ardupilot, kalibr, imucal, json"), std::string::npos) << r.err;
-  r = Run({"export", "-c", cal, "-f", "kalibr", "-o", Path("x.yaml"), "--force"});
+  r = run({"export", "-c", cal, "-f", "kalibr", "-o", Path("x.yaml"), "--force"}, driver);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("noise.kalibr.accelerometer_noise_density"), std::string::npos) << r.err;
-  r = Run({"export", "-c", cal, "-f", "c", "-o", Path("x.h"), "--c-name", "2bad"});
+  r = run({"export", "-c", cal, "-f", "c", "-o", Path("x.h"), "--c-name", "2bad"});
   EXPECT_EQ(r.status, 2);
-  r = Run({"export", "-c", cal, "-f", "json", "-o", Path("x.json"), "--full-scale-dps", "-5"});
+  r = run({"export", "-c", cal, "-f", "json", "-o", Path("x.json"), "--full-scale-dps", "-5"});
   EXPECT_EQ(r.status, 2);
-  r = Run({"export", "-c", cal, "-f", "ardupilot", "-o", Path("x.parm"), "--gyro-raw-per-radps", "0"});
+  r = run({"export", "-c", cal, "-f", "ardupilot", "-o", Path("x.parm"), "--gyro-raw-per-radps", "0"});
   EXPECT_EQ(r.status, 2);
-  r = Run({"export", "-c", cal, "-f", "imucal", "-o", Path("x.json"), "--temp-c", "100"});
+  r = run({"export", "-c", cal, "-f", "imucal", "-o", Path("x.json"), "--temp-c", "100"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("outside the calibration's fitted range [-40, 85] degC"), std::string::npos) << r.err;
   std::ofstream(Path("broken.yaml")) << "format: imufit-calibration\nversion: 1\ngyro: [1, 2\n";
-  r = Run({"export", "-c", Path("broken.yaml"), "-f", "json", "-o", Path("x.json")});
+  r = run({"export", "-c", Path("broken.yaml"), "-f", "json", "-o", Path("x.json")});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("broken.yaml:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(Path("x.json")));
-  r = Run({"export", "-c", cal, "-f", "json", "-o", cal});
+  r = run({"export", "-c", cal, "-f", "json", "-o", cal});
   EXPECT_EQ(r.status, 2) << "an output that names the input is refused";
+  for (const char* file : {"x.params", "x.yaml", "x.h", "x.parm"})
+    EXPECT_FALSE(fs::exists(Path(file))) << file;
+}
+
+// The autopilots' device IDs and instances, the envelope's temperatures and a unit in counts
+// exported with the default driver scale: each refusal (exit 2, nothing written) names the option.
+TEST_F(CliTest, ExportRefusalsNameTheOptionThatChangesThem) {
+  const std::string cal = Fixture("mems_truth.yaml");
+  const std::vector<std::string> driver = {"--gyro-raw-per-radps", "939.65", "--accel-raw-per-mps2",
+                                           "208.838"};
+  struct Case {
+    std::string format;
+    std::vector<std::string> args;
+    std::string named;
+  };
+  const std::vector<Case> cases = {
+      {"ardupilot", {}, "imufit: --device-id: a ardupilot export needs the sensors' device IDs"},
+      {"px4", {"--gyro-device-id", "5"}, "imufit: --accel-device-id: "},
+      {"px4", {"--device-id", "5", "--instance", "4"}, "imufit: --instance: \"4\" is not an instance 0..3"},
+      {"ardupilot",
+       {"--device-id", "5", "--instance", "0"},
+       "imufit: --instance: 0 is not an instance of ardupilot (1..3)"},
+      {"px4", {"--device-id", "4294967296"}, "imufit: --device-id: \"4294967296\" is not a 32-bit device ID"},
+      {"json", {"--device-id", "5"}, "imufit: --device-id: only px4, ardupilot use it, not json"},
+      {"c", {"--instance", "1"}, "imufit: --instance: only px4, ardupilot use it, not c"},
+      {"imucal",
+       {"--envelope-temp-c", "20,100"},
+       "imufit: --envelope-temp-c: 20,100 degC is not a range MIN,MAX inside "
+       "the calibration's fitted range [-40, 85] degC"},
+      {"imucal", {"--envelope-temp-c", "30,20"}, "imufit: --envelope-temp-c: 30,20 degC is not a range"},
+      {"kalibr",
+       {},
+       "imufit: --gyro-raw-per-radps: the calibration's scale at its reference temperature is 941.233 "
+       "raw per rad/s, 941.2 times --gyro-raw-per-radps 1"},
+      {"px4",
+       {"--device-id", "5", "--gyro-raw-per-radps", "939.65"},
+       "imufit: --accel-raw-per-mps2: the calibration's scale at its reference temperature is 209.257 raw "
+       "per m/s^2"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"export", "-c", cal, "-f", c.format, "-o", Path("x.out")};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const bool driver_given = std::find(args.begin(), args.end(), "--gyro-raw-per-radps") != args.end();
+    if ((c.format == "px4" || c.format == "ardupilot") && !driver_given)
+      args.insert(args.end(), driver.begin(), driver.end());
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.status, 2) << c.named;
+    EXPECT_EQ(r.err.rfind(c.named, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_FALSE(fs::exists(Path("x.out")));
+  }
+}
+
+// A missing output folder fails before anything is measured or printed: no loss on stdout.
+TEST_F(CliTest, ExportToAMissingFolderFailsBeforePrintingTheLoss) {
+  const RunResult r = Run({"export", "-c", Fixture("mems_truth.yaml"), "-f", "imucal", "-o",
+                           Path("no/such/folder/unit.json"), "--force"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no/such/folder"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "") << "the loss was printed before the error";
 }
 
 }  // namespace

@@ -153,7 +153,7 @@ TEST_F(CliTest, ExportTakesFormatNamesInAnyCaseAndRefusesOptionsTheFormatDoesNot
   EXPECT_TRUE(fs::exists(Path("unit.json")));
   r = Run({"export", "-c", calibration, "-f", "json", "-o", Path("x.json"), "--device-id", "7"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.err, "imufit: --device-id: only px4 use it, not json\n");
+  EXPECT_EQ(r.err, "imufit: --device-id: only px4, ardupilot use it, not json\n");
   r = Run({"export", "-c", calibration, "-f", "Px4", "-o", Path("x.params"), "--device-id", "7", "--temp-c",
            "20"});
   EXPECT_EQ(r.status, 2);
@@ -164,7 +164,7 @@ TEST_F(CliTest, ExportTakesFormatNamesInAnyCaseAndRefusesOptionsTheFormatDoesNot
   // The help lists the formats from the format table, and each option the formats it serves.
   const RunResult help = Run({"export", "--help"});
   EXPECT_NE(help.out.find("c, bin, px4, ardupilot, kalibr, imucal, json"), std::string::npos) << help.out;
-  EXPECT_NE(help.out.find("px4: the sensor's device ID"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("px4, ardupilot: the device ID of both sensors"), std::string::npos) << help.out;
   EXPECT_EQ(Listing(), std::set<std::string>{"unit.json"});
 }
 

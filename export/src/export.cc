@@ -28,6 +28,23 @@ std::string Figures(const Eigen::Vector3d& v) {
   return text;
 }
 
+// A driver scale (raw per SI unit) the calibration's own scale contradicts: a unit in counts
+// exported with the default 1 would lose its whole signal. Throws InputError naming the option.
+void RequireDriverScale(const Eigen::Vector3d& scale, double raw_per_si, const char* flag, const char* unit) {
+  constexpr double kMostRatio = 2.0;  // a driver's nominal scale is within a few percent of the unit's
+  const double ratio = scale.mean() / raw_per_si;
+  if (ratio > kMostRatio || ratio < 1.0 / kMostRatio) {
+    char text[400];
+    std::snprintf(
+        text, sizeof text,
+        "the calibration's scale at its reference temperature is %.6g raw per %s, %.4g times %s %.6g: "
+        "give what the unit's driver divides its raw output by to give %s (a unit in counts: its "
+        "counts per %s)",
+        scale.mean(), unit, ratio, flag, raw_per_si, unit, unit);
+    throw InputError(flag, text);
+  }
+}
+
 }  // namespace
 
 const char* ToString(ExportFormat format) {
@@ -66,6 +83,13 @@ ExportResult ExportCalibration(const Calibration& calibration, const ExportOptio
                                      " degC is outside the calibration's fitted range [" +
                                      FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
                                      FormatDouble(calibration.fit_temp_range_c[1]) + "] degC");
+  }
+  if (ExportOptionServes("gyro_raw_per_radps", options.format)) {
+    const double reference = calibration.model.basis.center_c;
+    RequireDriverScale(export_internal::GyroAt(calibration.model, reference).scale,
+                       options.gyro_raw_per_radps, "--gyro-raw-per-radps", "rad/s");
+    RequireDriverScale(export_internal::AccelAt(calibration.model, reference).scale,
+                       options.accel_raw_per_mps2, "--accel-raw-per-mps2", "m/s^2");
   }
   switch (options.format) {
     case ExportFormat::kC:
@@ -118,6 +142,46 @@ std::optional<std::string> LossBeyondBounds(const ExportLoss& loss, double max_g
 }
 
 namespace export_internal {
+
+SensorIds DeviceIds(const ExportOptions& options, const char* format) {
+  const std::optional<long long> gyro = options.gyro_device_id ? options.gyro_device_id : options.device_id;
+  const std::optional<long long> accel =
+      options.accel_device_id ? options.accel_device_id : options.device_id;
+  if (!gyro || !accel) {
+    throw InputError(options.device_id || options.gyro_device_id || options.accel_device_id
+                         ? (gyro ? "--accel-device-id" : "--gyro-device-id")
+                         : "--device-id",
+                     std::string("a ") + format +
+                         " export needs the sensors' device IDs: --device-id (gyro and accelerometer on one "
+                         "die), or --gyro-device-id and --accel-device-id");
+  }
+  // The autopilots keep the unsigned device ID in an INT32 parameter: the same 32 bits.
+  const auto bits = [](long long id) { return static_cast<int32_t>(static_cast<uint32_t>(id)); };
+  return {bits(*gyro), bits(*accel)};
+}
+
+int InstanceOf(const ExportOptions& options, int low, int high, int fallback, const char* format) {
+  if (!options.instance) return fallback;
+  if (*options.instance < low || *options.instance > high) {
+    throw InputError("--instance", std::to_string(*options.instance) + " is not an instance of " + format +
+                                       " (" + std::to_string(low) + ".." + std::to_string(high) + ")");
+  }
+  return *options.instance;
+}
+
+ExportLoss WorstOf(const ExportLoss& a, const ExportLoss& b) {
+  ExportLoss worst = a;
+  worst.gyro_worst_dps = a.gyro_worst_dps.cwiseMax(b.gyro_worst_dps);
+  worst.gyro_rms_dps = a.gyro_rms_dps.cwiseMax(b.gyro_rms_dps);
+  worst.accel_worst_mg = a.accel_worst_mg.cwiseMax(b.accel_worst_mg);
+  worst.accel_rms_mg = a.accel_rms_mg.cwiseMax(b.accel_rms_mg);
+  return worst;
+}
+
+std::string WorstFigures(const ExportLoss& loss) {
+  return "gyro worst " + Figures(loss.gyro_worst_dps) + " deg/s, accel worst " +
+         Figures(loss.accel_worst_mg) + " mg";
+}
 
 std::string CalibrationFileName(const ExportOptions& options) {
   return CommentSafe(options.calibration_file.substr(options.calibration_file.find_last_of('/') + 1));

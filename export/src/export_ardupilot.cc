@@ -16,6 +16,17 @@
 // INS_*OFFS = d0 + p(T_cal - 35) (T_cal = 35 degC clamped to the fitted range). The
 // accelerometer's scale k / S(T) is held at T_cal; the gyro scale, misalignments and
 // g-sensitivity have no parameter and are the loss.
+//
+// Instances n = 1..3 (--instance): INS_TCALn_*, and the offsets of the n-th sensor, whose names
+// differ (INS_ACCOFFS, INS_ACC2OFFS, INS_ACC3OFFS; INS_ACC_ID, INS_ACC2_ID; INS_ACC1_CALTEMP,
+// INS_ACC2_CALTEMP). INS_ACC_ID and INS_GYR_ID are the device IDs: ArduPilot accepts the
+// instance's offsets as a 3D accelerometer calibration only when the saved ID is the sensor's
+// (AP_InertialSensor::register_accel, accel_calibrated_ok_all). INS_TCALn_TMIN/TMAX lie in the
+// parameters' range -70..80 degC (their metadata, which ground stations enforce): a fitted range
+// beyond it is clamped, and ArduPilot then holds the correction at the end of the range; the loss
+// is measured over the envelope with that clamping. The INS_TCALn_* parameters other than
+// ENABLE exist only once INS_TCALn_ENABLE is 1 (AP_PARAM_FLAG_ENABLE): the file says to load it
+// twice.
 #include <algorithm>
 #include <cmath>
 
@@ -28,6 +39,21 @@ constexpr const char* kConsumer =
     "ArduPilot (4.1 and later: INS_TCAL1 about its fixed 35 degC, INS_ACCOFFS/ACCSCAL/GYROFFS; .parm)";
 constexpr double kArduPilotReferenceC = 35.0;  // TEMP_REFERENCE
 constexpr double kScaleFactor = 1e6;           // SCALE_FACTOR of the stored coefficients
+constexpr double kTempParameterLowC = -70.0;   // INS_TCALn_TMIN/TMAX @Range
+constexpr double kTempParameterHighC = 80.0;
+
+// The names of instance n's parameters: INS_TCAL<n>_, and the sensor's own, whose first instance
+// has no number (INS_ACCOFFS) or 1 (INS_ACC1_CALTEMP).
+struct InstanceNames {
+  std::string tcal;    // "INS_TCAL2_"
+  std::string accel;   // "INS_ACC2" (OFFS, SCAL, _ID)
+  std::string gyro;    // "INS_GYR2" (OFFS, _ID)
+  std::string number;  // "2" (INS_ACC2_CALTEMP)
+};
+InstanceNames NamesOf(int instance) {
+  const std::string n = std::to_string(instance), suffix = instance == 1 ? "" : n;
+  return {"INS_TCAL" + n + "_", "INS_ACC" + suffix, "INS_GYR" + suffix, n};
+}
 
 // One sensor's parameters, as ArduPilot reads them back (float32).
 struct TcalSensor {
@@ -43,6 +69,9 @@ class ParameterList {
     lines_ += name + " " + FloatText(value, name) + "\n";
     return ReadFloat(FloatText(value, name));
   }
+  void Integer(const std::string& name, int32_t value) {
+    lines_ += name + " " + std::to_string(value) + "\n";
+  }
   const std::string& text() const { return lines_; }
 
  private:
@@ -57,9 +86,9 @@ float Polynomial(const TcalSensor& sensor, int axis, float t) {
 
 // The bias cubic of a sensor re-expanded about 35 degC (in SI), its offsets at T_cal, and for the
 // accelerometer the scale at T_cal.
-TcalSensor AddSensor(const Calibration& calibration, const std::string& name, const double* params,
-                     double raw_per_si, bool accel, double cal_temp_c, ParameterList* tcal,
-                     ParameterList* offsets) {
+TcalSensor AddSensor(const Calibration& calibration, const InstanceNames& names, const std::string& name,
+                     const double* params, double raw_per_si, bool accel, double cal_temp_c,
+                     ParameterList* tcal, ParameterList* offsets) {
   TcalSensor sensor;
   Eigen::Vector4d d[3];
   for (int axis = 0; axis < 3; ++axis) {
@@ -70,7 +99,7 @@ TcalSensor AddSensor(const Calibration& calibration, const std::string& name, co
   for (int order = 1; order <= 3; ++order) {
     for (int axis = 0; axis < 3; ++axis) {
       sensor.coefficient[order - 1][axis] = tcal->Add(
-          "INS_TCAL1_" + name + std::to_string(order) + "_" + "XYZ"[axis], d[axis](order) * kScaleFactor);
+          names.tcal + name + std::to_string(order) + "_" + "XYZ"[axis], d[axis](order) * kScaleFactor);
     }
   }
   const double t_cal = cal_temp_c - kArduPilotReferenceC;
@@ -78,10 +107,11 @@ TcalSensor AddSensor(const Calibration& calibration, const std::string& name, co
   for (int axis = 0; axis < 3; ++axis) {
     const std::string xyz(1, "XYZ"[axis]);
     const double offset = EvaluateTemperaturePolynomial(d[axis].data(), t_cal);
-    sensor.offset[axis] = offsets->Add(std::string(accel ? "INS_ACCOFFS_" : "INS_GYROFFS_") + xyz, offset);
-    if (accel) sensor.scale[axis] = offsets->Add("INS_ACCSCAL_" + xyz, raw_per_si / at_cal.scale(axis));
+    sensor.offset[axis] = offsets->Add((accel ? names.accel : names.gyro) + "OFFS_" + xyz, offset);
+    if (accel)
+      sensor.scale[axis] = offsets->Add(names.accel + "SCAL_" + xyz, raw_per_si / at_cal.scale(axis));
   }
-  sensor.cal_temp = offsets->Add(accel ? "INS_ACC1_CALTEMP" : "INS_GYR1_CALTEMP", cal_temp_c);
+  sensor.cal_temp = offsets->Add((accel ? "INS_ACC" : "INS_GYR") + names.number + "_CALTEMP", cal_temp_c);
   return sensor;
 }
 
@@ -89,14 +119,20 @@ TcalSensor AddSensor(const Calibration& calibration, const std::string& name, co
 
 ExportResult ExportArduPilot(const Calibration& calibration, const ExportOptions& options,
                              const Envelope& envelope) {
+  const SensorIds ids = DeviceIds(options, "ardupilot");
+  const InstanceNames names = NamesOf(InstanceOf(options, 1, 3, 1, "ardupilot"));
   const double cal_temp_c = ClampToRange(calibration, kArduPilotReferenceC);
+  const double tmin_c = std::clamp(calibration.fit_temp_range_c[0], kTempParameterLowC, kTempParameterHighC);
+  const double tmax_c = std::clamp(calibration.fit_temp_range_c[1], kTempParameterLowC, kTempParameterHighC);
   ParameterList tcal, offsets;
-  tcal.Add("INS_TCAL1_ENABLE", 1.0);
-  const float tmin = tcal.Add("INS_TCAL1_TMIN", calibration.fit_temp_range_c[0]);
-  const float tmax = tcal.Add("INS_TCAL1_TMAX", calibration.fit_temp_range_c[1]);
-  const TcalSensor accel = AddSensor(calibration, "ACC", calibration.model.accel.data(),
+  tcal.Add(names.tcal + "ENABLE", 1.0);
+  const float tmin = tcal.Add(names.tcal + "TMIN", tmin_c);
+  const float tmax = tcal.Add(names.tcal + "TMAX", tmax_c);
+  offsets.Integer(names.accel + "_ID", ids.accel);
+  offsets.Integer(names.gyro + "_ID", ids.gyro);
+  const TcalSensor accel = AddSensor(calibration, names, "ACC", calibration.model.accel.data(),
                                      options.accel_raw_per_mps2, true, cal_temp_c, &tcal, &offsets);
-  const TcalSensor gyro = AddSensor(calibration, "GYR", calibration.model.gyro.data(),
+  const TcalSensor gyro = AddSensor(calibration, names, "GYR", calibration.model.gyro.data(),
                                     options.gyro_raw_per_radps, false, cal_temp_c, &tcal, &offsets);
 
   const double k_gyro = options.gyro_raw_per_radps, k_accel = options.accel_raw_per_mps2;
@@ -116,9 +152,21 @@ ExportResult ExportArduPilot(const Calibration& calibration, const ExportOptions
     }
   };
   ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
-  result.content = Commented(ProvenanceLines(calibration, options, result), "# ") +
-                   "# ArduPilot re-measures the gyro offsets at every boot unless INS_GYR_CAL is 0.\n" +
-                   tcal.text() + offsets.text();
+  std::vector<std::string> notes = ProvenanceLines(calibration, options, result);
+  if (tmin_c != calibration.fit_temp_range_c[0] || tmax_c != calibration.fit_temp_range_c[1]) {
+    result.warning = "the fitted range [" + FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                     FormatDouble(calibration.fit_temp_range_c[1]) + "] degC lies beyond " + names.tcal +
+                     "TMIN/TMAX's range [-70, 80] degC: written as [" + FormatDouble(tmin_c) + ", " +
+                     FormatDouble(tmax_c) +
+                     "]; ArduPilot holds the correction at the end beyond it (in the loss)";
+    notes.push_back("warning: " + result.warning);
+  }
+  notes.push_back(names.tcal + "ENABLE must be 1 before the other " + names.tcal +
+                  "* parameters exist: load this file, refresh the parameters, and load it again.");
+  notes.push_back(names.accel + "_ID and " + names.gyro +
+                  "_ID must be the IDs ArduPilot reports for the sensors; reboot after loading.");
+  notes.push_back("ArduPilot re-measures the gyro offsets at every boot unless INS_GYR_CAL is 0.");
+  result.content = Commented(notes, "# ") + tcal.text() + offsets.text();
   return result;
 }
 

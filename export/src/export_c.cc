@@ -107,21 +107,24 @@ std::string CString(const std::string& text) {
   return literal + "\"";
 }
 
-// A double literal of C that reads back as exactly `value`.
-std::string CNumber(double value, const std::string& name) {
+// A double literal of C that reads back as exactly `value`; for the float build (`to_float`) the
+// same literal cast to float, which converts it as the implicit conversion would (round to
+// nearest) but says so: the header compiles under -Wconversion -Wfloat-conversion -Werror.
+std::string CNumber(double value, const std::string& name, bool to_float) {
   std::string text = DoubleText(value, name);
   if (text.find_first_of(".e") == std::string::npos) text += ".0";
-  return text;
+  return to_float ? "(float)" + text : text;
 }
 
-void AppendRows(const double* params, int coefficients, const char* sensor, bool last, std::string* out) {
+void AppendRows(const double* params, int coefficients, const char* sensor, bool last, bool to_float,
+                std::string* out) {
   *out += "    { \\\n";
   for (int i = 0; i < coefficients; ++i) {
     const std::string name =
         std::string(sensor) + " " + kCoefficientNames[i].group + " " + kCoefficientNames[i].axis;
     *out += "      {";
     for (int k = 0; k < kPolynomialTerms; ++k) {
-      *out += (k ? ", " : "") + CNumber(params[i * kPolynomialTerms + k], name);
+      *out += (k ? ", " : "") + CNumber(params[i * kPolynomialTerms + k], name, to_float);
     }
     *out += std::string("}") + (i + 1 < coefficients ? "," : " ") + " /* " + name + " */ \\\n";
   }
@@ -149,29 +152,37 @@ std::string HeaderText(const Calibration& calibration, const ExportOptions& opti
   }
   out += " * " + builds_note + "\n *\n";
   out +=
-      " * Use with the runtime (the float build: IMUFIT_RUNTIME_FLOAT defined, imufit_calibration_f,\n"
-      " * imufit_correct_f):\n"
+      " * Use with the runtime, the double build:\n"
       " *   static const imufit_calibration calibration = " +
       name +
       "_INITIALIZER;\n"
-      " *   imufit_correct(&calibration, temp_c, gyro_raw, accel_raw, omega_radps, a_mps2);\n */\n";
+      " *   imufit_correct(&calibration, temp_c, gyro_raw, accel_raw, omega_radps, a_mps2);\n"
+      " * or the float build (IMUFIT_RUNTIME_FLOAT defined before imufit_runtime.h):\n"
+      " *   static const imufit_calibration_f calibration = " +
+      name +
+      "_INITIALIZER_F;\n"
+      " *   imufit_correct_f(&calibration, temp_c, gyro_raw, accel_raw, omega_radps, a_mps2);\n */\n";
   out += "#ifndef " + name + "_H_\n#define " + name + "_H_\n\n#include \"imufit_runtime.h\"\n\n";
   out +=
       "/* serial, SHA-256 of the calibration file, reference temperature and fitted range (degC), then\n"
       " * c0..c3 of every gyro and accelerometer coefficient in powers of dT = T - T_ref. */\n";
-  out += "#define " + name + "_INITIALIZER \\\n  { \\\n    " + CString(calibration.serial) + ", \\\n    {";
   const auto sha = Sha256Bytes(options.calibration_sha256);
-  for (size_t i = 0; i < sha.size(); ++i) {
-    char byte[8];
-    std::snprintf(byte, sizeof byte, "0x%02x", sha[i]);
-    out += (i ? ", " : "") + std::string(byte);
+  for (const bool to_float : {false, true}) {
+    out += "#define " + name + (to_float ? "_INITIALIZER_F" : "_INITIALIZER") + " \\\n  { \\\n    " +
+           CString(calibration.serial) + ", \\\n    {";
+    for (size_t i = 0; i < sha.size(); ++i) {
+      char byte[8];
+      std::snprintf(byte, sizeof byte, "0x%02x", sha[i]);
+      out += (i ? ", " : "") + std::string(byte);
+    }
+    out += "}, \\\n    " + CNumber(calibration.model.basis.center_c, "reference_temp_c", to_float) + ", " +
+           CNumber(calibration.fit_temp_range_c[0], "fit_temp_range_c", to_float) + ", " +
+           CNumber(calibration.fit_temp_range_c[1], "fit_temp_range_c", to_float) + ", \\\n";
+    AppendRows(calibration.model.gyro.data(), kGyroCoefficients, "gyro", false, to_float, &out);
+    AppendRows(calibration.model.accel.data(), kAccelCoefficients, "accel", true, to_float, &out);
+    out += to_float ? "  }\n" : "  }\n\n";
   }
-  out += "}, \\\n    " + CNumber(calibration.model.basis.center_c, "reference_temp_c") + ", " +
-         CNumber(calibration.fit_temp_range_c[0], "fit_temp_range_c") + ", " +
-         CNumber(calibration.fit_temp_range_c[1], "fit_temp_range_c") + ", \\\n";
-  AppendRows(calibration.model.gyro.data(), kGyroCoefficients, "gyro", false, &out);
-  AppendRows(calibration.model.accel.data(), kAccelCoefficients, "accel", true, &out);
-  out += "  }\n\n#endif  /* " + name + "_H_ */\n";
+  out += "\n#endif  /* " + name + "_H_ */\n";
   return out;
 }
 

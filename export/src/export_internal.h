@@ -3,6 +3,7 @@
 #ifndef IMUFIT_IO_SRC_EXPORT_INTERNAL_H_
 #define IMUFIT_IO_SRC_EXPORT_INTERNAL_H_
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -29,8 +30,10 @@ struct Envelope {
   double temp_high_c = 0.0;
   double full_scale_radps = 0.0;
   double max_specific_force_mps2 = 0.0;
+  // Where each bound comes from, in words naming the option that changes it.
+  std::string temp_source, rate_source, force_source;
 };
-// Throws InputError for a non-positive or non-finite full scale or g.
+// Throws InputError for a temperature range outside the calibration's fitted range.
 Envelope EnvelopeOf(const Calibration& calibration, const ExportOptions& options);
 std::string DescribeEnvelope(const Envelope& envelope);
 
@@ -76,6 +79,21 @@ std::string Commented(const std::vector<std::string>& lines, const std::string& 
 // A result naming its consumer and envelope, with the consumer's loss measured over it.
 ExportResult MeasuredResult(const char* consumer, const Calibration& calibration, const Envelope& envelope,
                             const ConsumerCorrection& correction);
+
+// The device IDs of a px4 or ardupilot export: --gyro-device-id / --accel-device-id, else
+// --device-id, as the INT32 parameter holds the unsigned 32 bits. Throws InputError naming the
+// options when one is missing.
+struct SensorIds {
+  int32_t gyro = 0;
+  int32_t accel = 0;
+};
+SensorIds DeviceIds(const ExportOptions& options, const char* format);
+// --instance, within [low, high] for `format`, else `fallback`. Throws InputError outside.
+int InstanceOf(const ExportOptions& options, int low, int high, int fallback, const char* format);
+// Per axis the larger worst case and the larger RMS of two measurements over the same envelope.
+ExportLoss WorstOf(const ExportLoss& a, const ExportLoss& b);
+// "gyro worst x .. y .. z deg/s, accel worst x .. y .. z mg".
+std::string WorstFigures(const ExportLoss& loss);
 
 // The cubic `c` (powers of T - from_reference_c) re-expanded exactly in powers of T - to_reference_c.
 Eigen::Vector4d Rebased(const double* c, double from_reference_c, double to_reference_c);

@@ -29,29 +29,45 @@ std::vector<Eigen::Vector3d> Corners(double scale) {
 }  // namespace
 
 Envelope EnvelopeOf(const Calibration& calibration, const ExportOptions& options) {
-  if (!(options.full_scale_dps > 0.0) || !std::isfinite(options.full_scale_dps)) {
-    throw InputError("--full-scale-dps",
-                     "the envelope's full scale must be a positive number of deg/s, not " +
-                         FormatDouble(options.full_scale_dps));
-  }
-  if (!(options.max_g > 0.0) || !std::isfinite(options.max_g)) {
-    throw InputError("--max-g", "the envelope's specific force must be a positive number of g, not " +
-                                    FormatDouble(options.max_g));
-  }
+  // ExportOptions::Validate() has checked the full scale and g (positive, finite).
+  const ExportOptions defaults;
+  const auto given = [](bool is_default, const char* flag) {
+    return std::string(flag) + (is_default ? ", the default" : "");
+  };
   Envelope envelope;
   envelope.temp_low_c = calibration.fit_temp_range_c[0];
   envelope.temp_high_c = calibration.fit_temp_range_c[1];
+  envelope.temp_source = "the calibration's fitted range; --envelope-temp-c";
+  if (!options.envelope_temp_c.empty()) {
+    if (options.envelope_temp_c.size() != 2)
+      throw InputError("--envelope-temp-c", "the envelope's temperatures are two numbers MIN,MAX");
+    const double low = options.envelope_temp_c[0], high = options.envelope_temp_c[1];
+    if (!(low <= high) || !(low >= envelope.temp_low_c) || !(high <= envelope.temp_high_c)) {
+      throw InputError("--envelope-temp-c",
+                       FormatDouble(low) + "," + FormatDouble(high) +
+                           " degC is not a range MIN,MAX inside the calibration's fitted range [" +
+                           FormatDouble(envelope.temp_low_c) + ", " + FormatDouble(envelope.temp_high_c) +
+                           "] degC");
+    }
+    envelope.temp_low_c = low;
+    envelope.temp_high_c = high;
+    envelope.temp_source = "--envelope-temp-c";
+  }
   envelope.full_scale_radps = options.full_scale_dps / kRadToDeg;
+  envelope.rate_source = given(options.full_scale_dps == defaults.full_scale_dps, "--full-scale-dps");
   envelope.max_specific_force_mps2 = options.max_g * kStandardGravityMps2;
+  envelope.force_source = given(options.max_g == defaults.max_g, "--max-g");
   return envelope;
 }
 
 std::string DescribeEnvelope(const Envelope& envelope) {
-  char text[240];
-  std::snprintf(text, sizeof text,
-                "[%g, %g] degC x rate up to %g deg/s x specific force up to %g g, on each axis",
-                envelope.temp_low_c, envelope.temp_high_c, envelope.full_scale_radps * kRadToDeg,
-                envelope.max_specific_force_mps2 / kStandardGravityMps2);
+  char text[400];
+  std::snprintf(
+      text, sizeof text,
+      "[%g, %g] degC (%s) x rate up to %g deg/s (%s) x specific force up to %g g (%s), on each axis",
+      envelope.temp_low_c, envelope.temp_high_c, envelope.temp_source.c_str(),
+      envelope.full_scale_radps * kRadToDeg, envelope.rate_source.c_str(),
+      envelope.max_specific_force_mps2 / kStandardGravityMps2, envelope.force_source.c_str());
   return text;
 }
 

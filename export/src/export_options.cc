@@ -2,6 +2,7 @@
 // checks. `imufit export` takes its options, their help and defaults from here.
 #include <cerrno>
 #include <cstdlib>
+#include <optional>
 #include <vector>
 
 #include "imufit/export/export.h"
@@ -19,7 +20,10 @@ const std::vector<FormatOption>& FormatOptions() {
       {"gyro_raw_per_radps", {ExportFormat::kPx4, ExportFormat::kArduPilot, ExportFormat::kKalibr}},
       {"accel_raw_per_mps2", {ExportFormat::kPx4, ExportFormat::kArduPilot, ExportFormat::kKalibr}},
       {"temp_c", {ExportFormat::kKalibr, ExportFormat::kImucal}},
-      {"device_id", {ExportFormat::kPx4}},
+      {"device_id", {ExportFormat::kPx4, ExportFormat::kArduPilot}},
+      {"gyro_device_id", {ExportFormat::kPx4, ExportFormat::kArduPilot}},
+      {"accel_device_id", {ExportFormat::kPx4, ExportFormat::kArduPilot}},
+      {"instance", {ExportFormat::kPx4, ExportFormat::kArduPilot}},
       {"c_name", {ExportFormat::kC}},
       {"rostopic", {ExportFormat::kKalibr}},
   };
@@ -39,6 +43,29 @@ std::string ForFormats(const char* key, const std::string& help) {
   return formats.empty() ? help : formats + ": " + help;
 }
 
+// A whole number in decimal, nullopt for any other text.
+std::optional<long long> WholeNumber(const std::string& text) {
+  char* end = nullptr;
+  errno = 0;
+  const long long n = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno == ERANGE) return std::nullopt;
+  return n;
+}
+
+// A 32-bit unsigned device ID (PX4 and ArduPilot keep its bits in an INT32 parameter).
+void DeviceId(OptionTable<ExportOptions>* t, const char* key, const char* flag, const char* help,
+              std::optional<long long> ExportOptions::*member) {
+  t->Text(
+      key, flag, ForFormats(key, help),
+      [member](const ExportOptions& o) { return o.*member ? std::to_string(*(o.*member)) : std::string(); },
+      [member](const std::string& text, ExportOptions* o) -> std::string {
+        const std::optional<long long> id = WholeNumber(text);
+        if (!id || *id < 0 || *id > 0xFFFFFFFFLL) return "\"" + text + "\" is not a 32-bit device ID";
+        o->*member = id;
+        return "";
+      });
+}
+
 OptionTable<ExportOptions> MakeExportOptionTable() {
   using O = ExportOptions;
   OptionTable<O> t;
@@ -51,6 +78,12 @@ OptionTable<ExportOptions> MakeExportOptionTable() {
         o->format = *format;
         return "";
       });
+  t.Numbers(
+      "envelope_temp_c", "--envelope-temp-c",
+      "the envelope: the temperatures MIN,MAX the loss is measured over, inside the fitted range "
+      "(default: the calibration's fitted range)",
+      "degC", [](const O& o) { return o.envelope_temp_c; },
+      [](const std::vector<double>& v, O* o) { o->envelope_temp_c = v; }, 2);
   t.Number("full_scale_dps", "--full-scale-dps", "the envelope: the largest angular rate on each axis",
            "deg/s", &O::full_scale_dps, PositiveFinite());
   t.Number("max_g", "--max-g", "the envelope: the largest specific force on each axis", "g", &O::max_g,
@@ -67,15 +100,23 @@ OptionTable<ExportOptions> MakeExportOptionTable() {
                               "the temperature the one-temperature formats are taken at (default: the "
                               "calibration's reference, clamped to its fitted range)"),
                    "degC", &O::temp_c, {}, "the reference");
+  DeviceId(&t, "device_id", "--device-id", "the device ID of both sensors (one die)", &O::device_id);
+  DeviceId(&t, "gyro_device_id", "--gyro-device-id",
+           "the gyro's device ID (TC_G0_ID, CAL_GYRO0_ID; INS_GYR_ID), instead of --device-id",
+           &O::gyro_device_id);
+  DeviceId(&t, "accel_device_id", "--accel-device-id",
+           "the accelerometer's device ID (TC_A0_ID, CAL_ACC0_ID; INS_ACC_ID), instead of --device-id",
+           &O::accel_device_id);
   t.Text(
-      "device_id", "--device-id", ForFormats("device_id", "the sensor's device ID (TC_G0_ID, CAL_ACC0_ID)"),
-      [](const O& o) { return o.device_id ? std::to_string(*o.device_id) : std::string(); },
+      "instance", "--instance",
+      ForFormats("instance",
+                 "the parameter instance: px4 0..3 (TC_G0..3, TC_A0..3, CAL_ACC0..3; default 0), "
+                 "ardupilot 1..3 (INS_TCAL1..3, INS_ACC..ACC3; default 1)"),
+      [](const O& o) { return o.instance ? std::to_string(*o.instance) : std::string(); },
       [](const std::string& text, O* o) -> std::string {
-        char* end = nullptr;
-        errno = 0;
-        const long long id = std::strtoll(text.c_str(), &end, 10);
-        if (text.empty() || *end != '\0' || errno == ERANGE) return "\"" + text + "\" is not a whole number";
-        o->device_id = id;
+        const std::optional<long long> n = WholeNumber(text);
+        if (!n || *n < 0 || *n > 3) return "\"" + text + "\" is not an instance 0..3";
+        o->instance = static_cast<int>(*n);
         return "";
       });
   t.String("c_name", "--c-name", ForFormats("c_name", "the C name of the unit (NAME_INITIALIZER)"),

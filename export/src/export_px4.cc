@@ -10,11 +10,19 @@
 //   gyro      = d - offset - CAL_GYRO0_xOFF
 //   accel     = (d - offset - CAL_ACC0_xOFF) * CAL_ACC0_xSCALE
 //
-// then PX4's board rotation, which is imufit's body frame only if the sensor is mounted so.
+// (any instance n of TC_Gn / TC_An / CAL_ACCn: PX4 finds a sensor's parameters by their _ID), then
+// PX4's board rotation, which is imufit's body frame only if the sensor is mounted so.
 // With d = raw / k (k the driver's raw per SI unit), imufit's model gives exactly
 // offset(T) = V(T) / k, a cubic written here in powers of T - TREF with TREF the calibration's
 // reference; the accelerometer's scale k / S(T) is held at TREF; the gyro scale, both
 // misalignments and the g-sensitivity have no parameter, and are the loss.
+//
+// How the scale is loaded differs between releases (src/lib/sensor_calibration/Accelerometer.cpp):
+// v1.12 passes CAL_ACCn_xSCALE through set_scale(), which keeps the scale it holds (1 after boot)
+// unless the new one differs from it by more than 0.01 (Euclidean norm of the difference);
+// releases that read the parameters directly apply it as written. Both are measured; the loss
+// reported is the worse of the two, per axis. TC_G_ENABLE and TC_A_ENABLE take effect at the next
+// boot (@reboot_required), and the boot also resets set_scale()'s reference to 1.
 #include <cmath>
 #include <cstdint>
 
@@ -25,9 +33,11 @@ namespace imufit::export_internal {
 namespace {
 
 constexpr const char* kConsumer =
-    "PX4 (v1.12 and later: TC_G0/TC_A0 thermal compensation, CAL_ACC0 scale; .params of QGroundControl)";
-constexpr int kTypeInt32 = 6;   // MAV_PARAM_TYPE_INT32
-constexpr int kTypeReal32 = 9;  // MAV_PARAM_TYPE_REAL32
+    "PX4 v1.12 and later (TC_Gn/TC_An thermal compensation, CAL_ACCn scale, loaded through v1.12's "
+    "set_scale() and directly; .params of QGroundControl)";
+constexpr float kSetScaleThreshold = 0.01f;  // set_scale(): |scale - current| must exceed it
+constexpr int kTypeInt32 = 6;                // MAV_PARAM_TYPE_INT32
+constexpr int kTypeReal32 = 9;               // MAV_PARAM_TYPE_REAL32
 
 struct Parameter {
   std::string name;
@@ -101,52 +111,76 @@ std::string ParamsText(const std::vector<std::string>& provenance, const Paramet
   return out;
 }
 
+// The scale PX4 v1.12's set_scale() holds after boot: the written one, or 1 when it lies within
+// 0.01 (Euclidean norm) of 1.
+// 0.01 (Euclidean norm) of 1: matrix::Vector::longerThan, in float, x + y + z in that order.
+Eigen::Vector3f SetScaleAfterBoot(const float written[3]) {
+  float norm_squared = 0.0f;
+  for (int axis = 0; axis < 3; ++axis) norm_squared += (1.0f - written[axis]) * (1.0f - written[axis]);
+  if (norm_squared > kSetScaleThreshold * kSetScaleThreshold)
+    return Eigen::Vector3f(written[0], written[1], written[2]);
+  return Eigen::Vector3f::Ones();
+}
+
 }  // namespace
 
 ExportResult ExportPx4(const Calibration& calibration, const ExportOptions& options,
                        const Envelope& envelope) {
-  if (!options.device_id)
-    throw InputError("--device-id", "a px4 export needs the sensor's device ID (TC_G0_ID)");
-  if (*options.device_id < 0 || *options.device_id > 0xFFFFFFFFLL) {
-    throw InputError("--device-id", std::to_string(*options.device_id) + " is not a 32-bit device ID");
-  }
-  // PX4 keeps the unsigned device ID in an INT32 parameter: the same 32 bits.
-  const int32_t device_id = static_cast<int32_t>(static_cast<uint32_t>(*options.device_id));
+  const SensorIds ids = DeviceIds(options, "px4");
+  const std::string n = std::to_string(InstanceOf(options, 0, 3, 0, "px4"));
   const double k_gyro = options.gyro_raw_per_radps, k_accel = options.accel_raw_per_mps2;
   ParameterList list;
   list.Integer("TC_G_ENABLE", 1);
   list.Integer("TC_A_ENABLE", 1);
   const Px4Thermal gyro =
-      AddThermal(calibration, "TC_G0", calibration.model.gyro.data(), k_gyro, device_id, &list);
+      AddThermal(calibration, "TC_G" + n, calibration.model.gyro.data(), k_gyro, ids.gyro, &list);
   const Px4Thermal accel =
-      AddThermal(calibration, "TC_A0", calibration.model.accel.data(), k_accel, device_id, &list);
-  list.Integer("CAL_GYRO0_ID", device_id);
-  list.Integer("CAL_ACC0_ID", device_id);
+      AddThermal(calibration, "TC_A" + n, calibration.model.accel.data(), k_accel, ids.accel, &list);
+  list.Integer("CAL_GYRO" + n + "_ID", ids.gyro);
+  list.Integer("CAL_ACC" + n + "_ID", ids.accel);
   float scale[3];
   const SensorCoefficients<double> at_reference =
       AccelAt(calibration.model, calibration.model.basis.center_c);
   for (int axis = 0; axis < 3; ++axis) {
     const std::string xyz(1, "XYZ"[axis]);
-    list.Real("CAL_GYRO0_" + xyz + "OFF", 0.0);
-    list.Real("CAL_ACC0_" + xyz + "OFF", 0.0);
-    scale[axis] = list.Real("CAL_ACC0_" + xyz + "SCALE", k_accel / at_reference.scale(axis));
+    list.Real("CAL_GYRO" + n + "_" + xyz + "OFF", 0.0);
+    list.Real("CAL_ACC" + n + "_" + xyz + "OFF", 0.0);
+    scale[axis] = list.Real("CAL_ACC" + n + "_" + xyz + "SCALE", k_accel / at_reference.scale(axis));
   }
+  const Eigen::Vector3f set_scale = SetScaleAfterBoot(scale);
 
-  const ConsumerCorrection consumer = [=](double temp_c, const Eigen::Vector3d& gyro_raw,
-                                          const Eigen::Vector3d& accel_raw, Eigen::Vector3d* omega_radps,
-                                          Eigen::Vector3d* a_mps2) {
-    float gyro_offset[3], accel_offset[3];
-    Offsets(gyro, static_cast<float>(temp_c), gyro_offset);
-    Offsets(accel, static_cast<float>(temp_c), accel_offset);
-    for (int axis = 0; axis < 3; ++axis) {
-      const float d_gyro = static_cast<float>(gyro_raw(axis) / k_gyro);
-      const float d_accel = static_cast<float>(accel_raw(axis) / k_accel);
-      (*omega_radps)(axis) = d_gyro - gyro_offset[axis] - 0.0f;
-      (*a_mps2)(axis) = (d_accel - accel_offset[axis] - 0.0f) * scale[axis];
-    }
+  const auto consumer = [=](const Eigen::Vector3f& accel_scale) -> ConsumerCorrection {
+    return [=](double temp_c, const Eigen::Vector3d& gyro_raw, const Eigen::Vector3d& accel_raw,
+               Eigen::Vector3d* omega_radps, Eigen::Vector3d* a_mps2) {
+      float gyro_offset[3], accel_offset[3];
+      Offsets(gyro, static_cast<float>(temp_c), gyro_offset);
+      Offsets(accel, static_cast<float>(temp_c), accel_offset);
+      for (int axis = 0; axis < 3; ++axis) {
+        const float d_gyro = static_cast<float>(gyro_raw(axis) / k_gyro);
+        const float d_accel = static_cast<float>(accel_raw(axis) / k_accel);
+        (*omega_radps)(axis) = d_gyro - gyro_offset[axis] - 0.0f;
+        (*a_mps2)(axis) = (d_accel - accel_offset[axis] - 0.0f) * accel_scale(axis);
+      }
+    };
   };
-  ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
-  result.content = ParamsText(ProvenanceLines(calibration, options, result), list);
+  ExportResult result = MeasuredResult(kConsumer, calibration, envelope,
+                                       consumer(Eigen::Vector3f(scale[0], scale[1], scale[2])));
+  const ExportLoss through_set_scale = MeasureLoss(calibration.model, envelope, consumer(set_scale));
+  std::vector<std::string> notes = {
+      "loss with CAL_ACC" + n + "_xSCALE applied as written: " + WorstFigures(result.loss),
+      "loss with PX4 v1.12's set_scale() (" +
+          std::string(set_scale == Eigen::Vector3f::Ones() && scale[0] != 1.0f
+                          ? "which ignores this scale: within 0.01 of 1, it keeps 1"
+                          : "which applies this scale") +
+          "): " + WorstFigures(through_set_scale)};
+  result.loss = WorstOf(result.loss, through_set_scale);
+  std::vector<std::string> provenance = ProvenanceLines(calibration, options, result);
+  provenance.insert(provenance.end(), notes.begin(), notes.end());
+  provenance.push_back(
+      "TC_G_ENABLE and TC_A_ENABLE take effect only after a reboot: load this file, then reboot");
+  provenance.push_back("the vehicle; TC_G" + n + "_ID/CAL_GYRO" + n + "_ID and TC_A" + n + "_ID/CAL_ACC" + n +
+                       "_ID must be the device IDs PX4 reports for the gyro and the accelerometer.");
+  result.content = ParamsText(provenance, list);
   return result;
 }
 

@@ -389,6 +389,21 @@ def allan(
 def allan_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of allan()'s options from the library's option table."""
 
+def export(
+    calibration: str | os.PathLike[str] | Calibration,
+    format: str,
+    output: str | os.PathLike[str] | None = None,
+    **options: Any,
+) -> dict[str, Any]:
+    """The calibration in a consumer's format, as `imufit export` writes it (docs/export.md):
+    {content: bytes, loss: {points, gyro_worst_dps, gyro_rms_dps, accel_worst_mg, accel_rms_mg}
+    (arrays x, y, z; deg/s and mg) or None for a lossless format, consumer, envelope, warning}.
+    Written atomically to `output` when given. Options: export_options(). Nothing is refused for
+    its loss: compare `loss` with your bound. Raises InputError for a bad option or calibration."""
+
+def export_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of export()'s options (`imufit export`'s option table)."""
+
 class NoiseTerms:
     """IEEE 952 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2,
     SI units of y (gyro in rad/s: Q rad, N rad/sqrt(s), B rad/s, K rad/s/sqrt(s), R rad/s^2)."""

@@ -69,6 +69,7 @@ void BindCalibration(py::module_& m);
 void BindFit(py::module_& m);
 void BindNoise(py::module_& m);
 void BindPlan(py::module_& m);
+void BindExport(py::module_& m);
 
 }  // namespace imufit::python
 

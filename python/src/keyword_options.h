@@ -31,7 +31,11 @@ void SetKeyword(const OptionEntry<Options>& entry, const std::string& function, 
           if (kind.count > 0 && !numbers.empty() && numbers.size() != kind.count) throw py::cast_error();
           kind.set(numbers, options);
         } else if constexpr (std::is_same_v<Kind, TextOption<Options>>) {
-          const std::string text = kind.path ? PathString(value) : value.cast<std::string>();
+          // A whole number (a device ID, an instance) is taken as its decimal text.
+          const bool whole = py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value);
+          const std::string text = kind.path ? PathString(value)
+                                   : whole   ? std::string(py::str(value))
+                                             : value.cast<std::string>();
           if (const std::string error = kind.set(text, options); !error.empty())
             ThrowBadArgument(function, entry.key + " " + error);
         } else {

@@ -117,5 +117,6 @@ PYBIND11_MODULE(_imufit, m) {
   BindCalibration(m);
   BindFit(m);
   BindNoise(m);
+  BindExport(m);
   BindPlan(m);
 }

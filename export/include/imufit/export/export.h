@@ -2,10 +2,10 @@
 //
 //   c       a C header for the firmware runtime (model/c/imufit_runtime.h): an initializer macro
 //   bin     the runtime's packed little-endian blob (magic, version, length, CRC-32), for EEPROM
-//   px4     PX4 parameters in the ground station's tab-separated .params format: the TC_G0_* /
-//           TC_A0_* bias cubics, CAL_ACC0_xSCALE
-//   ardupilot  ArduPilot parameters (.parm): INS_TCAL1_* about its fixed 35 degC, offsets and
-//           accelerometer scale at the calibration temperature
+//   px4     PX4 parameters in the ground station's tab-separated .params format: the TC_Gn_* /
+//           TC_An_* bias cubics, CAL_ACCn_xSCALE, the device IDs (instance n = --instance)
+//   ardupilot  ArduPilot parameters (.parm): INS_TCALn_* about its fixed 35 degC, offsets and
+//           accelerometer scale at the calibration temperature, INS_ACC_ID / INS_GYR_ID
 //   kalibr  Kalibr's imu.yaml: the noise densities and its scale-misalignment intrinsics
 //   imucal  imucal's Ferraris JSON (K, R, b, K_ga) at one temperature
 //   json    the whole calibration in JSON (the calibration file's schema, docs/calibration.schema.json)
@@ -13,8 +13,9 @@
 // Every format that cannot hold the whole model measures its loss before anything is written: the
 // full model (`imufit apply`'s SensorModel::Correct) and the consumer's own equations, evaluated
 // with the consumer's arithmetic (float32 where it uses it) on the numbers exactly as the file
-// prints them, over the envelope: the calibration's fitted temperature range x every axis of the
-// angular rate in [-full_scale, full_scale] x every axis of the specific force in [-max_g, max_g] g.
+// prints them, over the envelope: the temperatures (the calibration's fitted range, or a range
+// inside it) x every axis of the angular rate in [-full_scale, full_scale] x every axis of the
+// specific force in [-max_g, max_g] g.
 // The loss (worst case and RMS per axis, deg/s and mg) and the provenance are written into the
 // exported file's comments (or its comment field).
 #ifndef IMUFIT_EXPORT_EXPORT_H_
@@ -24,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -46,9 +48,12 @@ std::string ExportFormatNames();
 // another.
 struct ExportOptions {
   ExportFormat format = ExportFormat::kJson;
-  // The envelope the loss is measured over (with the calibration's fitted temperature range).
-  double full_scale_dps = 500.0;  // each axis of the angular rate in [-full_scale_dps, full_scale_dps]
-  double max_g = 2.0;             // each axis of the specific force in [-max_g, max_g] standard g
+  // The envelope the loss is measured over: the temperatures, each axis of the angular rate in
+  // [-full_scale_dps, full_scale_dps], each axis of the specific force in [-max_g, max_g] g.
+  // envelope_temp_c: {min, max} degC inside the calibration's fitted range; empty: that range.
+  std::vector<double> envelope_temp_c;
+  double full_scale_dps = 500.0;
+  double max_g = 2.0;
   // What the consumer's driver divides the unit's raw output by to give SI (px4, ardupilot,
   // kalibr, which read rad/s and m/s^2 from a driver): raw per rad/s, raw per m/s^2. 1 for a unit
   // that reports SI; 939.65 for a +/-2000 deg/s gyro at 16.4 LSB per deg/s.
@@ -57,8 +62,15 @@ struct ExportOptions {
   // The temperature the one-temperature formats (kalibr, imucal) are taken at, degC; by default
   // the calibration's reference temperature clamped to its fitted range.
   std::optional<double> temp_c;
-  // px4: the sensor's device ID (TC_G0_ID, TC_A0_ID, CAL_GYRO0_ID, CAL_ACC0_ID); required.
+  // px4, ardupilot: the sensors' device IDs (PX4's TC_G0_ID / CAL_GYRO0_ID and TC_A0_ID /
+  // CAL_ACC0_ID; ArduPilot's INS_GYR_ID and INS_ACC_ID). device_id serves both sensors (one die);
+  // gyro_device_id and accel_device_id each one (separate dies). Required.
   std::optional<long long> device_id;
+  std::optional<long long> gyro_device_id;
+  std::optional<long long> accel_device_id;
+  // px4: the parameter instance 0..3 (TC_G<n>, TC_A<n>, CAL_GYRO<n>, CAL_ACC<n>), default 0;
+  // ardupilot: 1..3 (INS_TCAL<n>, INS_ACC/ACC2/ACC3, INS_GYR/GYR2/GYR3), default 1.
+  std::optional<int> instance;
   // c: the C identifier the header is named by (NAME_INITIALIZER, NAME_H_).
   std::string c_name = "imufit_unit";
   // kalibr: the IMU's ROS topic.
@@ -94,6 +106,7 @@ struct ExportResult {
   ExportLoss loss;
   std::string consumer;  // the consumer and the version of its equations that were emulated
   std::string envelope;  // the envelope, in words
+  std::string warning;   // "" or what the user must know (a parameter range clamped); also in the file
 };
 
 // Thrown when the calibration cannot be exported to the format (exit status 1): a term the
