@@ -25,6 +25,7 @@
 #include "imufit/factory/report.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/machine_text.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
@@ -61,6 +62,13 @@ struct Manifest {
   std::string station_sha256;      // "" without a station file
   std::string fit_options;         // FitRunOptions::Describe(): what the unit was fitted with
   std::string issued_to;           // --customer and --order, as the certificate prints them
+  // The outcome as judged when the unit was fitted (its certificate's budget and measurements), so
+  // that a unit skipped as unchanged states the same U and criteria: each key figure's U, and each
+  // criterion's name, outcome and acceptance. `judged` is false in a manifest of an imufit that did
+  // not record them: then the unit is done again.
+  bool judged = false;
+  std::vector<std::pair<std::string, double>> expanded_u;
+  std::vector<CriterionResult> criteria;  // name, outcome and pass only
 };
 
 std::optional<Manifest> ReadManifest(const std::string& path) {
@@ -81,16 +89,31 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
     // unit is done again.
     if (node["fit_options"]) m.fit_options = node["fit_options"].as<std::string>();
     if (node["issued_to"]) m.issued_to = node["issued_to"].as<std::string>();
+    if (const YAML::Node judged = node["judged"]) {
+      m.judged = true;
+      for (const auto& entry : judged["expanded_u"])
+        m.expanded_u.emplace_back(entry.first.as<std::string>(), entry.second.as<double>());
+      for (const YAML::Node& item : judged["criteria"]) {
+        CriterionResult c;
+        c.name = item[0].as<std::string>();
+        c.pass = item[2].as<bool>();
+        if (!ValueOf(kOutcomeNames, item[1].as<std::string>(), &c.outcome)) return std::nullopt;
+        m.criteria.push_back(c);
+      }
+    }
     return m;
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the unit is done again
   }
 }
 
+// Written by the one machine-text writer (io/machine_text.h): every value a string to every YAML
+// reader (a serial "007" or a hash of digits is quoted, not read as a number).
 void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction* transaction) {
-  YAML::Emitter out;
-  out << YAML::BeginMap << YAML::Key << "format" << YAML::Value << kManifestFormat << YAML::Key << "version"
-      << YAML::Value << 1;
+  MachineDoc doc = MachineDoc::Map();
+  doc.CommentFirst({"imufit batch: this unit's inputs and outcome; delete to redo it"});
+  doc.Add("format", MachineDoc::Text(kManifestFormat));
+  doc.Add("version", MachineDoc::Integer(1));
   const std::pair<const char*, const std::string*> fields[] = {{"software", &m.software},
                                                                {"plan_sha256", &m.plan_sha256},
                                                                {"samples_sha256", &m.samples_sha256},
@@ -103,13 +126,21 @@ void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction
                                                                {"station_sha256", &m.station_sha256},
                                                                {"fit_options", &m.fit_options},
                                                                {"issued_to", &m.issued_to}};
-  for (const auto& [key, value] : fields)
-    out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
-  out << YAML::EndMap;
-  WriteFileAtomically(
-      path,
-      std::string("# imufit batch: this unit's inputs and outcome; delete to redo it\n") + out.c_str() + "\n",
-      transaction);
+  for (const auto& [key, value] : fields) doc.Add(key, MachineDoc::Text(*value));
+  MachineDoc judged = MachineDoc::Map();
+  MachineDoc expanded = MachineDoc::Map();
+  for (const auto& [name, u] : m.expanded_u) expanded.Add(name, MachineDoc::Number(u));
+  judged.Add("expanded_u", std::move(expanded));
+  MachineDoc criteria = MachineDoc::List(MachineDoc::Style::kBlock);
+  for (const CriterionResult& c : m.criteria) {
+    criteria.Push(std::move(MachineDoc::List()
+                                .Push(MachineDoc::Text(c.name))
+                                .Push(MachineDoc::Text(OutcomeName(c.outcome)))
+                                .Push(MachineDoc::Bool(c.pass))));
+  }
+  judged.Add("criteria", std::move(criteria));
+  doc.Add("judged", std::move(judged));
+  WriteFileAtomically(path, YamlText(doc), transaction);
 }
 
 // Temporary files of outputs a killed run never committed (OutputFile's ".NAME.tmp-XXXXXX").
@@ -283,7 +314,7 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
       previous->samples_sha256 != manifest.samples_sha256 ||
       previous->limits_sha256 != manifest.limits_sha256 ||
       previous->station_sha256 != manifest.station_sha256 || previous->fit_options != manifest.fit_options ||
-      previous->issued_to != manifest.issued_to) {
+      previous->issued_to != manifest.issued_to || !previous->judged) {
     return false;
   }
   UnitStatus status = UnitStatus::kError;
@@ -296,17 +327,56 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
   unit->skipped = true;
   unit->serial = previous->serial;
   unit->status = status;
+  if (unit->status == UnitStatus::kFitted) {
+    const Calibration calibration = ReadCalibration(paths.calibration);
+    JudgeUnit(shared.certify, calibration, nullptr, unit);
+    // The outcome is the one judged when the unit was fitted (with its certificate's noise, window
+    // errors and uncertainty budget), as its manifest and the store hold it: not judged again from
+    // less. The figures' values and sigmas are the calibration's; their U and the criteria the
+    // manifest's.
+    for (Figure& f : unit->figures) {
+      for (const auto& [name, u] : previous->expanded_u) {
+        if (name == f.name) f.expanded = u;
+      }
+    }
+    if (unit->verdict) {
+      bool pass = false;
+      if (!ValueOf(kVerdictNames, previous->verdict, &pass)) return false;  // not ours: done again
+      unit->verdict->pass = pass;
+      unit->verdict->criteria = previous->criteria;
+    }
+    unit->attachments = {{"calibration", paths.calibration, previous->calibration_sha256}};
+    if (shared.options->write_reports)
+      unit->attachments.push_back({"certificate", paths.report, Sha256OfFile(paths.report)});
+  }
   unit->message = previous->message;
-  // The verdict is judged again (it is the manifest's, from the same calibration and limits).
-  if (unit->status == UnitStatus::kFitted)
-    JudgeUnit(shared.certify, ReadCalibration(paths.calibration), std::nullopt, unit);
   return true;
+}
+
+// Refuses a unit whose run (serial, plan and samples) the store holds under another lot than this
+// batch's: a run keeps the lot it was first recorded in, so recording it would put it there, and
+// `imufit lot --lot` of this batch's lot would not find it. The unit is an error saying so, neither
+// recorded nor marked done (throws InputError).
+void RefuseAnotherLotsRun(const Shared& shared, const UnitOutcome& unit) {
+  if (shared.store == nullptr) return;
+  StoredFit run;
+  run.serial = unit.serial.empty() ? unit.unit : unit.serial;
+  run.plan_sha256 = unit.plan_sha256;
+  run.samples_sha256 = unit.samples_sha256;
+  const std::optional<std::string> lot = shared.store->LotOfRun(run);
+  if (!lot || *lot == shared.certify.lot) return;
+  throw InputError(unit.samples_path, "this run of " + run.serial + " is recorded in lot " +
+                                          QuoteForMessage(*lot) + " of " + shared.store->path() + ", not " +
+                                          QuoteForMessage(shared.certify.lot) +
+                                          ": a run belongs to the lot it was first recorded in (give --lot " +
+                                          *lot + ", or another --store)");
 }
 
 // A unit skipped as unchanged that the store does not know (a new store, or another one): recorded
 // from its manifest and calibration, so that the store holds every unit of the lot.
 void RecordSkippedUnit(const Shared& shared, const UnitPaths& paths, UnitOutcome* unit) {
   if (shared.store == nullptr || shared.store->HasUnit(shared.certify.lot, unit->unit)) return;
+  RefuseAnotherLotsRun(shared, *unit);
   if (unit->status == UnitStatus::kFitted) {
     std::ifstream stream(paths.calibration, std::ios::binary);
     unit->calibration_yaml.assign(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
@@ -329,7 +399,9 @@ void FitUnit(const Shared& shared, const UnitInput& input, const UnitPaths& path
   options.serial = input.listed ? input.serial : SerialFile(input.dir);
   options.serial_source = input.listed ? input.serial_source : (input.dir / "serial.txt").string();
   options.plan_sha256 = unit->plan_sha256;
-  options.keep_static_stretch = shared.options->write_reports;  // the certificate's noise section
+  // The certificate's noise section: measured whenever the unit is judged, printed or not.
+  options.keep_static_stretch =
+      shared.options->write_reports || shared.certify.limits || shared.certify.store != nullptr;
   unit->fit = FitRun(unit->plan_path, unit->samples_path, options);
   FitRunResult& result = *unit->fit;
   if (!result.serial.empty()) unit->serial = result.serial;  // serial.txt, the samples', the plan's
@@ -354,6 +426,10 @@ void WriteUnitManifest(const UnitPaths& paths, const UnitOutcome& unit, Manifest
   manifest.status = unit.StatusText();
   manifest.verdict = unit.VerdictText();
   manifest.message = unit.message;
+  for (const Figure& f : unit.figures) {
+    if (f.sigma >= 0.0 && f.expanded >= 0.0) manifest.expanded_u.emplace_back(f.name, f.expanded);
+  }
+  if (unit.verdict) manifest.criteria = unit.verdict->criteria;
   if (!unit.calibration_yaml.empty()) manifest.calibration_sha256 = Sha256Hex(unit.calibration_yaml);
   fs::create_directories(paths.folder);
   WriteManifest(paths.manifest, manifest, transaction);
@@ -411,7 +487,13 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
     FindInputs(*shared.options, input, &unit);
     manifest = InputsManifest(shared, unit);
     if (TakeUnchanged(shared, manifest, paths, &unit)) {
-      RecordSkippedUnit(shared, paths, &unit);
+      try {
+        RecordSkippedUnit(shared, paths, &unit);
+      } catch (const InputError& e) {  // recorded under another lot: said, not recorded
+        unit.status = UnitStatus::kError;
+        unit.verdict.reset();
+        unit.message = e.what();
+      }
       return unit;
     }
     FitUnit(shared, input, paths, &unit);
@@ -423,6 +505,16 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
     unit.status = UnitStatus::kError;
     unit.message = std::string("error: ") + e.what();
     outside = true;
+  }
+  if (!outside && !unit.plan_sha256.empty()) {
+    try {
+      RefuseAnotherLotsRun(shared, unit);
+    } catch (const InputError& e) {  // a run of another lot: said, neither recorded nor marked done
+      unit.status = UnitStatus::kError;
+      unit.verdict.reset();
+      unit.message = e.what();
+      outside = true;
+    }
   }
   try {
     if (!outside && unit.fit && unit.fit->calibration) {
@@ -583,6 +675,7 @@ void Prepare(const BatchOptions& options, Shared* shared, std::vector<UnitInput>
                                       : ReadUnitsList(options.units_list, options.shard);
   shared->options = &options;
   shared->fit_options = options.fit.Describe();
+  shared->certify.fit_options = shared->fit_options;
   shared->certify.software = options.fit.software;
   shared->certify.windows = options.fit.windows;
   shared->certify.samples_input = options.fit.input;
