@@ -18,6 +18,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
+#include "imufit/pipeline/fit_run.h"
 #include "imufit/plan/plan_check.h"
 #include "imufit/plan/plan_design.h"
 #include "imufit/plan/plan_prediction.h"
@@ -30,11 +31,13 @@ struct ScheduleArguments {
   std::string limits;
   std::string noise_yaml;
   CliOptions<SimulationOptions> options;  // SimulationOptionTable(): the schedule and the noise
-  CliOptions<FitOptions> fit;             // FitOptionTable(): the model the fit will estimate
+  CliOptions<FitRunOptions> fit;          // FitRunOptionTable(): the model the fit will estimate
 };
 
 // The options of `imufit fit` that shape the model a plan must determine (what the fit's findings
-// advise: --gyro-temp-order, --fit accel, ...); the solver's own are not a plan's.
+// advise: --gyro-temp-order, --fit accel, ...); the solver's own are not a plan's. plan check also
+// takes the fit's --prior (the values a subset holds), so that the fit's command line checks as it
+// is; held values carry no uncertainty, so the prediction does not depend on them.
 const char* const kPlanFitOptions[] = {"fit",
                                        "gyro_temp_order",
                                        "accel_temp_order",
@@ -95,7 +98,8 @@ std::optional<Limits> AddLimitTolerances(const ScheduleArguments& args, PlanChec
 int RunPlanCheck(const PlanCheckArguments& args) {
   const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan check");
   PlanCheckOptions check_options = OptionsOf(args.check, PlanCheckOptionTable(), "imufit plan check");
-  const FitOptions fit = OptionsOf(args.schedule.fit, FitOptionTable(), "imufit plan check");
+  FitOptions fit = OptionsOf(args.schedule.fit, FitRunOptionTable(), "imufit plan check").fit;
+  fit.held.reset();  // read (a bad file is refused), not used: held values carry no uncertainty
   const std::optional<Limits> limits = AddLimitTolerances(args.schedule, &check_options);
   const Plan plan = ReadPlan(args.plan);
   const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, fit, check_options);
@@ -143,7 +147,7 @@ TableSite DesignSite(const Plan& candidates, bool candidates_given, const PlanDe
 int RunPlanDesign(const PlanDesignArguments& args) {
   const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan design");
   PlanDesignOptions options = OptionsOf(args.design, PlanDesignOptionTable(), "imufit plan design");
-  options.fit = OptionsOf(args.schedule.fit, FitOptionTable(), "imufit plan design");
+  options.fit = OptionsOf(args.schedule.fit, FitRunOptionTable(), "imufit plan design").fit;
   AddLimitTolerances(args.schedule, &options.check);
   Plan candidates;
   if (!args.candidates.empty()) {
@@ -187,7 +191,7 @@ void AddScheduleOptions(CliCommand command, ScheduleArguments* args) {
       command, SimulationOptionTable(),
       {"start_time_s", "temp_noise_c", "quantize", "time_jitter_s", "drop_probability", "drop_burst",
        "gyro_full_scale_raw", "accel_full_scale_raw", "seed", "gyro_random_walk", "accel_random_walk"});
-  for (const char* key : kPlanFitOptions) args->fit.AddOne(command, FitOptionTable(), key);
+  for (const char* key : kPlanFitOptions) args->fit.AddOne(command, FitRunOptionTable(), key);
   command.Option(
       "--limits", &args->limits,
       "acceptance limits YAML: each coefficient criterion met at --min-ratio:1 (tolerance / U), each "
@@ -210,6 +214,8 @@ CommandRunner AddPlanCommand(CliCommand command) {
   AddScheduleOptions(check, &check_args->schedule);
   check_args->schedule.options.Find("ramp_c").Excludes(check_args->schedule.options.Find("soak_temps_c"));
   check_args->check.Add(check, PlanCheckOptionTable(), kPlanWindowExceptions);
+  check_args->schedule.fit.AddOne(check, FitRunOptionTable(),
+                                  "prior");  // design's --prior is the data sheet's
   check.Option("--format", &check_args->format, "text (a table), yaml or json")
       .OneOf({"text", "yaml", "json"});
 
