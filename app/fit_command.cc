@@ -167,6 +167,10 @@ void PrintFit(const FitRunOptions& options, const FitRunResult& result) {
       "  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
       stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
       stats.trimmed_samples);
+  if (stats.short_samples + stats.saturated_samples + stats.gap_turn_samples > 0) {
+    // Besides the transitions and the trim: every sample the windows left out, with its reason.
+    std::printf("  left out of the windows: %s\n", LeftOutNote(stats, options.windows).c_str());
+  }
   if (const std::string note = TimeStampNote(stats); !note.empty()) {
     std::printf("  time stamps: %s\n", note.c_str());
   }
