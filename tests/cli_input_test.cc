@@ -788,7 +788,13 @@ TEST_F(CliInputTest, TemperaturesInFahrenheitDisagreeWithTheSoakSetPoints) {
 // An unlabelled log piped through /dev/stdin is read once (its samples kept for the two passes):
 // the same calibration as from the file.
 TEST_F(CliInputTest, AnUnlabelledLogThroughAPipeIsReadOnce) {
-  ASSERT_EQ(Run(SmallRunArgs(Path("unlabelled.csv"), {"--no-segment-column"})).status, 0);
+  // Dwells long enough at 50 Hz for the segmentation to find them.
+  ASSERT_EQ(Run({"simulate", "--plan=" + Fixture("plan_6pos.yaml"),
+                 "--calibration=" + Fixture("mems_truth.yaml"), "--output=" + Path("unlabelled.csv"),
+                 "--rate=50", "--dwell=5", "--transition=1", "--temps=-20,5,30,60",
+                 "--gyro-noise-density=2e-4", "--accel-noise-density=2e-3", "--no-segment-column", "-q"})
+                .status,
+            0);
   ASSERT_EQ(Fit(Path("unlabelled.csv")).status, 0);
   const std::string from_file = ReadBytes(Path("cal.yaml"));
   const RunResult r = RunProgram("/bin/sh", {"-c", "cat '" + Path("unlabelled.csv") + "' | '" + IMUFIT_EXE +
