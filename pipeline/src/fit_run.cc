@@ -75,10 +75,12 @@ const RecordedOption kRecordedOptions[] = {
        r->fitted = o.Groups(true);
        r->held = o.Groups(false);
        if (!r->held->empty()) r->held_values = o.held ? "prior" : "scale 1, others 0";
-       // A sensor held whole at nominal values is not calibrated: its consumers are told so.
-       r->uncalibrated_sensors.emplace();
-       if (!o.held && o.gyro_fit == SensorFit::kNone) r->uncalibrated_sensors->push_back("gyro");
-       if (!o.held && o.accel_fit == SensorFit::kNone) r->uncalibrated_sensors->push_back("accel");
+       // A sensor held whole at nominal values is not calibrated: its consumers are told so (the
+       // key only then, so that the calibration of a whole fit is written as before).
+       std::vector<std::string> uncalibrated;
+       if (!o.held && o.gyro_fit == SensorFit::kNone) uncalibrated.push_back("gyro");
+       if (!o.held && o.accel_fit == SensorFit::kNone) uncalibrated.push_back("accel");
+       if (!uncalibrated.empty()) r->uncalibrated_sensors = uncalibrated;
      },
      ReadFittedGroups},
     {"loss", [](const FitOptions& o, FitRecord* r) { r->loss = RobustLossName(o.loss); },
@@ -251,7 +253,7 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
   RecordRunHeader(header, &result.record);
-  for (const std::string& sensor : *result.record.uncalibrated_sensors) {
+  for (const std::string& sensor : result.record.uncalibrated_sensors.value_or(std::vector<std::string>())) {
     result.run_warnings.push_back("--fit " + FitGroupsText(options.fit) + " holds the " + sensor +
                                   " whole at nominal values (no --prior): the calibration does not calibrate "
                                   "it (fit record uncalibrated_sensors; apply and export refuse it)");
