@@ -742,6 +742,13 @@ TEST_F(CliInputTest, AnUncalibratedSensorIsRecordedAndNeverUsedAsFitted) {
         << r.err;
     EXPECT_FALSE(fs::exists(Path("cal.json")));
   }
+  // A certificate marks it (a warning on the page), never certifies it as fitted.
+  r = Run({"report", "-c", Path("cal.yaml"), "-p", Fixture("plan_6pos.yaml"), "-s", raw, "-o",
+           Path("cert.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(
+      ReadBytes(Path("cert.html")).find("Warning: " + Path("cal.yaml") + ": the gyro is not calibrated"),
+      std::string::npos);
   r = Run({"apply", "-c", Path("cal.yaml"), "-s", raw, "-o", Path("corrected.csv"), "-q",
            "--allow-uncalibrated"});
   ASSERT_EQ(r.status, 0) << r.err;
