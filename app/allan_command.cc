@@ -43,6 +43,7 @@ struct AllanArguments {
   SamplesInputArguments input;  // --temp-c, for a raw log without temp_c; --time-unit
   bool quiet = false;
   bool allow_mismatch = false;  // with --calibration
+  bool allow_uncalibrated = false;
 };
 
 [[noreturn]] void BadInvocation(const std::string& message) { throw InputError("imufit allan", message); }
@@ -223,7 +224,8 @@ UniformSeries ReadSeries(const AllanArguments& args, const AllanSettings& settin
   if (args.calibration.empty()) {
     series = ReadUniformSeries(args.samples, args.columns, series_options);
   } else {
-    const Calibration calibration = ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch);
+    const Calibration calibration =
+        ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch, args.allow_uncalibrated);
     CorrectFileReport correction;
     series = ReadCorrectedSeries(args.samples, calibration, args.input.Get().Format(), args.columns,
                                  series_options, &correction);
@@ -375,6 +377,7 @@ CommandRunner AddAllanCommand(CliCommand command) {
           .Excludes(scale);
   AddTempOption(command, &args->input);
   AddAllowMismatchFlag(command, &args->allow_mismatch);
+  AddAllowUncalibratedFlag(command, &args->allow_uncalibrated);
   args->input.TempOption().Needs(calibration);  // a temperature only matters to the correction
   args->allan.AddOne(command, AllanOptionTable(), "threads");
   command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");

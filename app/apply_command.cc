@@ -18,15 +18,20 @@ struct ApplyArguments {
   std::string output;
   bool quiet = false;
   bool allow_mismatch = false;
+  bool allow_uncalibrated = false;
   SamplesInputArguments input;
 };
 
 int RunApply(const ApplyArguments& args) {
   RefuseToOverwriteInputs(args.output, {args.calibration, args.samples});
-  const Calibration calibration = ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch);
+  const Calibration calibration =
+      ReadUnitCalibration(args.calibration, args.samples, args.allow_mismatch, args.allow_uncalibrated);
+  // A sensor passed through uncalibrated (--allow-uncalibrated) is marked in the output's header.
+  std::string comment = CorrectedByComment(calibration, Sha256OfFile(args.calibration), SoftwareVersion());
+  for (const std::string& sensor : UncalibratedSensors(calibration))
+    comment += "\nuncalibrated: " + sensor + " (as logged, not corrected)";
   const CorrectFileReport report =
-      CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().Format(),
-                         CorrectedByComment(calibration, Sha256OfFile(args.calibration), SoftwareVersion()));
+      CorrectSamplesFile(calibration, args.samples, args.output, args.input.Get().Format(), comment);
   WarnOutsideFitTempRange(calibration, report);
   if (!args.quiet) {
     std::printf("corrected %lld samples -> %s\n", report.samples, args.output.c_str());
@@ -37,8 +42,9 @@ int RunApply(const ApplyArguments& args) {
 }  // namespace
 
 Calibration ReadUnitCalibration(const std::string& calibration_path, const std::string& samples_path,
-                                bool allow_mismatch) {
+                                bool allow_mismatch, bool allow_uncalibrated) {
   Calibration calibration = ReadCalibration(calibration_path);
+  CheckCalibratedSensors(calibration, calibration_path, CalibrationUse::kCorrect, allow_uncalibrated);
   SerialSource source;
   source.kind = SerialSource::Kind::kStated;
   source.name = "the calibration " + calibration_path;
@@ -75,6 +81,7 @@ CommandRunner AddApplyCommand(CliCommand command) {
   command.Option("--output,-o", &args->output, "corrected samples CSV to write (.gz compresses)").Required();
   AddTempOption(command, &args->input);
   AddAllowMismatchFlag(command, &args->allow_mismatch);
+  AddAllowUncalibratedFlag(command, &args->allow_uncalibrated);
   command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunApply(*args); };
 }

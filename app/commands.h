@@ -85,8 +85,27 @@ struct CorrectFileReport;
 // unless `allow_mismatch` (then a warning); as fit, report and batch refuse (unit_serial.h).
 // apply_command.cc; apply and allan --calibration share it, and --allow-mismatch
 // (AddAllowMismatchFlag).
+// A sensor the calibration does not calibrate (UncalibratedSensors) is refused too, unless
+// `allow_uncalibrated` (CheckCalibratedSensors).
 Calibration ReadUnitCalibration(const std::string& calibration_path, const std::string& samples_path,
-                                bool allow_mismatch);
+                                bool allow_mismatch, bool allow_uncalibrated);
+
+// How a command uses a calibration's sensors (CheckCalibratedSensors).
+enum class CalibrationUse {
+  kCorrect,  // apply, allan --calibration: the samples corrected
+  kExport,   // export: the coefficients handed on
+  kCertify,  // report: the coefficients certified
+};
+// One sentence per sensor that `calibration` (read from `path`) does not calibrate
+// (UncalibratedSensors: held whole at nominal values by a fit of the other sensor alone).
+std::vector<std::string> UncalibratedNotes(const Calibration& calibration, const std::string& path);
+// The one check of every consumer of a calibration (calibration_use.cc): correcting or exporting a
+// sensor it does not calibrate is refused (PlanMismatchError: exit 1, naming the sensor) unless
+// `allow_uncalibrated`; otherwise, and when certifying, each such sensor is warned about on stderr
+// and its note returned, for the certificate to carry.
+std::vector<std::string> CheckCalibratedSensors(const Calibration& calibration, const std::string& path,
+                                                CalibrationUse use, bool allow_uncalibrated);
+void AddAllowUncalibratedFlag(CliCommand command, bool* allow_uncalibrated);
 void AddAllowMismatchFlag(CliCommand command, bool* allow_mismatch);
 // Warns once, with a count, when corrected samples lay outside the calibration's fit temperature
 // range (an extrapolation): apply_command.cc; apply and allan --calibration share it.

@@ -18,6 +18,7 @@ struct ExportArguments {
   std::string output;
   std::vector<double> max_loss = {0.5, 10.0};  // worst case: deg/s, mg
   bool force = false;
+  bool allow_uncalibrated = false;
   bool quiet = false;
   CliOptions<ExportOptions> options;  // ExportOptionTable(): --format, the envelope, the formats' own
 };
@@ -45,6 +46,7 @@ int RunExport(const ExportArguments& args) {
   }
   RefuseToOverwriteInputs(args.output, {args.calibration});
   const Calibration calibration = ReadCalibration(args.calibration);
+  CheckCalibratedSensors(calibration, args.calibration, CalibrationUse::kExport, args.allow_uncalibrated);
   options.software = SoftwareVersion();
   options.calibration_file = args.calibration;
   options.calibration_sha256 = Sha256OfFile(args.calibration);
@@ -87,6 +89,7 @@ CommandRunner AddExportCommand(CliCommand command) {
       .Expected(2)
       .ShowDefault();
   command.Flag("--force", &args->force, "write a lossy export even beyond --max-loss");
+  AddAllowUncalibratedFlag(command, &args->allow_uncalibrated);
   args->options.Add(command, ExportOptionTable(), {"format"});
   command.Flag("--quiet,-q", &args->quiet, "print nothing but warnings and errors");
   return [args] { return RunExport(*args); };

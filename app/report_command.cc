@@ -58,6 +58,10 @@ int RunReport(const ReportArguments& args) {
   UnitOutcome unit;
   FitRunResult& fit = unit.fit.emplace();
   Calibration calibration = ReadCalibration(args.calibration);
+  // A sensor the calibration does not calibrate is marked on the certificate, never certified as fitted.
+  for (std::string& note : CheckCalibratedSensors(calibration, args.calibration, CalibrationUse::kCertify,
+                                                  /*allow_uncalibrated=*/true))
+    unit.warnings.push_back(std::move(note));
   fit.plan = ReadPlan(args.plan);
   // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
   // the unit's own log's, then the plan's. Sources that disagree are warned about (unit_serial.h).

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "cli_util.h"
 
@@ -664,6 +665,216 @@ TEST_F(CliInputTest, APlanOfFacesAndCornersIsNotADeadAxis) {
                            Path("cal.yaml"), "-q", "--gyro-temp-order", "1", "--accel-temp-order", "1"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("does not respond"), std::string::npos) << r.err;
+}
+
+// A gyro logged in deg/s (a logger that converts with its datasheet's 16.4 LSB per deg/s) fitted
+// with --fit gyro-bias,accel against a prior in counts: the held scale cannot be absorbed by the
+// bias, and the run is refused naming deg/s instead of correcting a spin to a sixteenth of itself.
+// The raw log with the same options fits as before.
+TEST_F(CliInputTest, AGyroInDegPerSecondAgainstAPriorInCountsIsNamed) {
+  const std::string raw = RawRun();
+  const std::vector<std::string> subset = {"--fit", "gyro-bias,accel", "--prior", Fixture("mems_truth.yaml")};
+  ASSERT_EQ(Fit(raw, subset).status, 0);
+  const std::string correct = ReadBytes(Path("cal.yaml"));
+  fs::remove(Path("cal.yaml"));
+  constexpr double kDatasheetLsbPerDps = 16.4;
+  std::string text = ReadBytes(raw);
+  for (const char* column : {"gyro_x", "gyro_y", "gyro_z"})
+    text = MapColumn(text, column,
+                     [](const std::string& f, int) { return Scaled(f, 1.0 / kDatasheetLsbPerDps); });
+  std::ofstream(Path("dps.csv")) << text;
+  RunResult r = Fit(Path("dps.csv"), subset);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("the gyro looks logged in deg/s, while the held values are raw counts"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  // The whole model fits the scale: the deg/s log calibrates (gain 1), as before.
+  EXPECT_EQ(Fit(Path("dps.csv")).status, 0);
+  // The correct log, the same options: the same calibration.
+  ASSERT_EQ(Fit(raw, subset).status, 0);
+  EXPECT_EQ(Coefficients(ReadBytes(Path("cal.yaml"))), Coefficients(correct));
+}
+
+// A subset that holds part of a sensor without --prior holds it at scale 1 raw per rad/s: refused,
+// naming --prior, before any work.
+TEST_F(CliInputTest, ASubsetHoldingAScaleNobodyGaveIsRefused) {
+  const std::string raw = RawRun();
+  for (const char* subset : {"gyro-bias,accel", "gyro,accel-bias"}) {
+    const RunResult r = Fit(raw, {"--fit", subset});
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("--fit " + std::string(subset) + " holds"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("give them with --prior CAL.yaml"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  }
+  EXPECT_EQ(Fit(raw, {"--fit", "gyro-bias,accel", "--prior", Fixture("mems_truth.yaml")}).status, 0);
+}
+
+// A sensor held whole without a prior (--fit accel) is recorded as not calibrated; apply, allan and
+// export refuse it (or pass it through marked, --allow-uncalibrated); a file of an older imufit
+// without the key is read the same from its held groups.
+TEST_F(CliInputTest, AnUncalibratedSensorIsRecordedAndNeverUsedAsFitted) {
+  const std::string raw = RawRun();
+  RunResult r = Fit(raw, {"--fit", "accel"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("holds the gyro whole at nominal values (no --prior)"), std::string::npos) << r.err;
+  const YAML::Node cal = YAML::LoadFile(Path("cal.yaml"));
+  EXPECT_EQ(cal["fit"]["uncalibrated_sensors"].as<std::vector<std::string>>(),
+            std::vector<std::string>{"gyro"});
+  std::string old = ReadBytes(Path("cal.yaml"));
+  old.erase(old.find("  uncalibrated_sensors:"),
+            old.find('\n', old.find("  uncalibrated_sensors:")) + 1 - old.find("  uncalibrated_sensors:"));
+  std::ofstream(Path("old.yaml")) << old;
+  for (const std::string& calibration : {Path("cal.yaml"), Path("old.yaml")}) {
+    r = Run({"apply", "-c", calibration, "-s", raw, "-o", Path("corrected.csv"), "-q"});
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find(": the gyro is not calibrated (held at scale 1 raw per rad/s and 0 by a fit of the "
+                         "accelerometer alone, without --prior): correcting would write its raw output as if "
+                         "it were in SI units"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(Path("corrected.csv")));
+    r = Run({"export", "-c", calibration, "--format", "json", "-o", Path("cal.json"), "-q"});
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("an export would hand its nominal values on as a calibration"), std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(Path("cal.json")));
+  }
+  // A certificate marks it (a warning on the page), never certifies it as fitted.
+  r = Run({"report", "-c", Path("cal.yaml"), "-p", Fixture("plan_6pos.yaml"), "-s", raw, "-o",
+           Path("cert.html")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(
+      ReadBytes(Path("cert.html")).find("Warning: " + Path("cal.yaml") + ": the gyro is not calibrated"),
+      std::string::npos);
+  r = Run({"apply", "-c", Path("cal.yaml"), "-s", raw, "-o", Path("corrected.csv"), "-q",
+           "--allow-uncalibrated"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(ReadBytes(Path("corrected.csv")).find("# uncalibrated: gyro (as logged, not corrected)"),
+            std::string::npos);
+  // A whole calibration is used as before.
+  ASSERT_EQ(Fit(raw).status, 0);
+  EXPECT_EQ(Run({"apply", "-c", Path("cal.yaml"), "-s", raw, "-o", Path("whole.csv"), "-q"}).status, 0);
+  EXPECT_EQ(ReadBytes(Path("whole.csv")).find("uncalibrated"), std::string::npos);
+}
+
+// The plan's soak set-points (soak_temps_c): a log in Fahrenheit is refused with the hint; without
+// set-points a log above 125 degC is warned about; the log in degC fits as without set-points.
+TEST_F(CliInputTest, TemperaturesInFahrenheitDisagreeWithTheSoakSetPoints) {
+  const std::string raw = RawRun();
+  ASSERT_EQ(Fit(raw).status, 0);
+  const std::string without = ReadBytes(Path("cal.yaml"));
+  std::string plan = ReadBytes(Fixture("plan_6pos.yaml"));
+  plan.insert(plan.find("segments:"), "soak_temps_c: [-20, 5, 30, 60]\n");
+  std::ofstream(Path("plan_soaks.yaml")) << plan;
+  const auto fit = [this](const std::string& plan_path, const std::string& samples) {
+    return Run({"fit", "-p", plan_path, "-s", samples, "-o", Path("cal.yaml"), "-q"});
+  };
+  RunResult r = fit(Path("plan_soaks.yaml"), raw);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(Coefficients(ReadBytes(Path("cal.yaml"))), Coefficients(without));
+  fs::remove(Path("cal.yaml"));
+  std::ofstream(Path("fahrenheit.csv")) << MapColumn(ReadBytes(raw), "temp_c", [](const std::string& f, int) {
+    std::ostringstream out;
+    out.precision(17);
+    out << std::stod(f) * 9.0 / 5.0 + 32.0;
+    return out.str();
+  });
+  r = fit(Path("plan_soaks.yaml"), Path("fahrenheit.csv"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  ExpectOneLine(r,
+                "degC (soak_temps_c; the unit's thermometer within 15 degC of them at the coldest and "
+                "warmest): Fahrenheit? (");
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  r = fit(Fixture("plan_6pos.yaml"), Path("fahrenheit.csv"));
+  EXPECT_NE(r.err.find("above any IMU's rating (125 degC): Fahrenheit?"), std::string::npos) << r.err;
+}
+
+// An unlabelled log piped through /dev/stdin is read once (its samples kept for the two passes):
+// the same calibration as from the file.
+TEST_F(CliInputTest, AnUnlabelledLogThroughAPipeIsReadOnce) {
+  // Dwells long enough at 50 Hz for the segmentation to find them.
+  ASSERT_EQ(Run({"simulate", "--plan=" + Fixture("plan_6pos.yaml"),
+                 "--calibration=" + Fixture("mems_truth.yaml"), "--output=" + Path("unlabelled.csv"),
+                 "--rate=50", "--dwell=5", "--transition=1", "--temps=-20,5,30,60",
+                 "--gyro-noise-density=2e-4", "--accel-noise-density=2e-3", "--no-segment-column", "-q"})
+                .status,
+            0);
+  ASSERT_EQ(Fit(Path("unlabelled.csv")).status, 0);
+  const std::string from_file = ReadBytes(Path("cal.yaml"));
+  const RunResult r = RunProgram("/bin/sh", {"-c", "cat '" + Path("unlabelled.csv") + "' | '" + IMUFIT_EXE +
+                                                       "' fit -p '" + Fixture("plan_6pos.yaml") +
+                                                       "' -s /dev/stdin -o '" + Path("piped.yaml") + "' -q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(Coefficients(ReadBytes(Path("piped.yaml"))), Coefficients(from_file));
+  const YAML::Node piped = YAML::LoadFile(Path("piped.yaml"));
+  EXPECT_EQ(piped["fit"]["samples_sha256"].as<std::string>(),
+            YAML::LoadFile(Path("cal.yaml"))["fit"]["samples_sha256"].as<std::string>());
+}
+
+// fit --check-samples with another unit's run is refused as apply refuses it (its header's serial),
+// unless --allow-mismatch.
+TEST_F(CliInputTest, CheckSamplesOfAnotherUnitAreRefusedAsApplyRefusesThem) {
+  const std::string raw = RawRun();
+  std::ofstream(Path("mine.csv")) << "# serial: SN0001\n" << ReadBytes(raw);
+  std::ofstream(Path("other.csv")) << "# serial: SN0002\n" << ReadBytes(raw);
+  RunResult r = Fit(Path("mine.csv"), {"--check-samples", Path("other.csv")});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("other.csv:1:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("SN0002"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
+  ASSERT_EQ(Fit(Path("mine.csv")).status, 0);
+  const RunResult apply =
+      Run({"apply", "-c", Path("cal.yaml"), "-s", Path("other.csv"), "-o", Path("c.csv")});
+  EXPECT_EQ(apply.status, r.status) << apply.err;
+  r = Fit(Path("mine.csv"), {"--check-samples", Path("other.csv"), "--allow-mismatch"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("SN0002"), std::string::npos) << r.err;
+  EXPECT_EQ(Fit(Path("mine.csv"), {"--check-samples", Path("mine.csv")}).status, 0);
+}
+
+// A two-axis plan whose spin axes x and y were exchanged in the plan (the log as the table turned):
+// said as channels that follow another axis, never a dead gyro.
+TEST_F(CliInputTest, ATwoAxisPlanWithItsSpinAxesExchangedIsNotADeadGyro) {
+  std::string plan = "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81274\nsegments:\n";
+  const char* faces[] = {"[0, 0, 1]", "[0, 0, -1]", "[1, 0, 0]", "[-1, 0, 0]", "[0, 1, 0]", "[0, -1, 0]"};
+  int id = 1;
+  for (const char* up : faces) plan += "  - {id: " + std::to_string(id++) + ", up: " + up + "}\n";
+  std::string spins;
+  for (const char* axis : {"[1, 0, 0]", "[0, 1, 0]", "[0, 0, 1]"}) {
+    for (const int rate : {90, -90})
+      spins += "  - {id: " + std::to_string(id++) + ", up: [0, 0, 1], rate_dps: " + std::to_string(rate) +
+               ", axis: " + axis + "}\n";
+  }
+  std::ofstream(Path("two_axis.yaml")) << plan + spins;
+  std::string exchanged = spins;
+  for (size_t at = exchanged.find("[1, 0, 0]"); at != std::string::npos;
+       at = exchanged.find("[1, 0, 0]", at + 1))
+    exchanged.replace(at, 9, "[0, 9, 0]");
+  for (size_t at = exchanged.find("[0, 1, 0]"); at != std::string::npos;
+       at = exchanged.find("[0, 1, 0]", at + 1))
+    exchanged.replace(at, 9, "[1, 0, 0]");
+  for (size_t at = exchanged.find("[0, 9, 0]"); at != std::string::npos;
+       at = exchanged.find("[0, 9, 0]", at + 1))
+    exchanged.replace(at, 9, "[0, 1, 0]");
+  std::ofstream(Path("two_axis_exchanged.yaml")) << plan + exchanged;
+  const std::string raw = Path("two_axis.csv");
+  ASSERT_EQ(Run({"simulate", "--plan=" + Path("two_axis.yaml"), "--calibration=" + Fixture("mems_truth.yaml"),
+                 "--output=" + raw, "--rate=20", "--dwell=8", "--temps=-20,5,30,60",
+                 "--gyro-noise-density=2e-4", "--accel-noise-density=2e-3", "-q"})
+                .status,
+            0);
+  RunResult r = Run({"fit", "-p", Path("two_axis.yaml"), "-s", raw, "-o", Path("cal.yaml"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  fs::remove(Path("cal.yaml"));
+  r = Run({"fit", "-p", Path("two_axis_exchanged.yaml"), "-s", raw, "-o", Path("cal.yaml"), "-q"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("gyro x and y look exchanged"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("dead"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("cal.yaml")));
 }
 
 }  // namespace

@@ -141,6 +141,49 @@ Calibration ExampleCalibration() {
   return calibration;
 }
 
+// A plan's soak set-points (soak_temps_c) are read, written back by PlanYaml to the same numbers, and
+// a value outside what an IMU reports (a set-point in kelvin) is refused at its place; a record's
+// uncalibrated_sensors names sensors only.
+TEST_F(IoTest, PlanSoakSetPointsAndUncalibratedSensorsAreRead) {
+  const std::string text =
+      "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsoak_temps_c: [-40, 25.5, 85]\n"
+      "segments:\n  - {id: 1, up: [0, 0, 1]}\n";
+  const Plan plan = ReadPlanText(text, "plan.yaml");
+  EXPECT_EQ(plan.soak_temps_c, (std::vector<double>{-40.0, 25.5, 85.0}));
+  EXPECT_EQ(ReadPlanText(PlanYaml(plan, ""), "again.yaml").soak_temps_c, plan.soak_temps_c);
+  EXPECT_TRUE(
+      ReadPlanText(
+          "format: imufit-plan\nversion: 1\ngravity_mps2: 9.81\nsegments:\n  - {id: 1, up: [0, 0, 1]}\n",
+          "none.yaml")
+          .soak_temps_c.empty());
+  std::string kelvin = text;
+  kelvin.replace(kelvin.find("85]"), 3, "358.15]");
+  try {
+    ReadPlanText(kelvin, "plan.yaml");
+    ADD_FAILURE() << "a set-point in kelvin";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("plan.yaml:4:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("358.15 degC is outside -100..200 degC"), std::string::npos)
+        << e.what();
+  }
+  Calibration calibration;
+  calibration.model = SensorModel::Identity();
+  calibration.fit.emplace().uncalibrated_sensors = std::vector<std::string>{"gyro"};
+  const std::string path = Path("cal.yaml");
+  WriteCalibration(path, calibration);
+  EXPECT_EQ(UncalibratedSensors(ReadCalibration(path)), std::vector<std::string>{"gyro"});
+  std::string bad = testing::ReadFile(path);
+  bad.replace(bad.find("[gyro]"), 6, "[magnetometer]");
+  std::ofstream(path) << bad;
+  try {
+    ReadCalibration(path);
+    ADD_FAILURE() << "magnetometer";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"magnetometer\" is not a sensor (gyro, accel)"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST_F(IoTest, CalibrationRoundTripsBitExactly) {
   const Calibration written = ExampleCalibration();
   const std::string path = (dir_ / "cal.yaml").string();

@@ -12,6 +12,7 @@
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/model/constants.h"
+#include "imufit/pipeline/consistency.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/pipeline/run_windows.h"
 #include "imufit/sim/simulator.h"
@@ -284,6 +285,52 @@ TEST_F(UnlabelledRun, ALogThatDisagreesWithThePlanNamesFileAndTime) {
         << message;
     EXPECT_NE(message.find("with the raw axes as they are: at t = 24."), std::string::npos) << message;
   }
+}
+
+// The run's temperatures against the plan's soak set-points: agreeing within kSoakToleranceC at the
+// coldest and warmest (self-heating), refused beyond with "Fahrenheit?" when 9/5 T + 32 explains it;
+// without set-points, a warning above kMaxRatedTempC only.
+TEST(CheckRunTemperatures, NamesFahrenheitAgainstTheSoakSetPoints) {
+  const auto windows_at = [](const std::vector<double>& temps_c) {
+    std::vector<Window> windows;
+    for (const double temp_c : temps_c) {
+      Window w;
+      w.temp_c = temp_c;
+      windows.push_back(w);
+    }
+    return windows;
+  };
+  const std::vector<double> soaks = {-40.0, 25.0, 85.0};
+  // A unit 8 degC warmer than the chamber (self-heating) agrees.
+  EXPECT_EQ(CheckRunTemperatures(windows_at({-32.0, 33.0, 93.0}), soaks).refusal, "");
+  const TemperatureFinding fahrenheit = CheckRunTemperatures(windows_at({-40.0, 77.0, 185.0}), soaks);
+  EXPECT_NE(fahrenheit.refusal.find("Fahrenheit? (-40..185 degF is -40..85 degC"), std::string::npos)
+      << fahrenheit.refusal;
+  const TemperatureFinding stopped = CheckRunTemperatures(windows_at({-40.0, 25.0}), soaks);
+  EXPECT_NE(stopped.refusal.find("a chamber run stopped early?"), std::string::npos) << stopped.refusal;
+  EXPECT_EQ(CheckRunTemperatures(windows_at({-40.0, 185.0}), {}).refusal, "");
+  EXPECT_NE(CheckRunTemperatures(windows_at({-40.0, 185.0}), {}).warning.find("Fahrenheit?"),
+            std::string::npos);
+  EXPECT_EQ(CheckRunTemperatures(windows_at({-40.0, 125.0}), {}).warning, "");
+}
+
+// The uncalibrated sensors of a record: its key, else (an older file) a sensor whose bias is held
+// without a prior.
+TEST(UncalibratedSensors, FromTheRecordOrItsHeldGroups) {
+  Calibration calibration;
+  EXPECT_TRUE(UncalibratedSensors(calibration).empty());
+  FitRecord& record = calibration.fit.emplace();
+  record.held =
+      std::vector<std::string>{"gyro.bias", "gyro.scale", "gyro.misalignment", "gyro.g_sensitivity"};
+  record.held_values = "scale 1, others 0";
+  EXPECT_EQ(UncalibratedSensors(calibration), std::vector<std::string>{"gyro"});
+  record.held_values = "prior";
+  EXPECT_TRUE(UncalibratedSensors(calibration).empty());
+  record.held = std::vector<std::string>{"gyro.scale", "gyro.misalignment"};  // a bias-only gyro
+  record.held_values = "scale 1, others 0";
+  EXPECT_TRUE(UncalibratedSensors(calibration).empty());
+  record.uncalibrated_sensors = std::vector<std::string>{"accel"};
+  EXPECT_EQ(UncalibratedSensors(calibration), std::vector<std::string>{"accel"});
 }
 
 }  // namespace

@@ -115,6 +115,20 @@ void CheckUnit(const yaml::Located& sensor, const std::string& expected) {
 
 }  // namespace
 
+std::vector<std::string> UncalibratedSensors(const Calibration& calibration) {
+  if (!calibration.fit) return {};
+  const FitRecord& record = *calibration.fit;
+  if (record.uncalibrated_sensors) return *record.uncalibrated_sensors;
+  // An older record: a sensor whose bias is held was held whole; without a prior, at nominal.
+  std::vector<std::string> sensors;
+  if (!record.held || record.held_values.value_or("") == "prior") return sensors;
+  for (const char* sensor : {"gyro", "accel"}) {
+    if (std::count(record.held->begin(), record.held->end(), std::string(sensor) + ".bias") > 0)
+      sensors.push_back(sensor);
+  }
+  return sensors;
+}
+
 Calibration ReadCalibration(const std::string& path) {
   const YAML::Node root_node = yaml::LoadFile(path);
   if (!root_node.IsMap()) throw InputError(path, "not an imufit calibration (expected a YAML mapping)");

@@ -153,6 +153,13 @@ void CheckFitOptionNames(const yaml::Located& block, const FitRecord& record) {
       block[key].At(i).Fail(QuoteForMessage(name) + " is not a coefficient group (" + list + ")");
     }
   }
+  if (record.uncalibrated_sensors) {
+    for (size_t i = 0; i < record.uncalibrated_sensors->size(); ++i) {
+      const std::string& name = (*record.uncalibrated_sensors)[i];
+      if (name != "gyro" && name != "accel")
+        block["uncalibrated_sensors"].At(i).Fail(QuoteForMessage(name) + " is not a sensor (gyro, accel)");
+    }
+  }
 }
 
 }  // namespace

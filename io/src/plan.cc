@@ -9,6 +9,7 @@
 #include "imufit/io/error.h"
 #include "imufit/io/machine_text.h"
 #include "imufit/io/output_file.h"
+#include "imufit/io/samples.h"
 #include "imufit/model/constants.h"
 #include "yaml_util.h"
 
@@ -51,7 +52,8 @@ namespace {
 Plan ReadPlanNode(const YAML::Node& root_node, const std::string& path) {
   const yaml::Located root{&path, root_node, ""};
   if (!root_node.IsMap()) throw InputError(path, "not an imufit plan (expected a YAML mapping)");
-  root.RejectUnknownKeys({"format", "version", "gravity_mps2", "latitude_deg", "serial", "segments"});
+  root.RejectUnknownKeys(
+      {"format", "version", "gravity_mps2", "latitude_deg", "serial", "soak_temps_c", "segments"});
   root.RequireFormat("imufit-plan", kPlanFormatVersion);
   Plan plan;
   plan.path = path;
@@ -65,6 +67,18 @@ Plan ReadPlanNode(const YAML::Node& root_node, const std::string& path) {
     plan.site.latitude_rad = latitude_deg * kDegToRad;
   }
   if (root.Has("serial")) plan.serial = root["serial"].String();
+  if (root.Has("soak_temps_c")) {
+    const yaml::Located soak = root["soak_temps_c"];
+    if (soak.Size() == 0) soak.Fail("soak_temps_c lists the chamber's set-points, degC: at least one");
+    for (size_t i = 0; i < soak.Size(); ++i) {
+      const double temp_c = soak.At(i).Double();
+      if (!(temp_c >= kMinPlausibleTempC && temp_c <= kMaxPlausibleTempC)) {
+        soak.At(i).Fail(FormatDouble(temp_c) + " degC is outside " + FormatDouble(kMinPlausibleTempC) + ".." +
+                        FormatDouble(kMaxPlausibleTempC) + " degC (soak_temps_c is in degC)");
+      }
+      plan.soak_temps_c.push_back(temp_c);
+    }
+  }
 
   const yaml::Located segments = root["segments"];
   if (segments.Size() == 0) segments.Fail("a plan needs at least one segment");
@@ -161,6 +175,7 @@ std::string PlanYaml(const Plan& plan, const std::string& comment) {
   if (plan.site.latitude_rad)
     doc.Add("latitude_deg", MachineDoc::Number(*plan.site.latitude_rad / kDegToRad));
   if (!plan.serial.empty()) doc.Add("serial", MachineDoc::Text(plan.serial));
+  if (!plan.soak_temps_c.empty()) doc.Add("soak_temps_c", MachineDoc::Numbers(plan.soak_temps_c));
   MachineDoc segments = MachineDoc::List(MachineDoc::Style::kBlock);
   for (const TableSegment& s : plan.segments) {
     MachineDoc segment = MachineDoc::Map(MachineDoc::Style::kFlow);

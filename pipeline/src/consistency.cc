@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "imufit/base/text.h"
+#include "imufit/fit/validation.h"
 #include "imufit/model/constants.h"
 
 namespace imufit {
@@ -83,7 +86,137 @@ std::string DownweightedSegments(const FitSummary& fit, const std::vector<Window
   return text;
 }
 
+// A unit of measure a logger may write a sensor in, as raw units per SI unit.
+struct LoggedUnit {
+  double raw_per_si;
+  const char* name;
+};
+constexpr LoggedUnit kGyroUnits[] = {
+    {1.0, "rad/s"}, {kRadToDeg, "deg/s"}, {1e3 * kRadToDeg, "mdeg/s"}, {3600.0 * kRadToDeg, "deg/h"}};
+constexpr LoggedUnit kAccelUnits[] = {
+    {1.0, "m/s^2"}, {1.0 / kStandardGravityMps2, "g"}, {1e3 / kStandardGravityMps2, "mg"}};
+
+// The unit among `units` whose raw-per-SI lies within kLoggedUnitTolerance of `raw_per_si`, or nullptr.
+const LoggedUnit* UnitOf(double raw_per_si, const LoggedUnit* begin, const LoggedUnit* end) {
+  for (const LoggedUnit* unit = begin; unit != end; ++unit) {
+    if (std::abs(raw_per_si / unit->raw_per_si - 1.0) <= kLoggedUnitTolerance) return unit;
+  }
+  return nullptr;
+}
+
+// The mean magnitude of a sensor's scale factors at the reference temperature, raw per SI unit.
+double MeanScale(const double* params) {
+  double sum = 0.0;
+  for (int axis = 0; axis < 3; ++axis) sum += std::abs(params[(kScaleCoefficient + axis) * kPolynomialTerms]);
+  return sum / 3.0;
+}
+
+// One sensor's gain of the corrected output over the truth, sum(corrected . truth) / sum(|truth|^2)
+// over the windows `use` admits, or nullopt when they carry no signal to judge it by.
+template <typename Truth, typename Error, typename Use>
+std::optional<double> Gain(const std::vector<WindowError>& errors, Truth truth, Error error, Use use) {
+  double along = 0.0, power = 0.0;
+  for (const WindowError& e : errors) {
+    if (!use(e)) continue;
+    along += (truth(e) + error(e)).dot(truth(e));
+    power += truth(e).squaredNorm();
+  }
+  if (!(power > 0.0)) return std::nullopt;
+  return along / power;
+}
+
+// The finding for one sensor whose corrected output is `gain` times the truth: the log's raw units
+// per SI unit (gain times the calibration's scale), named when they are a unit loggers write.
+std::string ScaleFinding(const char* sensor, double gain, double model_scale, const char* si,
+                         const LoggedUnit* begin, const LoggedUnit* end) {
+  if (std::abs(gain - 1.0) <= kGrossScaleError) return "";
+  const double logged = gain * model_scale;
+  std::string text = std::string(sensor) + " corrected to " + NumberText("%.3g", gain) +
+                     " times the plan's truth: the log reads " + NumberText("%.4g", logged) + " raw per " +
+                     si + " where the calibration's " + (sensor[0] == 'g' ? "gyro" : "accelerometer") +
+                     " scale is " + NumberText("%.4g", model_scale);
+  if (const LoggedUnit* unit = UnitOf(logged, begin, end)) {
+    text += std::string(" (the ") + sensor + " looks logged in " + unit->name;
+    if (const LoggedUnit* held = UnitOf(model_scale, begin, end))
+      text += std::string(", the calibration's values are in ") + held->name;
+    else
+      text += ", while the held values are raw counts";
+    text += ": give --prior a calibration of the log's unit, or log in the prior's)";
+  } else {
+    text += " (a wrong unit of measure, or a prior of another kind of unit?)";
+  }
+  return text;
+}
+
 }  // namespace
+
+std::string UnitOfMeasureFinding(const FitSummary& fit, const std::vector<Window>& windows,
+                                 const TableSite& site, const std::vector<TableSegment>& segments,
+                                 const FitOptions& options) {
+  const std::vector<WindowError> errors = PredictWindows(fit.model, windows, site, segments);
+  std::string text;
+  const auto add = [&text](const std::string& finding) {
+    if (!finding.empty()) text += (text.empty() ? "" : "; ") + finding;
+  };
+  // A sensor held whole without a prior is not calibrated (fit record uncalibrated_sensors): not judged.
+  if (options.gyro_fit != SensorFit::kNone || options.held) {
+    const double min_rate = options.min_excitation_rate_radps;
+    const std::optional<double> gain = Gain(
+        errors, [](const WindowError& e) { return e.omega_true_radps; },
+        [](const WindowError& e) { return e.gyro_radps; },
+        [min_rate](const WindowError& e) { return e.omega_true_radps.norm() >= min_rate; });
+    if (gain)
+      add(ScaleFinding("gyro", *gain, MeanScale(fit.model.gyro.data()), "rad/s", std::begin(kGyroUnits),
+                       std::end(kGyroUnits)));
+  }
+  if (options.accel_fit != SensorFit::kNone || options.held) {
+    const std::optional<double> gain = Gain(
+        errors, [](const WindowError& e) { return e.a_true_mps2; },
+        [](const WindowError& e) { return e.accel_mps2; },
+        [](const WindowError& e) { return e.specific_force_known; });
+    if (gain)
+      add(ScaleFinding("accel", *gain, MeanScale(fit.model.accel.data()), "m/s^2", std::begin(kAccelUnits),
+                       std::end(kAccelUnits)));
+  }
+  return text;
+}
+
+TemperatureFinding CheckRunTemperatures(const std::vector<Window>& windows,
+                                        const std::vector<double>& soak_temps_c) {
+  TemperatureFinding finding;
+  if (windows.empty()) return finding;
+  const auto [coldest, warmest] = std::minmax_element(
+      windows.begin(), windows.end(), [](const Window& a, const Window& b) { return a.temp_c < b.temp_c; });
+  const double lo = coldest->temp_c, hi = warmest->temp_c;
+  const auto celsius_of_fahrenheit = [](double temp_f) { return (temp_f - 32.0) * 5.0 / 9.0; };
+  const std::string span = NumberText("%.4g", lo) + ".." + NumberText("%.4g", hi);
+  const std::string as_celsius =
+      NumberText("%.4g", celsius_of_fahrenheit(lo)) + ".." + NumberText("%.4g", celsius_of_fahrenheit(hi));
+  if (soak_temps_c.empty()) {
+    if (hi > kMaxRatedTempC) {
+      finding.warning = "the run's temperatures reach " + NumberText("%.4g", hi) +
+                        " degC, above any IMU's rating (" + NumberText("%.4g", kMaxRatedTempC) +
+                        " degC): Fahrenheit? (" + span + " degF is " + as_celsius +
+                        " degC; temp_c must be degC; the plan's soak_temps_c would have it refused)";
+    }
+    return finding;
+  }
+  const auto [cold_soak, warm_soak] = std::minmax_element(soak_temps_c.begin(), soak_temps_c.end());
+  const auto agrees = [&](double cold, double warm) {
+    return std::abs(cold - *cold_soak) <= kSoakToleranceC && std::abs(warm - *warm_soak) <= kSoakToleranceC;
+  };
+  if (agrees(lo, hi)) return finding;
+  finding.refusal = "the run's temperatures span " + span + " degC where the plan's soak set-points span " +
+                    NumberText("%.4g", *cold_soak) + ".." + NumberText("%.4g", *warm_soak) +
+                    " degC (soak_temps_c; the unit's thermometer within " +
+                    NumberText("%.3g", kSoakToleranceC) + " degC of them at the coldest and warmest)";
+  if (agrees(celsius_of_fahrenheit(lo), celsius_of_fahrenheit(hi))) {
+    finding.refusal += ": Fahrenheit? (" + span + " degF is " + as_celsius + " degC; temp_c must be degC)";
+  } else {
+    finding.refusal += ": a run of another plan, or a chamber run stopped early?";
+  }
+  return finding;
+}
 
 double ReducedChi2Limit(int dof) {
   return kModelErrorAllowance * kModelErrorAllowance *
@@ -99,8 +232,11 @@ bool JudgedByTheGate(const FitOptions& options, bool gyro) {
   return options.accel_fit == SensorFit::kAll && options.accel_temp_order >= default_order;
 }
 
-std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows,
-                          const FitOptions& options) {
+std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows, const TableSite& site,
+                          const std::vector<TableSegment>& segments, const FitOptions& options) {
+  // Every fit, subsets included: a held scale in another unit than the log's.
+  const std::string unit = UnitOfMeasureFinding(fit, windows, site, segments, options);
+  if (!unit.empty()) return unit + ": a wrong unit of measure, not a calibration";
   const bool gyro = JudgedByTheGate(options, true), accel = JudgedByTheGate(options, false);
   if (!gyro && !accel) return "";
   std::string text;

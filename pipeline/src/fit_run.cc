@@ -75,6 +75,12 @@ const RecordedOption kRecordedOptions[] = {
        r->fitted = o.Groups(true);
        r->held = o.Groups(false);
        if (!r->held->empty()) r->held_values = o.held ? "prior" : "scale 1, others 0";
+       // A sensor held whole at nominal values is not calibrated: its consumers are told so (the
+       // key only then, so that the calibration of a whole fit is written as before).
+       std::vector<std::string> uncalibrated;
+       if (!o.held && o.gyro_fit == SensorFit::kNone) uncalibrated.push_back("gyro");
+       if (!o.held && o.accel_fit == SensorFit::kNone) uncalibrated.push_back("accel");
+       if (!uncalibrated.empty()) r->uncalibrated_sensors = uncalibrated;
      },
      ReadFittedGroups},
     {"loss", [](const FitOptions& o, FitRecord* r) { r->loss = RobustLossName(o.loss); },
@@ -183,10 +189,30 @@ void CheckBeforeFit(const std::string& plan_path, const std::string& samples_pat
   if (!dead.empty()) throw PlanMismatchError(samples_path + ": " + dead);
 }
 
+// A subset that fits part of a sensor (--fit gyro-bias, accel-bias) holds the rest at stated
+// values. Without --prior nobody stated them: they would be scale 1 raw per rad/s (or m/s^2), and
+// the fitted bias would absorb what that scale gets wrong (a gyro logged in counts: a bias of
+// thousands of deg/s). Refused before any work. Throws PlanMismatchError.
+void RefuseUnstatedHeldValues(const FitOptions& fit) {
+  if (fit.held) return;
+  std::vector<std::string> held;
+  for (const std::string& group : fit.Groups(false)) {
+    const bool gyro = group.compare(0, 5, "gyro.") == 0;
+    if ((gyro ? fit.gyro_fit : fit.accel_fit) == SensorFit::kBias) held.push_back(group);
+  }
+  if (held.empty()) return;
+  throw PlanMismatchError(
+      "--fit " + FitGroupsText(fit) + " holds " + Join(held, ", ") +
+      " but nothing gives their values: without --prior they would be scale 1 raw per SI unit and 0, "
+      "which the fitted bias would absorb; give them with --prior CAL.yaml (a calibration of this unit "
+      "or of its model), or fit the whole sensor (--fit gyro, --fit accel)");
+}
+
 // The fit of `plan` (named by its path) and the samples `open` opens for it.
 FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
                       const std::function<std::unique_ptr<RunReader>(const Plan&)>& open,
                       const FitRunOptions& options) {
+  RefuseUnstatedHeldValues(options.fit);
   FitRunResult result;
   result.plan = std::move(plan);
   result.plan_sha256 = std::move(plan_sha256);
@@ -200,11 +226,26 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
   result.run = samples->Read(options.windows, options.keep_static_stretch
                                                   ? std::optional<NoiseStretchOptions>(options.noise_stretch)
                                                   : std::nullopt);
+  const TemperatureFinding temperatures = CheckRunTemperatures(result.run.windows, result.plan.soak_temps_c);
+  if (!temperatures.refusal.empty()) throw PlanMismatchError(samples_path + ": " + temperatures.refusal);
+  if (!temperatures.warning.empty())
+    result.run_warnings.push_back(samples_path + ": " + temperatures.warning);
   CheckBeforeFit(plan_path, samples_path, options, result);
   // A held-out run is read before fitting, so that a bad file is reported before any work.
   Plan check_plan;
   std::vector<Window> check_windows;
   if (!options.check_samples.empty()) {
+    // Another unit's run checks nothing of this unit's calibration: refused as apply refuses it
+    // (at the held-out run's header serial), unless --allow-mismatch (then a warning).
+    SerialSource fitted;
+    fitted.kind = SerialSource::Kind::kStated;
+    fitted.name = "the unit fitted (" + samples_path + ")";
+    fitted.serial = result.serial;
+    for (std::string& warning :
+         ResolveSerial({fitted, SamplesHeaderSerial(options.check_samples)}, options.allow_serial_mismatch)
+             .warnings) {
+      result.serial_warnings.push_back(std::move(warning));
+    }
     check_plan = options.check_plan.empty() ? result.plan : ReadPlan(options.check_plan);
     check_windows = ReadRunWindows(check_plan, options.check_samples, options.windows, options.input).windows;
   }
@@ -212,6 +253,11 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
   result.fit = FitThermalModel(result.run.windows, result.plan.site, result.plan.segments, options.fit);
   result.record = RecordOf(result, plan_path, samples_path, options.fit);
   RecordRunHeader(header, &result.record);
+  for (const std::string& sensor : result.record.uncalibrated_sensors.value_or(std::vector<std::string>())) {
+    result.run_warnings.push_back("--fit " + FitGroupsText(options.fit) + " holds the " + sensor +
+                                  " whole at nominal values (no --prior): the calibration does not calibrate "
+                                  "it (fit record uncalibrated_sensors; apply and export refuse it)");
+  }
   if (const std::vector<int>& missing = *result.record.segments_without_windows; !missing.empty()) {
     std::string ids;
     for (const int id : missing) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
@@ -222,7 +268,8 @@ FitRunResult FitRunOf(Plan plan, std::string plan_sha256,
         (missing.size() == 1 ? "it" : "them"));
   }
   if (!result.fit.IsSolutionUsable()) return result;
-  result.inconsistency = Inconsistency(result.fit, result.run.windows, options.fit);
+  result.inconsistency =
+      Inconsistency(result.fit, result.run.windows, result.plan.site, result.plan.segments, options.fit);
   if (!result.inconsistency.empty()) {
     if (!options.write_inconsistent) {
       throw PlanMismatchError(samples_path + ": the fit is inconsistent with the run's noise: " +

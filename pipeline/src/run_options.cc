@@ -145,7 +145,9 @@ OptionTable<FitRunOptions> MakeFitRunOptionTable() {
   OptionTable<O> t;
   t.Include(FitOptionTable(), &O::fit);
   OptionEntry<O>& prior = t.Text(
-      "prior", "--prior", "calibration YAML whose values the held groups keep (default: scale 1, the rest 0)",
+      "prior", "--prior",
+      "calibration YAML whose values the held groups keep (without it: a sensor fitted in part is "
+      "refused, a sensor held whole is scale 1, the rest 0, recorded as not calibrated)",
       [](const O&) { return std::string(); },
       [](const std::string& path, O* o) {
         o->fit.held = path.empty() ? std::nullopt : std::optional<SensorModel>(ReadCalibration(path).model);

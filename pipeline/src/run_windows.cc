@@ -1,6 +1,8 @@
 #include "imufit/pipeline/run_windows.h"
 
+#include <filesystem>
 #include <set>
+#include <system_error>
 #include <utility>
 
 #include "imufit/io/error.h"
@@ -32,6 +34,13 @@ void ReadSamples(const Plan& plan, Reader* reader, Labeller* labeller, WindowBui
     builder->Add(sample);
     if (stretch != nullptr) stretch->Add(sample);
   }
+}
+
+// Whether `path` can be opened again from its start: a regular file (also through /dev/stdin
+// redirected from one), not a pipe.
+bool IsRereadable(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::is_regular_file(path, error);
 }
 
 }  // namespace
@@ -101,6 +110,20 @@ void RunReader::CheckSpan(const WindowOptions& options, double span_s, long long
 
 RunWindows RunReader::ReadFile(WindowBuilder* builder, NoiseStretchFinder* stretch) {
   RunWindows run;
+  if (!first_pass_->has_segment() && !IsRereadable(first_pass_->path())) {
+    // A pipe (/dev/stdin, a process substitution) can be read once: its samples are kept in memory
+    // (as read and checked at their lines) for the two passes.
+    SamplesInMemory kept;
+    kept.name = first_pass_->path();
+    for (Sample sample; first_pass_->Next(&sample);) kept.samples.push_back(sample);
+    MemorySamplesReader samples(kept);
+    run.segmentation = SegmentSamples(plan_, &samples, input_);
+    Labeller labeller(*run.segmentation);
+    samples.Rewind();
+    ReadSamples(plan_, &samples, &labeller, builder, stretch);
+    run.samples_sha256 = digest_.HexDigest();
+    return run;
+  }
   // Without a segment column the first pass finds the segments and the second labels the samples.
   std::optional<SamplesReader> second_pass;
   std::optional<Labeller> labeller;

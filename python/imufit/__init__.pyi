@@ -76,6 +76,7 @@ class FitRecord:
     fitted: list[str] | None  # the coefficient groups the fit estimated, e.g. gyro.bias
     held: list[str] | None  # the groups held at their stated values (sigma 0)
     held_values: str | None  # where the held values came from: prior, or scale 1, others 0
+    uncalibrated_sensors: list[str] | None  # sensors held whole without a prior (gyro, accel): not calibrated by this file
     loss: str | None  # the robust loss
     gyro_bias_stability_radps: float | None  # the gyro bias stability in the sigmas, rad/s (0: white noise)
     accel_bias_stability_mps2: float | None  # the accelerometer bias stability in the sigmas, m/s^2

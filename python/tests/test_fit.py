@@ -66,12 +66,18 @@ def test_fit_options_map_onto_the_command(fixtures, tmp_path, run_imufit):
 
 def test_fit_a_subset_holds_the_rest(fixtures, tmp_path, run_imufit):
     plan, samples = fixtures / "plan_6pos.yaml", fixtures / "mems_6pos_soak.csv.gz"
-    run_imufit("fit", "--plan", plan, "--samples", samples, "-o", tmp_path / "cli.yaml", "-q", "--fit", "gyro-bias,accel")
+    prior = fixtures / "mems_truth.yaml"
+    run_imufit("fit", "--plan", plan, "--samples", samples, "-o", tmp_path / "cli.yaml", "-q", "--fit", "gyro-bias,accel",
+               "--prior", prior)
     cli = imufit.Calibration.load(tmp_path / "cli.yaml")
-    result = imufit.fit(plan, samples, fit="gyro-bias,accel")
+    result = imufit.fit(plan, samples, fit="gyro-bias,accel", prior=prior)
     cal = result.calibration
-    assert np.all(cal.gyro["scale"][:, 0] == 1) and np.all(cal.gyro["misalignment"] == 0)
+    held = imufit.Calibration.load(prior)
+    np.testing.assert_allclose(cal.gyro["scale"], held.gyro["scale"], rtol=1e-9)
     assert np.all(result.sigma["gyro"]["scale"] == 0)
+    # Without a prior the held gyro scale would be 1 raw per rad/s: refused, naming --prior.
+    with pytest.raises(imufit.FitError, match="--prior"):
+        imufit.fit(plan, samples, fit="gyro-bias,accel")
     assert_parameters_close({"gyro": cal.gyro, "accel": cal.accel}, {"gyro": cli.gyro, "accel": cli.accel})
     with pytest.raises(ValueError, match="is not a group to fit"):
         imufit.fit(plan, samples, fit="magnetometer")

@@ -14,6 +14,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -56,6 +57,13 @@ MachineDoc CalibrationDoc(const Calibration& calibration);
 // Writes atomically (OutputFile), in `transaction` when not null.
 void WriteCalibration(const std::string& path, const Calibration& calibration,
                       OutputTransaction* transaction = nullptr);
+
+// The sensors ("gyro", "accel") that `calibration` does not calibrate: held whole at nominal
+// values (scale 1 raw per SI unit, the rest 0) by a fit that estimated only the other sensor
+// (`imufit fit --fit accel` without --prior). Read from the record's `uncalibrated_sensors`; for a
+// file written before that key, from its `held` groups and `held_values`. A consumer that would
+// use such a sensor as calibrated (apply, export, a certificate) refuses or marks it.
+std::vector<std::string> UncalibratedSensors(const Calibration& calibration);
 
 // The current UTC time as "YYYY-MM-DDTHH:MM:SSZ".
 std::string UtcNow();

@@ -48,6 +48,8 @@
   X(std::vector<std::string>, fitted, "the coefficient groups the fit estimated, e.g. gyro.bias")       \
   X(std::vector<std::string>, held, "the groups held at their stated values (sigma 0)")                 \
   X(std::string, held_values, "where the held values came from: prior, or scale 1, others 0")           \
+  X(std::vector<std::string>, uncalibrated_sensors,                                                     \
+    "sensors held whole without a prior (gyro, accel): not calibrated by this file")                    \
   X(std::string, loss, "the robust loss")                                                               \
   X(double, gyro_bias_stability_radps, "the gyro bias stability in the sigmas, rad/s (0: white noise)") \
   X(double, accel_bias_stability_mps2, "the accelerometer bias stability in the sigmas, m/s^2")         \

@@ -26,6 +26,11 @@ inline constexpr double kMaxLeverArmM = 3.0;
 struct Plan {
   std::string path;    // the file it was read from
   std::string serial;  // may be empty
+  // The climatic chamber's soak set-points, degC, as the plan states them (`soak_temps_c`); empty
+  // when the plan does not say. A log whose temperatures disagree with them is refused
+  // (pipeline/consistency.h, CheckRunTemperatures): a thermometer logged in Fahrenheit, a run of another
+  // plan.
+  std::vector<double> soak_temps_c;
   TableSite site;
   std::vector<TableSegment> segments;
 

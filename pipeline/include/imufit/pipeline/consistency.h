@@ -42,9 +42,44 @@ double ReducedChi2Limit(int dof);
 // its sigmas are inflated by the reduced chi-square instead.
 bool JudgedByTheGate(const FitOptions& options, bool gyro);
 
-// Why the fit of `windows` with `options` is inconsistent, on one line ("" when it is not).
-std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows,
-                          const FitOptions& options);
+// A corrected output further than this fraction from the truth, as a gain, is a gross error: no
+// held scale of the right unit (a prior of the same model, a lower temperature order) is off by
+// 10 %, while a unit of measure mistaken is off by a factor (deg/s for counts: 16; mg for m/s^2: 100).
+inline constexpr double kGrossScaleError = 0.1;
+// How near (relative) the log's raw units per SI unit must lie to a unit loggers write to be named.
+inline constexpr double kLoggedUnitTolerance = 0.05;
+
+// The unit-of-measure finding of every fit, subsets included ("" when none): a sensor whose
+// corrected output over the run's windows is not the truth within kGrossScaleError, as a gain
+// (rate windows for the gyro, windows of known specific force for the accelerometer). This is
+// what a held scale in another unit than the log's does (a --prior in counts, a gyro logged in
+// deg/s): the fitted bias cannot absorb a scale. The log's raw units per SI unit (the gain times
+// the calibration's scale) are named when they are a unit loggers write (deg/s, mg, g, ...). A
+// sensor held whole without a prior is not judged (it is not calibrated: fit_run.cc records so).
+std::string UnitOfMeasureFinding(const FitSummary& fit, const std::vector<Window>& windows,
+                                 const TableSite& site, const std::vector<TableSegment>& segments,
+                                 const FitOptions& options);
+
+// Why the fit of `windows` (of the plan's `site` and `segments`) with `options` is inconsistent, on
+// one line ("" when it is not): the unit-of-measure finding of every fit, then the gate's findings.
+std::string Inconsistency(const FitSummary& fit, const std::vector<Window>& windows, const TableSite& site,
+                          const std::vector<TableSegment>& segments, const FitOptions& options);
+
+// How far a unit's thermometer may read from the chamber's soak set-points at the ends of a run,
+// degC: it reads its own die, warmer than the chamber by its self-heating (a few degC, some 10 in a
+// powered tactical unit), and lags a ramp.
+inline constexpr double kSoakToleranceC = 15.0;
+// Above this no IMU is rated (automotive grade ends at 125 degC): a log beyond it is suspect.
+inline constexpr double kMaxRatedTempC = 125.0;
+
+// The run's temperatures (its windows') against the plan's soak set-points (Plan::soak_temps_c).
+struct TemperatureFinding {
+  std::string refusal;  // the coldest and warmest windows are not the coldest and warmest set-points
+                        // within kSoakToleranceC (with a "Fahrenheit?" hint when 9/5 T + 32 explains it)
+  std::string warning;  // without set-points: windows above kMaxRatedTempC
+};
+TemperatureFinding CheckRunTemperatures(const std::vector<Window>& windows,
+                                        const std::vector<double>& soak_temps_c);
 
 }  // namespace imufit
 
