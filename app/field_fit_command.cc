@@ -123,7 +123,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
     }
     std::printf("imufit fit --field: %s\n", fit.BriefReport().c_str());
     std::printf("  session: %lld samples, %.1f .. %.1f degC; body frame: %s (docs/spec.md section 1)\n",
-                result.samples_read, fit.temp_range_c[0], fit.temp_range_c[1], kBodyFrameConvention);
+                result.samples_read, fit.temp_range_c[0], fit.temp_range_c[1], kBodyFrameAccelerometerXy);
     std::printf("  static gyro RMS %.5f deg/s over the poses\n", DpsFromRadps(fit.gyro_static_rms_radps));
     PrintFieldCoefficients(fit);
     const bool scaled = fit.noise_scale[0] > 1.0 || fit.noise_scale[1] > 1.0 || fit.noise_scale[2] > 1.0;

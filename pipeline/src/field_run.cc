@@ -8,23 +8,23 @@
 namespace imufit {
 namespace {
 
-// The session's own figures, under `fit: field:` (kept by every reader as an unknown key).
-YAML::Node FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& options) {
-  YAML::Node field;
-  field["poses"] = static_cast<int>(fit.poses.size());
-  field["turns"] = static_cast<int>(fit.turns.size());
-  field["gravity_mps2"] = options.gravity_mps2;
-  field["accel_norm_rms_mps2"] = fit.accel_norm_rms_mps2;
-  field["gyro_static_rms_radps"] = fit.gyro_static_rms_radps;
-  field["gravity_direction_rms_rad"] = fit.direction_rms_rad;
-  field["reduced_chi2"] = fit.reduced_chi2;
+// The session's own figures, the `fit: field:` block.
+FieldRecord FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& options) {
+  FieldRecord field;
+  field.poses = static_cast<int>(fit.poses.size());
+  field.turns = static_cast<int>(fit.turns.size());
+  field.gravity_mps2 = options.gravity_mps2;
+  field.accel_norm_rms_mps2 = fit.accel_norm_rms_mps2;
+  field.gyro_static_rms_radps = fit.gyro_static_rms_radps;
+  field.gravity_direction_rms_rad = fit.direction_rms_rad;
+  field.reduced_chi2 = fit.reduced_chi2;
   // The noise of the rests (accelerometer, gyro) and the turns as multiples of the log's white noise.
-  field["noise_scale_accel_rests"] = fit.noise_scale[0];
-  field["noise_scale_gyro_rests"] = fit.noise_scale[1];
-  field["noise_scale_turns"] = fit.noise_scale[2];
+  field.noise_scale_accel_rests = fit.noise_scale[0];
+  field.noise_scale_gyro_rests = fit.noise_scale[1];
+  field.noise_scale_turns = fit.noise_scale[2];
   int saturated = 0;
   for (const FieldTurn& turn : fit.turns) saturated += turn.saturated ? 1 : 0;
-  field["saturated_turns"] = saturated;
+  field.saturated_turns = saturated;
   return field;
 }
 
@@ -52,9 +52,9 @@ Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& 
     record.held->push_back("gyro.g_sensitivity");
     record.held_values = "scale 1, others 0";
   }
-  record.extra["field"] = FieldFigures(fit, options);
+  record.field = FieldFigures(fit, options);
   calibration.fit = record;
-  calibration.extra["body_frame"] = kBodyFrameConvention;
+  calibration.body_frame = kBodyFrameAccelerometerXy;
   return calibration;
 }
 

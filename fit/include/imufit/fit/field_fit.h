@@ -26,7 +26,8 @@
 //     Earth's rotation (at most 7.3e-5 rad/s) is not modelled: the session has no north.
 //  4. The body frame. Without a table it is a convention (docs/spec.md section 1, "field
 //     calibration"): x along the accelerometer's x axis, y in the plane of its x and y axes, so the
-//     accelerometer's misalignment xy, xz and yz are held at 0 (kBodyFrameConvention).
+//     accelerometer's misalignment xy, xz and yz are held at 0 (the body frame `accelerometer_xy`,
+//     io/calibration.h).
 //  5. Uncertainty. Every residual is normalised by its noise, so the covariance of the
 //     coefficients is (J^T J)^-1 at the solution; `sigma` holds its square roots (0 for a held
 //     term). Where a group of residuals (accelerometer at rest, gyro at rest, turns) is larger than
@@ -54,8 +55,6 @@
 
 namespace imufit {
 
-// The body frame of a field calibration, as the calibration file's `body_frame:` key states it.
-inline constexpr const char* kBodyFrameConvention = "accelerometer_xy";
 // The accelerometer's misalignment terms the convention holds at 0 (indices into its 6).
 inline constexpr int kFieldHeldAccelMisalignment[3] = {0, 1, 3};  // xy, xz, yz
 
