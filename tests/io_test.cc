@@ -328,7 +328,7 @@ TEST_F(IoTest, FieldRecordAndBodyFrameRoundTrip) {
   field.noise_scale_turns = 1.0;
   field.saturated_turns = 0;
   const std::string text = CalibrationToYaml(calibration);
-  for (const char* line : {"\n  field:\n    poses: 12\n    turns: 11\n    gravity_mps2: 9.8066499999999994\n",
+  for (const char* line : {"\n  field:\n    poses: 12\n    turns: 11\n    gravity_mps2: 9.80665\n",
                            "\n    gravity_direction_rms_rad: .nan\n", "\nbody_frame: accelerometer_xy\n"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "\nin:\n" << text;
   }
