@@ -101,13 +101,15 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   const FieldRunResult result =
       FieldFitRun(samples, run.input, options, SoftwareVersion(), serial, run.allow_serial_mismatch);
   const FieldFitSummary& fit = result.fit;
-  // The coefficients are constant in temperature (order 0): a unit that warmed during the session
-  // is fitted at its mean, its drift taken for noise.
+  // At order 0 the coefficients are constant in temperature: a unit that warmed during the
+  // session is fitted at its mean, its drift taken for noise.
   constexpr double kConstantTempSpanC = 1.0;
-  if (fit.temp_range_c[1] - fit.temp_range_c[0] > kConstantTempSpanC) {
+  if (options.bias_temp_order == 0 && options.scale_temp_order == 0 &&
+      fit.temp_range_c[1] - fit.temp_range_c[0] > kConstantTempSpanC) {
     std::fprintf(stderr,
-                 "imufit: warning: the session spans %.3g .. %.3g degC; a field calibration is constant in "
-                 "temperature: let the unit warm up before the session\n",
+                 "imufit: warning: the session spans %.3g .. %.3g degC; at --bias-temp-order 0 a field "
+                 "calibration is constant in temperature: let the unit warm up before the session, or fit "
+                 "the warm-up (--bias-temp-order, docs/field.md)\n",
                  fit.temp_range_c[0], fit.temp_range_c[1]);
   }
   for (const std::string& warning : result.serial_warnings)

@@ -215,6 +215,30 @@ TEST_F(CliTest, FieldFitWarnsOfAWarmUp) {
   EXPECT_NE(r.err.find("warning: the session spans 17"), std::string::npos) << r.err;
 }
 
+// The same warm-up fitted over temperature: the biases cubic, the file's orders say so, no
+// warning; scale factors in temperature from a 8-degree warm-up are refused with exit 1, naming
+// the spread they need, and nothing is written.
+TEST_F(CliTest, FieldFitOverAWarmUp) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--warmup-c", "8", "--warmup-tau-s", "30", "--poses", "20"})).status,
+            0);
+  const std::string out = Path("cal.yaml");
+  RunResult r = Run({"fit", "--field", "--samples", raw, "-o", out, "--bias-temp-order", "3", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  const YAML::Node cal = YAML::LoadFile(out);
+  EXPECT_EQ(cal["fit"]["gyro_temp_order"].as<int>(), 3);
+  EXPECT_NE(cal["gyro"]["bias"]["x"][1].as<double>(), 0.0);
+  EXPECT_EQ(cal["gyro"]["scale"]["x"][1].as<double>(), 0.0);
+  const std::string refused = Path("refused.yaml");
+  r = Run({"fit", "--field", "--samples", raw, "-o", refused, "--scale-temp-order", "1", "-q"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("too little to fit the scale factors (order 1) in temperature, which needs 10 degC"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(refused));
+}
+
 // The unit's serial as for a table fit: the samples header's, and a stated one that contradicts it
 // refused unless --allow-mismatch.
 TEST_F(CliTest, FieldFitTakesTheSerialOfTheSamples) {

@@ -13,6 +13,13 @@ OptionTable<FieldFitOptions> MakeFieldFitOptionTable() {
            "m/s^2", &O::gravity_mps2, Between(9.7, 9.9));
   t.Number("min_pose_s", "--min-pose-s", "a rest shorter than this is not a pose", "s", &O::min_pose_s,
            PositiveFinite());
+  t.Number(
+      "bias_temp_order", "--bias-temp-order",
+      "over temperature (a warm-up, or several sessions): order of the biases' polynomials in temperature",
+      "", &O::bias_temp_order, Between(0, 3));
+  t.Number("scale_temp_order", "--scale-temp-order",
+           "over temperature: order of the scale factors' polynomials in temperature (needs a wider spread)",
+           "", &O::scale_temp_order, Between(0, 3));
   return t;
 }
 
@@ -35,6 +42,8 @@ std::string FieldFitOptions::Validate() const {
     return "the observability thresholds must be > 0";
   }
   if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (!(min_bias_temp_span_c > 0.0 && min_scale_temp_span_c > 0.0))
+    return "the temperature spans must be > 0";
   return "";
 }
 

@@ -1,5 +1,7 @@
 #include "imufit/pipeline/field_run.h"
 
+#include <algorithm>
+
 #include "imufit/io/run_header.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
@@ -41,8 +43,8 @@ Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& 
   record.termination = fit.termination;
   record.gyro_residual_rms_radps = fit.gyro_static_rms_radps;
   record.accel_residual_rms_mps2 = fit.accel_norm_rms_mps2;
-  record.gyro_temp_order = 0;
-  record.accel_temp_order = 0;
+  record.gyro_temp_order = std::max(options.bias_temp_order, options.scale_temp_order);
+  record.accel_temp_order = record.gyro_temp_order;
   record.g_sensitivity_fitted = options.fit_g_sensitivity;
   record.fitted = std::vector<std::string>{"gyro.bias",  "gyro.scale",  "gyro.misalignment",
                                            "accel.bias", "accel.scale", "accel.misalignment"};

@@ -69,6 +69,16 @@ struct FieldFitOptions {
   int min_poses = 9;
   // Whether the gyro g-sensitivity H is fitted (else held at 0).
   bool fit_g_sensitivity = true;
+  // Over temperature (a warm-up, or several sessions at different temperatures): the order of the
+  // polynomials in temperature of the biases (gyro and accelerometer) and of the scale factors
+  // (gyro and accelerometer), 0..3. Misalignments and H stay constant. 0: one temperature.
+  int bias_temp_order = 0;
+  int scale_temp_order = 0;
+  // A bias in temperature needs its poses to span this much, degC, and order + 1 of them at least
+  // kDistinctTempC apart; a scale factor in temperature needs this span, and in the coldest and
+  // warmest third of it a pose near each of the six directions and turns about each axis.
+  double min_bias_temp_span_c = 2.0;
+  double min_scale_temp_span_c = 10.0;
   // A pose is "near" a direction (+x, -x, ...) within this angle, degrees: every one of the six must
   // have one, or the accelerometer's scale and bias of that axis rest on one side only.
   double near_direction_deg = 50.0;
@@ -83,6 +93,9 @@ struct FieldFitOptions {
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
 };
+
+// Two poses' temperatures count as distinct when this far apart, degC.
+inline constexpr double kDistinctTempC = 0.5;
 
 // The options a user sets (gravity_mps2, min_pose_s), described once (base/option_table.h;
 // field_fit_options.cc): `imufit fit --field` takes them from here.
@@ -133,7 +146,12 @@ struct FieldFitSummary {
   std::vector<FieldTurn> turns;
   SensorModel model = SensorModel::Identity();  // basis: TemperatureBasis::Reference()
   SensorModel sigma{};                          // 1-sigma, same layout; 0 for a held term
-  std::array<double, 2> temp_range_c{0.0, 0.0};
+  // 1-sigma of each coefficient's value at the coldest and the warmest pose (at order 0, sigma's
+  // c0): what a user reads off the curve, which the terms' sigmas alone do not give.
+  SensorModel sigma_at_low{};
+  SensorModel sigma_at_high{};
+  std::array<double, 2> temp_range_c{0.0, 0.0};       // of the samples, degC
+  std::array<double, 2> pose_temp_range_c{0.0, 0.0};  // of the poses' mean readings, degC
   int iterations = -1;
   std::string termination;
   // Noise of one sample, raw, per axis (the log's floor, pooled over the poses).
