@@ -258,5 +258,28 @@ TEST_F(CliTest, FieldFitTakesTheSerialOfTheSamples) {
   EXPECT_EQ(YAML::LoadFile(other)["serial"].as<std::string>(), "SN0002");
 }
 
+// Local gravity from the site: --latitude and --height-m give WGS-84 normal gravity (the file's
+// fit: field: gravity_mps2 says which); with --gravity-mps2 as well, or a height alone, refused.
+TEST_F(CliTest, FieldFitTakesGravityFromTheSite) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--gravity-mps2", "9.812464"})).status, 0);
+  const std::string out = Path("cal.yaml");
+  RunResult r =
+      Run({"fit", "--field", "--samples", raw, "-o", out, "--latitude", "52.27", "--height-m", "80", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  constexpr double kNormalGravityAt52NMps2 =
+      9.812464;  // WGS-84 at 52.27 deg, 80 m (model_test checks the formula)
+  constexpr double kRoundingMps2 = 1e-5;
+  EXPECT_NEAR(YAML::LoadFile(out)["fit"]["field"]["gravity_mps2"].as<double>(), kNormalGravityAt52NMps2,
+              kRoundingMps2);
+  r = Run({"fit", "--field", "--samples", raw, "-o", Path("both.yaml"), "--latitude", "52", "--gravity-mps2",
+           "9.81"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("one or the other"), std::string::npos) << r.err;
+  r = Run({"fit", "--field", "--samples", raw, "-o", Path("height.yaml"), "--height-m", "80"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("height_m needs latitude_deg"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace imufit::testing

@@ -621,8 +621,12 @@ std::string FieldFitSummary::BriefReport() const {
               : "");
 }
 
-FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options) {
-  IMUFIT_CHECK(options.Validate().empty(), "FieldFitOptions::Validate() first");
+FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& given) {
+  IMUFIT_CHECK(given.Validate().empty(), "FieldFitOptions::Validate() first");
+  FieldFitOptions options = given;  // gravity resolved once: every stage reads gravity_mps2
+  options.gravity_mps2 = given.GravityMps2();
+  options.latitude_deg.reset();
+  options.height_m = 0.0;
   FieldFitSummary summary;
   FindFieldPoses(samples, options, &summary.poses, &summary.turns, &summary.gyro_noise_raw,
                  &summary.accel_noise_raw);

@@ -15,7 +15,7 @@ FieldRecord FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& opti
   FieldRecord field;
   field.poses = static_cast<int>(fit.poses.size());
   field.turns = static_cast<int>(fit.turns.size());
-  field.gravity_mps2 = options.gravity_mps2;
+  field.gravity_mps2 = options.GravityMps2();
   field.accel_norm_rms_mps2 = fit.accel_norm_rms_mps2;
   field.gyro_static_rms_radps = fit.gyro_static_rms_radps;
   field.gravity_direction_rms_rad = fit.direction_rms_rad;

@@ -42,6 +42,7 @@
 #define IMUFIT_FIT_FIELD_FIT_H_
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,10 @@ inline constexpr int kFieldHeldAccelMisalignment[3] = {0, 1, 3};  // xy, xz, yz
 struct FieldFitOptions {
   // Local gravity, m/s^2: the length every pose's corrected specific force must have.
   double gravity_mps2 = kStandardGravityMps2;
+  // Or local gravity from the site (model/local_gravity.h: WGS-84 normal gravity): geodetic
+  // latitude, degrees, and height above the ellipsoid, m. Not together with gravity_mps2.
+  std::optional<double> latitude_deg;
+  double height_m = 0.0;
   // How rests are told from motion (window, noise quantile, threshold): the segmentation's.
   SegmentationOptions detection;
   // A steady stretch shorter than this is not a pose, s.
@@ -92,6 +97,9 @@ struct FieldFitOptions {
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
+  // The gravity the fit uses: from latitude_deg and height_m when latitude_deg is set, else
+  // gravity_mps2.
+  double GravityMps2() const;
 };
 
 // Two poses' temperatures count as distinct when this far apart, degC.
