@@ -1,9 +1,11 @@
 // End-to-end tests of a calibration by hand: `imufit simulate --field` -> `imufit fit --field` ->
 // `imufit apply`, judged on the corrected samples against issue 32's bars (|a| within 1 mg of g at
 // every pose, gravity's direction after the turns within 0.3 deg RMS), and the command's refusals.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -279,6 +281,41 @@ TEST_F(CliTest, FieldFitTakesGravityFromTheSite) {
   r = Run({"fit", "--field", "--samples", raw, "-o", Path("height.yaml"), "--height-m", "80"});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("height_m needs latitude_deg"), std::string::npos) << r.err;
+}
+
+// --repeat: a second session of the same unit agrees within the combined sigmas; a session of a
+// unit whose gyro x scale is 2 % off is named as differing there, and the file is the first's.
+TEST_F(CliTest, FieldFitRepeatCompareSessions) {
+  const std::string first = Path("first.csv");
+  const std::string second = Path("second.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(first, {})).status, 0);
+  std::vector<std::string> second_args = FieldSessionArgs(second, {});
+  const auto seed = std::find(second_args.begin(), second_args.end(), "--seed");
+  ASSERT_NE(seed, second_args.end());
+  *(seed + 1) = "13";  // another session of the same unit
+  ASSERT_EQ(Run(second_args).status, 0);
+  const std::string out = Path("cal.yaml");
+  RunResult r = Run({"fit", "--field", "--samples", first, "--repeat", second, "-o", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("repeatability against " + second), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the procedure is repeatable"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("differs:"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(out));
+
+  // Another unit: the truth's gyro x scale 2 % larger.
+  std::ifstream in(Fixture("mems_truth.yaml"));
+  std::string truth((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "x: [948.31,";  // the gyro's x scale, 2 % larger below
+  ASSERT_NE(truth.find(from), std::string::npos);
+  truth.replace(truth.find(from), from.size(), "x: [967.2762,");
+  const std::string other_truth = Path("other_truth.yaml");
+  std::ofstream(other_truth) << truth;
+  second_args[3] = other_truth;
+  ASSERT_EQ(Run(second_args).status, 0);
+  r = Run({"fit", "--field", "--samples", first, "--repeat", second, "-o", Path("cal2.yaml")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("differs: gyro scale x"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the sessions differ beyond their sigmas"), std::string::npos) << r.out;
 }
 
 }  // namespace

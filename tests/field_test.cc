@@ -625,5 +625,49 @@ TEST(FieldFitTest, MonteCarloSigmasOverTemperature) {
   }
 }
 
+// Repeatability is judged honestly: two sessions of one unit differ by about their combined sigma
+// (over 20 pairs, the RMS of difference / combined sigma within the Monte Carlo band, none beyond
+// kFieldRepeatZ more often than chance allows), and a unit whose gyro x scale changed by 0.5 %
+// between the sessions is named.
+TEST(FieldFitTest, RepeatedSessionsAgreeWithinTheirCombinedSigmas) {
+  constexpr int kPairs = 20;
+  double sum_z2 = 0.0;
+  int count = 0;
+  int beyond = 0;
+  for (int s = 0; s < kPairs; ++s) {
+    const SensorModel truth = FieldTruth(5000 + s);
+    const FieldFitSummary a =
+        FitField(Simulate(truth, ShortSession(6000 + s), FieldSessionOptions{}).samples, {});
+    const FieldFitSummary b =
+        FitField(Simulate(truth, ShortSession(7000 + s), FieldSessionOptions{}).samples, {});
+    ASSERT_TRUE(a.IsSolutionUsable() && b.IsSolutionUsable()) << "pair " << s;
+    const FieldRepeatability r = CompareFieldFits(a, b);
+    EXPECT_EQ(r.differences.size(), 30u);  // 21 gyro + 9 accel coefficients fitted
+    for (const FieldCoefficientDifference& d : r.differences) {
+      sum_z2 += d.z * d.z;
+      ++count;
+    }
+    beyond += static_cast<int>(r.beyond.size());
+  }
+  const double rms = std::sqrt(sum_z2 / count);
+  std::printf("repeatability z RMS %.3f over %d, %d beyond %.0f sigma\n", rms, count, beyond,
+              FieldRepeatability::kFieldRepeatZ);
+  EXPECT_GE(rms, kMinZRms);
+  EXPECT_LE(rms, kMaxZRms);
+  constexpr int kMostBeyondByChance = 6;  // 600 differences at 1 in 370 each: 1.6 expected
+  EXPECT_LE(beyond, kMostBeyondByChance);
+
+  const SensorModel truth = FieldTruth(5100);
+  SensorModel changed = truth;
+  changed.gyro[kScaleCoefficient * kPolynomialTerms] *= 1.005;
+  const FieldFitSummary a = FitField(Simulate(truth, ShortSession(6100), FieldSessionOptions{}).samples, {});
+  const FieldFitSummary b =
+      FitField(Simulate(changed, ShortSession(7100), FieldSessionOptions{}).samples, {});
+  const FieldRepeatability r = CompareFieldFits(a, b);
+  ASSERT_FALSE(r.beyond.empty());
+  EXPECT_TRUE(r.beyond.front().gyro);
+  EXPECT_EQ(r.beyond.front().coefficient, kScaleCoefficient);
+}
+
 }  // namespace
 }  // namespace imufit

@@ -621,6 +621,32 @@ std::string FieldFitSummary::BriefReport() const {
               : "");
 }
 
+FieldRepeatability CompareFieldFits(const FieldFitSummary& first, const FieldFitSummary& second) {
+  FieldRepeatability out;
+  double sum_z2 = 0.0;
+  for (const bool gyro : {true, false}) {
+    const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
+    for (int c = 0; c < coefficients; ++c) {
+      const int i = c * kPolynomialTerms;
+      const double sigma_a = (gyro ? first.sigma.gyro.data() : first.sigma.accel.data())[i];
+      const double sigma_b = (gyro ? second.sigma.gyro.data() : second.sigma.accel.data())[i];
+      if (!(sigma_a > 0.0 && sigma_b > 0.0)) continue;  // held in either
+      FieldCoefficientDifference d;
+      d.gyro = gyro;
+      d.coefficient = c;
+      d.difference = (gyro ? second.model.gyro.data() : second.model.accel.data())[i] -
+                     (gyro ? first.model.gyro.data() : first.model.accel.data())[i];
+      d.combined_sigma = std::hypot(sigma_a, sigma_b);
+      d.z = d.difference / d.combined_sigma;
+      sum_z2 += d.z * d.z;
+      out.differences.push_back(d);
+      if (std::abs(d.z) > FieldRepeatability::kFieldRepeatZ) out.beyond.push_back(d);
+    }
+  }
+  if (!out.differences.empty()) out.z_rms = std::sqrt(sum_z2 / static_cast<double>(out.differences.size()));
+  return out;
+}
+
 FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& given) {
   IMUFIT_CHECK(given.Validate().empty(), "FieldFitOptions::Validate() first");
   FieldFitOptions options = given;  // gravity resolved once: every stage reads gravity_mps2

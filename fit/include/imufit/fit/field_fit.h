@@ -186,6 +186,27 @@ struct FieldFitSummary {
 // Fits the model to a session by hand, `samples` in time order (raw; temp_c as read).
 FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options);
 
+// Two sessions of one unit compared (`imufit fit --field --repeat`): for every coefficient both
+// fitted, the difference of their values at 25 degC (c0) against the combined 1-sigma of two
+// independent sessions, sqrt(sigma_a^2 + sigma_b^2). A hand procedure that is repeatable gives
+// differences of about one combined sigma (z RMS near 1); a larger z names what the procedure does
+// not reproduce (a pose held by hand that moved, a turn too fast for the gyro's range, ...).
+struct FieldCoefficientDifference {
+  bool gyro = true;
+  int coefficient = 0;      // the model's index (model/sensor_model.h)
+  double difference = 0.0;  // second - first, SI
+  double combined_sigma = 0.0;
+  double z = 0.0;  // difference / combined_sigma
+};
+struct FieldRepeatability {
+  std::vector<FieldCoefficientDifference> differences;
+  double z_rms = 0.0;
+  // The threshold beyond which a difference is named (|z| > kFieldRepeatZ: by chance once in 370).
+  static constexpr double kFieldRepeatZ = 3.0;
+  std::vector<FieldCoefficientDifference> beyond;
+};
+FieldRepeatability CompareFieldFits(const FieldFitSummary& first, const FieldFitSummary& second);
+
 // Step 1 alone: the poses and turns of a session (their means; `up` and the errors not set) and the
 // noise floor. Poses the session lacks are reported by FitField, not here.
 void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& options,
