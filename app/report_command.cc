@@ -58,6 +58,14 @@ int RunReport(const ReportArguments& args) {
   UnitOutcome unit;
   FitRunResult& fit = unit.fit.emplace();
   Calibration calibration = ReadCalibration(args.calibration);
+  if (calibration
+          .body_frame) {  // fit --field: no table run whose known truths a certificate states errors against
+    throw InputError(
+        args.calibration,
+        "a calibration by hand (body_frame: " + *calibration.body_frame +
+            ", imufit fit --field) cannot be certified against a table run: the certificate states "
+            "its errors on the rate table's known truths (docs/field.md)");
+  }
   fit.plan = ReadPlan(args.plan);
   // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
   // the unit's own log's, then the plan's. Sources that disagree are warned about (unit_serial.h).

@@ -318,5 +318,41 @@ TEST_F(CliTest, FieldFitRepeatCompareSessions) {
   EXPECT_NE(r.out.find("the sessions differ beyond their sigmas"), std::string::npos) << r.out;
 }
 
+// Downstream: apply, allan --calibration and export take a field calibration; report (the
+// certificate against a table run, with its limits) refuses it, saying why, and writes nothing.
+TEST_F(CliTest, FieldCalibrationDownstream) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {})).status, 0);
+  const std::string cal = Path("cal.yaml");
+  ASSERT_EQ(Run({"fit", "--field", "--samples", raw, "-o", cal, "-q"}).status, 0);
+  EXPECT_EQ(Run({"apply", "--calibration", cal, "--samples", raw, "-o", Path("corrected.csv"), "-q"}).status,
+            0);
+  // allan wants regular stamps (its own refusal of jitter is not the calibration's): a steady log.
+  std::vector<std::string> steady_args = FieldSessionArgs(Path("steady.csv"), {});
+  for (const char* jitter : {"--time-jitter-s", "--drop-probability"}) {
+    const auto at = std::find(steady_args.begin(), steady_args.end(), jitter);
+    ASSERT_NE(at, steady_args.end());
+    steady_args.erase(at, at + 2);
+  }
+  ASSERT_EQ(Run(steady_args).status, 0);
+  const RunResult allan =
+      Run({"allan", "-s", Path("steady.csv"), "--calibration", cal, "-o", Path("adev.csv"), "-q"});
+  EXPECT_EQ(allan.status, 0) << allan.err;
+  for (const char* format : {"json", "c", "imucal"}) {
+    const RunResult r =
+        Run({"export", "-c", cal, "-f", format, "-o", Path(std::string("out.") + format), "-q"});
+    EXPECT_EQ(r.status, 0) << format << ": " << r.err;
+  }
+  const std::string html = Path("report.html");
+  const RunResult r = Run({"report", "-c", cal, "-p", Fixture("plan_6pos.yaml"), "-s", raw, "-o", html});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(
+      r.err.find(
+          "a calibration by hand (body_frame: accelerometer_xy, imufit fit --field) cannot be certified"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(html));
+}
+
 }  // namespace
 }  // namespace imufit::testing
