@@ -52,6 +52,29 @@ void PrintFieldCoefficients(const FieldFitSummary& fit) {
   }
 }
 
+// The second session against the first: each coefficient's difference in its familiar unit and in
+// combined sigmas, those beyond FieldRepeatability::kFieldRepeatZ named, and the verdict.
+void PrintRepeatability(const std::string& repeat, const FieldFitSummary& first,
+                        const FieldFitSummary& second) {
+  const FieldRepeatability r = CompareFieldFits(first, second);
+  std::printf(
+      "  repeatability against %s (%zu poses): %zu coefficients, difference / combined sigma RMS %.3g\n",
+      repeat.c_str(), second.poses.size(), r.differences.size(), r.z_rms);
+  for (const FieldCoefficientDifference& d : r.beyond) {
+    const Sensor sensor = d.gyro ? Sensor::kGyro : Sensor::kAccel;
+    const double factor = EngineeringFactor(first.model, sensor, d.coefficient, kReferenceTempC);
+    std::printf("    differs: %s %s %s by %+.4g +- %.3g %s (%.1f sigma)\n", d.gyro ? "gyro" : "accel",
+                kCoefficientNames[d.coefficient].group, kCoefficientNames[d.coefficient].axis,
+                factor * d.difference, std::abs(factor) * d.combined_sigma,
+                EngineeringUnit(sensor, d.coefficient), d.z);
+  }
+  std::printf("  %s\n", r.beyond.empty() && r.z_rms < 1.5
+                            ? "the sessions agree within their sigmas: the procedure is repeatable"
+                            : "the sessions differ beyond their sigmas: the procedure does not reproduce "
+                              "the coefficients named (rests not still, turns too fast, the unit moved in "
+                              "the hand)");
+}
+
 }  // namespace
 
 void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
@@ -59,6 +82,12 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
       "--field", &args->field,
       "a session by hand, without a plan or a table: the unit rested in at least 9 arbitrary poses and "
       "was turned by hand between them (docs/field.md)");
+  command
+      .Option(
+          "--repeat", &args->repeat,
+          "a second session of the same unit by hand: fitted alike and compared, coefficient by coefficient, "
+          "against the two sessions' combined sigma (is the procedure repeatable?); the file is the first's")
+      .Needs(field);
   args->options.Add(command, FieldFitOptionTable());
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key).Needs(field);
 }
@@ -101,13 +130,15 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   const FieldRunResult result =
       FieldFitRun(samples, run.input, options, SoftwareVersion(), serial, run.allow_serial_mismatch);
   const FieldFitSummary& fit = result.fit;
-  // The coefficients are constant in temperature (order 0): a unit that warmed during the session
-  // is fitted at its mean, its drift taken for noise.
+  // At order 0 the coefficients are constant in temperature: a unit that warmed during the
+  // session is fitted at its mean, its drift taken for noise.
   constexpr double kConstantTempSpanC = 1.0;
-  if (fit.temp_range_c[1] - fit.temp_range_c[0] > kConstantTempSpanC) {
+  if (options.bias_temp_order == 0 && options.scale_temp_order == 0 &&
+      fit.temp_range_c[1] - fit.temp_range_c[0] > kConstantTempSpanC) {
     std::fprintf(stderr,
-                 "imufit: warning: the session spans %.3g .. %.3g degC; a field calibration is constant in "
-                 "temperature: let the unit warm up before the session\n",
+                 "imufit: warning: the session spans %.3g .. %.3g degC; at --bias-temp-order 0 a field "
+                 "calibration is constant in temperature: let the unit warm up before the session, or fit "
+                 "the warm-up (--bias-temp-order, docs/field.md)\n",
                  fit.temp_range_c[0], fit.temp_range_c[1]);
   }
   for (const std::string& warning : result.serial_warnings)
@@ -123,13 +154,24 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
     }
     std::printf("imufit fit --field: %s\n", fit.BriefReport().c_str());
     std::printf("  session: %lld samples, %.1f .. %.1f degC; body frame: %s (docs/spec.md section 1)\n",
-                result.samples_read, fit.temp_range_c[0], fit.temp_range_c[1], kBodyFrameConvention);
+                result.samples_read, fit.temp_range_c[0], fit.temp_range_c[1], kBodyFrameAccelerometerXy);
     std::printf("  static gyro RMS %.5f deg/s over the poses\n", DpsFromRadps(fit.gyro_static_rms_radps));
     PrintFieldCoefficients(fit);
     const bool scaled = fit.noise_scale[0] > 1.0 || fit.noise_scale[1] > 1.0 || fit.noise_scale[2] > 1.0;
     std::printf("  note: the sigmas reflect %s; Earth's rotation (up to 0.004 deg/s) is not modelled\n",
                 scaled ? "the session's scatter, beyond its white noise (tremor, drift)"
                        : "the session's white noise");
+  }
+  if (!args.repeat.empty()) {
+    RefuseToOverwriteInputs(output, {args.repeat});
+    const FieldRunResult second = FieldFitRun(args.repeat, run.input, options, SoftwareVersion(),
+                                              result.serial, run.allow_serial_mismatch);
+    if (!second.fit.IsSolutionUsable()) {
+      std::fprintf(stderr, "imufit: %s (--repeat): %s, nothing written\n", args.repeat.c_str(),
+                   second.fit.BriefReport().c_str());
+      return 1;
+    }
+    if (!quiet) PrintRepeatability(args.repeat, fit, second.fit);
   }
   WriteCalibration(output, *result.calibration);
   if (!quiet) std::printf("  wrote %s\n", output.c_str());

@@ -15,6 +15,7 @@ namespace imufit {
 struct FieldFitArguments {
   bool field = false;                   // --field: a session by hand
   CliOptions<FieldFitOptions> options;  // FieldFitOptionTable()
+  std::string repeat;                   // --repeat: a second session of the unit, compared
 };
 
 // Adds --field and the field fit's own options (which need it) to `command`.
@@ -26,8 +27,9 @@ void RefuseTableOptions(const FitRunArguments& run);
 
 // The field fit of `samples` written to `output`; `run` gives how the samples are read (--temp-c,
 // --time-unit, columns, rest detection) and whether the g-sensitivity is fitted (--no-g-sensitivity).
-// Returns the exit status: 0, or 1 when the session does not determine the model (the message says
-// what it lacks) or the fit does not converge; nothing is written then.
+// With --repeat, the second session is fitted alike and compared (CompareFieldFits); the file is
+// the first session's. Returns the exit status: 0, or 1 when a session does not determine the
+// model (the message says what it lacks) or the fit does not converge; nothing is written then.
 int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
                 const std::string& serial, bool quiet, const FitRunOptions& run);
 

@@ -58,6 +58,14 @@ int RunReport(const ReportArguments& args) {
   UnitOutcome unit;
   FitRunResult& fit = unit.fit.emplace();
   Calibration calibration = ReadCalibration(args.calibration);
+  // fit --field: no table run whose known truths a certificate states errors against.
+  if (calibration.body_frame) {
+    throw InputError(
+        args.calibration,
+        "a calibration by hand (body_frame: " + *calibration.body_frame +
+            ", imufit fit --field) cannot be certified against a table run: the certificate states "
+            "its errors on the rate table's known truths (docs/field.md)");
+  }
   // A sensor the calibration does not calibrate is marked on the certificate, never certified as fitted.
   for (std::string& note : CheckCalibratedSensors(calibration, args.calibration, CalibrationUse::kCertify,
                                                   /*allow_uncalibrated=*/true))

@@ -1,9 +1,11 @@
 // End-to-end tests of a calibration by hand: `imufit simulate --field` -> `imufit fit --field` ->
 // `imufit apply`, judged on the corrected samples against issue 32's bars (|a| within 1 mg of g at
 // every pose, gravity's direction after the turns within 0.3 deg RMS), and the command's refusals.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -215,6 +217,30 @@ TEST_F(CliTest, FieldFitWarnsOfAWarmUp) {
   EXPECT_NE(r.err.find("warning: the session spans 17"), std::string::npos) << r.err;
 }
 
+// The same warm-up fitted over temperature: the biases cubic, the file's orders say so, no
+// warning; scale factors in temperature from a 8-degree warm-up are refused with exit 1, naming
+// the spread they need, and nothing is written.
+TEST_F(CliTest, FieldFitOverAWarmUp) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--warmup-c", "8", "--warmup-tau-s", "30", "--poses", "20"})).status,
+            0);
+  const std::string out = Path("cal.yaml");
+  RunResult r = Run({"fit", "--field", "--samples", raw, "-o", out, "--bias-temp-order", "3", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  const YAML::Node cal = YAML::LoadFile(out);
+  EXPECT_EQ(cal["fit"]["gyro_temp_order"].as<int>(), 3);
+  EXPECT_NE(cal["gyro"]["bias"]["x"][1].as<double>(), 0.0);
+  EXPECT_EQ(cal["gyro"]["scale"]["x"][1].as<double>(), 0.0);
+  const std::string refused = Path("refused.yaml");
+  r = Run({"fit", "--field", "--samples", raw, "-o", refused, "--scale-temp-order", "1", "-q"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("too little to fit the scale factors (order 1) in temperature, which needs 10 degC"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(refused));
+}
+
 // The unit's serial as for a table fit: the samples header's, and a stated one that contradicts it
 // refused unless --allow-mismatch.
 TEST_F(CliTest, FieldFitTakesTheSerialOfTheSamples) {
@@ -232,6 +258,100 @@ TEST_F(CliTest, FieldFitTakesTheSerialOfTheSamples) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
   EXPECT_EQ(YAML::LoadFile(other)["serial"].as<std::string>(), "SN0002");
+}
+
+// Local gravity from the site: --latitude and --height-m give WGS-84 normal gravity (the file's
+// fit: field: gravity_mps2 says which); with --gravity-mps2 as well, or a height alone, refused.
+TEST_F(CliTest, FieldFitTakesGravityFromTheSite) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--gravity-mps2", "9.812464"})).status, 0);
+  const std::string out = Path("cal.yaml");
+  RunResult r =
+      Run({"fit", "--field", "--samples", raw, "-o", out, "--latitude", "52.27", "--height-m", "80", "-q"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  constexpr double kNormalGravityAt52NMps2 =
+      9.812464;  // WGS-84 at 52.27 deg, 80 m (model_test checks the formula)
+  constexpr double kRoundingMps2 = 1e-5;
+  EXPECT_NEAR(YAML::LoadFile(out)["fit"]["field"]["gravity_mps2"].as<double>(), kNormalGravityAt52NMps2,
+              kRoundingMps2);
+  r = Run({"fit", "--field", "--samples", raw, "-o", Path("both.yaml"), "--latitude", "52", "--gravity-mps2",
+           "9.81"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("one or the other"), std::string::npos) << r.err;
+  r = Run({"fit", "--field", "--samples", raw, "-o", Path("height.yaml"), "--height-m", "80"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("height_m needs latitude_deg"), std::string::npos) << r.err;
+}
+
+// --repeat: a second session of the same unit agrees within the combined sigmas; a session of a
+// unit whose gyro x scale is 2 % off is named as differing there, and the file is the first's.
+TEST_F(CliTest, FieldFitRepeatCompareSessions) {
+  const std::string first = Path("first.csv");
+  const std::string second = Path("second.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(first, {})).status, 0);
+  std::vector<std::string> second_args = FieldSessionArgs(second, {});
+  const auto seed = std::find(second_args.begin(), second_args.end(), "--seed");
+  ASSERT_NE(seed, second_args.end());
+  *(seed + 1) = "13";  // another session of the same unit
+  ASSERT_EQ(Run(second_args).status, 0);
+  const std::string out = Path("cal.yaml");
+  RunResult r = Run({"fit", "--field", "--samples", first, "--repeat", second, "-o", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("repeatability against " + second), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the procedure is repeatable"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("differs:"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(out));
+
+  // Another unit: the truth's gyro x scale 2 % larger.
+  std::ifstream in(Fixture("mems_truth.yaml"));
+  std::string truth((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "x: [948.31,";  // the gyro's x scale, 2 % larger below
+  ASSERT_NE(truth.find(from), std::string::npos);
+  truth.replace(truth.find(from), from.size(), "x: [967.2762,");
+  const std::string other_truth = Path("other_truth.yaml");
+  std::ofstream(other_truth) << truth;
+  second_args[3] = other_truth;
+  ASSERT_EQ(Run(second_args).status, 0);
+  r = Run({"fit", "--field", "--samples", first, "--repeat", second, "-o", Path("cal2.yaml")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("differs: gyro scale x"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the sessions differ beyond their sigmas"), std::string::npos) << r.out;
+}
+
+// Downstream: apply, allan --calibration and export take a field calibration; report (the
+// certificate against a table run, with its limits) refuses it, saying why, and writes nothing.
+TEST_F(CliTest, FieldCalibrationDownstream) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {})).status, 0);
+  const std::string cal = Path("cal.yaml");
+  ASSERT_EQ(Run({"fit", "--field", "--samples", raw, "-o", cal, "-q"}).status, 0);
+  EXPECT_EQ(Run({"apply", "--calibration", cal, "--samples", raw, "-o", Path("corrected.csv"), "-q"}).status,
+            0);
+  // allan wants regular stamps (its own refusal of jitter is not the calibration's): a steady log.
+  std::vector<std::string> steady_args = FieldSessionArgs(Path("steady.csv"), {});
+  for (const char* jitter : {"--time-jitter-s", "--drop-probability"}) {
+    const auto at = std::find(steady_args.begin(), steady_args.end(), jitter);
+    ASSERT_NE(at, steady_args.end());
+    steady_args.erase(at, at + 2);
+  }
+  ASSERT_EQ(Run(steady_args).status, 0);
+  const RunResult allan =
+      Run({"allan", "-s", Path("steady.csv"), "--calibration", cal, "-o", Path("adev.csv"), "-q"});
+  EXPECT_EQ(allan.status, 0) << allan.err;
+  for (const char* format : {"json", "c", "imucal"}) {
+    const RunResult r =
+        Run({"export", "-c", cal, "-f", format, "-o", Path(std::string("out.") + format), "-q"});
+    EXPECT_EQ(r.status, 0) << format << ": " << r.err;
+  }
+  const std::string html = Path("report.html");
+  const RunResult r = Run({"report", "-c", cal, "-p", Fixture("plan_6pos.yaml"), "-s", raw, "-o", html});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(
+      r.err.find(
+          "a calibration by hand (body_frame: accelerometer_xy, imufit fit --field) cannot be certified"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(html));
 }
 
 }  // namespace

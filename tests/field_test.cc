@@ -39,6 +39,21 @@ SensorModel FieldTruth(std::uint64_t seed) {
   return model;
 }
 
+// FieldTruth with the biases' temperature terms of RandomMemsModel kept, each made `boost` times
+// larger: a unit whose biases drift as it warms up (what bias_temp_order fits).
+SensorModel WarmingTruth(std::uint64_t seed, double boost) {
+  SensorModel model = FieldTruth(seed);
+  const SensorModel full = testing::RandomMemsModel(seed);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 1; k < kPolynomialTerms; ++k) {
+      const int i = (kBiasCoefficient + axis) * kPolynomialTerms + k;
+      model.gyro[i] = boost * full.gyro[i];
+      model.accel[i] = boost * full.accel[i];
+    }
+  }
+  return model;
+}
+
 struct Session {
   std::vector<Sample> samples;
   std::vector<FieldPoseTruth> poses;
@@ -189,7 +204,8 @@ TEST(FieldSessionTest, PosesAreTiltedAndTurnsAtHandSpeed) {
   EXPECT_GT(temps.back(), temps.front());
 }
 
-// Jets against central differences, at the start and away from it, for each residual; the gyro
+// Jets against central differences (through FieldTermsCost's chain rule over the cubic's terms), at
+// the start and away from it, for each residual; the gyro
 // residual at rest is K_g of what SensorModel::Correct (imufit apply) gives.
 TEST(FieldCostTest, AutodiffAgreesWithCentralDifferencesAndCallsTheModel) {
   const SensorModel truth = FieldTruth(3);
@@ -204,6 +220,8 @@ TEST(FieldCostTest, AutodiffAgreesWithCentralDifferencesAndCallsTheModel) {
   layout.accel0 = truth.accel;
   layout.gyro_step.fill(0.01);
   layout.accel_step.fill(0.01);
+  // Away from the basis's centre, so that every term of the cubic has a derivative (FieldTermsCost).
+  constexpr double kX = 0.7;
   const PoseDirection from(poses[turns[1].from].accel_mean);
   const PoseDirection to(poses[turns[1].to].accel_mean);
   std::vector<TurnSample> turn_samples;
@@ -214,11 +232,11 @@ TEST(FieldCostTest, AutodiffAgreesWithCentralDifferencesAndCallsTheModel) {
   }
   std::unique_ptr<ceres::CostFunction> costs[] = {
       std::unique_ptr<ceres::CostFunction>(
-          FieldTurnCost::Create(&layout, &from, &to, turn_samples, 0.0, 1e-3)),
+          FieldTurnCost::Create(&layout, &from, &to, turn_samples, kX, 1e-3)),
       std::unique_ptr<ceres::CostFunction>(
-          FieldPoseGyroCost::Create(&layout, poses[0].gyro_mean, poses[0].accel_mean, 0.0, gyro_noise)),
+          FieldPoseGyroCost::Create(&layout, poses[0].gyro_mean, poses[0].accel_mean, kX, gyro_noise)),
       std::unique_ptr<ceres::CostFunction>(
-          FieldPoseAccelCost::Create(&layout, &from, poses[0].accel_mean, 0.0, 9.80665, accel_noise))};
+          FieldPoseAccelCost::Create(&layout, &from, poses[0].accel_mean, kX, 9.80665, accel_noise))};
   std::mt19937_64 engine(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (const bool at_start : {true, false}) {
@@ -487,6 +505,168 @@ TEST(FieldFitTest, MonteCarloSigmasMatchTheSpread) {
     EXPECT_GE(rms, kMinZRms) << kClasses[k].name;
     EXPECT_LE(rms, kMaxZRms) << kClasses[k].name;
   }
+}
+
+// A warm-up: 24 poses while the unit warms by about 14 degC (tau 40 s over a 2-minute session).
+SimulationOptions WarmUpSession(std::uint64_t seed) {
+  SimulationOptions options = ShortSession(seed);
+  options.soak_temps_c = {25.0};
+  return options;
+}
+FieldSessionOptions WarmUp() {
+  FieldSessionOptions warm;
+  warm.poses = 24;
+  warm.warmup_c = 15.0;
+  warm.warmup_tau_s = 40.0;
+  return warm;
+}
+
+// (fitted - true) / sigma of a coefficient's value at the coldest and the warmest pose.
+std::array<double, 2> ZAtEnds(const FieldFitSummary& fit, const SensorModel& truth, bool gyro,
+                              int coefficient) {
+  std::array<double, 2> z{};
+  const int i = coefficient * kPolynomialTerms;
+  for (int end = 0; end < 2; ++end) {
+    const double x = fit.pose_temp_range_c[end] - kReferenceTempC;
+    const double fitted =
+        EvaluateTemperaturePolynomial((gyro ? fit.model.gyro.data() : fit.model.accel.data()) + i, x);
+    const double true_value =
+        EvaluateTemperaturePolynomial((gyro ? truth.gyro.data() : truth.accel.data()) + i, x);
+    const SensorModel& sigma = end == 0 ? fit.sigma_at_low : fit.sigma_at_high;
+    z[end] = (fitted - true_value) / (gyro ? sigma.gyro.data() : sigma.accel.data())[i];
+  }
+  return z;
+}
+
+// A warm-up fitted with the biases cubic in temperature: the biases recovered along the curve
+// within their sigmas at both ends, the constant coefficients as at one temperature, and the
+// residuals those of white noise where the fit at one temperature takes the drift for noise.
+TEST(FieldFitTest, WarmUpFitsTheBiasesInTemperature) {
+  const SensorModel truth = WarmingTruth(21, 5.0);
+  const Session session = Simulate(truth, WarmUpSession(21), WarmUp());
+  FieldFitOptions options;
+  options.bias_temp_order = 3;
+  const FieldFitSummary fit = FitField(session.samples, options);
+  ASSERT_TRUE(fit.IsSolutionUsable()) << fit.BriefReport();
+  EXPECT_GT(fit.pose_temp_range_c[1] - fit.pose_temp_range_c[0], 10.0);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const bool gyro : {true, false}) {
+      for (const double z : ZAtEnds(fit, truth, gyro, kBiasCoefficient + axis)) {
+        EXPECT_LT(std::abs(z), kWorstZ) << (gyro ? "gyro" : "accel") << " bias " << axis;
+      }
+    }
+  }
+  for (const CoefficientClass& k : kClasses) {
+    if (k.first == kBiasCoefficient) continue;  // c0 of a bias: extrapolated to 25 degC
+    for (const double z : ZScores(fit, truth, k)) EXPECT_LT(std::abs(z), kWorstZ) << k.name;
+  }
+  EXPECT_LT(fit.reduced_chi2, 1.5);
+  EXPECT_EQ(fit.noise_scale[1], 1.0);  // the gyro at rest: white noise, the drift fitted
+  const FieldFitSummary constant = FitField(session.samples, FieldFitOptions{});
+  EXPECT_GT(constant.gyro_static_rms_radps, 3.0 * fit.gyro_static_rms_radps);
+}
+
+// What the temperatures cannot determine is refused, named: a cubic from one temperature, scale
+// factors in temperature from a narrow warm-up.
+TEST(FieldFitTest, RefusesTemperatureOrdersTheSessionCannotDetermine) {
+  const SensorModel truth = FieldTruth(22);
+  FieldFitOptions options;
+  options.bias_temp_order = 3;
+  const FieldFitSummary flat =
+      FitField(Simulate(truth, ShortSession(22), FieldSessionOptions{}).samples, options);
+  EXPECT_EQ(flat.status, FieldFitStatus::kUndetermined);
+  EXPECT_NE(flat.BriefReport().find("too little to fit the biases (order 3) in temperature"),
+            std::string::npos)
+      << flat.BriefReport();
+  FieldSessionOptions narrow = WarmUp();
+  narrow.warmup_c = 6.0;
+  options.bias_temp_order = 1;
+  options.scale_temp_order = 1;
+  const FieldFitSummary scale = FitField(Simulate(truth, WarmUpSession(22), narrow).samples, options);
+  EXPECT_EQ(scale.status, FieldFitStatus::kUndetermined);
+  const std::string report = scale.BriefReport();
+  EXPECT_NE(report.find("too little to fit the scale factors (order 1)"), std::string::npos) << report;
+  EXPECT_EQ(report.find("the biases"), std::string::npos) << report;
+}
+
+// The sigmas of a warm-up fit are honest: over 50 warm-ups (each its own unit and seed) the
+// z-scores of the biases at the coldest and warmest pose, and of the constant coefficients, have
+// an RMS near 1.
+TEST(FieldFitTest, MonteCarloSigmasOverTemperature) {
+  constexpr int kSessions = 50;
+  std::vector<double> sum_z2(std::size(kClasses), 0.0);
+  std::vector<int> count(std::size(kClasses), 0);
+  for (int s = 0; s < kSessions; ++s) {
+    const SensorModel truth = WarmingTruth(3000 + s, 3.0);
+    FieldFitOptions options;
+    options.bias_temp_order = 3;
+    const FieldFitSummary fit = FitField(Simulate(truth, WarmUpSession(4000 + s), WarmUp()).samples, options);
+    ASSERT_TRUE(fit.IsSolutionUsable()) << "session " << s << ": " << fit.BriefReport();
+    for (size_t k = 0; k < std::size(kClasses); ++k) {
+      std::vector<double> z;
+      if (kClasses[k].first == kBiasCoefficient) {
+        for (int c = kBiasCoefficient; c < kBiasCoefficient + 3; ++c) {
+          for (const double end : ZAtEnds(fit, truth, kClasses[k].gyro, c)) z.push_back(end);
+        }
+      } else {
+        z = ZScores(fit, truth, kClasses[k]);
+      }
+      for (const double value : z) {
+        sum_z2[k] += value * value;
+        ++count[k];
+      }
+    }
+  }
+  for (size_t k = 0; k < std::size(kClasses); ++k) {
+    const double rms = std::sqrt(sum_z2[k] / count[k]);
+    std::printf("%-20s z-score RMS %.3f over %d (warm-ups)\n", kClasses[k].name, rms, count[k]);
+    EXPECT_GE(rms, kMinZRms) << kClasses[k].name;
+    EXPECT_LE(rms, kMaxZRms) << kClasses[k].name;
+  }
+}
+
+// Repeatability is judged honestly: two sessions of one unit differ by about their combined sigma
+// (over 20 pairs, the RMS of difference / combined sigma within the Monte Carlo band, none beyond
+// kFieldRepeatZ more often than chance allows), and a unit whose gyro x scale changed by 0.5 %
+// between the sessions is named.
+TEST(FieldFitTest, RepeatedSessionsAgreeWithinTheirCombinedSigmas) {
+  constexpr int kPairs = 20;
+  double sum_z2 = 0.0;
+  int count = 0;
+  int beyond = 0;
+  for (int s = 0; s < kPairs; ++s) {
+    const SensorModel truth = FieldTruth(5000 + s);
+    const FieldFitSummary a =
+        FitField(Simulate(truth, ShortSession(6000 + s), FieldSessionOptions{}).samples, {});
+    const FieldFitSummary b =
+        FitField(Simulate(truth, ShortSession(7000 + s), FieldSessionOptions{}).samples, {});
+    ASSERT_TRUE(a.IsSolutionUsable() && b.IsSolutionUsable()) << "pair " << s;
+    const FieldRepeatability r = CompareFieldFits(a, b);
+    EXPECT_EQ(r.differences.size(), 30u);  // 21 gyro + 9 accel coefficients fitted
+    for (const FieldCoefficientDifference& d : r.differences) {
+      sum_z2 += d.z * d.z;
+      ++count;
+    }
+    beyond += static_cast<int>(r.beyond.size());
+  }
+  const double rms = std::sqrt(sum_z2 / count);
+  std::printf("repeatability z RMS %.3f over %d, %d beyond %.0f sigma\n", rms, count, beyond,
+              FieldRepeatability::kFieldRepeatZ);
+  EXPECT_GE(rms, kMinZRms);
+  EXPECT_LE(rms, kMaxZRms);
+  constexpr int kMostBeyondByChance = 6;  // 600 differences at 1 in 370 each: 1.6 expected
+  EXPECT_LE(beyond, kMostBeyondByChance);
+
+  const SensorModel truth = FieldTruth(5100);
+  SensorModel changed = truth;
+  changed.gyro[kScaleCoefficient * kPolynomialTerms] *= 1.005;
+  const FieldFitSummary a = FitField(Simulate(truth, ShortSession(6100), FieldSessionOptions{}).samples, {});
+  const FieldFitSummary b =
+      FitField(Simulate(changed, ShortSession(7100), FieldSessionOptions{}).samples, {});
+  const FieldRepeatability r = CompareFieldFits(a, b);
+  ASSERT_FALSE(r.beyond.empty());
+  EXPECT_TRUE(r.beyond.front().gyro);
+  EXPECT_EQ(r.beyond.front().coefficient, kScaleCoefficient);
 }
 
 }  // namespace

@@ -356,6 +356,53 @@ TEST_F(IoTest, FitRecordRoundTripsThroughItsTypedMembers) {
   EXPECT_NE(e.message().find("fit.iterations: \"seven\" is not an integer"), std::string::npos) << e.what();
 }
 
+// A calibration by hand: the `fit: field:` block round-trips through its typed record (after the
+// fit's other keys, a key it does not know kept), `body_frame` through its typed member (after the
+// records); a body frame imufit does not know is refused at its line.
+TEST_F(IoTest, FieldRecordAndBodyFrameRoundTrip) {
+  Calibration calibration = ExampleCalibration();
+  calibration.body_frame = kBodyFrameAccelerometerXy;
+  FieldRecord& field = calibration.fit->field.emplace();
+  field.poses = 12;
+  field.turns = 11;
+  field.gravity_mps2 = 9.80665;
+  field.accel_norm_rms_mps2 = 0.00082805122694389294;
+  field.gravity_direction_rms_rad = std::numeric_limits<double>::quiet_NaN();
+  field.noise_scale_turns = 1.0;
+  field.saturated_turns = 0;
+  const std::string text = CalibrationToYaml(calibration);
+  for (const char* line : {"\n  field:\n    poses: 12\n    turns: 11\n    gravity_mps2: 9.80665\n",
+                           "\n    gravity_direction_rms_rad: .nan\n", "\nbody_frame: accelerometer_xy\n"}) {
+    EXPECT_NE(text.find(line), std::string::npos) << line << "\nin:\n" << text;
+  }
+  const Calibration read = ReadCalibration(Write("field.yaml", text));
+  EXPECT_EQ(read.body_frame, std::optional<std::string>(kBodyFrameAccelerometerXy));
+  ASSERT_TRUE(read.fit && read.fit->field);
+  EXPECT_EQ(read.fit->field->poses, 12);
+  EXPECT_EQ(read.fit->field->accel_norm_rms_mps2, field.accel_norm_rms_mps2);  // ==, bit for bit
+  EXPECT_TRUE(std::isnan(*read.fit->field->gravity_direction_rms_rad));
+  EXPECT_FALSE(read.fit->field->reduced_chi2.has_value());  // not written: not set
+  EXPECT_FALSE(read.extra.IsMap() && read.extra["body_frame"]);
+  EXPECT_EQ(CalibrationToYaml(read), text);
+
+  std::string unknown = text;
+  unknown.insert(unknown.find("    poses: 12"), "    hand: left\n");
+  const Calibration kept = ReadCalibration(Write("field_unknown.yaml", unknown));
+  EXPECT_EQ(kept.fit->field->extra["hand"].as<std::string>(), "left");
+  EXPECT_NE(CalibrationToYaml(kept).find("saturated_turns: 0\n    hand: left\n"), std::string::npos);
+
+  std::string wrong = text;
+  wrong.replace(wrong.find("body_frame: accelerometer_xy"), 28, "body_frame: table");
+  const InputError e = Catch([&] { ReadCalibration(Write("frame.yaml", wrong)); });
+  EXPECT_NE(e.message().find("body_frame: \"table\" is not a body frame imufit knows (accelerometer_xy)"),
+            std::string::npos)
+      << e.what();
+  std::string turns = text;
+  turns.replace(turns.find("turns: 11"), 9, "turns: [11]");
+  const InputError t = Catch([&] { ReadCalibration(Write("turns.yaml", turns)); });
+  EXPECT_NE(t.message().find("fit.field.turns"), std::string::npos) << t.what();
+}
+
 // ---------------------------------------------------------------- machine-readable text
 
 // The one writer: numbers a YAML 1.1 reader reads as numbers (a mantissa with a point, -0 as a
@@ -424,7 +471,8 @@ TEST(MachineText, TheJsonSchemaTypesTheFitRecordAsItsTable) {
                                                          {"bool", "boolean"},
                                                          {"std::vector<double>", "array of number"},
                                                          {"std::vector<int>", "array of integer"},
-                                                         {"std::vector<std::string>", "array of string"}};
+                                                         {"std::vector<std::string>", "array of string"},
+                                                         {"FieldRecord", "object"}};
   const auto schema_type = [](const YAML::Node& property) {
     if (!property || !property["type"]) return std::string("(none)");
     const YAML::Node type = property["type"];
@@ -437,8 +485,16 @@ TEST(MachineText, TheJsonSchemaTypesTheFitRecordAsItsTable) {
   EXPECT_EQ(schema_type(properties[#key]), json_types.at(#type)) << "fit." #key; \
   ++keys;
   IMUFIT_FIT_RECORD_FIELDS(IMUFIT_EXPECT_SCHEMA_TYPE)
-#undef IMUFIT_EXPECT_SCHEMA_TYPE
   EXPECT_EQ(properties.size(), keys) << "a key in the schema that the record does not have";
+  const YAML::Node field_properties = properties["field"]["properties"];
+  keys = 0;
+#undef IMUFIT_EXPECT_SCHEMA_TYPE
+#define IMUFIT_EXPECT_SCHEMA_TYPE(type, key, description)                                    \
+  EXPECT_EQ(schema_type(field_properties[#key]), json_types.at(#type)) << "fit.field." #key; \
+  ++keys;
+  IMUFIT_FIELD_RECORD_FIELDS(IMUFIT_EXPECT_SCHEMA_TYPE)
+#undef IMUFIT_EXPECT_SCHEMA_TYPE
+  EXPECT_EQ(field_properties.size(), keys) << "a key in the schema that the field record does not have";
 }
 
 // The noise block round-trips through its typed record; a value of the wrong type is located.

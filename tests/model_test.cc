@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "imufit/model/check.h"
+#include "imufit/model/local_gravity.h"
 #include "imufit/model/rate_table.h"
 #include "imufit/model/sensor_model.h"
 #include "imufit/model/temperature_polynomial.h"
@@ -238,6 +239,21 @@ TEST(RateTable, RateAboutATiltedAxisAndTurns) {
   turn.axis = Eigen::Vector3d::UnitY();  // horizontal: gravity turns in the body frame
   EXPECT_FALSE(turn.SpecificForceIsKnown());
   EXPECT_LE((TurnTruth(site, turn, 8.0).omega_radps - Eigen::Vector3d(0, 2.0 * M_PI / 8.0, 0)).norm(), 1e-15);
+}
+
+// WGS-84 normal gravity against the published values at the equator and the pole (NIMA TR8350.2,
+// table 3.4: the pole's follows from the equator's through k and e^2), symmetric about the equator,
+// growing towards the poles, and the free-air gradient of about -3.086e-6 m/s^2 per metre.
+TEST(LocalGravity, NormalGravityOfWgs84) {
+  constexpr double kPublishedDigitsMps2 = 1e-9;  // the published values' last digit
+  EXPECT_NEAR(NormalGravityMps2(0.0, 0.0), 9.7803253359, kPublishedDigitsMps2);
+  EXPECT_NEAR(NormalGravityMps2(M_PI / 2.0, 0.0), 9.8321849378, kPublishedDigitsMps2);
+  EXPECT_NEAR(NormalGravityMps2(-M_PI / 2.0, 0.0), 9.8321849378, kPublishedDigitsMps2);
+  EXPECT_EQ(NormalGravityMps2(M_PI / 4.0, 0.0), NormalGravityMps2(-M_PI / 4.0, 0.0));
+  EXPECT_LT(NormalGravityMps2(M_PI / 6.0, 0.0), NormalGravityMps2(M_PI / 3.0, 0.0));
+  const double per_metre =
+      (NormalGravityMps2(M_PI / 4.0, 1000.0) - NormalGravityMps2(M_PI / 4.0, 0.0)) / 1000.0;
+  EXPECT_NEAR(per_metre, -3.086e-6, 0.005e-6);
 }
 
 }  // namespace

@@ -11,17 +11,22 @@
 //   pose   2                                          gravity's direction at a pose, u = (u0 + d1 e1
 //                                                     + d2 e2) / |...|, d = kPoseStep q
 //
-// and expanded into the model's layout (term k of coefficient i at i * kPolynomialTerms + k).
-// kTerms = 1 is the fit at one temperature; the temperature argument x of each residual is that of
-// its pose or turn, so a higher kTerms needs no other change here.
+// and expanded into the model's layout (term k of coefficient i at i * kPolynomialTerms + k, in
+// the fit's temperature basis FieldLayout::basis). Terms a fit does not estimate (above its
+// temperature orders, H when not fitted) are held by a SubsetManifold. Each residual is written
+// in the coefficients' values at its pose's or turn's temperature argument x and wrapped in
+// FieldTermsCost, which maps the term blocks to those values (a linear map), so that the Jets are
+// as small at order 3 as at order 0.
 // Header-only so that tests can instantiate the costs with ceres::Jet and with double.
 #ifndef IMUFIT_FIT_SRC_FIELD_COST_H_
 #define IMUFIT_FIT_SRC_FIELD_COST_H_
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/cost_function.h>
 #include <Eigen/Core>
 
 #include "imufit/fit/field_fit.h"
@@ -32,7 +37,7 @@ namespace imufit {
 
 // Where the solver's q lives in the model's parameters (see above).
 struct FieldLayout {
-  static constexpr int kTerms = 1;
+  static constexpr int kTerms = kPolynomialTerms;
   static constexpr int kAccelFree = 9;
   static constexpr int kGyroBlock = kGyroCoefficients * kTerms;
   static constexpr int kAccelBlock = kAccelFree * kTerms;
@@ -40,6 +45,9 @@ struct FieldLayout {
   // The accelerometer coefficients fitted: bias x y z, scale x y z, misalignment yx zx zy.
   static constexpr int kAccelFreeCoefficient[kAccelFree] = {0, 1, 2, 3, 4, 5, 8, 10, 11};
 
+  // The fit's temperature basis: the session's temperatures to about [-1, 1] (the model's
+  // parameters below are in it; the calibration is rebased to powers of dT after the fit).
+  TemperatureBasis basis = TemperatureBasis::Reference();
   std::array<double, kGyroParameters> gyro0{};  // p0, the model's layout
   std::array<double, kAccelParameters> accel0{};
   std::array<double, kGyroBlock> gyro_step{};
@@ -52,34 +60,138 @@ struct FieldLayout {
   static constexpr int kTurnGroup = 2;
   std::array<double, 3> noise_scale{1.0, 1.0, 1.0};
 
-  template <typename T>
-  void Gyro(const T* q, T* p) const {
-    for (int i = 0; i < kGyroParameters; ++i) p[i] = T(gyro0[i]);
+  void Gyro(const double* q, double* p) const {
+    for (int i = 0; i < kGyroParameters; ++i) p[i] = gyro0[i];
     for (int c = 0; c < kGyroCoefficients; ++c) {
-      for (int k = 0; k < kTerms; ++k) {
-        p[c * kPolynomialTerms + k] += T(gyro_step[c * kTerms + k]) * q[c * kTerms + k];
-      }
+      for (int k = 0; k < kTerms; ++k)
+        p[c * kPolynomialTerms + k] += gyro_step[c * kTerms + k] * q[c * kTerms + k];
     }
   }
-  template <typename T>
-  void Accel(const T* q, T* p) const {
-    for (int i = 0; i < kAccelParameters; ++i) p[i] = T(accel0[i]);
+  void Accel(const double* q, double* p) const {
+    for (int i = 0; i < kAccelParameters; ++i) p[i] = accel0[i];
     for (int f = 0; f < kAccelFree; ++f) {
       const int c = kAccelFreeCoefficient[f];
-      for (int k = 0; k < kTerms; ++k) {
-        p[c * kPolynomialTerms + k] += T(accel_step[f * kTerms + k]) * q[f * kTerms + k];
+      for (int k = 0; k < kTerms; ++k)
+        p[c * kPolynomialTerms + k] += accel_step[f * kTerms + k] * q[f * kTerms + k];
+    }
+  }
+  // The values at argument x of the coefficients a block holds (gyro: all kGyroCoefficients;
+  // accel: the kAccelFree fitted), and d value / d q (`derivative`, one per q, may be null).
+  void GyroAt(const double* q, double x, double* at, double* derivative) const {
+    double p[kGyroParameters];
+    Gyro(q, p);
+    for (int c = 0; c < kGyroCoefficients; ++c) {
+      at[c] = EvaluateTemperaturePolynomial(p + c * kPolynomialTerms, x);
+      if (derivative == nullptr) continue;
+      double power = 1.0;
+      for (int k = 0; k < kTerms; ++k, power *= x)
+        derivative[c * kTerms + k] = gyro_step[c * kTerms + k] * power;
+    }
+  }
+  void AccelAt(const double* q, double x, double* at, double* derivative) const {
+    double p[kAccelParameters];
+    Accel(q, p);
+    for (int f = 0; f < kAccelFree; ++f) {
+      at[f] = EvaluateTemperaturePolynomial(p + kAccelFreeCoefficient[f] * kPolynomialTerms, x);
+      if (derivative == nullptr) continue;
+      double power = 1.0;
+      for (int k = 0; k < kTerms; ++k, power *= x)
+        derivative[f * kTerms + k] = accel_step[f * kTerms + k] * power;
+    }
+  }
+};
+
+// A sensor's coefficients from their values at one temperature (gyro: kGyroCoefficients values;
+// accel: the kAccelFree fitted, the body frame's three misalignments 0).
+template <typename T>
+SensorCoefficients<T> GyroCoefficientsFromValues(const T* at) {
+  T p[kGyroParameters];
+  for (int i = 0; i < kGyroParameters; ++i) p[i] = T(0.0);
+  for (int c = 0; c < kGyroCoefficients; ++c) p[c * kPolynomialTerms] = at[c];
+  return CoefficientsAt(p, kGyroCoefficients, T(0.0));
+}
+template <typename T>
+SensorCoefficients<T> AccelCoefficientsFromValues(const T* at) {
+  T p[kAccelParameters];
+  for (int i = 0; i < kAccelParameters; ++i) p[i] = T(0.0);
+  for (int f = 0; f < FieldLayout::kAccelFree; ++f)
+    p[FieldLayout::kAccelFreeCoefficient[f] * kPolynomialTerms] = at[f];
+  return CoefficientsAt(p, kAccelCoefficients, T(0.0));
+}
+
+// A residual written in the coefficients' values at its temperature (blocks: gyro values
+// [kGyroCoefficients] and/or accel values [kAccelFree], then blocks passed through), evaluated as
+// a function of the solver's term blocks (kGyroBlock, kAccelBlock): value = sum_k (p0 + step q)_k
+// x^k is linear in q, so the Jacobian is the inner one times step_k x^k. The autodiff Jets stay
+// as small as a fit at one temperature.
+class FieldTermsCost : public ceres::CostFunction {
+ public:
+  FieldTermsCost(const FieldLayout* layout, ceres::CostFunction* inner, bool gyro, bool accel, double x)
+      : layout_(layout), inner_(inner), gyro_(gyro), accel_(accel), x_(x) {
+    set_num_residuals(inner->num_residuals());
+    const std::vector<int32_t>& sizes = inner->parameter_block_sizes();
+    for (size_t b = 0; b < sizes.size(); ++b) {
+      const bool is_gyro = gyro_ && b == 0;
+      const bool is_accel = accel_ && b == (gyro_ ? 1u : 0u);
+      mutable_parameter_block_sizes()->push_back(is_gyro    ? FieldLayout::kGyroBlock
+                                                 : is_accel ? FieldLayout::kAccelBlock
+                                                            : sizes[b]);
+    }
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const size_t blocks = parameter_block_sizes().size();
+    const int rows = num_residuals();
+    double gyro_at[kGyroCoefficients];
+    double accel_at[FieldLayout::kAccelFree];
+    double gyro_d[FieldLayout::kGyroBlock];
+    double accel_d[FieldLayout::kAccelBlock];
+    std::vector<const double*> inner_parameters(parameters, parameters + blocks);
+    size_t b = 0;
+    if (gyro_) {
+      layout_->GyroAt(parameters[b], x_, gyro_at, gyro_d);
+      inner_parameters[b++] = gyro_at;
+    }
+    if (accel_) {
+      layout_->AccelAt(parameters[b], x_, accel_at, accel_d);
+      inner_parameters[b++] = accel_at;
+    }
+    if (jacobians == nullptr) return inner_->Evaluate(inner_parameters.data(), residuals, nullptr);
+    std::vector<double> gyro_j(gyro_ ? rows * kGyroCoefficients : 0);
+    std::vector<double> accel_j(accel_ ? rows * FieldLayout::kAccelFree : 0);
+    std::vector<double*> inner_jacobians(jacobians, jacobians + blocks);
+    b = 0;
+    if (gyro_) {
+      inner_jacobians[b] = jacobians[b] != nullptr ? gyro_j.data() : nullptr;
+      ++b;
+    }
+    if (accel_) inner_jacobians[b] = jacobians[b] != nullptr ? accel_j.data() : nullptr;
+    if (!inner_->Evaluate(inner_parameters.data(), residuals, inner_jacobians.data())) return false;
+    b = 0;
+    if (gyro_) Chain(gyro_j.data(), gyro_d, kGyroCoefficients, rows, jacobians[b++]);
+    if (accel_) Chain(accel_j.data(), accel_d, FieldLayout::kAccelFree, rows, jacobians[b++]);
+    return true;
+  }
+
+ private:
+  // d r / d q[c, k] = d r / d value[c] * d value[c] / d q[c, k], row-major.
+  static void Chain(const double* inner, const double* derivative, int values, int rows, double* out) {
+    if (out == nullptr) return;
+    constexpr int kTerms = FieldLayout::kTerms;
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < values; ++c) {
+        for (int k = 0; k < kTerms; ++k) {
+          out[(r * values + c) * kTerms + k] = inner[r * values + c] * derivative[c * kTerms + k];
+        }
       }
     }
   }
-  // Both sensors' coefficients at the temperature argument x.
-  template <typename T>
-  UnitCoefficients<T> CoefficientsAtArgument(const T* gyro_q, const T* accel_q, const T& x) const {
-    T gyro[kGyroParameters];
-    T accel[kAccelParameters];
-    Gyro(gyro_q, gyro);
-    Accel(accel_q, accel);
-    return {CoefficientsAt(gyro, kGyroCoefficients, x), CoefficientsAt(accel, kAccelCoefficients, x)};
-  }
+
+  const FieldLayout* layout_;
+  std::unique_ptr<ceres::CostFunction> inner_;
+  bool gyro_;
+  bool accel_;
+  double x_;
 };
 
 // Gravity's direction at a pose: u0 and two unit vectors perpendicular to it.
@@ -107,26 +219,26 @@ Vector3<T> InRawUnits(const SensorCoefficients<T>& c, const Vector3<T>& error) {
 class FieldPoseAccelCost {
  public:
   FieldPoseAccelCost(const FieldLayout* layout, const PoseDirection* pose, const Eigen::Vector3d& accel_mean,
-                     double x, double gravity_mps2, const Eigen::Vector3d& sigma_raw)
+                     double gravity_mps2, const Eigen::Vector3d& sigma_raw)
       : layout_(layout),
         pose_(pose),
         accel_mean_(accel_mean),
-        x_(x),
         gravity_mps2_(gravity_mps2),
         inverse_sigma_(sigma_raw.cwiseInverse()) {}
 
   static ceres::CostFunction* Create(const FieldLayout* layout, const PoseDirection* pose,
                                      const Eigen::Vector3d& accel_mean, double x, double gravity_mps2,
                                      const Eigen::Vector3d& sigma_raw) {
-    return new ceres::AutoDiffCostFunction<FieldPoseAccelCost, 3, FieldLayout::kAccelBlock, 2>(
-        new FieldPoseAccelCost(layout, pose, accel_mean, x, gravity_mps2, sigma_raw));
+    return new FieldTermsCost(
+        layout,
+        new ceres::AutoDiffCostFunction<FieldPoseAccelCost, 3, FieldLayout::kAccelFree, 2>(
+            new FieldPoseAccelCost(layout, pose, accel_mean, gravity_mps2, sigma_raw)),
+        /*gyro=*/false, /*accel=*/true, x);
   }
 
   template <typename T>
-  bool operator()(const T* accel_q, const T* pose_q, T* residual) const {
-    T accel[kAccelParameters];
-    layout_->Accel(accel_q, accel);
-    const SensorCoefficients<T> c = CoefficientsAt(accel, kAccelCoefficients, T(x_));
+  bool operator()(const T* accel_at, const T* pose_q, T* residual) const {
+    const SensorCoefficients<T> c = AccelCoefficientsFromValues(accel_at);
     const Vector3<T> a_hat = CorrectSensor(c, accel_mean_.cast<T>().eval(), Vector3<T>::Zero().eval());
     const Vector3<T> raw_error = InRawUnits(c, (a_hat - T(gravity_mps2_) * pose_->At(pose_q)).eval());
     const double scale = layout_->noise_scale[FieldLayout::kAccelGroup];
@@ -138,7 +250,6 @@ class FieldPoseAccelCost {
   const FieldLayout* layout_;
   const PoseDirection* pose_;
   Eigen::Vector3d accel_mean_;
-  double x_;
   double gravity_mps2_;
   Eigen::Vector3d inverse_sigma_;
 };
@@ -148,24 +259,25 @@ class FieldPoseAccelCost {
 class FieldPoseGyroCost {
  public:
   FieldPoseGyroCost(const FieldLayout* layout, const Eigen::Vector3d& gyro_mean,
-                    const Eigen::Vector3d& accel_mean, double x, const Eigen::Vector3d& sigma_raw)
+                    const Eigen::Vector3d& accel_mean, const Eigen::Vector3d& sigma_raw)
       : layout_(layout),
         gyro_mean_(gyro_mean),
         accel_mean_(accel_mean),
-        x_(x),
         inverse_sigma_(sigma_raw.cwiseInverse()) {}
 
   static ceres::CostFunction* Create(const FieldLayout* layout, const Eigen::Vector3d& gyro_mean,
                                      const Eigen::Vector3d& accel_mean, double x,
                                      const Eigen::Vector3d& sigma_raw) {
-    return new ceres::AutoDiffCostFunction<FieldPoseGyroCost, 3, FieldLayout::kGyroBlock,
-                                           FieldLayout::kAccelBlock>(
-        new FieldPoseGyroCost(layout, gyro_mean, accel_mean, x, sigma_raw));
+    return new FieldTermsCost(
+        layout,
+        new ceres::AutoDiffCostFunction<FieldPoseGyroCost, 3, kGyroCoefficients, FieldLayout::kAccelFree>(
+            new FieldPoseGyroCost(layout, gyro_mean, accel_mean, sigma_raw)),
+        /*gyro=*/true, /*accel=*/true, x);
   }
 
   template <typename T>
-  bool operator()(const T* gyro_q, const T* accel_q, T* residual) const {
-    const UnitCoefficients<T> c = layout_->CoefficientsAtArgument(gyro_q, accel_q, T(x_));
+  bool operator()(const T* gyro_at, const T* accel_at, T* residual) const {
+    const UnitCoefficients<T> c{GyroCoefficientsFromValues(gyro_at), AccelCoefficientsFromValues(accel_at)};
     Vector3<T> omega_hat;
     Vector3<T> a_hat;
     CorrectWith(c, gyro_mean_.cast<T>().eval(), accel_mean_.cast<T>().eval(), &omega_hat, &a_hat);
@@ -179,7 +291,6 @@ class FieldPoseGyroCost {
   const FieldLayout* layout_;
   Eigen::Vector3d gyro_mean_;
   Eigen::Vector3d accel_mean_;
-  double x_;
   Eigen::Vector3d inverse_sigma_;
 };
 
@@ -219,26 +330,27 @@ inline std::vector<double> TurnTimes(const std::vector<TurnSample>& samples) {
 class FieldTurnCost {
  public:
   FieldTurnCost(const FieldLayout* layout, const PoseDirection* from, const PoseDirection* to,
-                std::vector<TurnSample> samples, double x, double sigma_rad)
+                std::vector<TurnSample> samples, double sigma_rad)
       : layout_(layout),
         from_(from),
         to_(to),
         samples_(std::move(samples)),
         times_s_(TurnTimes(samples_)),
-        x_(x),
         inverse_sigma_(1.0 / sigma_rad) {}
 
   static ceres::CostFunction* Create(const FieldLayout* layout, const PoseDirection* from,
                                      const PoseDirection* to, std::vector<TurnSample> samples, double x,
                                      double sigma_rad) {
-    return new ceres::AutoDiffCostFunction<FieldTurnCost, 2, FieldLayout::kGyroBlock,
-                                           FieldLayout::kAccelBlock, 2, 2>(
-        new FieldTurnCost(layout, from, to, std::move(samples), x, sigma_rad));
+    return new FieldTermsCost(
+        layout,
+        new ceres::AutoDiffCostFunction<FieldTurnCost, 2, kGyroCoefficients, FieldLayout::kAccelFree, 2, 2>(
+            new FieldTurnCost(layout, from, to, std::move(samples), sigma_rad)),
+        /*gyro=*/true, /*accel=*/true, x);
   }
 
   template <typename T>
-  bool operator()(const T* gyro_q, const T* accel_q, const T* from_q, const T* to_q, T* residual) const {
-    const UnitCoefficients<T> c = layout_->CoefficientsAtArgument(gyro_q, accel_q, T(x_));
+  bool operator()(const T* gyro_at, const T* accel_at, const T* from_q, const T* to_q, T* residual) const {
+    const UnitCoefficients<T> c{GyroCoefficientsFromValues(gyro_at), AccelCoefficientsFromValues(accel_at)};
     const Vector3<T> predicted =
         RotateIntoCurrentFrame(IntegrateTurn(c, samples_, times_s_), from_->At(from_q));
     const Vector3<T> error = predicted - to_->At(to_q);
@@ -254,7 +366,6 @@ class FieldTurnCost {
   const PoseDirection* to_;
   std::vector<TurnSample> samples_;
   std::vector<double> times_s_;  // of samples_, from the first
-  double x_;
   double inverse_sigma_;
 };
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <tuple>
+#include <utility>
 
 #include <ceres/ceres.h>
 #include <Eigen/Dense>
@@ -25,22 +27,27 @@ std::string Format(const char* format, double a, double b = 0.0) {
 
 // The session's poses in each of the six directions, and the turns about each gyro axis, judged on
 // the start (field_fit.h, step 5): the findings in plain words.
+// `in` (when not empty) keeps the poses judged, and the turns between two of them.
 std::vector<std::string> CoverageProblems(const std::vector<FieldPose>& poses,
                                           const std::vector<FieldTurn>& turns,
                                           const std::vector<std::vector<TurnSample>>& turn_samples,
-                                          const SensorModel& start, const FieldFitOptions& options) {
+                                          const SensorModel& start, const FieldFitOptions& options,
+                                          const std::vector<bool>& in = {}) {
   std::vector<std::string> problems;
   const UnitCoefficients<double> c = start.CoefficientsAtTemperature(25.0);
   std::vector<Eigen::Vector3d> ups;
   for (const FieldPose& pose : poses) {
     ups.push_back(CorrectSensor(c.accel, pose.accel_mean, Eigen::Vector3d::Zero().eval()).normalized());
   }
+  const auto kept = [&in](size_t pose) { return in.empty() || in[pose]; };
   const char* axes = "xyz";
   const double near = std::cos(options.near_direction_deg * kDegToRad);
   for (int axis = 0; axis < 3; ++axis) {
     for (const double sign : {1.0, -1.0}) {
       double best = -1.0;
-      for (const Eigen::Vector3d& up : ups) best = std::max(best, sign * up(axis));
+      for (size_t p = 0; p < ups.size(); ++p) {
+        if (kept(p)) best = std::max(best, sign * ups[p](axis));
+      }
       if (best >= near) continue;
       // `up` along +axis: gravity points along -axis and the axis points up.
       problems.push_back(std::string("no pose with gravity near ") + (sign > 0 ? "-" : "+") + axes[axis] +
@@ -51,6 +58,7 @@ std::vector<std::string> CoverageProblems(const std::vector<FieldPose>& poses,
   // gravity's angle to it, summed over the turns.
   Eigen::Vector3d moved = Eigen::Vector3d::Zero();
   for (size_t t = 0; t < turns.size(); ++t) {
+    if (!kept(turns[t].from) || !kept(turns[t].to)) continue;
     Eigen::Vector3d angle = Eigen::Vector3d::Zero();
     Eigen::Vector3d omega_before;
     Eigen::Vector3d a_hat;
@@ -77,6 +85,76 @@ std::vector<std::string> CoverageProblems(const std::vector<FieldPose>& poses,
   return problems;
 }
 
+// What the poses' temperatures cannot determine of the orders asked (field_fit.h, bias_temp_order
+// and scale_temp_order), in plain words: too narrow a span, too few distinct temperatures, and
+// for the scale factors the coldest and warmest third without a pose near each direction or turns
+// about each axis.
+std::vector<std::string> TemperatureProblems(const std::vector<FieldPose>& poses,
+                                             const std::vector<FieldTurn>& turns,
+                                             const std::vector<std::vector<TurnSample>>& turn_samples,
+                                             const SensorModel& start, const FieldFitOptions& options) {
+  std::vector<std::string> problems;
+  if (options.bias_temp_order == 0 && options.scale_temp_order == 0) return problems;
+  std::vector<double> temps;
+  for (const FieldPose& pose : poses) temps.push_back(pose.temp_c);
+  std::sort(temps.begin(), temps.end());
+  const double low = temps.front();
+  const double high = temps.back();
+  int distinct = 1;
+  for (size_t i = 1, last = 0; i < temps.size(); ++i) {
+    if (temps[i] - temps[last] >= kDistinctTempC) ++distinct, last = i;
+  }
+  const std::string span =
+      Format("the poses span %.3g degC (%.4g", high - low, low) + Format(" .. %.4g degC)", high);
+  const auto order_text = [](const char* what, int order) {
+    return std::string(what) + " (order " + std::to_string(order) + ")";
+  };
+  for (const auto& [what, order, min_span] :
+       {std::tuple{"the biases", options.bias_temp_order, options.min_bias_temp_span_c},
+        {"the scale factors", options.scale_temp_order, options.min_scale_temp_span_c}}) {
+    if (order == 0) continue;
+    if (high - low < min_span || distinct < order + 1) {
+      problems.push_back(span + ", " + std::to_string(distinct) + " distinct" +
+                         Format(" (%.2g degC apart): too little to fit ", kDistinctTempC) +
+                         order_text(what, order) + " in temperature, which needs " +
+                         Format("%.3g degC and ", min_span) + std::to_string(order + 1) +
+                         " distinct temperatures: lower the order, or record over a wider warm-up");
+    }
+  }
+  if (options.scale_temp_order == 0 || !problems.empty()) return problems;
+  for (const bool cold : {true, false}) {
+    std::vector<bool> in(poses.size());
+    for (size_t p = 0; p < poses.size(); ++p) {
+      in[p] =
+          cold ? poses[p].temp_c <= low + (high - low) / 3.0 : poses[p].temp_c >= high - (high - low) / 3.0;
+    }
+    const std::string where =
+        cold ? Format("among the coldest poses (%.4g .. %.4g degC): ", low, low + (high - low) / 3.0)
+             : Format("among the warmest poses (%.4g .. %.4g degC): ", high - (high - low) / 3.0, high);
+    for (const std::string& problem : CoverageProblems(poses, turns, turn_samples, start, options, in)) {
+      problems.push_back(where + problem + ", so the scale factors cannot follow temperature");
+    }
+  }
+  return problems;
+}
+
+// Whether the fit estimates term k of a coefficient (field_fit.h: the temperature orders; H only
+// when fitted; misalignments and H constant).
+bool TermFitted(bool gyro, int coefficient, int k, const FieldFitOptions& options) {
+  if (gyro && coefficient >= kGSensitivityCoefficient) return options.fit_g_sensitivity && k == 0;
+  if (coefficient < kScaleCoefficient) return k <= options.bias_temp_order;
+  if (coefficient < kMisalignmentCoefficient) return k <= options.scale_temp_order;
+  return k == 0;
+}
+
+// A column of the solver's Jacobian (tangent space): a fitted term, or a pose's direction.
+struct FieldColumn {
+  bool gyro = true;
+  int coefficient = 0;  // the model's index
+  int term = 0;         // k, in the fit's basis
+  int q = 0;            // index into the block
+};
+
 // The Ceres problem's parameters and what they mean.
 struct FieldProblem {
   FieldLayout layout;
@@ -87,12 +165,24 @@ struct FieldProblem {
   ceres::Problem problem;
   // The residual blocks of each group (FieldLayout::kAccelGroup, kGyroGroup, kTurnGroup).
   std::array<std::vector<ceres::ResidualBlockId>, 3> groups;
+  // The fitted terms, in the Jacobian's column order (before the poses').
+  std::vector<FieldColumn> columns;
 
-  // The model at the current q.
+  // The model at the current q, in powers of dT (TemperatureBasis::Reference()).
   SensorModel Model() const {
+    SensorModel fitted;
+    layout.Gyro(gyro_q.data(), fitted.gyro.data());
+    layout.Accel(accel_q.data(), fitted.accel.data());
+    const Eigen::Matrix4d rebase = RebaseTemperaturePolynomial(layout.basis, TemperatureBasis::Reference());
     SensorModel model;
-    layout.Gyro(gyro_q.data(), model.gyro.data());
-    layout.Accel(accel_q.data(), model.accel.data());
+    model.basis = TemperatureBasis::Reference();
+    for (auto [from, to] :
+         {std::pair{fitted.gyro.data(), model.gyro.data()}, {fitted.accel.data(), model.accel.data()}}) {
+      const int count = from == fitted.gyro.data() ? kGyroParameters : kAccelParameters;
+      for (int i = 0; i < count; i += kPolynomialTerms) {
+        Eigen::Map<Eigen::Vector4d>(to + i) = rebase * Eigen::Map<const Eigen::Vector4d>(from + i);
+      }
+    }
     return model;
   }
   // Every parameter block in the Jacobian's column order.
@@ -135,7 +225,12 @@ void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTu
   const UnitCoefficients<double> c = start.CoefficientsAtTemperature(25.0);
   fp->directions.reserve(poses.size());
   fp->pose_q.assign(poses.size(), {0.0, 0.0});
-  const TemperatureBasis basis = TemperatureBasis::Reference();
+  // The fit's basis: the poses' temperatures to [-1, 1] (at one temperature, x = 0 everywhere).
+  const auto [coldest, warmest] = std::minmax_element(
+      poses.begin(), poses.end(), [](const FieldPose& a, const FieldPose& b) { return a.temp_c < b.temp_c; });
+  fp->layout.basis.center_c = 0.5 * (coldest->temp_c + warmest->temp_c);
+  fp->layout.basis.half_range_c = std::max(0.5 * (warmest->temp_c - coldest->temp_c), 1.0);
+  const TemperatureBasis& basis = fp->layout.basis;
   for (size_t p = 0; p < poses.size(); ++p) {
     const double n = static_cast<double>(poses[p].last - poses[p].first + 1);
     fp->directions.emplace_back(CorrectSensor(c.accel, poses[p].accel_mean, Eigen::Vector3d::Zero().eval()));
@@ -162,32 +257,40 @@ void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTu
         nullptr, fp->gyro_q.data(), fp->accel_q.data(), fp->pose_q[turns[t].from].data(),
         fp->pose_q[turns[t].to].data()));
   }
-  if (!options.fit_g_sensitivity) {
+  // The terms not fitted are held (their q stays 0); the rest are the Jacobian's columns.
+  for (const bool gyro : {true, false}) {
     std::vector<int> held;
-    for (int h = 0; h < 9; ++h) {
-      for (int k = 0; k < FieldLayout::kTerms; ++k)
-        held.push_back((kGSensitivityCoefficient + h) * FieldLayout::kTerms + k);
+    const int values = gyro ? kGyroCoefficients : FieldLayout::kAccelFree;
+    for (int v = 0; v < values; ++v) {
+      const int coefficient = gyro ? v : FieldLayout::kAccelFreeCoefficient[v];
+      for (int k = 0; k < FieldLayout::kTerms; ++k) {
+        const int q = v * FieldLayout::kTerms + k;
+        if (TermFitted(gyro, coefficient, k, options)) {
+          fp->columns.push_back({gyro, coefficient, k, q});
+        } else {
+          held.push_back(q);
+        }
+      }
     }
-    fp->problem.SetManifold(fp->gyro_q.data(), new ceres::SubsetManifold(FieldLayout::kGyroBlock, held));
+    if (held.empty()) continue;
+    double* block = gyro ? fp->gyro_q.data() : fp->accel_q.data();
+    fp->problem.SetManifold(
+        block, new ceres::SubsetManifold(gyro ? FieldLayout::kGyroBlock : FieldLayout::kAccelBlock, held));
   }
 }
 
-// The name of the model parameter behind Jacobian column `column` (Blocks() order, H columns
-// absent when not fitted), e.g. "gyro scale z", or "the direction of pose 4".
-std::string ColumnName(int column, bool fit_g_sensitivity) {
-  const int gyro_columns =
-      fit_g_sensitivity ? FieldLayout::kGyroBlock : FieldLayout::kGyroBlock - 9 * FieldLayout::kTerms;
-  if (column < gyro_columns) {
-    const CoefficientName& name = kCoefficientNames[column / FieldLayout::kTerms];
-    return std::string("gyro ") + name.group + " " + name.axis;
+// The name of the model parameter behind Jacobian column `column` (Blocks() order), e.g. "gyro
+// scale z", "accel bias x (its dT^2 term)", or "the direction of pose 4".
+std::string ColumnName(int column, const std::vector<FieldColumn>& columns) {
+  if (column >= static_cast<int>(columns.size())) {
+    return "the direction of pose " + std::to_string((column - static_cast<int>(columns.size())) / 2 + 1);
   }
-  column -= gyro_columns;
-  if (column < FieldLayout::kAccelBlock) {
-    const CoefficientName& name =
-        kCoefficientNames[FieldLayout::kAccelFreeCoefficient[column / FieldLayout::kTerms]];
-    return std::string("accel ") + name.group + " " + name.axis;
-  }
-  return "the direction of pose " + std::to_string((column - FieldLayout::kAccelBlock) / 2 + 1);
+  const FieldColumn& c = columns[column];
+  const CoefficientName& name = kCoefficientNames[c.coefficient];
+  return std::string(c.gyro ? "gyro " : "accel ") + name.group + " " + name.axis +
+         (c.term == 0   ? ""
+          : c.term == 1 ? " (its change with temperature)"
+                        : " (its dT^" + std::to_string(c.term) + " term in temperature)");
 }
 
 // The residuals and their Jacobian at the current q, dense, rows in group order (accel, gyro,
@@ -245,11 +348,12 @@ bool NoiseScales(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residua
 
 // Step 5: the covariance (J^T J)^-1 in q, or the parameter a direction without information moves
 // most (then `covariance` is untouched and the name returned).
-std::string Covariance(const Eigen::MatrixXd& jacobian, bool fit_g_sensitivity, Eigen::MatrixXd* covariance) {
+std::string Covariance(const Eigen::MatrixXd& jacobian, const std::vector<FieldColumn>& columns,
+                       Eigen::MatrixXd* covariance) {
   const Eigen::MatrixXd information = jacobian.transpose() * jacobian;
   const Eigen::VectorXd diagonal = information.diagonal();
   for (int i = 0; i < diagonal.size(); ++i) {
-    if (!(diagonal(i) > 0.0)) return ColumnName(i, fit_g_sensitivity);
+    if (!(diagonal(i) > 0.0)) return ColumnName(i, columns);
   }
   const Eigen::VectorXd d = diagonal.cwiseSqrt().cwiseInverse();
   const Eigen::MatrixXd scaled = d.asDiagonal() * information * d.asDiagonal();
@@ -258,7 +362,7 @@ std::string Covariance(const Eigen::MatrixXd& jacobian, bool fit_g_sensitivity, 
   if (!(eigen.eigenvalues()(0) > kRankTolerance * eigen.eigenvalues().maxCoeff())) {
     Eigen::Index largest = 0;
     eigen.eigenvectors().col(0).cwiseAbs().maxCoeff(&largest);
-    return ColumnName(static_cast<int>(largest), fit_g_sensitivity);
+    return ColumnName(static_cast<int>(largest), columns);
   }
   *covariance = d.asDiagonal() *
                 (eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
@@ -267,58 +371,104 @@ std::string Covariance(const Eigen::MatrixXd& jacobian, bool fit_g_sensitivity, 
   return "";
 }
 
-// The 1-sigma of every model parameter from the covariance in q (0 for a held term).
-SensorModel Sigmas(const Eigen::MatrixXd& covariance, const FieldLayout& layout, bool fit_g_sensitivity) {
-  SensorModel sigma{};
-  sigma.basis = TemperatureBasis::Reference();
-  int column = 0;
-  for (int c = 0; c < kGyroCoefficients; ++c) {
-    const bool held = !fit_g_sensitivity && c >= kGSensitivityCoefficient;
-    for (int k = 0; k < FieldLayout::kTerms; ++k) {
-      if (held) continue;
-      const int q = c * FieldLayout::kTerms + k;
-      sigma.gyro[c * kPolynomialTerms + k] = layout.gyro_step[q] * std::sqrt(covariance(column, column));
-      ++column;
+// Each coefficient's covariance over its terms, in the model's units and the fit's basis (4 x 4,
+// zero for terms held), from the covariance in q; `visit(gyro, coefficient, covariance)`.
+template <typename Visit>
+void CoefficientCovariances(const Eigen::MatrixXd& covariance, const FieldProblem& fp, Visit&& visit) {
+  size_t first = 0;
+  while (first < fp.columns.size()) {
+    size_t end = first;
+    while (end < fp.columns.size() && fp.columns[end].gyro == fp.columns[first].gyro &&
+           fp.columns[end].coefficient == fp.columns[first].coefficient) {
+      ++end;
     }
-  }
-  for (int f = 0; f < FieldLayout::kAccelFree; ++f) {
-    for (int k = 0; k < FieldLayout::kTerms; ++k, ++column) {
-      sigma.accel[FieldLayout::kAccelFreeCoefficient[f] * kPolynomialTerms + k] =
-          layout.accel_step[f * FieldLayout::kTerms + k] * std::sqrt(covariance(column, column));
+    Eigen::Matrix4d c = Eigen::Matrix4d::Zero();
+    for (size_t i = first; i < end; ++i) {
+      for (size_t j = first; j < end; ++j) {
+        const FieldColumn& a = fp.columns[i];
+        const FieldColumn& b = fp.columns[j];
+        const double step_a = a.gyro ? fp.layout.gyro_step[a.q] : fp.layout.accel_step[a.q];
+        const double step_b = b.gyro ? fp.layout.gyro_step[b.q] : fp.layout.accel_step[b.q];
+        c(a.term, b.term) =
+            step_a * step_b * covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+      }
     }
+    visit(fp.columns[first].gyro, fp.columns[first].coefficient, c);
+    first = end;
   }
-  return sigma;
 }
 
-// Coefficients the session fixes too loosely to be of use, in plain words.
-std::vector<std::string> LooseCoefficients(const SensorModel& model, const SensorModel& sigma,
-                                           const FieldFitOptions& options) {
+// The 1-sigma of every model parameter in powers of dT (0 for a held term), and of each
+// coefficient's value at the coldest and warmest pose, from the covariance in q.
+void Sigmas(const Eigen::MatrixXd& covariance, const FieldProblem& fp,
+            const std::array<double, 2>& pose_temps_c, FieldFitSummary* summary) {
+  const Eigen::Matrix4d rebase = RebaseTemperaturePolynomial(fp.layout.basis, TemperatureBasis::Reference());
+  for (SensorModel* sigma : {&summary->sigma, &summary->sigma_at_low, &summary->sigma_at_high}) {
+    *sigma = SensorModel{};
+    sigma->basis = TemperatureBasis::Reference();
+  }
+  CoefficientCovariances(covariance, fp, [&](bool gyro, int coefficient, const Eigen::Matrix4d& c) {
+    const Eigen::Matrix4d reference = rebase * c * rebase.transpose();
+    const int i = coefficient * kPolynomialTerms;
+    const auto at = [&](double temp_c) {
+      const double x = fp.layout.basis.Argument(temp_c);
+      const Eigen::Vector4d powers(1.0, x, x * x, x * x * x);
+      return std::sqrt(std::max(0.0, powers.dot(c * powers)));
+    };
+    for (int k = 0; k < kPolynomialTerms; ++k) {
+      (gyro ? summary->sigma.gyro.data() : summary->sigma.accel.data())[i + k] =
+          std::sqrt(std::max(0.0, reference(k, k)));
+    }
+    (gyro ? summary->sigma_at_low.gyro.data() : summary->sigma_at_low.accel.data())[i] = at(pose_temps_c[0]);
+    (gyro ? summary->sigma_at_high.gyro.data() : summary->sigma_at_high.accel.data())[i] =
+        at(pose_temps_c[1]);
+  });
+}
+
+// Coefficients the session fixes too loosely to be of use (their sigma at the coldest or warmest
+// pose), in plain words.
+std::vector<std::string> LooseCoefficients(const FieldFitSummary& fit, const FieldFitOptions& options) {
   std::vector<std::string> loose;
   const char* axes = "xyz";
+  // The larger of a coefficient's sigmas at the two ends, and where.
+  const auto worst = [&](bool gyro, int coefficient, double* temp_c) {
+    const int i = coefficient * kPolynomialTerms;
+    const double low = (gyro ? fit.sigma_at_low.gyro.data() : fit.sigma_at_low.accel.data())[i];
+    const double high = (gyro ? fit.sigma_at_high.gyro.data() : fit.sigma_at_high.accel.data())[i];
+    *temp_c = low >= high ? fit.pose_temp_range_c[0] : fit.pose_temp_range_c[1];
+    return std::max(low, high);
+  };
+  const bool over_temperature = fit.pose_temp_range_c[1] > fit.pose_temp_range_c[0] &&
+                                (options.bias_temp_order > 0 || options.scale_temp_order > 0);
+  const auto at = [&](double temp_c) {
+    return over_temperature ? Format(" at %.4g degC", temp_c) : std::string();
+  };
   for (int axis = 0; axis < 3; ++axis) {
-    const int i = (kScaleCoefficient + axis) * kPolynomialTerms;
-    if (sigma.gyro[i] > options.max_relative_scale_sigma * std::abs(model.gyro[i])) {
-      loose.push_back(std::string("turns about ") + axes[axis] + " too small to fix the gyro's " +
-                      axes[axis] + " scale" +
-                      Format(" (1 sigma %.2g %%)", 100.0 * sigma.gyro[i] / std::abs(model.gyro[i])));
-    }
-    if (sigma.accel[i] > options.max_relative_scale_sigma * std::abs(model.accel[i])) {
-      loose.push_back(std::string("poses too few or too close together to fix the accelerometer's ") +
-                      axes[axis] + " scale" +
-                      Format(" (1 sigma %.2g %%)", 100.0 * sigma.accel[i] / std::abs(model.accel[i])));
+    const int c = kScaleCoefficient + axis;
+    double temp_c = 0.0;
+    for (const bool gyro : {true, false}) {
+      const double sigma = worst(gyro, c, &temp_c);
+      const double* p = (gyro ? fit.model.gyro.data() : fit.model.accel.data()) + c * kPolynomialTerms;
+      const double scale = std::abs(EvaluateTemperaturePolynomial(p, temp_c - kReferenceTempC));
+      if (sigma <= options.max_relative_scale_sigma * scale) continue;
+      loose.push_back(std::string(gyro ? "turns about "
+                                       : "poses too few or too close together to fix the accelerometer's ") +
+                      (gyro ? std::string(1, axes[axis]) + " too small to fix the gyro's " : std::string()) +
+                      axes[axis] + " scale" + Format(" (1 sigma %.2g %%", 100.0 * sigma / scale) +
+                      at(temp_c) + ")");
     }
   }
   for (int m = 0; m < 6; ++m) {
     const int c = kMisalignmentCoefficient + m;
-    const int i = c * kPolynomialTerms;
-    if (sigma.gyro[i] > options.max_misalignment_sigma_rad) {
+    double temp_c = 0.0;
+    if (const double sigma = worst(true, c, &temp_c); sigma > options.max_misalignment_sigma_rad) {
       loose.push_back(std::string("turns too few or too small to fix the gyro's misalignment ") +
-                      kCoefficientNames[c].axis + Format(" (1 sigma %.2g mrad)", 1e3 * sigma.gyro[i]));
+                      kCoefficientNames[c].axis + Format(" (1 sigma %.2g mrad)", 1e3 * sigma));
     }
-    if (sigma.accel[i] > options.max_misalignment_sigma_rad) {
+    if (const double sigma = worst(false, c, &temp_c); sigma > options.max_misalignment_sigma_rad) {
       loose.push_back(
           std::string("poses too few or too close together to fix the accelerometer's misalignment ") +
-          kCoefficientNames[c].axis + Format(" (1 sigma %.2g mrad)", 1e3 * sigma.accel[i]));
+          kCoefficientNames[c].axis + Format(" (1 sigma %.2g mrad)", 1e3 * sigma));
     }
   }
   return loose;
@@ -327,11 +477,11 @@ std::vector<std::string> LooseCoefficients(const SensorModel& model, const Senso
 // The residuals in physical units after the fit, and each pose's and turn's own figures.
 void Residuals(const FieldProblem& fp, const std::vector<std::vector<TurnSample>>& turn_samples,
                const FieldFitOptions& options, FieldFitSummary* summary) {
-  const UnitCoefficients<double> c = summary->model.CoefficientsAtTemperature(25.0);
   double accel_sum = 0.0;
   double gyro_sum = 0.0;
   for (size_t p = 0; p < summary->poses.size(); ++p) {
     FieldPose& pose = summary->poses[p];
+    const UnitCoefficients<double> c = summary->model.CoefficientsAtTemperature(pose.temp_c);
     Eigen::Vector3d omega_hat;
     Eigen::Vector3d a_hat;
     CorrectWith(c, pose.gyro_mean, pose.accel_mean, &omega_hat, &a_hat);
@@ -344,6 +494,8 @@ void Residuals(const FieldProblem& fp, const std::vector<std::vector<TurnSample>
   int fitted_turns = 0;
   for (size_t t = 0; t < summary->turns.size(); ++t) {
     FieldTurn& turn = summary->turns[t];
+    const UnitCoefficients<double> c = summary->model.CoefficientsAtTemperature(
+        0.5 * (summary->poses[turn.from].temp_c + summary->poses[turn.to].temp_c));
     const auto up_of = [&](int pose) {
       Eigen::Vector3d omega_hat;
       Eigen::Vector3d a_hat;
@@ -413,8 +565,7 @@ bool Solve(const FieldFitOptions& options, FieldProblem* fp, FieldFitSummary* su
     Eigen::VectorXd residuals;
     std::array<int, 4> group_rows{};
     const Eigen::MatrixXd jacobian = Jacobian(fp, &residuals, &group_rows);
-    if (const std::string missing = Covariance(jacobian, options.fit_g_sensitivity, covariance);
-        !missing.empty()) {
+    if (const std::string missing = Covariance(jacobian, fp->columns, covariance); !missing.empty()) {
       summary->status = FieldFitStatus::kUndetermined;
       summary->undetermined.push_back("the session holds no information on the " + missing);
       return false;
@@ -470,8 +621,38 @@ std::string FieldFitSummary::BriefReport() const {
               : "");
 }
 
-FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options) {
-  IMUFIT_CHECK(options.Validate().empty(), "FieldFitOptions::Validate() first");
+FieldRepeatability CompareFieldFits(const FieldFitSummary& first, const FieldFitSummary& second) {
+  FieldRepeatability out;
+  double sum_z2 = 0.0;
+  for (const bool gyro : {true, false}) {
+    const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
+    for (int c = 0; c < coefficients; ++c) {
+      const int i = c * kPolynomialTerms;
+      const double sigma_a = (gyro ? first.sigma.gyro.data() : first.sigma.accel.data())[i];
+      const double sigma_b = (gyro ? second.sigma.gyro.data() : second.sigma.accel.data())[i];
+      if (!(sigma_a > 0.0 && sigma_b > 0.0)) continue;  // held in either
+      FieldCoefficientDifference d;
+      d.gyro = gyro;
+      d.coefficient = c;
+      d.difference = (gyro ? second.model.gyro.data() : second.model.accel.data())[i] -
+                     (gyro ? first.model.gyro.data() : first.model.accel.data())[i];
+      d.combined_sigma = std::hypot(sigma_a, sigma_b);
+      d.z = d.difference / d.combined_sigma;
+      sum_z2 += d.z * d.z;
+      out.differences.push_back(d);
+      if (std::abs(d.z) > FieldRepeatability::kFieldRepeatZ) out.beyond.push_back(d);
+    }
+  }
+  if (!out.differences.empty()) out.z_rms = std::sqrt(sum_z2 / static_cast<double>(out.differences.size()));
+  return out;
+}
+
+FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& given) {
+  IMUFIT_CHECK(given.Validate().empty(), "FieldFitOptions::Validate() first");
+  FieldFitOptions options = given;  // gravity resolved once: every stage reads gravity_mps2
+  options.gravity_mps2 = given.GravityMps2();
+  options.latitude_deg.reset();
+  options.height_m = 0.0;
   FieldFitSummary summary;
   FindFieldPoses(samples, options, &summary.poses, &summary.turns, &summary.gyro_noise_raw,
                  &summary.accel_noise_raw);
@@ -491,6 +672,14 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
   TurnSets turns = SplitTurns(samples, summary.turns);
   const SensorModel start = FieldStart(summary.poses, turns.fitted, turns.fitted_samples, options);
   summary.undetermined = CoverageProblems(summary.poses, turns.fitted, turns.fitted_samples, start, options);
+  for (std::string& problem :
+       TemperatureProblems(summary.poses, turns.fitted, turns.fitted_samples, start, options)) {
+    summary.undetermined.push_back(std::move(problem));
+  }
+  const auto [coldest, warmest] =
+      std::minmax_element(summary.poses.begin(), summary.poses.end(),
+                          [](const FieldPose& a, const FieldPose& b) { return a.temp_c < b.temp_c; });
+  summary.pose_temp_range_c = {coldest->temp_c, warmest->temp_c};
   if (!summary.undetermined.empty()) {
     summary.status = FieldFitStatus::kUndetermined;
     return summary;
@@ -501,15 +690,14 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
   Eigen::MatrixXd covariance;
   if (!Solve(options, &fp, &summary, &covariance)) return summary;
   summary.model = fp.Model();
-  summary.model.basis = TemperatureBasis::Reference();
-  summary.sigma = Sigmas(covariance, fp.layout, options.fit_g_sensitivity);
+  Sigmas(covariance, fp, summary.pose_temp_range_c, &summary);
   if (!AllFinite(summary.model) || !AllFinite(summary.sigma)) {  // never written: docs/spec.md section 4
     summary.status = FieldFitStatus::kFailed;
     summary.termination = "the solution or its covariance is not finite";
     return summary;
   }
   Residuals(fp, turns.all_samples, options, &summary);
-  summary.undetermined = LooseCoefficients(summary.model, summary.sigma, options);
+  summary.undetermined = LooseCoefficients(summary, options);
   summary.status = summary.undetermined.empty() ? FieldFitStatus::kConverged : FieldFitStatus::kUndetermined;
   return summary;
 }

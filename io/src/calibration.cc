@@ -20,7 +20,7 @@ namespace {
 
 constexpr const char* kKnownKeys[] = {
     "format", "version", "serial", "created_utc", "software", "reference_temp_c", "fit_temp_range_c", "gyro",
-    "accel",  "sigma",   "fit",    "check",       "noise"};
+    "accel",  "sigma",   "fit",    "check",       "noise",    "body_frame"};
 
 // One sensor's coefficient tree (bias, scale, misalignment[, g_sensitivity]), each coefficient a
 // list c0..c3 on one line.
@@ -179,6 +179,13 @@ Calibration ReadCalibration(const std::string& path) {
   if (root.Has("fit")) calibration.fit = ReadFitRecord(root["fit"]);
   if (root.Has("check")) calibration.check = ReadCheckRecord(root["check"]);
   if (root.Has("noise")) calibration.noise = ReadNoiseRecord(root["noise"]);
+  if (root.Has("body_frame")) {
+    calibration.body_frame = root["body_frame"].String();
+    if (*calibration.body_frame != kBodyFrameAccelerometerXy) {
+      root["body_frame"].Fail(QuoteForMessage(*calibration.body_frame) +
+                              " is not a body frame imufit knows (" + kBodyFrameAccelerometerXy + ")");
+    }
+  }
   calibration.extra = YAML::Node(YAML::NodeType::Map);
   for (const auto& entry : root_node) {
     const std::string& key = entry.first.Scalar();
@@ -214,10 +221,11 @@ MachineDoc CalibrationDoc(const Calibration& calibration) {
   if (calibration.fit) doc.Add("fit", FitRecordDoc(*calibration.fit));
   if (calibration.check) doc.Add("check", CheckRecordDoc(*calibration.check));
   if (calibration.noise) doc.Add("noise", NoiseDoc(*calibration.noise));
+  if (calibration.body_frame) doc.Add("body_frame", MachineDoc::Text(*calibration.body_frame));
   if (calibration.extra.IsMap()) {
     for (const auto& entry : calibration.extra) {
       const std::string& key = entry.first.Scalar();
-      IMUFIT_CHECK(key != "fit" && key != "check" && key != "noise",
+      IMUFIT_CHECK(key != "fit" && key != "check" && key != "noise" && key != "body_frame",
                    "the records are written from their typed members");
       doc.Add(key, MachineDocOfYaml(entry.second));
     }

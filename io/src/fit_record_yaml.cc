@@ -26,6 +26,11 @@ void VisitFitRecord(Record& record, Visit&& visit) {
 }
 
 template <typename Record, typename Visit>
+void VisitFieldRecord(Record& record, Visit&& visit) {
+  IMUFIT_FIELD_RECORD_FIELDS(IMUFIT_RECORD_VISIT)
+}
+
+template <typename Record, typename Visit>
 void VisitCheckRecord(Record& record, Visit&& visit) {
   IMUFIT_CHECK_RECORD_FIELDS(IMUFIT_RECORD_VISIT)
 }
@@ -45,6 +50,7 @@ MachineDoc ValueDoc(const std::vector<double>& values) {
 }
 MachineDoc ValueDoc(const std::vector<int>& values) { return MachineDoc::Integers(values); }
 MachineDoc ValueDoc(const std::vector<std::string>& values) { return MachineDoc::Texts(values); }
+MachineDoc ValueDoc(const FieldRecord& record);  // a block of its own, below
 
 template <typename Record, typename VisitRecord>
 MachineDoc RecordDoc(const Record& record, VisitRecord visit_record) {
@@ -101,6 +107,8 @@ void Get(const yaml::Located& value, std::vector<T>* out) {
   }
 }
 
+void Get(const yaml::Located& value, FieldRecord* out);  // a block of its own, below
+
 template <typename Record, typename VisitRecord>
 Record ReadRecord(const yaml::Located& block, VisitRecord visit_record) {
   block.RequireMap();
@@ -119,6 +127,14 @@ Record ReadRecord(const yaml::Located& block, VisitRecord visit_record) {
     record.extra.force_insert(entry.first, entry.second);
   }
   return record;
+}
+
+MachineDoc ValueDoc(const FieldRecord& record) {
+  return RecordDoc(record, [](const FieldRecord& r, auto&& visit) { VisitFieldRecord(r, visit); });
+}
+
+void Get(const yaml::Located& value, FieldRecord* out) {
+  *out = ReadRecord<FieldRecord>(value, [](FieldRecord& r, auto&& visit) { VisitFieldRecord(r, visit); });
 }
 
 // The coefficient groups a fit estimates or holds, as the record names them: "gyro.bias", ...,

@@ -1,5 +1,7 @@
 #include "imufit/pipeline/field_run.h"
 
+#include <algorithm>
+
 #include "imufit/io/run_header.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
@@ -8,23 +10,23 @@
 namespace imufit {
 namespace {
 
-// The session's own figures, under `fit: field:` (kept by every reader as an unknown key).
-YAML::Node FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& options) {
-  YAML::Node field;
-  field["poses"] = static_cast<int>(fit.poses.size());
-  field["turns"] = static_cast<int>(fit.turns.size());
-  field["gravity_mps2"] = options.gravity_mps2;
-  field["accel_norm_rms_mps2"] = fit.accel_norm_rms_mps2;
-  field["gyro_static_rms_radps"] = fit.gyro_static_rms_radps;
-  field["gravity_direction_rms_rad"] = fit.direction_rms_rad;
-  field["reduced_chi2"] = fit.reduced_chi2;
+// The session's own figures, the `fit: field:` block.
+FieldRecord FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& options) {
+  FieldRecord field;
+  field.poses = static_cast<int>(fit.poses.size());
+  field.turns = static_cast<int>(fit.turns.size());
+  field.gravity_mps2 = options.GravityMps2();
+  field.accel_norm_rms_mps2 = fit.accel_norm_rms_mps2;
+  field.gyro_static_rms_radps = fit.gyro_static_rms_radps;
+  field.gravity_direction_rms_rad = fit.direction_rms_rad;
+  field.reduced_chi2 = fit.reduced_chi2;
   // The noise of the rests (accelerometer, gyro) and the turns as multiples of the log's white noise.
-  field["noise_scale_accel_rests"] = fit.noise_scale[0];
-  field["noise_scale_gyro_rests"] = fit.noise_scale[1];
-  field["noise_scale_turns"] = fit.noise_scale[2];
+  field.noise_scale_accel_rests = fit.noise_scale[0];
+  field.noise_scale_gyro_rests = fit.noise_scale[1];
+  field.noise_scale_turns = fit.noise_scale[2];
   int saturated = 0;
   for (const FieldTurn& turn : fit.turns) saturated += turn.saturated ? 1 : 0;
-  field["saturated_turns"] = saturated;
+  field.saturated_turns = saturated;
   return field;
 }
 
@@ -41,8 +43,8 @@ Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& 
   record.termination = fit.termination;
   record.gyro_residual_rms_radps = fit.gyro_static_rms_radps;
   record.accel_residual_rms_mps2 = fit.accel_norm_rms_mps2;
-  record.gyro_temp_order = 0;
-  record.accel_temp_order = 0;
+  record.gyro_temp_order = std::max(options.bias_temp_order, options.scale_temp_order);
+  record.accel_temp_order = record.gyro_temp_order;
   record.g_sensitivity_fitted = options.fit_g_sensitivity;
   record.fitted = std::vector<std::string>{"gyro.bias",  "gyro.scale",  "gyro.misalignment",
                                            "accel.bias", "accel.scale", "accel.misalignment"};
@@ -52,9 +54,9 @@ Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& 
     record.held->push_back("gyro.g_sensitivity");
     record.held_values = "scale 1, others 0";
   }
-  record.extra["field"] = FieldFigures(fit, options);
+  record.field = FieldFigures(fit, options);
   calibration.fit = record;
-  calibration.extra["body_frame"] = kBodyFrameConvention;
+  calibration.body_frame = kBodyFrameAccelerometerXy;
   return calibration;
 }
 

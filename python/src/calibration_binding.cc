@@ -264,6 +264,12 @@ void WriteSamples(const py::object& path, const py::dict& samples, const std::st
 void BindFitRecords(py::module_& m) {
 #define IMUFIT_RECORD_ATTRIBUTE(type, key, description) .def_readonly(#key, &Record::key, description)
   {
+    using Record = FieldRecord;
+    py::class_<Record>(m, "FieldRecord",
+                       "A calibration by hand (`imufit fit --field`): the session's own figures, the `fit: "
+                       "field:` block.") IMUFIT_FIELD_RECORD_FIELDS(IMUFIT_RECORD_ATTRIBUTE);
+  }
+  {
     using Record = FitRecord;
     py::class_<Record>(m, "FitRecord",
                        "What the fit did and on which files: the calibration's `fit:` block, each key an "
@@ -297,6 +303,10 @@ void BindCalibrationFile(py::class_<Calibration>& c) {
       .def_readwrite("serial", &Calibration::serial)
       .def_readwrite("created_utc", &Calibration::created_utc)
       .def_readwrite("software", &Calibration::software)
+      .def_readwrite(
+          "body_frame", &Calibration::body_frame,
+          "The body frame's convention of a calibration by hand ('accelerometer_xy'), or None: the "
+          "axes of the table's fixture.")
       .def_property(
           "fit_temp_range_c",
           [](const Calibration& c) { return py::make_tuple(c.fit_temp_range_c[0], c.fit_temp_range_c[1]); },

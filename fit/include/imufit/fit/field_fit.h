@@ -26,7 +26,8 @@
 //     Earth's rotation (at most 7.3e-5 rad/s) is not modelled: the session has no north.
 //  4. The body frame. Without a table it is a convention (docs/spec.md section 1, "field
 //     calibration"): x along the accelerometer's x axis, y in the plane of its x and y axes, so the
-//     accelerometer's misalignment xy, xz and yz are held at 0 (kBodyFrameConvention).
+//     accelerometer's misalignment xy, xz and yz are held at 0 (the body frame `accelerometer_xy`,
+//     io/calibration.h).
 //  5. Uncertainty. Every residual is normalised by its noise, so the covariance of the
 //     coefficients is (J^T J)^-1 at the solution; `sigma` holds its square roots (0 for a held
 //     term). Where a group of residuals (accelerometer at rest, gyro at rest, turns) is larger than
@@ -41,6 +42,7 @@
 #define IMUFIT_FIT_FIELD_FIT_H_
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,14 +56,16 @@
 
 namespace imufit {
 
-// The body frame of a field calibration, as the calibration file's `body_frame:` key states it.
-inline constexpr const char* kBodyFrameConvention = "accelerometer_xy";
 // The accelerometer's misalignment terms the convention holds at 0 (indices into its 6).
 inline constexpr int kFieldHeldAccelMisalignment[3] = {0, 1, 3};  // xy, xz, yz
 
 struct FieldFitOptions {
   // Local gravity, m/s^2: the length every pose's corrected specific force must have.
   double gravity_mps2 = kStandardGravityMps2;
+  // Or local gravity from the site (model/local_gravity.h: WGS-84 normal gravity): geodetic
+  // latitude, degrees, and height above the ellipsoid, m. Not together with gravity_mps2.
+  std::optional<double> latitude_deg;
+  double height_m = 0.0;
   // How rests are told from motion (window, noise quantile, threshold): the segmentation's.
   SegmentationOptions detection;
   // A steady stretch shorter than this is not a pose, s.
@@ -70,6 +74,16 @@ struct FieldFitOptions {
   int min_poses = 9;
   // Whether the gyro g-sensitivity H is fitted (else held at 0).
   bool fit_g_sensitivity = true;
+  // Over temperature (a warm-up, or several sessions at different temperatures): the order of the
+  // polynomials in temperature of the biases (gyro and accelerometer) and of the scale factors
+  // (gyro and accelerometer), 0..3. Misalignments and H stay constant. 0: one temperature.
+  int bias_temp_order = 0;
+  int scale_temp_order = 0;
+  // A bias in temperature needs its poses to span this much, degC, and order + 1 of them at least
+  // kDistinctTempC apart; a scale factor in temperature needs this span, and in the coldest and
+  // warmest third of it a pose near each of the six directions and turns about each axis.
+  double min_bias_temp_span_c = 2.0;
+  double min_scale_temp_span_c = 10.0;
   // A pose is "near" a direction (+x, -x, ...) within this angle, degrees: every one of the six must
   // have one, or the accelerometer's scale and bias of that axis rest on one side only.
   double near_direction_deg = 50.0;
@@ -83,7 +97,13 @@ struct FieldFitOptions {
 
   // An empty string when usable, else what is wrong.
   std::string Validate() const;
+  // The gravity the fit uses: from latitude_deg and height_m when latitude_deg is set, else
+  // gravity_mps2.
+  double GravityMps2() const;
 };
+
+// Two poses' temperatures count as distinct when this far apart, degC.
+inline constexpr double kDistinctTempC = 0.5;
 
 // The options a user sets (gravity_mps2, min_pose_s), described once (base/option_table.h;
 // field_fit_options.cc): `imufit fit --field` takes them from here.
@@ -134,7 +154,12 @@ struct FieldFitSummary {
   std::vector<FieldTurn> turns;
   SensorModel model = SensorModel::Identity();  // basis: TemperatureBasis::Reference()
   SensorModel sigma{};                          // 1-sigma, same layout; 0 for a held term
-  std::array<double, 2> temp_range_c{0.0, 0.0};
+  // 1-sigma of each coefficient's value at the coldest and the warmest pose (at order 0, sigma's
+  // c0): what a user reads off the curve, which the terms' sigmas alone do not give.
+  SensorModel sigma_at_low{};
+  SensorModel sigma_at_high{};
+  std::array<double, 2> temp_range_c{0.0, 0.0};       // of the samples, degC
+  std::array<double, 2> pose_temp_range_c{0.0, 0.0};  // of the poses' mean readings, degC
   int iterations = -1;
   std::string termination;
   // Noise of one sample, raw, per axis (the log's floor, pooled over the poses).
@@ -160,6 +185,27 @@ struct FieldFitSummary {
 
 // Fits the model to a session by hand, `samples` in time order (raw; temp_c as read).
 FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options);
+
+// Two sessions of one unit compared (`imufit fit --field --repeat`): for every coefficient both
+// fitted, the difference of their values at 25 degC (c0) against the combined 1-sigma of two
+// independent sessions, sqrt(sigma_a^2 + sigma_b^2). A hand procedure that is repeatable gives
+// differences of about one combined sigma (z RMS near 1); a larger z names what the procedure does
+// not reproduce (a pose held by hand that moved, a turn too fast for the gyro's range, ...).
+struct FieldCoefficientDifference {
+  bool gyro = true;
+  int coefficient = 0;      // the model's index (model/sensor_model.h)
+  double difference = 0.0;  // second - first, SI
+  double combined_sigma = 0.0;
+  double z = 0.0;  // difference / combined_sigma
+};
+struct FieldRepeatability {
+  std::vector<FieldCoefficientDifference> differences;
+  double z_rms = 0.0;
+  // The threshold beyond which a difference is named (|z| > kFieldRepeatZ: by chance once in 370).
+  static constexpr double kFieldRepeatZ = 3.0;
+  std::vector<FieldCoefficientDifference> beyond;
+};
+FieldRepeatability CompareFieldFits(const FieldFitSummary& first, const FieldFitSummary& second);
 
 // Step 1 alone: the poses and turns of a session (their means; `up` and the errors not set) and the
 // noise floor. Poses the session lacks are reported by FitField, not here.

@@ -28,11 +28,18 @@ namespace imufit {
 
 inline constexpr int kCalibrationFormatVersion = 1;
 
+// The body frames a calibration may state (docs/spec.md section 1): x along the accelerometer's x
+// axis, y in the plane of its x and y axes.
+inline constexpr const char* kBodyFrameAccelerometerXy = "accelerometer_xy";
+
 struct Calibration {
   std::string serial;
   std::string created_utc;  // ISO 8601, e.g. "2026-11-22T06:00:00Z"
   std::string software;     // e.g. "imufit 0.1.0"
   std::array<double, 2> fit_temp_range_c{-40.0, 85.0};
+  // The body frame's convention (`body_frame:`): a calibration by hand states kBodyFrameAccelerometerXy;
+  // absent, the axes of the table's fixture.
+  std::optional<std::string> body_frame;
   // The coefficients, in powers of x = T - reference_temp_c (basis.center_c; half_range_c = 1).
   // imufit writes reference_temp_c = 25 degC; a reader honours whatever the file states.
   SensorModel model;
@@ -44,7 +51,7 @@ struct Calibration {
   // The unit's noise figures (`noise:`, appended from `imufit allan --noise-yaml`: noise_file.h).
   std::optional<NoiseRecord> noise;
   // Further top-level keys: a YAML map, written after the records; on reading, every key this
-  // reader does not know. Holds no `fit`, `check` or `noise` key.
+  // reader does not know. Holds no `fit`, `check`, `noise` or `body_frame` key.
   YAML::Node extra;
 };
 

@@ -56,7 +56,24 @@
   X(double, bias_correlation_s, "correlation time of that bias wander, s")                              \
   X(std::vector<int>, segments_without_windows, "plan segments without a single usable window")         \
   X(int, missing_segments, "how many segments that is")                                                 \
-  X(std::string, inconsistent, "written with --write-inconsistent: why the fit is inconsistent")
+  X(std::string, inconsistent, "written with --write-inconsistent: why the fit is inconsistent")        \
+  X(FieldRecord, field, "a calibration by hand (fit --field): the session's own figures")
+
+// X(type, key, description): the `fit: field:` block of a calibration by hand (fit --field,
+// docs/field.md): the session's own figures.
+#define IMUFIT_FIELD_RECORD_FIELDS(X)                                                               \
+  X(int, poses, "rests the fit used")                                                               \
+  X(int, turns, "turns between them the fit used")                                                  \
+  X(double, gravity_mps2, "the local gravity the fit used, m/s^2")                                  \
+  X(double, accel_norm_rms_mps2, "RMS over the rests of |a| - g after correction, m/s^2")           \
+  X(double, gyro_static_rms_radps, "RMS of the corrected gyro at rest, over rests and axes, rad/s") \
+  X(double, gravity_direction_rms_rad, "RMS over the turns of the gravity direction's error, rad")  \
+  X(double, reduced_chi2, "reduced chi-square of the weighted residuals")                           \
+  X(double, noise_scale_accel_rests,                                                                \
+    "the rests' accelerometer noise as a multiple of the log's white noise")                        \
+  X(double, noise_scale_gyro_rests, "the rests' gyro noise as a multiple of the log's white noise") \
+  X(double, noise_scale_turns, "the turns' noise as a multiple of the log's white noise")           \
+  X(int, saturated_turns, "turns left out because a gyro axis touched its converter's rail")
 
 // X(type, key, description): the `check:` block, with `imufit fit --check-samples`.
 #define IMUFIT_CHECK_RECORD_FIELDS(X)                                      \
@@ -67,6 +84,11 @@
 #define IMUFIT_RECORD_MEMBER(type, key, description) std::optional<type> key;
 
 namespace imufit {
+
+struct FieldRecord {
+  IMUFIT_FIELD_RECORD_FIELDS(IMUFIT_RECORD_MEMBER)
+  YAML::Node extra;
+};
 
 struct FitRecord {
   IMUFIT_FIT_RECORD_FIELDS(IMUFIT_RECORD_MEMBER)

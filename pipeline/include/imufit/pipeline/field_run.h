@@ -1,6 +1,6 @@
 // imufit — a session by hand fitted as one call (`imufit fit --field`, docs/field.md): the samples
 // file read whole (the turns are integrated sample by sample), the field fit (fit/field_fit.h), and
-// the calibration it gives, in the body frame of kBodyFrameConvention (docs/spec.md section 1).
+// the calibration it gives, in the body frame of kBodyFrameAccelerometerXy (docs/spec.md section 1).
 //
 // The calibration holds the coefficients at order 0 in temperature (the fit's), their sigmas (0 for
 // the accelerometer misalignments the body frame holds), `fit_temp_range_c` the readings' range, a
