@@ -80,7 +80,9 @@ int RunBatchCommand(const BatchArguments& args) {
                   u.verdict ? u.VerdictText() : u.StatusText(), u.message.empty() ? "" : ": ",
                   u.message.c_str());
     }
-    if (result.complete) std::printf("  wrote %s/lot_summary.csv\n", options.output_dir.c_str());
+    // A shard writes no lot summary (the store holds the lot: imufit lot, imufit history --lot).
+    if (result.complete && options.shard.count == 1)
+      std::printf("  wrote %s/lot_summary.csv\n", options.output_dir.c_str());
   }
   if (!result.complete) {
     std::fprintf(stderr, "imufit batch: stopped after --max-units %d; run again to finish the lot\n",

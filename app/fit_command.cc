@@ -107,7 +107,9 @@ FitRunOptions ResolveOptions(const FitArguments& args) {
   FitRunOptions options = args.run.Resolve();
   options.software = SoftwareVersion();
   options.serial = args.serial;
-  options.keep_static_stretch = !args.report.empty();  // the certificate's noise section
+  // The certificate's noise section: measured whenever the unit is judged (CertifyUnit judges
+  // through the certificate with a report, limits or a store, whether its page is written or not).
+  options.keep_static_stretch = !args.report.empty() || !args.limits.empty() || !args.store.empty();
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit", problem);
   return options;
@@ -122,6 +124,7 @@ CertifySettings ReadFactoryInputs(const FitArguments& args, const FitRunOptions&
   settings.windows = options.windows;
   settings.samples_input = options.input;
   ReadLimitsAndStation(args.limits, args.station, &settings);
+  settings.fit_options = options.Describe();
   settings.customer = args.customer.customer;
   settings.order = args.customer.order;
   if (!args.store.empty()) {
@@ -164,6 +167,10 @@ void PrintFit(const FitRunOptions& options, const FitRunResult& result) {
       "  run: %lld samples, %d windows, %.1f .. %.1f degC; %lld samples in transitions, %lld trimmed\n",
       stats.samples, fit.windows_used, fit.temp_range_c[0], fit.temp_range_c[1], stats.transition_samples,
       stats.trimmed_samples);
+  if (stats.short_samples + stats.saturated_samples + stats.gap_turn_samples > 0) {
+    // Besides the transitions and the trim: every sample the windows left out, with its reason.
+    std::printf("  left out of the windows: %s\n", LeftOutNote(stats, options.windows).c_str());
+  }
   if (const std::string note = TimeStampNote(stats); !note.empty()) {
     std::printf("  time stamps: %s\n", note.c_str());
   }
@@ -253,9 +260,6 @@ int RunFit(const FitArguments& args) {
     RefuseToOverwriteInputs(args.report, {args.plan, args.samples, check_plan, check_samples, args.limits,
                                           args.output, args.station});
   }
-  if (!args.station.empty() && args.report.empty()) {
-    throw InputError("--station", "is shown on the certificate: give --report too");
-  }
   if (args.pdf.pdf && args.report.empty())
     throw InputError("--pdf", "prints the certificate: give --report too");
   if ((!args.customer.customer.empty() || !args.customer.order.empty()) && args.report.empty())
@@ -329,9 +333,10 @@ CommandRunner AddFitCommand(CliCommand command) {
   command.Option("--report", &args->report, "write the unit's calibration certificate (self-contained HTML)");
   AddPdfOptions(command, &args->pdf);
   AddCustomerOptions(command, &args->customer);
-  command.Option(
-      "--station", &args->station,
-      "station file (format imufit-station: station, operator, equipment) shown on the certificate");
+  command.Option("--station", &args->station,
+                 "station file (format imufit-station: station, operator, equipment, the Type B sources of "
+                 "U) shown on the "
+                 "certificate; its sources are in every U and verdict, with or without --report");
   command.Option(
       "--store", &args->store,
       "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");

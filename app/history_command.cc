@@ -114,19 +114,19 @@ int Trend(const HistoryArguments& args, ResultsStore* store) {
     return 0;
   }
   if (args.csv) {
-    std::printf("time_utc,serial,lot,value,sigma,unit,station\n");
+    std::printf("time_utc,serial,lot,value,sigma,unit,station,U\n");
   } else {
-    std::printf("%s over time:\n%-22s %-16s %-14s %-12s %14s %12s\n", args.trend.c_str(), "time (UTC)",
-                "serial", "lot", "station", "value", "1-sigma");
+    std::printf("%s over time:\n%-22s %-16s %-14s %-12s %14s %12s %12s\n", args.trend.c_str(), "time (UTC)",
+                "serial", "lot", "station", "value", "1-sigma", "U (k = 2)");
   }
   for (const TrendPoint& p : points) {
     if (args.csv) {
-      std::printf("%s,%s,%s,%s,%s,%s,%s\n", p.time_utc.c_str(), p.serial.c_str(), p.lot.c_str(),
+      std::printf("%s,%s,%s,%s,%s,%s,%s,%s\n", p.time_utc.c_str(), p.serial.c_str(), p.lot.c_str(),
                   FormatDouble(p.value).c_str(), FormatDouble(p.sigma).c_str(), p.unit.c_str(),
-                  p.station.c_str());
+                  p.station.c_str(), p.expanded_u >= 0 ? FormatDouble(p.expanded_u).c_str() : "");
     } else {
-      std::printf("%-22s %-16s %-14s %-12s %14.6g %12.3g %s\n", p.time_utc.c_str(), p.serial.c_str(),
-                  p.lot.c_str(), p.station.c_str(), p.value, p.sigma, p.unit.c_str());
+      std::printf("%-22s %-16s %-14s %-12s %14.6g %12.3g %12.3g %s\n", p.time_utc.c_str(), p.serial.c_str(),
+                  p.lot.c_str(), p.station.c_str(), p.value, p.sigma, p.expanded_u, p.unit.c_str());
     }
   }
   if (args.csv) return 0;

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
+#include "imufit/pipeline/fit_run.h"
 #include "imufit/plan/plan_check.h"
 #include "imufit/plan/plan_design.h"
 #include "imufit/plan/plan_prediction.h"
@@ -28,7 +31,23 @@ struct ScheduleArguments {
   std::string limits;
   std::string noise_yaml;
   CliOptions<SimulationOptions> options;  // SimulationOptionTable(): the schedule and the noise
+  CliOptions<FitRunOptions> fit;          // FitRunOptionTable(): the model the fit will estimate
 };
+
+// The options of `imufit fit` that shape the model a plan must determine (what the fit's findings
+// advise: --gyro-temp-order, --fit accel, ...); the solver's own are not a plan's. plan check also
+// takes the fit's --prior (the values a subset holds), so that the fit's command line checks as it
+// is; held values carry no uncertainty, so the prediction does not depend on them.
+const char* const kPlanFitOptions[] = {"fit",
+                                       "gyro_temp_order",
+                                       "accel_temp_order",
+                                       "fit_g_sensitivity",
+                                       "distinct_temp_c",
+                                       "min_excitation_rate_radps",
+                                       "rank_tolerance"};
+
+// Window options plan check takes from `imufit fit` but the full scales (a nominal unit never clips).
+const std::set<std::string> kPlanWindowExceptions = {"gyro_full_scale_raw", "accel_full_scale_raw"};
 
 struct PlanCheckArguments {
   std::string plan;
@@ -68,40 +87,78 @@ Options OptionsOf(const CliOptions<Options>& given, const OptionTable<Options>& 
   return options;
 }
 
-void AddLimitTolerances(const ScheduleArguments& args, PlanCheckOptions* check) {
-  if (!args.limits.empty()) TolerancesFromLimits(ReadLimits(args.limits), &check->tolerances);
+// The limits file's coefficient criteria as tolerances that a plan meets at `min_ratio`:1.
+std::optional<Limits> AddLimitTolerances(const ScheduleArguments& args, PlanCheckOptions* check) {
+  if (args.limits.empty()) return std::nullopt;
+  Limits limits = ReadLimits(args.limits);
+  TolerancesFromLimits(limits, &check->tolerances, check->min_ratio);
+  return limits;
 }
 
 int RunPlanCheck(const PlanCheckArguments& args) {
   const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan check");
   PlanCheckOptions check_options = OptionsOf(args.check, PlanCheckOptionTable(), "imufit plan check");
-  AddLimitTolerances(args.schedule, &check_options);
+  FitOptions fit = OptionsOf(args.schedule.fit, FitRunOptionTable(), "imufit plan check").fit;
+  fit.held.reset();  // read (a bad file is refused), not used: held values carry no uncertainty
+  const std::optional<Limits> limits = AddLimitTolerances(args.schedule, &check_options);
   const Plan plan = ReadPlan(args.plan);
-  const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, FitOptions(), check_options);
-  const std::string text = args.format == "yaml"   ? PlanCheckYaml(check)
-                           : args.format == "json" ? PlanCheckJson(check)
-                                                   : PlanCheckText(check, check_options);
+  const PlanCheck check = CheckPlan(plan.segments, plan.site, schedule, fit, check_options);
+  std::vector<PlanCriterion> criteria;
+  if (limits && check.undetermined.empty()) criteria = JudgeLimits(*limits, check, check_options);
+  const std::string text = args.format == "yaml"   ? PlanCheckYaml(check, criteria)
+                           : args.format == "json" ? PlanCheckJson(check, criteria)
+                                                   : PlanCheckText(check, check_options) +
+                                                         PlanCriteriaText(criteria, check_options);
   std::fputs(text.c_str(), stdout);
   if (!check.undetermined.empty()) {
     std::fprintf(stderr, "imufit: the plan does not determine the model (%zu finding%s)\n",
                  check.undetermined.size(), check.undetermined.size() == 1 ? "" : "s");
     return kExitNotDone;
   }
-  return check.tolerance_unmet ? kExitFailedLimits : kExitDone;
+  const bool unmet =
+      std::any_of(criteria.begin(), criteria.end(), [](const PlanCriterion& c) { return !c.met; });
+  return check.tolerance_unmet || unmet ? kExitFailedLimits : kExitDone;
+}
+
+// The site a designed plan is written for: the candidates' plan's, with the station's gravity
+// (given; else WGS84 normal gravity at the latitude given) and latitude.
+TableSite DesignSite(const Plan& candidates, bool candidates_given, const PlanDesignOptions& options,
+                     std::string* gravity_note) {
+  TableSite site = candidates.site;
+  if (options.check.latitude_deg) site.latitude_rad = *options.check.latitude_deg * kDegToRad;
+  if (options.gravity_mps2) {
+    site.gravity_mps2 = *options.gravity_mps2;
+    *gravity_note = "gravity_mps2: the station's, as given (--gravity-mps2).";
+  } else if (candidates_given) {
+    *gravity_note = "gravity_mps2: the candidates' plan's.";
+  } else if (options.check.latitude_deg) {
+    site.gravity_mps2 = NormalGravityMps2(*options.check.latitude_deg);
+    *gravity_note = "gravity_mps2: WGS84 normal gravity at " + FormatDouble(*options.check.latitude_deg) +
+                    " deg, sea level; replace it by the station's measured gravity (--gravity-mps2).";
+  } else {
+    *gravity_note =
+        "gravity_mps2: standard gravity, no station given: replace it by the station's (--gravity-mps2, "
+        "or --latitude for WGS84 normal gravity), or the fit reads the accelerometer's scale off by their "
+        "ratio.";
+  }
+  return site;
 }
 
 int RunPlanDesign(const PlanDesignArguments& args) {
   const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan design");
   PlanDesignOptions options = OptionsOf(args.design, PlanDesignOptionTable(), "imufit plan design");
+  options.fit = OptionsOf(args.schedule.fit, FitRunOptionTable(), "imufit plan design").fit;
   AddLimitTolerances(args.schedule, &options.check);
   Plan candidates;
   if (!args.candidates.empty()) {
     RefuseToOverwriteInputs(args.output, {args.candidates});
     candidates = ReadPlan(args.candidates);
   }
+  std::string gravity_note;
+  const TableSite site = DesignSite(candidates, !args.candidates.empty(), options, &gravity_note);
   PlanDesign design;
   try {
-    design = DesignPlan(candidates.segments, candidates.site, schedule, options);
+    design = DesignPlan(candidates.segments, site, schedule, options);
   } catch (const std::invalid_argument& e) {
     throw InputError("imufit plan design", e.what());
   }
@@ -112,8 +169,7 @@ int RunPlanDesign(const PlanDesignArguments& args) {
   }
   if (!design.met) return kExitFailedLimits;
   Plan plan;
-  plan.site = candidates.site;
-  if (options.check.latitude_deg) plan.site.latitude_rad = *options.check.latitude_deg * kDegToRad;
+  plan.site = site;
   plan.segments = design.segments;
   std::string temps;
   for (double t : design.soaks_c) temps += (temps.empty() ? "" : ",") + FormatDouble(t);
@@ -121,7 +177,8 @@ int RunPlanDesign(const PlanDesignArguments& args) {
       "Designed by imufit plan design (docs/plan.md): " + std::to_string(design.segments.size()) +
       " segments at " + std::to_string(design.soaks_c.size()) + " soaks, " +
       NumberText("%.2f", design.hours) + " h.\nRun it with --temps=" + temps + " --dwell " +
-      FormatDouble(schedule.dwell_s) + " --transition " + FormatDouble(schedule.transition_s) + ".";
+      FormatDouble(schedule.dwell_s) + " --transition " + FormatDouble(schedule.transition_s) + ".\n" +
+      gravity_note;
   WriteFileAtomically(args.output, PlanYaml(plan, comment));
   return 0;
 }
@@ -134,7 +191,11 @@ void AddScheduleOptions(CliCommand command, ScheduleArguments* args) {
       command, SimulationOptionTable(),
       {"start_time_s", "temp_noise_c", "quantize", "time_jitter_s", "drop_probability", "drop_burst",
        "gyro_full_scale_raw", "accel_full_scale_raw", "seed", "gyro_random_walk", "accel_random_walk"});
-  command.Option("--limits", &args->limits, "acceptance limits YAML: its coefficient limits as tolerances");
+  for (const char* key : kPlanFitOptions) args->fit.AddOne(command, FitRunOptionTable(), key);
+  command.Option(
+      "--limits", &args->limits,
+      "acceptance limits YAML: each coefficient criterion met at --min-ratio:1 (tolerance / U), each "
+      "noise criterion resolved by a static dwell");
   command.Option("--noise-yaml", &args->noise_yaml,
                  "the unit's noise from `imufit allan --noise-yaml` (the worst axis of each sensor); "
                  "--*-noise-density and --*-bias-instability given as well override it");
@@ -152,7 +213,9 @@ CommandRunner AddPlanCommand(CliCommand command) {
   check.Option("plan", &check_args->plan, "plan YAML").Required();
   AddScheduleOptions(check, &check_args->schedule);
   check_args->schedule.options.Find("ramp_c").Excludes(check_args->schedule.options.Find("soak_temps_c"));
-  check_args->check.Add(check, PlanCheckOptionTable());
+  check_args->check.Add(check, PlanCheckOptionTable(), kPlanWindowExceptions);
+  check_args->schedule.fit.AddOne(check, FitRunOptionTable(),
+                                  "prior");  // design's --prior is the data sheet's
   check.Option("--format", &check_args->format, "text (a table), yaml or json")
       .OneOf({"text", "yaml", "json"});
 
@@ -166,7 +229,7 @@ CommandRunner AddPlanCommand(CliCommand command) {
   design.Option("--candidates", &design_args->candidates,
                 "a plan whose segments are the candidates (and whose site is the run's)");
   AddScheduleOptions(design, &design_args->schedule);
-  design_args->design.Add(design, PlanDesignOptionTable());
+  design_args->design.Add(design, PlanDesignOptionTable(), kPlanWindowExceptions);
   return [check_args, design_args, check, design]() -> int {
     if (check.Parsed()) return RunPlanCheck(*check_args);
     if (design.Parsed()) return RunPlanDesign(*design_args);

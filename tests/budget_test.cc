@@ -6,12 +6,16 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "imufit/factory/certificate.h"
 #include "imufit/factory/certificate_page.h"
+#include "imufit/factory/certify.h"
 #include "imufit/factory/lot_summary.h"
 #include "imufit/factory/uncertainty_budget.h"
 #include "imufit/io/calibration.h"
@@ -21,6 +25,7 @@
 #include "imufit/io/station.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/sim/simulator.h"
+#include "imufit/store/store.h"
 
 namespace imufit {
 namespace {
@@ -29,6 +34,11 @@ namespace fs = std::filesystem;
 
 const std::string kPlan = std::string(IMUFIT_FIXTURES_DIR) + "/plan_6pos.yaml";
 const std::string kTruth = std::string(IMUFIT_FIXTURES_DIR) + "/mems_truth.yaml";
+
+// A 10 ppm table rate accuracy makes a gyro scale's U at least 20 ppm of the scale (by hand, above).
+constexpr double kTenPpmRateU = 20e-6;
+// Two U of one figure read from different outputs (a number written and read back): relative.
+constexpr double kSameURelative = 1e-12;
 
 // The propagated contribution of a 10 ppm rate error to a gyro scale factor: 10 ppm of it, to
 // within this fraction (the re-solved fit moves other coefficients a little too).
@@ -109,6 +119,222 @@ TEST_F(BudgetTest, TenPpmRateAccuracyGivesAGyroScaleUOfAtLeast20Ppm) {
   ASSERT_FALSE(budget.classes.empty());
   EXPECT_NE(budget.covers.find("Rate table rate accuracy"), std::string::npos);
   EXPECT_NE(budget.not_covered.find("drift"), std::string::npos);
+}
+
+// One U and one verdict (issue 29 items 3 and 4): a station declaring a 10 ppm table rate accuracy,
+// the unit certified with and without a certificate page; the unit's figures, the store's rows,
+// lot_summary.csv and every criterion (statistic: largest included) carry the budget's U, and the
+// verdict is the same criterion by criterion whatever is printed.
+TEST_F(BudgetTest, OneUAndOneVerdictWhateverIsPrinted) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const std::vector<Figure> plain = KeyFigures(*fit_->calibration);
+  const double nominal = FindFigure(plain, "gyro_scale_per_dps.x")->value;
+  std::ofstream((dir_ / "one_u_limits.yaml").string())
+      << "format: imufit-limits\nversion: 1\nnominal: {gyro_scale: " << nominal << ", accel_scale: 208.838}\n"
+      << "criteria:\n"
+         "  - {quantity: gyro_scale_error_ppm, max_abs: 100000}\n"
+         "  - {quantity: gyro_scale_error_ppm, statistic: largest, max_abs: 100000}\n"
+         "  - {quantity: gyro_residual_max_dps, max_abs: 100}\n";
+  std::ofstream((dir_ / "one_u_station.yaml").string())
+      << "format: imufit-station\nversion: 1\nstation: bench\nuncertainty:\n"
+         "  rate_accuracy: {u: 10, unit: ppm, source: table cert}\n";
+  struct Certified {
+    UnitOutcome unit;
+    std::vector<StoredFit> rows;
+  };
+  const auto certify = [&](bool report) {
+    const std::string name = report ? "with_report" : "no_report";
+    ResultsStore store((dir_ / (name + ".db")).string());
+    CertifySettings settings;
+    settings.software = "imufit test";
+    ReadLimitsAndStation((dir_ / "one_u_limits.yaml").string(), (dir_ / "one_u_station.yaml").string(),
+                         &settings);
+    settings.store = &store;
+    settings.lot = "LOT";
+    Certified c;
+    c.unit.unit = name;
+    c.unit.plan_path = kPlan;
+    c.unit.samples_path = (dir_ / "samples.csv").string();
+    c.unit.plan_sha256 = fit_->plan_sha256;
+    c.unit.samples_sha256 = fit_->run.samples_sha256;
+    c.unit.fit = *fit_;
+    const std::string page = report ? (dir_ / (name + ".html")).string() : "";
+    EXPECT_TRUE(
+        CertifyUnit(settings, {(dir_ / (name + ".yaml")).string(), page, "", Paper::kA4, {}}, &c.unit))
+        << c.unit.message;
+    c.rows = store.LatestOfLot("LOT");
+    return c;
+  };
+  const Certified with_report = certify(true), no_report = certify(false);
+  ASSERT_TRUE(with_report.unit.verdict && no_report.unit.verdict);
+  const Verdict& a = *with_report.unit.verdict;
+  const Verdict& b = *no_report.unit.verdict;
+  EXPECT_EQ(a.pass, b.pass);
+  EXPECT_EQ(a.Failed(), b.Failed()) << a.Table() << b.Table();
+  ASSERT_EQ(a.criteria.size(), b.criteria.size());
+  for (size_t i = 0; i < a.criteria.size(); ++i) {
+    EXPECT_EQ(a.criteria[i].outcome, b.criteria[i].outcome) << a.criteria[i].name;
+    EXPECT_EQ(a.criteria[i].pass, b.criteria[i].pass) << a.criteria[i].name;
+    EXPECT_EQ(a.criteria[i].expanded, b.criteria[i].expanded) << a.criteria[i].name;
+    // The scale-error rows, at 25 degC and the largest over the range, carry the rate accuracy.
+    if (a.criteria[i].name.find("gyro_scale_error_ppm") != std::string::npos) {
+      EXPECT_GE(a.criteria[i].expanded, kTenPpmRateU * 1e6 * 0.999) << a.criteria[i].name;
+    }
+  }
+  EXPECT_EQ(a.criteria.back().measured_text.find("not in calibration"), std::string::npos)
+      << "the worst window error is measured with or without a page";
+
+  const std::string csv = LotSummaryCsv([&] {
+    BatchResult batch;
+    batch.Add(no_report.unit);
+    return batch;
+  }());
+  for (const Certified* c : {&with_report, &no_report}) {
+    ASSERT_EQ(c->rows.size(), 1u);
+    for (const char* axis : {"x", "y", "z"}) {
+      const std::string name = std::string("gyro_scale_per_dps.") + axis;
+      const Figure* figure = FindFigure(c->unit.figures, name);
+      ASSERT_NE(figure, nullptr);
+      EXPECT_GE(figure->expanded / figure->value, kTenPpmRateU) << name;
+      const Figure* other = FindFigure(with_report.unit.figures, name);
+      EXPECT_DOUBLE_EQ(figure->expanded, other->expanded) << name;
+      bool stored = false;
+      for (const StoredFigure& g : c->rows[0].figures) {
+        if (g.name != name) continue;
+        stored = true;
+        EXPECT_NEAR(g.expanded_u, figure->expanded, kSameURelative * figure->expanded) << name;
+      }
+      EXPECT_TRUE(stored) << name;
+    }
+  }
+  // lot_summary.csv: the U column of gyro_scale_per_dps.x is the figure's.
+  std::istringstream lines(csv);
+  std::string header, row;
+  std::getline(lines, header);
+  std::getline(lines, row);
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream stream(line);
+    for (std::string cell; std::getline(stream, cell, ',');) out.push_back(cell);
+    return out;
+  };
+  const std::vector<std::string> names = cells(header), values = cells(row);
+  const Figure* x = FindFigure(no_report.unit.figures, "gyro_scale_per_dps.x");
+  bool found = false;
+  for (size_t i = 0; i < names.size() && i < values.size(); ++i) {
+    if (names[i] != "gyro_scale_per_dps.x.U") continue;
+    found = true;
+    EXPECT_NEAR(std::stod(values[i]), x->expanded, kSameURelative * x->expanded);
+  }
+  EXPECT_TRUE(found) << header;
+}
+
+// Under guard_band: 2 a value clear of its limit by 1.5 U is not accepted: its row says FAIL, not
+// PASS, with the guard band as the reason.
+TEST_F(BudgetTest, AGuardBandWiderThanUFailsTheRowItFails) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const std::vector<Figure> figures = KeyFigures(*fit_->calibration);
+  const Figure* bias = FindFigure(figures, "gyro_bias_dps.x");
+  ASSERT_NE(bias, nullptr);
+  Limits limits;
+  limits.decision_rule = DecisionRule::kGuarded;
+  limits.guard_band_u = 2.0;
+  LimitCriterion criterion;
+  criterion.quantity = "gyro_bias_dps";
+  criterion.unit = "deg/s";
+  criterion.axes = {"x"};
+  criterion.max_abs = std::abs(bias->value) + 1.5 * bias->expanded;
+  limits.criteria = {criterion};
+  const Verdict verdict = EvaluateLimits(limits, *fit_->calibration);
+  ASSERT_EQ(verdict.criteria.size(), 1u);
+  EXPECT_FALSE(verdict.pass);
+  EXPECT_FALSE(verdict.criteria[0].pass);
+  EXPECT_EQ(verdict.criteria[0].outcome, Outcome::kFail);
+  EXPECT_NE(verdict.criteria[0].reason.find("guard band"), std::string::npos) << verdict.criteria[0].reason;
+  EXPECT_EQ(verdict.Table().find("PASS\n"), std::string::npos) << verdict.Table();
+}
+
+// Issue 29 item 5: a real table stays tilted in the lab. Units are simulated on a table whose axis is
+// tilted by a lab-fixed angle (drawn from the station's rectangular half width, about north and
+// east), the simulator given each static position's true up: the lab tilt seen from that position's
+// body axes (north and up given by the plan, east = north x up). Each run is fitted with the plan as
+// written; the error of accel bias x and accel misalignment yx against the truth is compared with
+// the U the budget states for that figure. Their spread matches U / 2 and U covers about 95 %.
+constexpr int kTiltTrials = 80;
+constexpr double kTiltHalfWidthArcsec = 120.0;
+// The RMS error over U / 2, relative. Measured over four seeds of the draws (1, 2, 3, 29): 0.98 to
+// 1.24 for bias x, 0.84 to 1.00 for misalignment yx (80 draws of a tilt whose one component
+// dominates spread more than 1 / sqrt(2 N)); the tilt taken in the body frame gave 1.93 and 2.17.
+constexpr double kSpreadOverUTolerance = 0.3;
+// Coverage of U (k = 2, nominal 95 %) over the trials: at least this fraction (measured: 72 to 77 of
+// 80 for bias x, 76 to 79 for misalignment yx; the body-frame tilt covered 51 and 46).
+constexpr double kMinimumCoverage = 0.87;
+
+TEST(BudgetTiltTest, ULabFrameTiltCoversTheSpreadOfAccelBiasAndMisalignment) {
+  const fs::path dir = fs::temp_directory_path() / ("imufit_budget_tilt_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const Plan plan = ReadPlan(kPlan);
+  const Calibration truth = ReadCalibration(kTruth);
+  const std::vector<Figure> truth_figures = KeyFigures(truth);
+  const char* const kNames[] = {"accel_bias_mg.x", "accel_misalignment_mrad.yx"};
+  constexpr double kArcsec = 1.0 / 206264.806;
+  StationUncertainty tilt;
+  tilt.influence = StationInfluence::kTableAxisTilt;
+  tilt.u_si = kTiltHalfWidthArcsec * kArcsec / std::sqrt(3.0);
+  tilt.rectangular = true;
+  tilt.source = "test";
+  std::mt19937_64 random(29);
+  std::uniform_real_distribution<double> draw(-kTiltHalfWidthArcsec * kArcsec,
+                                              kTiltHalfWidthArcsec * kArcsec);
+  FitRunOptions options;
+  options.fit.gyro_temp_order = options.fit.accel_temp_order = 0;
+  double u[2] = {-1.0, -1.0}, squares[2] = {0.0, 0.0};
+  int covered[2] = {0, 0};
+  for (int trial = 0; trial < kTiltTrials; ++trial) {
+    const double about_north = draw(random), about_east = draw(random);
+    std::vector<TableSegment> tilted = plan.segments;
+    for (TableSegment& s : tilted) {
+      if (!s.IsStatic()) continue;  // about the turning axis the tilt averages out
+      ASSERT_TRUE(s.north.has_value()) << "the plan gives every static position's heading";
+      const Eigen::Vector3d east = s.north->cross(s.up);
+      const Eigen::Vector3d angle = about_north * *s.north + about_east * east;
+      const Eigen::Matrix3d rotation = Eigen::AngleAxisd(angle.norm(), angle.normalized()).toRotationMatrix();
+      s.up = rotation * s.up;
+      s.north = rotation * *s.north;
+    }
+    SimulationOptions simulation;
+    simulation.soak_temps_c = {25.0};
+    simulation.rate_hz = 20.0;
+    simulation.dwell_s = 4.0;
+    simulation.transition_s = 1.0;
+    simulation.gyro_noise_density = 8.7e-5;
+    simulation.accel_noise_density = 1.5e-4;
+    simulation.seed = 1000 + static_cast<unsigned>(trial);
+    const std::string samples = (dir / "samples.csv").string();
+    SamplesWriter writer(samples, SampleColumns{true, true}, "serial: SN-TILT");
+    SimulateRun(simulation, plan.site, tilted, truth.model,
+                [&](const Sample& raw, const SegmentTruth&) { writer.Write(raw); });
+    writer.Commit();
+    const FitRunResult fit = FitRun(kPlan, samples, options);
+    ASSERT_TRUE(fit.calibration.has_value()) << fit.fit.BriefReport();
+    if (trial == 0) {  // the U a certificate states: the same for every run of this plan
+      const UncertaintyBudget budget = ComputeBudget(*fit.calibration, fit.plan, fit.run.windows, {tilt});
+      for (int i = 0; i < 2; ++i) u[i] = budget.Find(kNames[i])->expanded;
+    }
+    const std::vector<Figure> fitted = KeyFigures(*fit.calibration);
+    for (int i = 0; i < 2; ++i) {
+      const double error = FindFigure(fitted, kNames[i])->value - FindFigure(truth_figures, kNames[i])->value;
+      squares[i] += error * error;
+      covered[i] += std::abs(error) <= u[i] ? 1 : 0;
+    }
+  }
+  fs::remove_all(dir);
+  for (int i = 0; i < 2; ++i) {
+    const double rms = std::sqrt(squares[i] / kTiltTrials);
+    EXPECT_NEAR(rms / (u[i] / 2.0), 1.0, kSpreadOverUTolerance)
+        << kNames[i] << ": RMS error " << rms << ", U " << u[i];
+    EXPECT_GE(covered[i], kMinimumCoverage * kTiltTrials) << kNames[i] << ": U " << u[i];
+  }
 }
 
 // By hand: gravity 10 ppm larger than the plan's makes every accelerometer scale 10 ppm smaller.

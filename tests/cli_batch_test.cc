@@ -571,3 +571,138 @@ TEST_F(FactoryCliTest, BatchFitsAStaticOnlyLotWithFitAccelAndRedoesUnitsWhenTheO
 
 }  // namespace
 }  // namespace imufit
+
+namespace imufit {
+namespace {
+
+namespace fs = std::filesystem;
+
+// BatchArgs(out) with `option`'s value replaced (--store, --lot).
+std::vector<std::string> WithOption(std::vector<std::string> args, const std::string& option,
+                                    const std::string& value) {
+  const auto at = std::find(args.begin(), args.end(), option);
+  EXPECT_NE(at, args.end()) << option;
+  if (at != args.end()) *(at + 1) = value;
+  return args;
+}
+
+// Issue 28: the manifest is written by the one machine-text writer; PyYAML's safe_load (YAML 1.1)
+// and yaml-cpp read it back alike, every value a string (version an integer), the outcome the lot
+// summary's. `--shard` writes no lot_summary.csv and does not say it wrote one (issue 29 item 6).
+TEST_F(FactoryCliTest, ManifestReadsBackAlikeInEveryReaderAndAShardClaimsNoLotSummary) {
+  std::vector<std::string> args = BatchArgs("out");
+  args.insert(args.end(), {"--no-report", "--jobs", "2"});
+  RunResult r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  auto summary = Summary("out");
+  for (const char* unit : {"unit-01", "unit-04", "unit-05"}) {
+    const std::string path = (dir_ / "out" / unit / "manifest.yaml").string();
+    const RunResult py =
+        RunProgram("/usr/bin/python3", {"-c",
+                                        "import sys, yaml\n"
+                                        "m = yaml.safe_load(open(sys.argv[1]))\n"
+                                        "assert m['version'] == 1 and type(m['version']) is int, m\n"
+                                        "for k, v in m.items():\n"
+                                        "    assert k == 'version' or type(v) is str, (k, v)\n"
+                                        "    print('%s=%s' % (k, v))\n",
+                                        path});
+    ASSERT_EQ(py.status, 0) << py.err;
+    const YAML::Node node = YAML::LoadFile(path);
+    for (const auto& entry : node) {
+      const std::string key = entry.first.as<std::string>();
+      EXPECT_NE(py.out.find(key + "=" + entry.second.as<std::string>() + "\n"), std::string::npos)
+          << key << " in " << py.out;
+    }
+    EXPECT_EQ(node["format"].as<std::string>(), "imufit-unit-manifest");
+    EXPECT_EQ(node["status"].as<std::string>(), summary[unit]["status"]) << unit;
+    EXPECT_EQ(node["verdict"].as<std::string>(), summary[unit]["verdict"]) << unit;
+    // (The test's CSV reader keeps a quoted cell's doubled quotes as one: compare without them.)
+    const auto unquoted = [](std::string text) {
+      text.erase(std::remove(text.begin(), text.end(), '"'), text.end());
+      return text;
+    };
+    EXPECT_EQ(unquoted(node["message"].as<std::string>()), unquoted(summary[unit]["message"])) << unit;
+  }
+
+  std::vector<std::string> shard = WithOption(BatchArgs("shard_out"), "--store", Path("shard.db"));
+  shard.insert(shard.end(), {"--no-report", "--shard", "1/2"});
+  r = Run(shard);
+  EXPECT_TRUE(r.status == 0 || r.status == kExitFailedLimits) << r.out << r.err;
+  EXPECT_NE(r.out.find("imufit batch: "), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir_ / "shard_out" / "lot_summary.csv"));
+  EXPECT_EQ(r.out.find("lot_summary.csv"), std::string::npos) << r.out;
+}
+
+// Runs `sql` on the SQLite store at `path` with Python's sqlite3 (another reader than ours): one
+// line per row, cells joined by "|".
+std::string Query(const fs::path& path, const std::string& sql) {
+  const std::string log =
+      (path.parent_path().parent_path() / ("query." + std::to_string(::getpid()))).string();
+  const RunResult r = testing::RunProgram("/usr/bin/python3",
+                                          {"-c",
+                                           "import sqlite3, sys\n"
+                                           "for row in sqlite3.connect(sys.argv[1]).execute(sys.argv[2]):\n"
+                                           "    print('|'.join(str(c) for c in row))\n",
+                                           path.string(), sql},
+                                          log + ".out", log + ".err");
+  EXPECT_EQ(r.status, 0) << r.err;
+  return r.out;
+}
+
+// Issue 29 item 6 end to end: the store's rows of a batch hold the fit options and the files
+// committed; a unit skipped as unchanged and recorded in another store keeps its calibration's time,
+// so that merging that store back adds no second fit; a batch under a new --lot on runs recorded
+// under another lot refuses them, saying so, and records nothing under the new lot.
+TEST_F(FactoryCliTest, StoreRowsHoldTheSpecAndARunKeepsItsLot) {
+  std::vector<std::string> args = BatchArgs("out");
+  args.push_back("--no-report");
+  RunResult r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  const fs::path store = dir_ / "store.db";
+  const std::string options =
+      Query(store, "SELECT count(*) FROM fits WHERE fit_options = '' OR fit_options IS NULL");
+  EXPECT_EQ(options, "0\n") << "every fit records its options";
+  const std::string sn01 =
+      Query(store,
+            "SELECT a.kind, a.path, a.sha256, f.time_utc FROM attachments a JOIN fits f ON "
+            "f.id = a.fit_id JOIN runs r ON r.run_key = f.run_key WHERE r.serial = 'SN-01'");
+  const std::string calibration = (dir_ / "out" / "unit-01" / "calibration.yaml").string();
+  EXPECT_NE(sn01.find("calibration|" + calibration + "|" + Sha256OfFile(calibration) + "|"),
+            std::string::npos)
+      << sn01;
+  const std::string fit_time = Query(store,
+                                     "SELECT f.time_utc FROM fits f JOIN runs r ON r.run_key = f.run_key "
+                                     "WHERE r.serial = 'SN-01'");
+
+  // The same lot again, into a new store: every unit unchanged, recorded there at its fit's time.
+  args = WithOption(BatchArgs("out"), "--store", Path("other.db"));
+  args.push_back("--no-report");
+  r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_NE(r.out.find("5 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(
+      Query(dir_ / "other.db",
+            "SELECT f.time_utc FROM fits f JOIN runs r ON r.run_key = f.run_key WHERE r.serial = 'SN-01'"),
+      fit_time);
+  r = Run({"store", "merge", Path("other.db"), "--into", store.string()});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(Query(store,
+                  "SELECT count(*) FROM fits f JOIN runs r ON r.run_key = f.run_key WHERE r.serial IN "
+                  "('SN-01', 'SN-02', 'SN-04')"),
+            "3\n")
+      << "one calibration is one fit after the merge";
+
+  // The same runs under a new lot: refused, said, nothing recorded under it.
+  const std::string fits_before = Query(store, "SELECT count(*) FROM fits");
+  args = WithOption(BatchArgs("out_b"), "--lot", "LOT-B");
+  args.push_back("--no-report");
+  r = Run(args);
+  EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_NE(r.out.find("is recorded in lot \"LOT-A\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("give --lot LOT-A, or another --store"), std::string::npos) << r.out;
+  EXPECT_EQ(Query(store, "SELECT count(*) FROM runs WHERE lot = 'LOT-B'"), "0\n");
+  EXPECT_EQ(Query(store, "SELECT count(*) FROM fits"), fits_before) << "nothing recorded";
+}
+
+}  // namespace
+}  // namespace imufit

@@ -282,5 +282,122 @@ TEST_F(CliPlanTest, BadInputExitsTwo) {
   EXPECT_EQ(Run({"plan", "check", Fixture("plan_24pos.yaml")}).status, 2);  // no noise given
 }
 
+// With a limits file each coefficient criterion is judged as metrology judges a procedure: its
+// tolerance (a [min, max] limit's half-width) over the U = 2 sigma the plan achieves, at least 4:1
+// (--min-ratio); a noise criterion by the plan's longest static dwell.
+TEST_F(CliPlanTest, LimitsAreJudgedByTheirRatioToUAndNoiseByTheStaticDwell) {
+  const std::string limits = Write("limits.yaml", R"(format: imufit-limits
+version: 1
+name: plan check test
+criteria:
+  - {quantity: accel_bias_mg, min: -9.17, max: 35}
+  - {quantity: gyro_bias_dps, max_abs: 0.004}
+)");
+  RunResult r = Run(Args({"--limits", limits, "--format", "yaml"}));
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const YAML::Node criteria = YAML::Load(r.out)["criteria"];
+  ASSERT_EQ(criteria.size(), 2u) << r.out;
+  const double gyro_sigma = YamlSigma(r.out, "gyro bias x");
+  const double gyro_ratio = criteria[1]["ratio"].as<double>();
+  EXPECT_GE(gyro_ratio, 4.0);
+  EXPECT_LE(gyro_ratio, 0.004 / (2.0 * gyro_sigma) * (1.0 + 1e-9));  // over the range, U >= 2 sigma(25 degC)
+  EXPECT_NEAR(criteria[0]["tolerance"].as<double>(), 0.5 * (35 + 9.17), 1e-9);
+  // A minimum the plan does not reach: exit 3, named.
+  r = Run(Args({"--limits", limits, "--min-ratio", "10"}));
+  EXPECT_EQ(r.status, 3) << r.out << r.err;
+  EXPECT_NE(r.out.find("criterion gyro_bias_dps x, y, z within +-0.004: tolerance 0.004 deg/s / U "),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("(at least 10:1): NOT MET"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: the plan cannot judge gyro_bias_dps"), std::string::npos) << r.out;
+  // A bias instability needs half an hour of rest; 20 s dwells do not resolve it.
+  const std::string noise = Write("noise_limits.yaml", R"(format: imufit-limits
+version: 1
+name: plan check test
+criteria:
+  - {quantity: gyro_bias_instability_dph, max_abs: 20}
+)");
+  r = Run(Args({"--limits", noise}));
+  EXPECT_EQ(r.status, 3) << r.out << r.err;
+  EXPECT_NE(r.out.find("needs a static stretch of 1800 s, the plan's longest is 20 s: not resolved"),
+            std::string::npos)
+      << r.out;
+}
+
+// Every option plan check's findings advise, plan check accepts: one-temperature, static and hand
+// plans are checked with the orders and groups the fit will use.
+TEST_F(CliPlanTest, EveryAdvisedOptionIsAccepted) {
+  const std::string help = Run({"plan", "check", "--help"}).out;
+  const std::vector<std::vector<std::string>> plans = {
+      {Fixture("plan_24pos.yaml"), "--temps", "25"},
+      {Fixture("plan_6faces_static.yaml"), "--temps=-40,0,40,85"},
+      {Fixture("plan_hand_6faces_3turns.yaml"), "--temps", "25"}};
+  const std::vector<std::vector<std::string>> remedies = {
+      {"--gyro-temp-order", "0", "--accel-temp-order", "0"},
+      {"--fit", "gyro-bias,accel", "--prior", Fixture("mems_truth.yaml")},
+      {}};
+  for (size_t i = 0; i < plans.size(); ++i) {
+    std::vector<std::string> args = {
+        "plan", "check", "--gyro-noise-density", "1e-4", "--accel-noise-density", "1e-3", "--dwell", "20"};
+    args.insert(args.end(), plans[i].begin(), plans[i].end());
+    const RunResult advised = Run(args);
+    for (size_t at = advised.out.find("--"); at != std::string::npos; at = advised.out.find("--", at + 2)) {
+      const std::string option = advised.out.substr(at, advised.out.find_first_of(" ,;)/", at) - at);
+      EXPECT_NE(help.find(option), std::string::npos) << option << " advised:\n" << advised.out;
+    }
+    args.insert(args.end(), remedies[i].begin(), remedies[i].end());
+    if (plans[i][0].find("hand") != std::string::npos) {
+      args.insert(args.end(), {"--gyro-temp-order", "0", "--accel-temp-order", "0"});
+    }
+    const RunResult checked = Run(args);
+    EXPECT_EQ(checked.status, 0) << plans[i][0] << "\n" << checked.out << checked.err;
+  }
+}
+
+// The windows plan check predicts are the fit's: occurrences too short for a window are said, and a
+// plan whose every occurrence is too short does not determine the model.
+TEST_F(CliPlanTest, WindowsTheFitWillLeaveOutAreSaid) {
+  RunResult r =
+      Run({"plan", "check", Fixture("plan_24pos.yaml"), "--gyro-noise-density", "1e-4",
+           "--accel-noise-density", "1e-3", "--temps=-20,10,50,85", "--dwell", "1", "--rate", "20"});
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("the fit would have no window: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("segment occurrences shorter than 20 samples (--window-min-samples)"),
+            std::string::npos)
+      << r.out;
+  r = Run({"plan", "check", Fixture("plan_24pos.yaml"), "--gyro-noise-density", "1e-4",
+           "--accel-noise-density", "1e-3", "--temps=-20,10,50,85", "--dwell", "1", "--rate", "20",
+           "--window-min-samples", "5"});
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+}
+
+// The designed plan carries the station's gravity: the one given, else WGS84 normal gravity at the
+// latitude (a plan at 9.80665 run at 9.81274 fits the accelerometer's scale 621 ppm off).
+TEST_F(CliPlanTest, DesignWritesTheStationsGravity) {
+  constexpr double kNormalGravityTolerance = 1e-4;  // m/s^2, absolute: the published 9.8127 at 52.27 deg
+  std::vector<std::string> args = {"plan",
+                                   "design",
+                                   "-o",
+                                   Path("a.yaml"),
+                                   "--latitude",
+                                   "52.27",
+                                   "--tolerance",
+                                   "gyro.bias=0.01,accel.bias=1",
+                                   "--gyro-noise-density",
+                                   "1e-4",
+                                   "--accel-noise-density",
+                                   "1e-3",
+                                   "--dwell",
+                                   "20"};
+  RunResult r = Run(args);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NEAR(YAML::LoadFile(Path("a.yaml"))["gravity_mps2"].as<double>(), 9.8127, kNormalGravityTolerance);
+  args[3] = Path("b.yaml");
+  args.insert(args.end(), {"--gravity-mps2", "9.81274"});
+  r = Run(args);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(YAML::LoadFile(Path("b.yaml"))["gravity_mps2"].as<double>(), 9.81274);
+}
+
 }  // namespace
 }  // namespace imufit::testing

@@ -197,9 +197,11 @@ TEST_F(FactoryCliTest, StationFileIsShownHashedAndChecked) {
   r = Run(std::vector<std::string>{"batch", Path("units"), "--station", bad, "-o", Path("out_bad")});
   EXPECT_EQ(r.status, kExitBadInput);
   EXPECT_NE(r.err.find("bad_station.yaml:11:1"), std::string::npos) << r.err;
+  // --station without --report: its Type B sources are in U whether a page is written or not
+  // (issue 29 item 4), so the fit takes it.
   r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("cal_no_report.yaml"), "--station", station});
-  EXPECT_EQ(r.status, kExitBadInput);
-  EXPECT_NE(r.err.find("--report"), std::string::npos) << r.err;
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(Path("cal_no_report.yaml")));
 
   // batch: every certificate shows the station; the manifest records its hash, and another station
   // file redoes the units (their certificates would change).
@@ -314,6 +316,76 @@ TEST_F(FactoryCliTest, TheCertificateNamesTheRunTheItemAndTheLaboratory) {
   r = Run({"fit", "-p", plan, "-s", samples, "-o", Path("c2.yaml"), "--customer", "X"});
   EXPECT_EQ(r.status, kExitBadInput);
   ExpectTroubleshootingQuotes(r.err);
+}
+
+// Issue 29 item 4, end to end: `fit --limits` and `fit --limits --report` judge the same unit the
+// same (the noise terms and the worst window error the certificate measures, the station's U): the
+// same acceptance table on stdout, exit status and store row. Under guard_band: 2 no row of a
+// failed criterion reads PASS.
+TEST_F(FactoryCliTest, FitJudgesTheSameWithAndWithoutACertificate) {
+  const std::string plan = Path("units/unit-01/plan.yaml"), samples = Path("units/unit-01/samples.csv.gz");
+  const std::string limits =
+      Write("one_verdict_limits.yaml",
+            "format: imufit-limits\nversion: 1\nname: one verdict\n"
+            "nominal: {gyro_scale: 939.65, accel_scale: 208.838}\n"
+            "decision_rule: guarded\nguard_band: 2\ncriteria:\n"
+            "  - {quantity: gyro_bias_dps, max_abs: 5}\n"
+            "  - {quantity: gyro_bias_dps, axes: [x], max_abs: 1.421}\n"
+            "  - {quantity: gyro_scale_error_ppm, max_abs: 20000}\n"
+            "  - {quantity: gyro_scale_error_ppm, statistic: largest, max_abs: 20000}\n"
+            "  - {quantity: gyro_residual_max_dps, max_abs: 1}\n"
+            "  - {quantity: accel_residual_max_mg, max_abs: 50}\n"
+            "  - {quantity: gyro_arw_deg_per_sqrt_hr, max_abs: 10}\n");
+  const std::string station = Write("one_verdict_station.yaml",
+                                    "format: imufit-station\nversion: 1\nstation: bench\nuncertainty:\n"
+                                    "  rate_accuracy: {u: 10, unit: ppm, source: table cert}\n"
+                                    "  table_axis_tilt: {half_width: 20, unit: arcsec, source: levelled}\n");
+  const auto fit = [&](const std::string& name, bool report) {
+    std::vector<std::string> args = {
+        "fit",  "-p",        plan,    "-s",      samples,           "-o", Path(name + ".yaml"), "--limits",
+        limits, "--station", station, "--store", Path(name + ".db")};
+    if (report) args.insert(args.end(), {"--report", Path(name + ".html")});
+    return Run(args);
+  };
+  const RunResult plain = fit("plain", false), certified = fit("certified", true);
+  EXPECT_EQ(plain.status, certified.status) << plain.out << certified.out;
+  // The acceptance table: from its first line to the line before "wrote".
+  const auto table = [](const std::string& out) {
+    const size_t from = out.find("  acceptance");
+    const size_t to = out.find("  wrote", from);
+    return from == std::string::npos ? std::string() : out.substr(from, to - from);
+  };
+  ASSERT_FALSE(table(plain.out).empty()) << plain.out;
+  EXPECT_EQ(table(plain.out), table(certified.out));
+  EXPECT_EQ(table(plain.out).find("not in calibration"), std::string::npos) << table(plain.out);
+  // No failed row reads PASS: the rows that read PASS are the criteria that passed.
+  const std::string rows = table(certified.out);
+  std::smatch counts;
+  ASSERT_TRUE(std::regex_search(rows, counts, std::regex("\\((\\d+) of (\\d+) criteria failed\\)"))) << rows;
+  const int failed = std::stoi(counts[1]), criteria = std::stoi(counts[2]);
+  int pass_rows = 0;
+  for (size_t at = rows.find("  PASS"); at != std::string::npos; at = rows.find("  PASS", at + 1))
+    ++pass_rows;
+  EXPECT_EQ(pass_rows, criteria - failed) << rows;
+  // Gyro bias x (+1.41445 deg/s, U about 0.0043 deg/s) against 1.421: clear of the limit by about
+  // 1.5 U, inside the guard band of 2 U: not accepted, and its row says FAIL.
+  std::smatch guarded;
+  ASSERT_TRUE(std::regex_search(rows, guarded, std::regex("\\|gyro_bias_dps\\.x\\|[^\\n]*< 1\\.421[^\\n]*")))
+      << rows;
+  EXPECT_NE(guarded.str().find("FAIL: inside the guard band w = 2 x U"), std::string::npos) << rows;
+  // The store's rows: the same verdict and message.
+  for (const char* column : {"verdict", "message"}) {
+    const std::string sql = std::string("SELECT ") + column + " FROM fits";
+    const auto query = [&](const std::string& db) {
+      return RunProgram("/usr/bin/python3",
+                        {"-c",
+                         "import sqlite3, sys\n"
+                         "print(sqlite3.connect(sys.argv[1]).execute(sys.argv[2]).fetchall())\n",
+                         db, sql})
+          .out;
+    };
+    EXPECT_EQ(query(Path("plain.db")), query(Path("certified.db"))) << column;
+  }
 }
 
 }  // namespace

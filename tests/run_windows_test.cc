@@ -55,9 +55,16 @@ TEST(Windows, OccurrencesTrimmingAndTemperatureSpans) {
   EXPECT_EQ(stats.samples, 67);
   EXPECT_EQ(stats.transition_samples, 10);
   EXPECT_EQ(stats.trimmed_samples, 12);
-  // Segment 4's three samples, and the last 4 samples of the ramp (26 kept = 11 + 11 + 4).
-  EXPECT_EQ(stats.short_windows, 2);
-  ASSERT_GE(windows.size(), 3u);
+  // Segment 4's three samples are left out, counted; the last 4 samples of the ramp (26 kept =
+  // 11 + 11 + 4) are merged into the window before them, not dropped.
+  EXPECT_EQ(stats.short_windows, 1);
+  EXPECT_EQ(stats.short_samples, 3);
+  EXPECT_EQ(stats.merged_remainders, 1);
+  EXPECT_EQ(stats.window_samples, 16 + 26);
+  EXPECT_EQ(AccountedSamples(stats), stats.samples);
+  ASSERT_EQ(windows.size(), 3u);
+  EXPECT_EQ(windows[2].samples, 15);
+  EXPECT_NEAR(windows[2].max_temp_c - windows[2].min_temp_c, 1.4, 1e-12);
   EXPECT_EQ(windows[0].segment, 3);
   EXPECT_EQ(windows[0].occurrence, 0);
   EXPECT_EQ(windows[0].samples, 16);
@@ -69,9 +76,95 @@ TEST(Windows, OccurrencesTrimmingAndTemperatureSpans) {
   EXPECT_NEAR(windows[1].min_temp_c, 20.4, 1e-12);  // the ramp's first kept sample
   for (size_t w = 1; w < windows.size(); ++w) {
     EXPECT_EQ(windows[w].occurrence, 1);
-    EXPECT_LE(windows[w].max_temp_c - windows[w].min_temp_c, 1.0 + 1e-12);
-    EXPECT_LE(windows[w].samples, 11);  // a 1 degC span at 0.1 degC per sample
   }
+  EXPECT_EQ(windows[1].samples, 11);  // a 1 degC span at 0.1 degC per sample
+  EXPECT_NEAR(windows[1].max_temp_c - windows[1].min_temp_c, 1.0, 1e-12);
+}
+
+// A merged remainder's statistics are those of one window over all its samples (pooled mean,
+// standard deviation and temperature), to rounding.
+TEST(Windows, AMergedRemainderIsOneWindowOverAllItsSamples) {
+  constexpr double kRounding = 1e-12;  // absolute, on values of order 1
+  WindowOptions options;
+  options.trim_s = 0.0;
+  options.max_duration_s = 1.0;
+  options.min_samples = 20;
+  WindowBuilder builder(options);
+  std::mt19937_64 engine(11);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<Sample> samples;
+  for (int i = 0; i < 115; ++i) {  // 1.15 s at 100 Hz: a window of 100 and a remainder of 15, merged
+    Sample s;
+    s.time_s = 0.01 * i;
+    s.segment = 1;
+    s.temp_c = 25.0 + 0.001 * i;
+    s.gyro = Eigen::Vector3d(noise(engine), 2.0 + noise(engine), -1.0);
+    s.accel = Eigen::Vector3d(0.0, 0.0, 9.8 + 0.01 * noise(engine));
+    samples.push_back(s);
+  }
+  for (const Sample& s : samples) builder.Add(s);
+  const std::vector<Window> windows = builder.Finish();
+  ASSERT_EQ(windows.size(), 1u);
+  EXPECT_EQ(windows[0].samples, 115);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero(), square = Eigen::Vector3d::Zero();
+  double temp = 0.0;
+  for (const Sample& s : samples) {
+    mean += s.gyro / 115.0;
+    temp += s.temp_c / 115.0;
+  }
+  for (const Sample& s : samples) square += (s.gyro - mean).cwiseAbs2() / 114.0;
+  EXPECT_LT((windows[0].gyro_mean - mean).norm(), kRounding);
+  EXPECT_LT((windows[0].gyro_std - square.cwiseSqrt()).norm(), kRounding);
+  EXPECT_NEAR(windows[0].temp_c, temp, kRounding);
+  EXPECT_EQ(windows[0].end_s, samples.back().time_s);
+  EXPECT_EQ(builder.stats().merged_remainders, 1);
+  EXPECT_EQ(AccountedSamples(builder.stats()), 115);
+}
+
+// On a ramp so fast that the span passes in fewer than min_samples, windows span more instead of
+// being dropped whole: no sample of a dwell is lost.
+TEST(Windows, AFastRampLosesNoSample) {
+  WindowOptions options;  // 0.5 degC span, 20 samples
+  options.trim_s = 0.0;
+  WindowBuilder builder(options);
+  Sample s;
+  for (int i = 0; i < 200; ++i) {  // 0.1 degC per sample: the span passes after 6 samples
+    s.time_s = 0.01 * i;
+    s.segment = 1;
+    s.temp_c = 25.0 + 0.1 * i;
+    builder.Add(s);
+  }
+  const std::vector<Window> windows = builder.Finish();
+  EXPECT_EQ(builder.stats().short_windows, 0);
+  EXPECT_EQ(builder.stats().window_samples, 200);
+  ASSERT_EQ(windows.size(), 10u);
+  for (const Window& w : windows) EXPECT_EQ(w.samples, 20);
+}
+
+// Every reason a sample is left out is counted, and a person reads each with its count.
+TEST(Windows, EverySampleLeftOutIsCountedWithItsReason) {
+  const std::vector<TableSegment> segments = SixPositionPlan();
+  SimulationOptions schedule;
+  schedule.dwell_s = 0.6;  // 60 samples, 50 trimmed: 10 left, shorter than 20
+  schedule.transition_s = 0.5;
+  schedule.soak_temps_c = {25.0};
+  WindowBuilder builder(WindowOptions(), segments);
+  SimulateRun(schedule, Site(), segments, SensorModel::Identity(),
+              [&](const Sample& raw, const SegmentTruth&) { builder.Add(raw); });
+  const std::vector<Window> windows = builder.Finish();
+  const WindowStats& stats = builder.stats();
+  EXPECT_TRUE(windows.empty());
+  EXPECT_EQ(stats.short_windows, static_cast<long long>(segments.size()));
+  // About 10 a segment (a stamp's rounding may trim one more).
+  EXPECT_EQ(stats.short_samples, stats.samples - stats.transition_samples - stats.trimmed_samples);
+  EXPECT_NEAR(static_cast<double>(stats.short_samples), 10.0 * segments.size(), 2.0);
+  EXPECT_EQ(AccountedSamples(stats), stats.samples);
+  const std::string note = LeftOutNote(stats, WindowOptions());
+  EXPECT_NE(note.find(std::to_string(stats.short_samples) + " in " + std::to_string(segments.size()) +
+                      " segment occurrences shorter than 20 samples (--window-min-samples)"),
+            std::string::npos)
+      << note;
+  EXPECT_NE(note.find("trimmed after moves (--trim 0.5 s)"), std::string::npos) << note;
 }
 
 TEST(Windows, ATurnIsOneWholeOccurrenceWithItsNoiseFromSecondDifferences) {

@@ -99,35 +99,45 @@ TEST(StoreForeignTest, AReadCreatesNothingInAnEmptyDatabase) {
   EXPECT_EQ(ResultsStore(target, StoreAccess::kRead).CountFits(), 1);
 }
 
+// Schema versions 2 (no latest_fits, no latest_figures, no judgement) and 3 (no latest_figures, no
+// judgement), read-only: queried through a private copy, the file left as it was (issue 29 item 6).
 TEST(StoreForeignTest, AReadOfAnOlderSchemaLeavesItAsItWasAndAReadOnlyOneCanBeQueried) {
-  const std::string target = FreshStore("old_read");
-  {
-    ResultsStore store(target);
-    store.Record(MakeFit("SN1", "lot-r", "2026-05-01T00:00:00Z", 1.0, "PASS"));
-    store.Record(MakeFit("SN2", "lot-r", "2026-05-01T00:01:00Z", 2.0, "FAIL"));
-  }
-  // As schema version 3 wrote it: no latest_figures, no judgement column.
-  Sql(target, std::string("DROP TABLE latest_figures; ALTER TABLE figures DROP COLUMN judgement; "
-                          "UPDATE schema_version SET version = 3;") +
-                  (IsPostgresStore(target) ? "" : " PRAGMA user_version = 3;"));
-  const std::vector<std::string> tables = Tables(target);
-  if (!IsPostgresStore(target)) fs::permissions(target, fs::perms::owner_read | fs::perms::group_read);
-  {
-    ResultsStore store(target, StoreAccess::kRead);
-    ASSERT_EQ(store.Yield("lot-r").size(), 1u);
-    EXPECT_EQ(store.Yield("lot-r")[0].units, 2);
-    EXPECT_EQ(store.Yield("lot-r")[0].passed, 1);
-    ASSERT_EQ(store.LotStats({"gyro_bias_dps.x"}).size(), 1u);
-    EXPECT_DOUBLE_EQ(store.LotStats({"gyro_bias_dps.x"})[0].mean, 1.5);
-  }
-  EXPECT_EQ(Tables(target), tables) << "a read migrates a private copy only";
-  EXPECT_EQ(Sql(target, "SELECT version FROM schema_version"), std::vector<std::string>{"3"});
-  if (!IsPostgresStore(target)) {
-    fs::permissions(target, fs::perms::owner_read | fs::perms::owner_write);
-    const std::string error = OpenError(target, StoreAccess::kRecord);
-    EXPECT_EQ(error, "") << "recording migrates it for good";
+  for (const int version : {2, 3}) {
+    SCOPED_TRACE("schema version " + std::to_string(version));
+    const std::string target = FreshStore("old_read_" + std::to_string(version));
+    {
+      ResultsStore store(target);
+      store.Record(MakeFit("SN1", "lot-r", "2026-05-01T00:00:00Z", 1.0, "PASS"));
+      store.Record(MakeFit("SN2", "lot-r", "2026-05-01T00:01:00Z", 2.0, "FAIL"));
+    }
+    // As that schema version wrote it.
+    Sql(target,
+        std::string(version == 2 ? "DROP TABLE latest_fits; " : "") +
+            "DROP TABLE latest_figures; ALTER TABLE figures DROP COLUMN judgement; "
+            "UPDATE schema_version SET version = " +
+            std::to_string(version) + ";" +
+            (IsPostgresStore(target) ? "" : " PRAGMA user_version = " + std::to_string(version) + ";"));
+    const std::vector<std::string> tables = Tables(target);
+    if (!IsPostgresStore(target)) fs::permissions(target, fs::perms::owner_read | fs::perms::group_read);
+    {
+      ResultsStore store(target, StoreAccess::kRead);
+      ASSERT_EQ(store.Yield("lot-r").size(), 1u);
+      EXPECT_EQ(store.Yield("lot-r")[0].units, 2);
+      EXPECT_EQ(store.Yield("lot-r")[0].passed, 1);
+      ASSERT_EQ(store.LotStats({"gyro_bias_dps.x"}).size(), 1u);
+      EXPECT_DOUBLE_EQ(store.LotStats({"gyro_bias_dps.x"})[0].mean, 1.5);
+      EXPECT_EQ(store.LatestOfLot("lot-r").size(), 2u);
+    }
+    EXPECT_EQ(Tables(target), tables) << "a read migrates a private copy only";
     EXPECT_EQ(Sql(target, "SELECT version FROM schema_version"),
-              std::vector<std::string>{std::to_string(kStoreSchemaVersion)});
+              std::vector<std::string>{std::to_string(version)});
+    if (!IsPostgresStore(target)) {
+      fs::permissions(target, fs::perms::owner_read | fs::perms::owner_write);
+      const std::string error = OpenError(target, StoreAccess::kRecord);
+      EXPECT_EQ(error, "") << "recording migrates it for good";
+      EXPECT_EQ(Sql(target, "SELECT version FROM schema_version"),
+                std::vector<std::string>{std::to_string(kStoreSchemaVersion)});
+    }
   }
 }
 

@@ -24,9 +24,11 @@
 
 #include <gtest/gtest.h>
 
+#include "imufit/factory/certify.h"
 #include "imufit/factory/lot_history.h"
 #include "imufit/factory/store_history.h"
 #include "imufit/io/error.h"
+#include "imufit/io/sha256.h"
 #include "imufit/store/store.h"
 #include "store_test_util.h"
 #include "test_util.h"
@@ -470,6 +472,63 @@ TEST(StoreTest, MergeIsIdempotent) {
     EXPECT_EQ(after[i].figures.size(), before[i].figures.size());
   }
   EXPECT_EQ(ResultsStore(into).Yield("lot-m")[0].units, 3);
+}
+
+}  // namespace
+}  // namespace imufit
+
+namespace imufit {
+namespace {
+
+// Issue 29 item 6: a unit's row as the factory records it, on both backends: fits.fit_options
+// filled, the committed files as attachments, the figures' U as stated (not 2 sigma), and a unit
+// recorded without its fit in hand (a batch's unchanged unit) at its calibration's time, so that
+// recording it again (a new store, then a merge) is the same fit. The run's lot is known.
+TEST(StoreTest, AUnitsRowHoldsItsFitOptionsAttachmentsUAndCalibrationTime) {
+  const std::string target = FreshStore("certified");
+  constexpr double kStatedU = 0.019;  // above 2 x sigma: the budget's, with Type B
+  const auto record = [&](const std::string& into) {
+    ResultsStore store(into);
+    CertifySettings settings;
+    settings.store = &store;
+    settings.lot = "lot-c";
+    settings.software = "imufit test";
+    settings.fit_options = "fitted=gyro.bias,gyro.scale; loss=huber";
+    UnitOutcome unit;
+    unit.unit = "u1";
+    unit.serial = "SN-C";
+    unit.status = UnitStatus::kFitted;
+    unit.skipped = true;
+    unit.calibrated_utc = "2026-03-01T10:00:00Z";
+    unit.calibration_yaml = "calibration of SN-C\n";
+    unit.plan_sha256 = std::string(64, '1');
+    unit.samples_sha256 = std::string(64, '4');
+    unit.attachments = {{"calibration", "out/u1/calibration.yaml", Sha256Hex(unit.calibration_yaml)}};
+    Figure figure = MakeFigure("gyro_scale_per_dps.x", "gyro.scale.x", "raw/(deg/s)", 939.6, 0.0015);
+    figure.expanded = kStatedU;
+    unit.figures = {figure};
+    EXPECT_TRUE(RecordUnit(settings, &unit)) << unit.message;
+  };
+  record(target);
+  ResultsStore store(target);
+  const std::vector<StoredFit> fits = store.BySerial("SN-C");
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_EQ(fits[0].fit_options, "fitted=gyro.bias,gyro.scale; loss=huber");
+  EXPECT_EQ(fits[0].time_utc, "2026-03-01T10:00:00Z") << "the calibration's time, not the recording's";
+  ASSERT_EQ(fits[0].attachments.size(), 1u);
+  EXPECT_EQ(fits[0].attachments[0].kind, "calibration");
+  EXPECT_EQ(fits[0].attachments[0].sha256, Sha256Hex("calibration of SN-C\n"));
+  ASSERT_EQ(fits[0].figures.size(), 1u);
+  EXPECT_EQ(fits[0].figures[0].expanded_u, kStatedU);
+  ASSERT_EQ(store.Trend("gyro_scale_per_dps.x", "SN-C").size(), 1u);
+  EXPECT_EQ(store.Trend("gyro_scale_per_dps.x", "SN-C")[0].expanded_u, kStatedU);
+  EXPECT_EQ(store.LotOfRun(fits[0]).value_or(""), "lot-c");
+  StoredFit elsewhere = fits[0];
+  elsewhere.samples_sha256 = std::string(64, '5');
+  EXPECT_FALSE(store.LotOfRun(elsewhere).has_value());
+  // Recorded again (the same unchanged unit, later): the same fit, one row.
+  record(target);
+  EXPECT_EQ(ResultsStore(target).CountFits(), 1);
 }
 
 }  // namespace

@@ -30,13 +30,19 @@ void Decide(const Verdict& verdict, CriterionResult* r) {
                : margin > 0.0 ? Outcome::kConditionalPass
                : margin > -u  ? Outcome::kConditionalFail
                               : Outcome::kFail;
-  const double guard = verdict.rule == DecisionRule::kGuarded ? verdict.guard_band_u * u : 0.0;
+  const bool guarded = verdict.rule == DecisionRule::kGuarded;
+  const double guard = guarded ? verdict.guard_band_u * u : 0.0;
   r->pass = margin > guard;
   if (r->outcome == Outcome::kConditionalPass || r->outcome == Outcome::kConditionalFail) {
     r->reason = "within U = " + Number(u) + " " + r->unit + " of the limit";
-    if (verdict.rule == DecisionRule::kGuarded && r->outcome == Outcome::kConditionalPass) {
+    if (guarded && r->outcome == Outcome::kConditionalPass)
       r->reason += ": inside the guard band, not accepted";
-    }
+  } else if (r->outcome == Outcome::kPass && !r->pass) {
+    // Clear of the limit by more than U but not by the guard band (guard_band > 1): not accepted,
+    // and its row says so.
+    r->outcome = Outcome::kFail;
+    r->reason = "inside the guard band w = " + Number(verdict.guard_band_u) + " x U = " + Number(guard) +
+                " " + r->unit + " of the limit: not accepted";
   }
 }
 
@@ -57,13 +63,10 @@ struct Reading {
   std::string unresolved;  // Figure::unresolved
 };
 
-Reading Read(const Context& context, const std::string& name, bool sigma, const std::vector<Figure>& figures,
-             const UncertaintyBudget* budget) {
-  // U of a figure: the budget's, else k = 2 times its 1-sigma; < 0: none.
-  const auto expanded = [&](const Figure& f) {
-    const FigureBudget* b = budget != nullptr ? budget->Find(f.name) : nullptr;
-    return b != nullptr ? b->expanded : f.sigma >= 0.0 ? 2.0 * f.sigma : -1.0;
-  };
+Reading Read(const Context& context, const std::string& name, bool sigma,
+             const std::vector<Figure>& figures) {
+  // U of a figure: its own (the budget's for a coefficient when there is one, else k x its 1-sigma).
+  const auto expanded = [](const Figure& f) { return f.expanded; };
   Reading reading;
   // Scale errors are relative to the nominal scale the limits file gives.
   if (const KeyFigure* quantity = FindKeyFigure(name);
@@ -99,9 +102,9 @@ Reading Read(const Context& context, const std::string& name, bool sigma, const 
 }
 
 // A statistic over a temperature range (LimitStatistic::kLargest, kVariation), the polynomial
-// evaluated at kRangeStatisticPoints temperatures: the value that binds, with its U there (2 x its
-// 1-sigma: the budget is at 25 degC), and `*at_c`, where; for a variation, largest - smallest, without
-// a U (the errors of its ends are correlated).
+// evaluated at kRangeStatisticPoints temperatures: the value that binds, with its U there (the
+// budget's at that temperature, the station's Type B sources included), and `*at_c`, where; for a variation,
+// largest - smallest, without a U (the errors of its ends are correlated).
 Reading ReadOverRange(const Context& context, const LimitCriterion& criterion, const std::string& name,
                       double* at_c) {
   const std::array<double, 2> range = criterion.over_c.value_or(context.calibration.fit_temp_range_c);
@@ -109,7 +112,7 @@ Reading ReadOverRange(const Context& context, const LimitCriterion& criterion, c
   double lowest_c = range[0], highest_c = range[0], largest_c = range[0];
   for (int i = 0; i < kRangeStatisticPoints; ++i) {
     const double temp_c = range[0] + (range[1] - range[0]) * i / (kRangeStatisticPoints - 1);
-    const Reading r = Read(context, name, false, KeyFigures(context.calibration, temp_c), nullptr);
+    const Reading r = Read(context, name, false, KeyFigures(context.calibration, temp_c, context.budget));
     if (!r.found) return r;
     if (i == 0 || r.value < lowest.value) lowest = r, lowest_c = temp_c;
     if (i == 0 || r.value > highest.value) highest = r, highest_c = temp_c;
@@ -175,10 +178,9 @@ CriterionResult Judge(const LimitCriterion& criterion, const std::string& name,
   const std::string range_text = RangeText(criterion, context.calibration);
   CriterionResult r = Named(criterion, name, range_text);
   double at_c = kFigureTempC;
-  const Reading reading =
-      range_text.empty()
-          ? Read(context, name, criterion.statistic == LimitStatistic::kSigma, figures, context.budget)
-          : ReadOverRange(context, criterion, name, &at_c);
+  const Reading reading = range_text.empty()
+                              ? Read(context, name, criterion.statistic == LimitStatistic::kSigma, figures)
+                              : ReadOverRange(context, criterion, name, &at_c);
   if (!reading.found) {
     r.measured_text = reading.unresolved.empty() ? "not in calibration" : "not resolved by this run";
     r.reason = reading.unresolved;
@@ -260,7 +262,8 @@ void CoefficientFigures(const KeyFigure& quantity, const Calibration& calibratio
 
 }  // namespace
 
-std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
+std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c,
+                               const UncertaintyBudget* budget) {
   std::vector<Figure> figures;
   for (const KeyFigure& quantity : kKeyFigures) {
     switch (quantity.source) {
@@ -291,6 +294,13 @@ std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c) {
       case FigureSource::kCertificate:  // measured by the certificate (MeasuredFigures)
       case FigureSource::kFitRange:     // judged as a range
         break;
+    }
+  }
+  if (budget != nullptr) {
+    for (const FigureBudget& b : budget->At(calibration, temp_c)) {
+      for (Figure& f : figures) {
+        if (f.name == b.name && f.sigma >= 0.0) f.expanded = b.expanded;
+      }
     }
   }
   return figures;
@@ -367,7 +377,7 @@ Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
   verdict.guard_band_u = limits.guard_band_u;
   const Context context{limits, calibration, budget};
   std::vector<Figure> figures = measured;  // found first: they take the place of the calibration's
-  for (const Figure& f : KeyFigures(calibration)) figures.push_back(f);
+  for (const Figure& f : KeyFigures(calibration, kFigureTempC, budget)) figures.push_back(f);
   for (const LimitCriterion& criterion : limits.criteria) {
     if (criterion.kind == LimitKind::kCoverage) {
       CriterionResult r;

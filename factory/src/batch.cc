@@ -25,6 +25,7 @@
 #include "imufit/factory/report.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
+#include "imufit/io/machine_text.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 #include "imufit/io/station.h"
@@ -87,10 +88,13 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
   }
 }
 
+// Written by the one machine-text writer (io/machine_text.h): every value a string to every YAML
+// reader (a serial "007" or a hash of digits is quoted, not read as a number).
 void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction* transaction) {
-  YAML::Emitter out;
-  out << YAML::BeginMap << YAML::Key << "format" << YAML::Value << kManifestFormat << YAML::Key << "version"
-      << YAML::Value << 1;
+  MachineDoc doc = MachineDoc::Map();
+  doc.CommentFirst({"imufit batch: this unit's inputs and outcome; delete to redo it"});
+  doc.Add("format", MachineDoc::Text(kManifestFormat));
+  doc.Add("version", MachineDoc::Integer(1));
   const std::pair<const char*, const std::string*> fields[] = {{"software", &m.software},
                                                                {"plan_sha256", &m.plan_sha256},
                                                                {"samples_sha256", &m.samples_sha256},
@@ -103,13 +107,8 @@ void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction
                                                                {"station_sha256", &m.station_sha256},
                                                                {"fit_options", &m.fit_options},
                                                                {"issued_to", &m.issued_to}};
-  for (const auto& [key, value] : fields)
-    out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
-  out << YAML::EndMap;
-  WriteFileAtomically(
-      path,
-      std::string("# imufit batch: this unit's inputs and outcome; delete to redo it\n") + out.c_str() + "\n",
-      transaction);
+  for (const auto& [key, value] : fields) doc.Add(key, MachineDoc::Text(*value));
+  WriteFileAtomically(path, YamlText(doc), transaction);
 }
 
 // Temporary files of outputs a killed run never committed (OutputFile's ".NAME.tmp-XXXXXX").
@@ -296,17 +295,46 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
   unit->skipped = true;
   unit->serial = previous->serial;
   unit->status = status;
+  if (unit->status == UnitStatus::kFitted) {
+    const Calibration calibration = ReadCalibration(paths.calibration);
+    JudgeUnit(shared.certify, calibration, nullptr, unit);
+    // The outcome is the one judged when the unit was fitted (with its certificate's noise, window
+    // errors and uncertainty budget), as its manifest and the store hold it: not judged again from
+    // less.
+    bool pass = false;
+    if (unit->verdict && ValueOf(kVerdictNames, previous->verdict, &pass)) unit->verdict->pass = pass;
+    unit->attachments = {{"calibration", paths.calibration, previous->calibration_sha256}};
+    if (shared.options->write_reports)
+      unit->attachments.push_back({"certificate", paths.report, Sha256OfFile(paths.report)});
+  }
   unit->message = previous->message;
-  // The verdict is judged again (it is the manifest's, from the same calibration and limits).
-  if (unit->status == UnitStatus::kFitted)
-    JudgeUnit(shared.certify, ReadCalibration(paths.calibration), std::nullopt, unit);
   return true;
+}
+
+// Refuses a unit whose run (serial, plan and samples) the store holds under another lot than this
+// batch's: a run keeps the lot it was first recorded in, so recording it would put it there, and
+// `imufit lot --lot` of this batch's lot would not find it. The unit is an error saying so, neither
+// recorded nor marked done (throws InputError).
+void RefuseAnotherLotsRun(const Shared& shared, const UnitOutcome& unit) {
+  if (shared.store == nullptr) return;
+  StoredFit run;
+  run.serial = unit.serial.empty() ? unit.unit : unit.serial;
+  run.plan_sha256 = unit.plan_sha256;
+  run.samples_sha256 = unit.samples_sha256;
+  const std::optional<std::string> lot = shared.store->LotOfRun(run);
+  if (!lot || *lot == shared.certify.lot) return;
+  throw InputError(unit.samples_path, "this run of " + run.serial + " is recorded in lot " +
+                                          QuoteForMessage(*lot) + " of " + shared.store->path() + ", not " +
+                                          QuoteForMessage(shared.certify.lot) +
+                                          ": a run belongs to the lot it was first recorded in (give --lot " +
+                                          *lot + ", or another --store)");
 }
 
 // A unit skipped as unchanged that the store does not know (a new store, or another one): recorded
 // from its manifest and calibration, so that the store holds every unit of the lot.
 void RecordSkippedUnit(const Shared& shared, const UnitPaths& paths, UnitOutcome* unit) {
   if (shared.store == nullptr || shared.store->HasUnit(shared.certify.lot, unit->unit)) return;
+  RefuseAnotherLotsRun(shared, *unit);
   if (unit->status == UnitStatus::kFitted) {
     std::ifstream stream(paths.calibration, std::ios::binary);
     unit->calibration_yaml.assign(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
@@ -329,7 +357,9 @@ void FitUnit(const Shared& shared, const UnitInput& input, const UnitPaths& path
   options.serial = input.listed ? input.serial : SerialFile(input.dir);
   options.serial_source = input.listed ? input.serial_source : (input.dir / "serial.txt").string();
   options.plan_sha256 = unit->plan_sha256;
-  options.keep_static_stretch = shared.options->write_reports;  // the certificate's noise section
+  // The certificate's noise section: measured whenever the unit is judged, printed or not.
+  options.keep_static_stretch =
+      shared.options->write_reports || shared.certify.limits || shared.certify.store != nullptr;
   unit->fit = FitRun(unit->plan_path, unit->samples_path, options);
   FitRunResult& result = *unit->fit;
   if (!result.serial.empty()) unit->serial = result.serial;  // serial.txt, the samples', the plan's
@@ -411,7 +441,13 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
     FindInputs(*shared.options, input, &unit);
     manifest = InputsManifest(shared, unit);
     if (TakeUnchanged(shared, manifest, paths, &unit)) {
-      RecordSkippedUnit(shared, paths, &unit);
+      try {
+        RecordSkippedUnit(shared, paths, &unit);
+      } catch (const InputError& e) {  // recorded under another lot: said, not recorded
+        unit.status = UnitStatus::kError;
+        unit.verdict.reset();
+        unit.message = e.what();
+      }
       return unit;
     }
     FitUnit(shared, input, paths, &unit);
@@ -423,6 +459,16 @@ UnitOutcome ProcessUnit(const Shared& shared, const UnitInput& input) {
     unit.status = UnitStatus::kError;
     unit.message = std::string("error: ") + e.what();
     outside = true;
+  }
+  if (!outside && !unit.plan_sha256.empty()) {
+    try {
+      RefuseAnotherLotsRun(shared, unit);
+    } catch (const InputError& e) {  // a run of another lot: said, neither recorded nor marked done
+      unit.status = UnitStatus::kError;
+      unit.verdict.reset();
+      unit.message = e.what();
+      outside = true;
+    }
   }
   try {
     if (!outside && unit.fit && unit.fit->calibration) {
@@ -583,6 +629,7 @@ void Prepare(const BatchOptions& options, Shared* shared, std::vector<UnitInput>
                                       : ReadUnitsList(options.units_list, options.shard);
   shared->options = &options;
   shared->fit_options = options.fit.Describe();
+  shared->certify.fit_options = shared->fit_options;
   shared->certify.software = options.fit.software;
   shared->certify.windows = options.fit.windows;
   shared->certify.samples_input = options.fit.input;

@@ -157,17 +157,12 @@ void Identify(const CertificateSources& sources, Certificate* c) {
 // The key figures at 25 degC, with their expanded uncertainty (the budget's, where it has the figure).
 std::vector<KeyFigureRow> FigureRows(const Calibration& cal, const UncertaintyBudget& budget) {
   std::vector<KeyFigureRow> rows;
-  for (const Figure& f : KeyFigures(cal)) {
+  for (const Figure& f : KeyFigures(cal, kFigureTempC, &budget)) {
     // Coefficients of the model, signed; the others are the fit's diagnostics (residual RMS,
     // segments missing) and noise figures.
     const KeyFigure* quantity = FindKeyFigure(f.name);
     const bool is_coefficient = quantity != nullptr && quantity->source == FigureSource::kCoefficient;
-    const FigureBudget* b = budget.Find(f.name);
-    rows.push_back({f.name, f.unit, is_coefficient, f.value, f.sigma,
-                    b != nullptr && f.sigma >= 0.0 ? b->expanded
-                    : f.sigma >= 0.0               ? kCoverageFactor * f.sigma
-                                                   : -1.0,
-                    f.extrapolated});
+    rows.push_back({f.name, f.unit, is_coefficient, f.value, f.sigma, f.expanded, f.extrapolated});
   }
   return rows;
 }
@@ -348,6 +343,7 @@ std::vector<Figure> MeasuredFigures(const Certificate& certificate) {
       if (term != nullptr && term->resolved) {
         f.value = term->value;
         f.sigma = term->sigma;
+        f.expanded = f.sigma >= 0.0 ? kCoverageFactor * f.sigma : -1.0;
       } else {
         f.unresolved = Unresolved(noise, a, quantity);
       }

@@ -51,13 +51,18 @@ Certificate MakeUnitCertificate(const CertifySettings& settings, const UnitFiles
 
 }  // namespace
 
-void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
-               const std::optional<Verdict>& certified, UnitOutcome* unit) {
-  unit->figures = KeyFigures(calibration);
+void JudgeUnit(const CertifySettings& settings, const Calibration& calibration, const Certificate* certified,
+               UnitOutcome* unit) {
+  unit->figures = certified != nullptr ? KeyFigures(calibration, kFigureTempC, &certified->budget)
+                                       : KeyFigures(calibration);
   unit->calibrated_utc = calibration.created_utc;
   if (!settings.limits) return;
-  unit->verdict = certified ? *certified : EvaluateLimits(*settings.limits, calibration);
+  unit->verdict = certified != nullptr ? *certified->verdict : EvaluateLimits(*settings.limits, calibration);
   unit->message = unit->verdict->FailedSummary();
+}
+
+bool JudgedAsCertified(const CertifySettings& settings, const UnitFiles& files) {
+  return !files.report.empty() || settings.limits || settings.store != nullptr;
 }
 
 void ReadLimitsAndStation(const std::string& limits_path, const std::string& station_path,
@@ -77,15 +82,22 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
   const Calibration& calibration = *unit->fit->calibration;
   unit->status = UnitStatus::kFitted;
   if (!files.calibration_is_input) unit->calibration_yaml = CalibrationToYaml(calibration);
+  // One judgement whatever is printed: the certificate's figures, U and verdict, also when no page
+  // is written (--no-report, fit --limits without --report), so that every output says the same.
   std::optional<Certificate> certificate;
-  if (!files.report.empty()) certificate = MakeUnitCertificate(settings, files, *unit);
-  JudgeUnit(settings, calibration, certificate ? certificate->verdict : std::nullopt, unit);
+  if (JudgedAsCertified(settings, files)) certificate = MakeUnitCertificate(settings, files, *unit);
+  JudgeUnit(settings, calibration, certificate ? &*certificate : nullptr, unit);
   // The calibration, the certificate, the caller's further outputs and the store's row: all or none.
   OutputTransaction outputs;
-  if (!files.calibration_is_input) WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
-  if (certificate) {
+  unit->attachments.clear();
+  if (!files.calibration_is_input) {
+    WriteFileAtomically(files.calibration, unit->calibration_yaml, &outputs);
+    unit->attachments.push_back({"calibration", files.calibration, Sha256Hex(unit->calibration_yaml)});
+  }
+  if (!files.report.empty()) {
     const std::string html = CertificateHtml(*certificate);
     WriteFileAtomically(files.report, html, &outputs);
+    unit->attachments.push_back({"certificate", files.report, Sha256Hex(html)});
     if (!files.pdf.empty()) WritePdf(html, files.pdf, files.paper, &outputs);
   }
   if (files.more) files.more(*unit, &outputs);
@@ -114,7 +126,7 @@ StoredFigure StoredFigureOf(const Figure& figure) {
   g.unit = figure.unit;
   g.value = figure.value;
   g.sigma = figure.sigma;
-  if (g.sigma >= 0) g.expanded_u = kCoverageFactor * g.sigma;
+  g.expanded_u = figure.sigma >= 0.0 ? figure.expanded : -1.0;
   return g;
 }
 
@@ -127,8 +139,14 @@ bool RecordUnit(const CertifySettings& settings, UnitOutcome* unit, OutputTransa
   row.unit = unit->unit.empty() ? unit->samples_path : unit->unit;
   row.serial = unit->serial.empty() ? row.unit : unit->serial;
   row.lot = settings.lot;
-  const bool fitted = unit->fit && unit->fit->calibration && unit->status == UnitStatus::kFitted;
-  row.time_utc = fitted ? unit->fit->calibration->created_utc : UtcNow();
+  // When the calibration was made: a unit skipped as unchanged keeps its original fit time (the
+  // same fit recorded again is the same row, also after a merge); a unit not fitted, now.
+  const bool fitted = unit->status == UnitStatus::kFitted;
+  row.time_utc = fitted && unit->fit && unit->fit->calibration ? unit->fit->calibration->created_utc
+                 : fitted && !unit->calibrated_utc.empty()     ? unit->calibrated_utc
+                                                               : UtcNow();
+  row.fit_options = settings.fit_options;
+  row.attachments = unit->attachments;
   row.software = settings.software;
   row.plan_sha256 = unit->plan_sha256;
   row.samples_sha256 = unit->samples_sha256;

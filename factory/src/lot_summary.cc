@@ -74,7 +74,7 @@ std::string LotSummaryCsv(const BatchResult& batch) {
         continue;
       }
       csv += "," + NumberCell(f->value) + "," + NumberCell(f->sigma, f->sigma >= 0.0) + "," +
-             NumberCell(kCoverageFactor * f->sigma, f->sigma >= 0.0);
+             NumberCell(f->expanded, f->sigma >= 0.0 && f->expanded >= 0.0);
     }
     csv += "\n";
   }

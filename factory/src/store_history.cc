@@ -137,6 +137,7 @@ BatchResult StoredLot(ResultsStore* store, const std::string& lot) {
     u.calibration_yaml = std::move(f.calibration_yaml);
     for (const StoredFigure& g : f.figures) {
       u.figures.push_back(MakeFigure(g.name, g.coefficient, g.unit, g.value, g.sigma));
+      u.figures.back().expanded = g.expanded_u;  // the U the fit was stated with, not re-derived
       bool accepted = false;
       if (!u.verdict || !ValueOf(kCriterionAcceptanceNames, g.outcome, &accepted)) continue;
       CriterionResult c;
@@ -204,7 +205,7 @@ std::string TrendPageHtml(const std::string& store, const std::string& figure,
                 h->Close("tbody").Close("table");
                 h->Element("h2", "Every fit");
                 h->Open("table").Open("thead");
-                Row(h, {"time (UTC)", "station", "serial", "lot", "value", "1-sigma"}, "th");
+                Row(h, {"time (UTC)", "station", "serial", "lot", "value", "1-sigma", "U (k = 2)"}, "th");
                 h->Close("thead").Open("tbody");
                 for (const TrendPoint& p : points) {
                   h->Open("tr", {{"data-serial", p.serial}})
@@ -214,6 +215,8 @@ std::string TrendPageHtml(const std::string& store, const std::string& figure,
                       .Element("td", p.lot);
                   Num(h, FormatDouble(p.value));
                   Num(h, p.sigma >= 0 ? FormatDouble(p.sigma) : "");
+                  Num(h, p.expanded_u >= 0 ? FormatDouble(p.expanded_u) : "",
+                      {{"data-u", FormatDouble(p.expanded_u)}});
                   h->Close("tr");
                 }
                 h->Close("tbody").Close("table");

@@ -27,7 +27,7 @@ const StationInfluenceInfo& Info(StationInfluence influence) {
   return kStationUncertainties[0];
 }
 
-std::vector<Component> Components(const StationUncertainty& source, double gravity_mps2) {
+std::vector<Component> Components(const StationUncertainty& source, const Plan& plan) {
   const std::string title = Info(source.influence).title;
   const double u = source.u_si;
   std::vector<Component> components;
@@ -46,8 +46,11 @@ std::vector<Component> Components(const StationUncertainty& source, double gravi
       components.push_back({title, {}});
       components.back().one_u.rate_scale = u;
       break;
-    case StationInfluence::kTableAxisTilt:
-      vector_components(kAxes, "about", &TruthPerturbation::tilt_rad);
+    case StationInfluence::kTableAxisTilt:  // in the lab: about north and about east
+      for (int i = 0; i < 2; ++i) {
+        components.push_back({title + (i == 0 ? " about north" : " about east"), {}});
+        components.back().one_u.tilt_rad[i] = u;
+      }
       break;
     case StationInfluence::kFixtureOrthogonality:
       vector_components(kPairs, "", &TruthPerturbation::orthogonality_rad);
@@ -57,7 +60,7 @@ std::vector<Component> Components(const StationUncertainty& source, double gravi
       break;
     case StationInfluence::kLocalGravity:
       components.push_back({title, {}});
-      components.back().one_u.gravity_scale = u / gravity_mps2;
+      components.back().one_u.gravity_scale = u / plan.site.gravity_mps2;
       break;
     case StationInfluence::kThermometer:
       components.push_back({title, {}});
@@ -105,24 +108,75 @@ bool IsCoefficient(const Figure& f) {
   return f.coefficient.rfind("gyro.", 0) == 0 || f.coefficient.rfind("accel.", 0) == 0;
 }
 
-// The coefficient key figures of the model the fit gives under the truth perturbed by `p`; empty
-// when that fit is not usable.
-std::vector<double> RefitFigures(const Calibration& calibration, const Plan& plan,
-                                 const std::vector<Window>& windows, const FitOptions& options,
-                                 const TruthPerturbation& p) {
+// The model the fit gives under the truth perturbed by `p`; nullopt when that fit is not usable.
+std::optional<SensorModel> Refit(const Plan& plan, const std::vector<Window>& windows,
+                                 const FitOptions& options, const TruthPerturbation& p) {
   TableSite site = plan.site;
   std::vector<TableSegment> segments = plan.segments;
   std::vector<Window> perturbed = windows;
   PerturbTruth(p, &site, &segments, &perturbed);
   const FitSummary fit = FitThermalModel(perturbed, site, segments, options);
-  if (!fit.IsSolutionUsable()) return {};
+  if (!fit.IsSolutionUsable()) return std::nullopt;
+  return fit.model;
+}
+
+// The coefficient key figures at `temp_c` of `calibration` with `model` in place of its own.
+std::vector<double> CoefficientValues(const Calibration& calibration, const SensorModel& model,
+                                      double temp_c) {
   Calibration refitted = calibration;
-  refitted.model = fit.model;
+  refitted.model = model;
   std::vector<double> values;
-  for (const Figure& f : KeyFigures(refitted)) {
+  for (const Figure& f : KeyFigures(refitted, temp_c)) {
     if (IsCoefficient(f)) values.push_back(f.value);
   }
   return values;
+}
+
+// The coefficient key figures of the model the fit gives under the truth perturbed by `p`; empty
+// when that fit is not usable.
+std::vector<double> RefitFigures(const Calibration& calibration, const Plan& plan,
+                                 const std::vector<Window>& windows, const FitOptions& options,
+                                 const TruthPerturbation& p) {
+  const std::optional<SensorModel> model = Refit(plan, windows, options, p);
+  return model ? CoefficientValues(calibration, *model, kFigureTempC) : std::vector<double>();
+}
+
+// The budgets of `calibration`'s coefficient figures at `temp_c`: Type A from its sigmas there, Type B
+// the differences of `budget`'s moved models from its re-solved one there; combined and expanded.
+std::vector<FigureBudget> FigureBudgets(const UncertaintyBudget& budget, const Calibration& calibration,
+                                        double temp_c) {
+  std::vector<FigureBudget> figures;
+  for (const Figure& f : KeyFigures(calibration, temp_c)) {
+    if (!IsCoefficient(f)) continue;
+    FigureBudget b;
+    b.name = f.name;
+    b.unit = f.unit;
+    b.value = f.value;
+    b.type_a = std::max(f.sigma, 0.0);
+    figures.push_back(b);
+  }
+  if (budget.resolved) {
+    const std::vector<double> base = CoefficientValues(calibration, *budget.resolved, temp_c);
+    for (const auto& [line, model] : budget.moved) {
+      const std::vector<double> moved = CoefficientValues(calibration, model, temp_c);
+      if (moved.size() != figures.size() || base.size() != figures.size()) continue;
+      for (size_t i = 0; i < base.size(); ++i) {
+        BudgetLine contribution = line;
+        contribution.contribution = moved[i] - base[i];
+        figures[i].type_b.push_back(contribution);
+      }
+    }
+  }
+  for (FigureBudget& f : figures) {
+    double variance = f.type_a * f.type_a;
+    for (const BudgetLine& line : f.type_b) variance += line.contribution * line.contribution;
+    std::sort(f.type_b.begin(), f.type_b.end(), [](const BudgetLine& a, const BudgetLine& b) {
+      return std::abs(a.contribution) > std::abs(b.contribution);
+    });
+    f.combined = std::sqrt(variance);
+    f.expanded = budget.coverage_factor * f.combined;
+  }
+  return figures;
 }
 
 std::string InputText(const StationUncertainty& s) {
@@ -194,6 +248,11 @@ const FigureBudget* UncertaintyBudget::Find(const std::string& name) const {
   return nullptr;
 }
 
+std::vector<FigureBudget> UncertaintyBudget::At(const Calibration& calibration, double temp_c) const {
+  if (temp_c == kFigureTempC) return figures;
+  return FigureBudgets(*this, calibration, temp_c);
+}
+
 UncertaintyBudget ComputeBudget(const Calibration& calibration, const Plan& plan,
                                 const std::vector<Window>& windows,
                                 const std::vector<StationUncertainty>& sources) {
@@ -201,41 +260,21 @@ UncertaintyBudget ComputeBudget(const Calibration& calibration, const Plan& plan
   budget.bias_stability_included =
       calibration.fit && (calibration.fit->gyro_bias_stability_radps.value_or(0.0) > 0.0 ||
                           calibration.fit->accel_bias_stability_mps2.value_or(0.0) > 0.0);
-  for (const Figure& f : KeyFigures(calibration)) {
-    if (!IsCoefficient(f)) continue;
-    FigureBudget b;
-    b.name = f.name;
-    b.unit = f.unit;
-    b.value = f.value;
-    b.type_a = std::max(f.sigma, 0.0);
-    budget.figures.push_back(b);
-  }
   if (calibration.fit && !windows.empty() && !sources.empty()) {
     const FitOptions options = RefitOptions(calibration);
-    const std::vector<double> base = RefitFigures(calibration, plan, windows, options, {});
-    if (base.size() == budget.figures.size()) {
+    budget.resolved = Refit(plan, windows, options, {});
+    if (budget.resolved) {
       budget.inputs = sources;
       for (const StationUncertainty& source : sources) {
-        for (const Component& c : Components(source, plan.site.gravity_mps2)) {
-          const std::vector<double> moved = RefitFigures(calibration, plan, windows, options, c.one_u);
-          if (moved.size() != base.size()) continue;
-          for (size_t i = 0; i < base.size(); ++i) {
-            budget.figures[i].type_b.push_back(
-                {c.name, source.source, InputText(source), moved[i] - base[i]});
+        for (const Component& c : Components(source, plan)) {
+          if (std::optional<SensorModel> moved = Refit(plan, windows, options, c.one_u)) {
+            budget.moved.push_back({{c.name, source.source, InputText(source), 0.0}, std::move(*moved)});
           }
         }
       }
     }
   }
-  for (FigureBudget& f : budget.figures) {
-    double variance = f.type_a * f.type_a;
-    for (const BudgetLine& line : f.type_b) variance += line.contribution * line.contribution;
-    std::sort(f.type_b.begin(), f.type_b.end(), [](const BudgetLine& a, const BudgetLine& b) {
-      return std::abs(a.contribution) > std::abs(b.contribution);
-    });
-    f.combined = std::sqrt(variance);
-    f.expanded = budget.coverage_factor * f.combined;
-  }
+  budget.figures = FigureBudgets(budget, calibration, kFigureTempC);
   budget.classes = Classes(budget.figures);
   Statements(&budget);
   return budget;
@@ -253,7 +292,7 @@ std::vector<double> MonteCarloTypeB(const Calibration& calibration, const Plan& 
   for (int trial = 0; trial < trials; ++trial) {
     TruthPerturbation draw;
     for (const StationUncertainty& source : sources) {
-      for (const Component& c : Components(source, plan.site.gravity_mps2)) {
+      for (const Component& c : Components(source, plan)) {
         draw = Sum(draw, Scaled(c.one_u, source.rectangular ? uniform(random) : normal(random)));
       }
     }

@@ -26,14 +26,27 @@ Eigen::Vector3d Direction(const Eigen::Matrix3d& map, const Eigen::Vector3d& v) 
 
 }  // namespace
 
+Eigen::Vector3d LabNorth(const TableSegment& segment) {
+  if (segment.north) return *segment.north;
+  int nearest = 0;
+  segment.up.cwiseAbs().maxCoeff(&nearest);
+  const Eigen::Vector3d next = Eigen::Vector3d::Unit((nearest + 1) % 3);
+  return (next - next.dot(segment.up) * segment.up).normalized();
+}
+
 void PerturbTruth(const TruthPerturbation& p, TableSite* site, std::vector<TableSegment>* segments,
                   std::vector<Window>* windows) {
   if (site != nullptr) site->gravity_mps2 *= 1.0 + p.gravity_scale;
   if (segments != nullptr) {
     const Eigen::Matrix3d fixture = FixtureMap(p);
-    const Eigen::Matrix3d tilt = Rotation(p.tilt_rad);
     for (TableSegment& s : *segments) {
-      const Eigen::Matrix3d map = s.IsStatic() ? Eigen::Matrix3d(tilt * fixture) : fixture;
+      // The lab's tilt in this position's body axes (before the fixture moves the directions).
+      Eigen::Matrix3d map = fixture;
+      if (s.IsStatic() && !p.tilt_rad.isZero()) {
+        const Eigen::Vector3d north = LabNorth(s);
+        const Eigen::Vector3d east = north.cross(s.up);
+        map = Rotation(p.tilt_rad[0] * north + p.tilt_rad[1] * east) * fixture;
+      }
       s.up = Direction(map, s.up);
       if (s.axis) s.axis = Direction(fixture, *s.axis);
       if (s.north) s.north = Direction(map, *s.north);

@@ -280,11 +280,11 @@ std::string UndeterminedMessage(const std::string& samples, const FitRunOptions&
                                 const FitRunResult& result) {
   const FitSummary& fit = result.fit;
   const WindowStats& stats = result.run.stats;
-  std::string held = std::to_string(stats.samples) + " samples, " + std::to_string(stats.transition_samples) +
-                     " in transitions, " + std::to_string(stats.trimmed_samples) + " trimmed after moves, " +
-                     std::to_string(fit.windows_used) + " windows used, " +
-                     std::to_string(stats.short_windows) + " windows shorter than " +
-                     std::to_string(options.windows.min_samples) + " samples dropped";
+  std::string held = std::to_string(stats.samples) + " samples, " + std::to_string(stats.window_samples) +
+                     " of them in the windows, " + std::to_string(fit.windows_used) + " windows used";
+  if (const std::string left_out = LeftOutNote(stats, options.windows); !left_out.empty()) {
+    held += "; left out: " + left_out;
+  }
   if (const std::string note = TimeStampNote(stats); !note.empty()) held += "; time stamps: " + note;
   if (const std::string note = SaturationNote(stats); !note.empty()) held += "; saturation: " + note;
   return samples + ": the run does not determine the model: " + Join(fit.undetermined, "; ") +

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -251,42 +252,46 @@ double PlanGroupFactor(const std::string& group) {
 }
 
 std::vector<Window> PlannedWindows(const std::vector<TableSegment>& segments, const TableSite& site,
-                                   const SimulationOptions& schedule, const WindowOptions& window_options) {
-  const int passes = schedule.ramp ? schedule.passes : static_cast<int>(schedule.soak_temps_c.size());
+                                   const SimulationOptions& schedule, const WindowOptions& window_options,
+                                   WindowStats* stats) {
+  // The run's time stamps, labels and temperatures as `imufit simulate` writes them (no noise, no
+  // losses), cut by the fit's own WindowBuilder: the same windows, trims, splits on a ramp, merged
+  // remainders and short occurrences left out as the fit will have. The outputs fed are zero (the
+  // cuts do not depend on them; a constant output is no saturation where every window is alike).
+  SimulationOptions timing = schedule;
+  timing.gyro_noise_density = timing.accel_noise_density = 0.0;
+  timing.gyro_random_walk = timing.accel_random_walk = 0.0;
+  timing.gyro_bias_instability = timing.accel_bias_instability = 0.0;
+  timing.temp_noise_c = timing.time_jitter_s = timing.drop_probability = 0.0;
+  timing.quantize = false;
+  timing.gyro_full_scale_raw = timing.accel_full_scale_raw = 0.0;
+  WindowBuilder builder(window_options, segments);
+  SimulateRun(timing, site, segments, SensorModel::Identity(),
+              [&builder](const Sample& raw, const SegmentTruth&) {
+                Sample labelled = raw;
+                labelled.gyro.setZero();
+                labelled.accel.setZero();
+                builder.Add(labelled);
+              });
+  std::vector<Window> windows = builder.Finish();
+  if (stats != nullptr) *stats = builder.stats();
+  std::map<int, const TableSegment*> by_id;
+  for (const TableSegment& segment : segments) by_id[segment.id] = &segment;
   const double interval = 1.0 / schedule.rate_hz;
-  const double period = schedule.dwell_s + schedule.transition_s;
-  const double total = passes * static_cast<double>(segments.size()) * period;
   const Eigen::Vector3d gyro_noise =
       Eigen::Vector3d::Constant(schedule.gyro_noise_density / std::sqrt(interval));
   const Eigen::Vector3d accel_noise =
       Eigen::Vector3d::Constant(schedule.accel_noise_density / std::sqrt(interval));
-  std::vector<Window> windows;
-  for (int pass = 0; pass < passes; ++pass) {
-    for (size_t i = 0; i < segments.size(); ++i) {
-      const TableSegment& segment = segments[i];
-      const double start = (pass * static_cast<double>(segments.size()) + i) * period;
-      Window w;
-      w.segment = segment.id;
-      w.occurrence = pass;
-      w.whole_occurrence = segment.IsTurn();
-      const double trim = w.whole_occurrence ? 0.0 : window_options.trim_s;
-      w.samples = std::llround((schedule.dwell_s - trim) * schedule.rate_hz);
-      if (w.samples < window_options.min_samples) continue;
-      w.interval_s = interval;
-      w.start_s = start + trim;
-      w.end_s = start + schedule.dwell_s;
-      const double mid = 0.5 * (w.start_s + w.end_s) / total;
-      w.temp_c = schedule.ramp ? schedule.ramp_from_c + (schedule.ramp_to_c - schedule.ramp_from_c) * mid
-                               : schedule.soak_temps_c[pass];
-      w.min_temp_c = w.max_temp_c = w.temp_c;
-      const SegmentTruth truth =
-          segment.IsTurn() ? TurnTruth(site, segment, w.DurationS()) : TruthOf(site, segment);
-      w.gyro_mean = truth.omega_radps;
-      w.accel_mean = truth.a_mps2;
-      w.gyro_std = w.gyro_noise = gyro_noise;
-      w.accel_std = w.accel_noise = accel_noise;
-      windows.push_back(w);
-    }
+  for (Window& w : windows) {
+    // The nominal unit (raw = truth) on the schedule's exact grid, with its white noise.
+    const TableSegment& segment = *by_id.at(w.segment);
+    w.interval_s = interval;
+    const SegmentTruth truth =
+        segment.IsTurn() ? TurnTruth(site, segment, w.DurationS()) : TruthOf(site, segment);
+    w.gyro_mean = truth.omega_radps;
+    w.accel_mean = truth.a_mps2;
+    w.gyro_std = w.gyro_noise = gyro_noise;
+    w.accel_std = w.accel_noise = accel_noise;
   }
   return windows;
 }
@@ -348,8 +353,21 @@ PlanCheck CheckPlan(const std::vector<TableSegment>& segments, const TableSite& 
   fit.bias_correlation_s = schedule.bias_correlation_s;
   TableSite planned_site = site;
   if (options.latitude_deg) planned_site.latitude_rad = *options.latitude_deg * kDegToRad;
-  const std::vector<Window> windows = PlannedWindows(segments, planned_site, schedule, WindowOptions());
+  WindowStats stats;
+  const std::vector<Window> windows =
+      PlannedWindows(segments, planned_site, schedule, options.windows, &stats);
+  if (windows.empty()) {
+    PlanCheck check;
+    check.undetermined.push_back("the fit would have no window: " + LeftOutNote(stats, options.windows));
+    return check;
+  }
   PlanCheck check = CheckWindows(windows, segments, planned_site, fit, options);
+  if (stats.short_samples + stats.saturated_samples + stats.gap_turn_samples > 0) {
+    check.left_out = LeftOutNote(stats, options.windows);
+  }
+  for (const TableSegment& segment : segments) {
+    if (segment.IsStatic()) check.longest_static_s = schedule.dwell_s;
+  }
   if (check.undetermined.empty()) Hours(schedule, segments.size(), fit, &check);
   return check;
 }

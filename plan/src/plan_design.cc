@@ -308,6 +308,15 @@ const std::map<std::string, double>& DefaultPlanPrior() {
   return prior;
 }
 
+double NormalGravityMps2(double latitude_deg) {
+  // WGS84: equatorial gravity, Somigliana's k and the first eccentricity squared.
+  constexpr double kEquatorMps2 = 9.7803253359;
+  constexpr double kSomiglianaK = 0.00193185265241;
+  constexpr double kEccentricity2 = 0.00669437999013;
+  const double sin2 = std::pow(std::sin(latitude_deg * kDegToRad), 2);
+  return kEquatorMps2 * (1.0 + kSomiglianaK * sin2) / std::sqrt(1.0 - kEccentricity2 * sin2);
+}
+
 double PlanDesignHours(size_t segments, size_t soaks, const SimulationOptions& schedule,
                        const PlanDesignOptions& options) {
   const double per_segment = schedule.transition_s + schedule.dwell_s;
@@ -371,9 +380,10 @@ PlanDesign DesignPlan(std::vector<TableSegment> candidates, const TableSite& sit
   SimulationOptions universe = schedule;
   universe.ramp = false;
   universe.soak_temps_c = set_points;
-  const std::vector<Window> windows = PlannedWindows(candidates, planned_site, universe, WindowOptions());
+  const std::vector<Window> windows =
+      PlannedWindows(candidates, planned_site, universe, options.check.windows);
   const PlanInformation info =
-      ComputePlanInformation(windows, planned_site, candidates, FitOptions(), options.check.weak_tolerance);
+      ComputePlanInformation(windows, planned_site, candidates, options.fit, options.check.weak_tolerance);
   result.undetermined = info.undetermined;
   if (!result.undetermined.empty()) return result;
 
@@ -400,7 +410,7 @@ PlanDesign DesignPlan(std::vector<TableSegment> candidates, const TableSite& sit
     SimulationOptions run = schedule;
     run.ramp = false;
     run.soak_temps_c = soaks;
-    return CheckPlan(segments, planned_site, run, FitOptions(), design.check);
+    return CheckPlan(segments, planned_site, run, options.fit, design.check);
   };
   double target = 1.0;
   for (int step = 0; step < kTargetSteps; ++step, target *= kTargetStep) {

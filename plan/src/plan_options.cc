@@ -83,6 +83,11 @@ OptionTable<PlanCheckOptions> MakePlanCheckOptionTable() {
   t.Number("cut_loss", "--cut-loss",
            "a segment whose removal grows every sigma by less than this fraction could be cut", "",
            &PlanCheckOptions::cut_loss, PositiveFinite());
+  t.Number("min_ratio", "--min-ratio",
+           "with --limits: the least ratio of a criterion's tolerance to the U (z sigma) the plan achieves "
+           "(4 for 4:1)",
+           "", &PlanCheckOptions::min_ratio, AtLeast(1.0));
+  t.Include(WindowOptionTable(), &PlanCheckOptions::windows);
   return t;
 }
 
@@ -131,6 +136,11 @@ OptionTable<PlanDesignOptions> MakePlanDesignOptionTable() {
       .repeatable = true;
   t.Number("max_exchange_rounds", "--exchange-rounds", "exchange rounds at most", "", &O::max_exchange_rounds,
            AtLeast(0));
+  t.OptionalNumber("gravity_mps2", "--gravity-mps2",
+                   "the station's gravity, written into the plan (the fit reads the accelerometer's scale "
+                   "against it)",
+                   "m/s^2", &O::gravity_mps2, Between(9.7, 9.9),
+                   "the candidates' plan's; else WGS84 normal gravity at --latitude; else 9.80665");
   return t;
 }
 

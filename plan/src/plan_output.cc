@@ -48,7 +48,7 @@ MachineDoc Lines(const std::vector<std::string>& values) {
   return MachineDoc::Texts(values, MachineDoc::Style::kBlock);
 }
 
-MachineDoc PlanCheckDoc(const PlanCheck& check) {
+MachineDoc PlanCheckDoc(const PlanCheck& check, const std::vector<PlanCriterion>& criteria) {
   MachineDoc doc = MachineDoc::Map();
   doc.Add("format", MachineDoc::Text("imufit-plan-check")).Add("version", MachineDoc::Integer(1));
   doc.Add("undetermined", Lines(check.undetermined));
@@ -95,6 +95,23 @@ MachineDoc PlanCheckDoc(const PlanCheck& check) {
   doc.Add("carriers", MachineDoc::Integers(check.carriers));
   doc.Add("cuttable", MachineDoc::Integers(check.cuttable));
   doc.Add("warnings", Lines(check.warnings));
+  doc.Add("left_out", MachineDoc::Text(check.left_out));
+  doc.Add("longest_static_s", Figure(check.longest_static_s));
+  MachineDoc judged = MachineDoc::List(MachineDoc::Style::kBlock);
+  for (const PlanCriterion& c : criteria) {
+    MachineDoc row = MachineDoc::Map(MachineDoc::Style::kFlow);
+    row.Add("name", MachineDoc::Text(c.name)).Add("unit", MachineDoc::Text(c.unit));
+    row.Add("noise", MachineDoc::Bool(c.noise)).Add("met", MachineDoc::Bool(c.met));
+    if (c.noise) {
+      row.Add("needed_s", Figure(c.needed_s)).Add("stretch_s", Figure(c.stretch_s));
+    } else {
+      row.Add("tolerance", Figure(c.tolerance))
+          .Add("expanded", Figure(c.expanded))
+          .Add("ratio", Figure(c.ratio));
+    }
+    judged.Push(std::move(row));
+  }
+  doc.Add("criteria", judged);
   return doc;
 }
 
@@ -128,6 +145,7 @@ std::string PlanCheckText(const PlanCheck& check, const PlanCheckOptions& option
                   check.plan_hours, check.needed_hours);
   }
   for (const std::string& w : check.warnings) out += "warning: " + w + "\n";
+  if (!check.left_out.empty()) out += "windows: the fit will leave out " + check.left_out + "\n";
   out += Format("temperatures: a cubic is best determined by soaks at %.4g, %.4g, %.4g, %.4g degC\n",
                 check.best_soaks_c[0], check.best_soaks_c[1], check.best_soaks_c[2], check.best_soaks_c[3]);
   out += Format("temperatures: the planned ones reach D-efficiency %.3f of those (1: as good)\n",
@@ -164,8 +182,12 @@ std::string PlanDesignText(const PlanDesign& design, const PlanDesignOptions& op
   return out;
 }
 
-std::string PlanCheckYaml(const PlanCheck& check) { return YamlText(PlanCheckDoc(check)); }
+std::string PlanCheckYaml(const PlanCheck& check, const std::vector<PlanCriterion>& criteria) {
+  return YamlText(PlanCheckDoc(check, criteria));
+}
 
-std::string PlanCheckJson(const PlanCheck& check) { return JsonText(PlanCheckDoc(check)); }
+std::string PlanCheckJson(const PlanCheck& check, const std::vector<PlanCriterion>& criteria) {
+  return JsonText(PlanCheckDoc(check, criteria));
+}
 
 }  // namespace imufit

@@ -12,6 +12,7 @@
 #include "imufit/io/key_figures.h"
 #include "imufit/model/constants.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/pipeline/static_stretch.h"
 
 namespace imufit {
 namespace {
@@ -58,23 +59,111 @@ std::string FigureOf(const PlanRow& row) {
   return "";
 }
 
+// A coefficient criterion's tolerance in its group's display unit (PlanGroupUnit): the limit on
+// the value or on its sigma, a [min, max] limit's half-width; 0 when the criterion is not on a
+// coefficient with a temperature curve. `quantity` is set to the criterion's key figure.
+double CoefficientTolerance(const LimitCriterion& criterion, const KeyFigure** quantity) {
+  *quantity = FindLimitQuantity(criterion.quantity);
+  const double half_width = criterion.max_abs > 0.0          ? criterion.max_abs
+                            : criterion.min && criterion.max ? 0.5 * (*criterion.max - *criterion.min)
+                                                             : 0.0;
+  if (!(half_width > 0.0) || *quantity == nullptr || !HasTemperatureCurve(**quantity)) return 0.0;
+  // The figure's own unit, except a scale error's (PlanGroupUnit: ppm).
+  const double factor = (*quantity)->source == FigureSource::kScaleError ? 1e6 / (*quantity)->per_unit : 1.0;
+  return half_width * factor;
+}
+
+// A criterion in the limits file's terms: "accel_bias_mg x, y within -9.17 .. 35".
+std::string CriterionName(const LimitCriterion& criterion) {
+  std::string name = criterion.quantity;
+  for (size_t i = 0; i < criterion.axes.size(); ++i) name += (i == 0 ? " " : ", ") + criterion.axes[i];
+  char bound[96];
+  if (criterion.max_abs > 0.0) {
+    std::snprintf(bound, sizeof bound, " within +-%g", criterion.max_abs);
+  } else if (criterion.min && criterion.max) {
+    std::snprintf(bound, sizeof bound, " within %g .. %g", *criterion.min, *criterion.max);
+  } else if (criterion.max) {
+    std::snprintf(bound, sizeof bound, " at most %g", *criterion.max);
+  } else if (criterion.min) {
+    std::snprintf(bound, sizeof bound, " at least %g", *criterion.min);
+  } else {
+    bound[0] = '\0';
+  }
+  return name + bound;
+}
+
 }  // namespace
 
-void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances) {
+void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances, double min_ratio) {
   for (const LimitCriterion& criterion : limits.criteria) {
-    const double half_width = criterion.max_abs > 0.0          ? criterion.max_abs
-                              : criterion.min && criterion.max ? 0.5 * (*criterion.max - *criterion.min)
-                                                               : 0.0;
-    if (!(half_width > 0.0)) continue;
-    // A coefficient's limit in its group's display unit: the figure's own, except a scale error's
-    // (PlanGroupUnit: ppm).
-    const KeyFigure* quantity = FindLimitQuantity(criterion.quantity);
-    if (quantity == nullptr || !HasTemperatureCurve(*quantity)) continue;
-    const double factor = quantity->source == FigureSource::kScaleError ? 1e6 / quantity->per_unit : 1.0;
-    const double tolerance = half_width * factor;
+    const KeyFigure* quantity = nullptr;
+    const double tolerance = CoefficientTolerance(criterion, &quantity) / min_ratio;
+    if (!(tolerance > 0.0)) continue;
     auto [it, inserted] = tolerances->emplace(quantity->path, tolerance);
     if (!inserted) it->second = std::min(it->second, tolerance);
   }
+}
+
+std::vector<PlanCriterion> JudgeLimits(const Limits& limits, const PlanCheck& check,
+                                       const PlanCheckOptions& options) {
+  std::vector<PlanCriterion> criteria;
+  for (const LimitCriterion& criterion : limits.criteria) {
+    const KeyFigure* quantity = FindLimitQuantity(criterion.quantity);
+    if (quantity == nullptr) continue;
+    PlanCriterion judged;
+    judged.name = CriterionName(criterion);
+    if (quantity->source == FigureSource::kNoise) {
+      judged.noise = true;
+      judged.unit = quantity->unit;
+      judged.needed_s = quantity->noise_term == kRandomWalk ? kMinAllanStretchS : kBiasInstabilityStretchS;
+      judged.stretch_s = check.longest_static_s;
+      judged.met = judged.stretch_s >= judged.needed_s;
+      criteria.push_back(judged);
+      continue;
+    }
+    judged.tolerance = CoefficientTolerance(criterion, &quantity);
+    if (!(judged.tolerance > 0.0)) continue;
+    judged.unit = PlanGroupUnit(quantity->path);
+    for (const PlanRow& row : check.rows) {
+      if (row.group != quantity->path || row.term != 0) continue;
+      const std::string axis = kCoefficientNames[row.coefficient].axis;
+      if (!criterion.axes.empty() &&
+          std::find(criterion.axes.begin(), criterion.axes.end(), axis) == criterion.axes.end()) {
+        continue;
+      }
+      judged.expanded = std::max(judged.expanded, options.z * std::max(row.sigma_range, row.sigma_spec));
+    }
+    if (!(judged.expanded > 0.0)) continue;  // a group the fit holds: nothing to judge
+    judged.ratio = judged.tolerance / judged.expanded;
+    judged.met = judged.ratio >= options.min_ratio;
+    criteria.push_back(judged);
+  }
+  return criteria;
+}
+
+std::string PlanCriteriaText(const std::vector<PlanCriterion>& criteria, const PlanCheckOptions& options) {
+  std::string out;
+  std::string unmet;
+  for (const PlanCriterion& c : criteria) {
+    char line[512];
+    if (c.noise) {
+      std::snprintf(line, sizeof line,
+                    "criterion %s: needs a static stretch of %.0f s, the plan's longest is %.0f s: %s\n",
+                    c.name.c_str(), c.needed_s, c.stretch_s,
+                    c.met ? "resolved"
+                          : "not resolved (lengthen a static dwell, or measure the noise apart: imufit allan "
+                            "--noise-yaml)");
+    } else {
+      std::snprintf(line, sizeof line,
+                    "criterion %s: tolerance %.4g %s / U %.4g %s = %.3g:1 (at least %.3g:1): %s\n",
+                    c.name.c_str(), c.tolerance, c.unit.c_str(), c.expanded, c.unit.c_str(), c.ratio,
+                    options.min_ratio, c.met ? "met" : "NOT MET");
+    }
+    out += line;
+    if (!c.met) unmet += (unmet.empty() ? "" : "; ") + c.name;
+  }
+  if (!unmet.empty()) out += "verdict: the plan cannot judge " + unmet + "\n";
+  return out;
 }
 
 std::vector<Window> NominalWindows(const std::vector<Window>& run, const Plan& plan,

@@ -119,6 +119,8 @@ void WindowBuilder::FollowOccurrence(int segment, double time_s) {
 
 bool WindowBuilder::WindowIsFull(const Sample& sample) const {
   if (occurrence_.whole) return false;  // a turn's window closes with its occurrence
+  // Closed sooner it would be dropped: on a fast ramp a window spans more instead.
+  if (window_.n < options_.min_samples) return false;
   return std::abs(sample.temp_c - window_.first_temp_c) > options_.max_temp_span_c ||
          (options_.max_duration_s > 0.0 && sample.time_s - window_.start_s >= options_.max_duration_s);
 }
@@ -205,10 +207,6 @@ void WindowBuilder::Close() {
   if (!window_.open) return;
   window_.open = false;
   const OpenWindow& w = window_;
-  if (w.n < options_.min_samples) {
-    ++stats_.short_windows;
-    return;
-  }
   Window window;
   window.segment = occurrence_.segment;
   window.occurrence = occurrence_.index;
@@ -231,7 +229,7 @@ void WindowBuilder::Close() {
   window.temp_c = w.temp_mean;
   window.min_temp_c = w.temp_min;
   window.max_temp_c = w.temp_max;
-  const Channels std_dev = (w.m2 / static_cast<double>(w.n - 1)).cwiseSqrt();
+  const Channels std_dev = (w.m2 / static_cast<double>(std::max(w.n - 1, 1LL))).cwiseSqrt();
   window.gyro_mean = w.mean.head<3>();
   window.accel_mean = w.mean.tail<3>();
   window.gyro_std = std_dev.head<3>();
@@ -242,17 +240,69 @@ void WindowBuilder::Close() {
     window.accel_noise = noise.tail<3>();
   }
   window.whole_occurrence = occurrence_.whole;
+  if (w.n < options_.min_samples) {
+    if (w.clipped_channel < 0 && MergeRemainder(window)) return;
+    ++stats_.short_windows;
+    stats_.short_samples += w.n;
+    return;
+  }
   if (w.clipped_channel >= 0) {
     NoteSaturation(window, w.clipped_channel, w.clipped_value);
     return;
   }
-  if (occurrence_.whole && !CloseTurn(&window)) return;
+  if (occurrence_.whole && !CloseTurn(&window)) {
+    stats_.gap_turn_samples += w.n;
+    return;
+  }
+  stats_.window_samples += w.n;
   windows_.push_back(window);
+}
+
+bool WindowBuilder::MergeRemainder(const Window& remainder) {
+  if (remainder.whole_occurrence || windows_.empty()) return false;
+  Window& before = windows_.back();
+  if (before.whole_occurrence || before.segment != remainder.segment ||
+      before.occurrence != remainder.occurrence) {
+    return false;
+  }
+  // Pooled mean and sum of squared deviations (Chan et al.); the second differences of both
+  // pieces (none across the seam), each recovered from its per-sample figure.
+  const double n1 = static_cast<double>(before.samples);
+  const double n2 = static_cast<double>(remainder.samples);
+  const double n = n1 + n2;
+  const double d1 = std::max(n1 - 2.0, 0.0), d2 = std::max(n2 - 2.0, 0.0);
+  const auto pool = [&](Eigen::Vector3d* mean, Eigen::Vector3d* std_dev, Eigen::Vector3d* noise,
+                        const Eigen::Vector3d& mean2, const Eigen::Vector3d& std2,
+                        const Eigen::Vector3d& noise2) {
+    const Eigen::Vector3d delta = mean2 - *mean;
+    const Eigen::Vector3d m2 = std_dev->cwiseAbs2() * (n1 - 1.0) +
+                               std2.cwiseAbs2() * std::max(n2 - 1.0, 0.0) + delta.cwiseAbs2() * (n1 * n2 / n);
+    const Eigen::Vector3d second = noise->cwiseAbs2() * (6.0 * d1) + noise2.cwiseAbs2() * (6.0 * d2);
+    *mean += delta * (n2 / n);
+    *std_dev = (m2 / (n - 1.0)).cwiseSqrt();
+    if (d1 + d2 > 0.0) *noise = (second / (6.0 * (d1 + d2))).cwiseSqrt();
+  };
+  pool(&before.gyro_mean, &before.gyro_std, &before.gyro_noise, remainder.gyro_mean, remainder.gyro_std,
+       remainder.gyro_noise);
+  pool(&before.accel_mean, &before.accel_std, &before.accel_noise, remainder.accel_mean, remainder.accel_std,
+       remainder.accel_noise);
+  before.temp_c += (remainder.temp_c - before.temp_c) * (n2 / n);
+  before.min_temp_c = std::min(before.min_temp_c, remainder.min_temp_c);
+  before.max_temp_c = std::max(before.max_temp_c, remainder.max_temp_c);
+  before.samples += remainder.samples;
+  before.end_s = remainder.end_s;
+  // The slots between the two pieces (none on a gap-free grid) and the remainder's own.
+  before.lost_samples += remainder.lost_samples;
+  before.longest_gap_s = std::max(before.longest_gap_s, remainder.longest_gap_s);
+  ++stats_.merged_remainders;
+  stats_.window_samples += remainder.samples;
+  return true;
 }
 
 void WindowBuilder::NoteSaturation(const Window& window, int channel, double value) {
   constexpr int kSaturationExamples = 4;
   ++stats_.saturated_windows;
+  stats_.saturated_samples += window.samples;
   if (static_cast<int>(stats_.saturation.size()) >= kSaturationExamples) return;
   char line[160];
   std::snprintf(line, sizeof line, "segment %d at t = %.1f s: %s %c at %.9g", window.segment, window.start_s,
@@ -282,7 +332,11 @@ void WindowBuilder::DropPinnedWindows() {
   }
   std::vector<Window> kept;
   for (size_t i = 0; i < windows_.size(); ++i) {
-    if (!pinned[i]) kept.push_back(windows_[i]);
+    if (!pinned[i]) {
+      kept.push_back(windows_[i]);
+    } else {
+      stats_.window_samples -= windows_[i].samples;  // counted saturated by NoteSaturation
+    }
   }
   windows_ = std::move(kept);
 }
@@ -291,6 +345,29 @@ std::vector<Window> WindowBuilder::Finish() {
   Close();
   DropPinnedWindows();
   return std::move(windows_);
+}
+
+long long AccountedSamples(const WindowStats& stats) {
+  return stats.transition_samples + stats.trimmed_samples + stats.short_samples + stats.saturated_samples +
+         stats.gap_turn_samples + stats.window_samples;
+}
+
+std::string LeftOutNote(const WindowStats& stats, const WindowOptions& options) {
+  std::string note;
+  const auto add = [&note](long long count, const std::string& what) {
+    if (count > 0) note += (note.empty() ? "" : ", ") + std::to_string(count) + " " + what;
+  };
+  add(stats.transition_samples, "in transitions (segment -1)");
+  add(stats.trimmed_samples, "trimmed after moves (--trim " + OptionNumberText(options.trim_s) + " s)");
+  add(stats.short_samples, "in " + std::to_string(stats.short_windows) + " segment occurrence" +
+                               (stats.short_windows == 1 ? "" : "s") + " shorter than " +
+                               std::to_string(options.min_samples) + " samples (--window-min-samples)");
+  add(stats.saturated_samples, "in " + std::to_string(stats.saturated_windows) + " saturated window" +
+                                   (stats.saturated_windows == 1 ? "" : "s"));
+  add(stats.gap_turn_samples, "in " + std::to_string(stats.turns_dropped_for_gaps) + " turn" +
+                                  (stats.turns_dropped_for_gaps == 1 ? "" : "s") +
+                                  " with a gap (--max-turn-gap)");
+  return note;
 }
 
 std::string SaturationNote(const WindowStats& stats) {

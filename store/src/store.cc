@@ -11,6 +11,7 @@
 #include <optional>
 #include <thread>
 
+#include "imufit/base/verdict.h"
 #include "imufit/io/error.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
@@ -18,6 +19,14 @@
 
 namespace imufit {
 namespace {
+
+// A name of a name table (base/verdict.h) as an SQL string literal: the store's columns hold these
+// names, and its queries compare with them, never with a literal typed again. (The names are plain
+// words: nothing to escape.)
+template <typename E, size_t N>
+std::string SqlName(const EnumName<E> (&names)[N], E value) {
+  return std::string("'") + NameOf(names, value) + "'";
+}
 
 InputError UnsupportedVersion(const std::string& name, int64_t found) {
   return InputError(name, "results store schema version " + std::to_string(found) +
@@ -297,16 +306,17 @@ CREATE INDEX latest_figures_values ON latest_figures (name, lot, value, figure_u
 constexpr const char* kDropLatestFigures =
     "DELETE FROM latest_figures WHERE lot = (SELECT lot FROM runs WHERE run_key = ?1) AND "
     "unit = (SELECT unit FROM runs WHERE run_key = ?1)";
-constexpr const char* kLatestFiguresSelect =
+const std::string kLatestFiguresSelect =
     "SELECT g.name, l.lot, l.unit, g.unit, g.value FROM latest_fits l JOIN fits f ON f.id = l.fit_id "
-    "JOIN figures g ON g.fit_id = l.fit_id WHERE f.status = 'fitted'";
+    "JOIN figures g ON g.fit_id = l.fit_id WHERE f.status = " +
+    SqlName(kUnitStatusNames, UnitStatus::kFitted);
 const std::string kRefreshLatestFigures =
-    std::string("INSERT INTO latest_figures (name, lot, unit, figure_unit, value) ") + kLatestFiguresSelect +
+    "INSERT INTO latest_figures (name, lot, unit, figure_unit, value) " + kLatestFiguresSelect +
     " AND l.lot = (SELECT lot FROM runs WHERE run_key = ?1) AND l.unit = (SELECT unit FROM runs WHERE "
     "run_key = ?1)";
 // Every unit's: how a version 2 or 3 store's latest_figures is filled.
 const std::string kFillLatestFigures =
-    std::string("INSERT INTO latest_figures (name, lot, unit, figure_unit, value) ") + kLatestFiguresSelect;
+    "INSERT INTO latest_figures (name, lot, unit, figure_unit, value) " + kLatestFiguresSelect;
 
 // A unit's latest fit is its fit with the latest time_utc, of those the one recorded last (the
 // highest id); a unit is its run's (lot, unit). One statement, safe with concurrent writers: the
@@ -358,10 +368,11 @@ constexpr const char* kLatestPerUnit =
     "FROM latest_fits l JOIN fits f ON f.id = l.fit_id JOIN runs r ON r.run_key = f.run_key) ";
 
 // The counts of Yield() and YieldBy() over the units of `latest`, after the group's column.
-constexpr const char* kYieldCounts =
-    ", count(*), sum(CASE WHEN verdict = 'PASS' THEN 1 ELSE 0 END), "
-    "sum(CASE WHEN verdict = 'FAIL' THEN 1 ELSE 0 END), "
-    "sum(CASE WHEN status <> 'fitted' THEN 1 ELSE 0 END) FROM latest ";
+const std::string kYieldCounts =
+    ", count(*), sum(CASE WHEN verdict = " + SqlName(kVerdictNames, true) +
+    " THEN 1 ELSE 0 END), sum(CASE WHEN verdict = " + SqlName(kVerdictNames, false) +
+    " THEN 1 ELSE 0 END), sum(CASE WHEN status <> " + SqlName(kUnitStatusNames, UnitStatus::kFitted) +
+    " THEN 1 ELSE 0 END) FROM latest ";
 
 // The sums behind LotStats(), per lot and figure over each unit's latest fit: n, S1 = sum(x - k), S2 =
 // sum((x - k)^2), shifted by k, one stored value of the figure, so that an offset common to every
@@ -555,6 +566,14 @@ bool ResultsStore::HasUnit(const std::string& lot, const std::string& unit) {
   return found;
 }
 
+std::optional<std::string> ResultsStore::LotOfRun(const StoredFit& fit) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::optional<std::string> lot;
+  db_->Query("SELECT lot FROM runs WHERE run_key = ?1", {RunKey(fit)},
+             [&](const SqlRow& row) { lot = row.Text(0); });
+  return lot;
+}
+
 int64_t ResultsStore::RecordAll(const std::vector<StoredFit>& fits) {
   const std::lock_guard<std::mutex> lock(mutex_);
   Transaction transaction(db_.get(), /*exclusive=*/false);
@@ -713,13 +732,13 @@ std::vector<TrendPoint> ResultsStore::Trend(const std::string& figure, const std
   const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<TrendPoint> points;
   db_->Query(
-      "SELECT f.time_utc, r.serial, r.lot, r.station, g.value, g.sigma, g.unit FROM figures g "
+      "SELECT f.time_utc, r.serial, r.lot, r.station, g.value, g.sigma, g.unit, g.expanded_u FROM figures g "
       "JOIN fits f ON f.id = g.fit_id JOIN runs r ON r.run_key = f.run_key "
       "WHERE (g.name = ?1 OR g.coefficient = ?1) AND (?2 = '' OR r.serial = ?2) "
       "AND (?3 = '' OR r.station = ?3) ORDER BY f.time_utc, f.id",
       {figure, serial, station}, [&](const SqlRow& row) {
-        points.push_back(
-            {row.Text(0), row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5), row.Text(6)});
+        points.push_back({row.Text(0), row.Text(1), row.Text(2), row.Text(3), row.Double(4), row.Double(5),
+                          row.Text(6), row.Double(7)});
       });
   return points;
 }
@@ -738,8 +757,9 @@ std::vector<LotValue> ResultsStore::LotValues(const std::vector<std::string>& fi
       // latest_fits in its key's order: no runs to join, nothing to sort.
       "SELECT l.lot, l.unit, g.value, g.sigma, g.unit, g.name, g.coefficient FROM latest_fits l "
       "JOIN fits f ON f.id = l.fit_id JOIN figures g ON g.fit_id = l.fit_id WHERE l.lot <> '' AND "
-      "f.status = 'fitted' AND (g.name IN (" +
-          list + ") OR g.coefficient IN (" + list + ")) ORDER BY l.lot, l.unit",
+      "f.status = " +
+          SqlName(kUnitStatusNames, UnitStatus::kFitted) + " AND (g.name IN (" + list +
+          ") OR g.coefficient IN (" + list + ")) ORDER BY l.lot, l.unit",
       std::vector<SqlValue>(figures.begin(), figures.end()), [&](const SqlRow& row) {
         const std::string name = row.Text(5), coefficient = row.Text(6);
         for (const std::string& figure : figures) {

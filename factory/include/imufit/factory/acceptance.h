@@ -31,6 +31,10 @@ struct Figure {
   std::string unit;         // "deg/s", "mg", ...
   double value = 0.0;
   double sigma = -1.0;  // 1-sigma; < 0 when the calibration has none
+  // U (k = kCoverageFactor): the one expanded uncertainty every output states for this figure. A
+  // coefficient's is its uncertainty budget's (Type A and the station's Type B sources) when
+  // KeyFigures() is given one, else k x sigma; < 0 when there is no sigma.
+  double expanded = -1.0;
   // A coefficient evaluated at 25 degC outside the calibration's fitted temperature range: the
   // polynomial extrapolated.
   bool extrapolated = false;
@@ -48,6 +52,7 @@ inline Figure MakeFigure(std::string name, std::string coefficient, std::string 
   figure.unit = std::move(unit);
   figure.value = value;
   figure.sigma = sigma;
+  figure.expanded = sigma >= 0.0 ? kCoverageFactor * sigma : -1.0;
   return figure;
 }
 
@@ -60,7 +65,9 @@ std::string FigureTitle(const std::string& name);
 // Every figure of the calibration at 25 degC (coefficients, noise figures, the fit record's), in
 // the order of kKeyFigures.
 // `temp_c`: the coefficients at another temperature (the statistics over a range of a limits file).
-std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c = kFigureTempC);
+// `budget`: the coefficients' U are its (at `temp_c`: UncertaintyBudget::At); without, k x sigma.
+std::vector<Figure> KeyFigures(const Calibration& calibration, double temp_c = kFigureTempC,
+                               const UncertaintyBudget* budget = nullptr);
 // The figure called `name` (or with that `coefficient` path); nullptr when there is none.
 const Figure* FindFigure(const std::vector<Figure>& figures, const std::string& name);
 
@@ -114,8 +121,9 @@ struct Verdict {
 
 // `measured`: figures measured elsewhere (a certificate's own Allan deviation: ARW, bias
 // instability) that take the place of the calibration's figures of the same name.
-// `budget`: the expanded uncertainty of each coefficient figure (uncertainty_budget.h); without it
-// (or for a figure it lacks), U = 2 x the figure's 1-sigma.
+// `budget`: the expanded uncertainty of each coefficient figure (uncertainty_budget.h), at 25 degC
+// and at every temperature a statistic over a range is taken at; without it (or for a figure it
+// lacks), U = 2 x the figure's 1-sigma. A measured figure's U is its own (Figure::expanded).
 Verdict EvaluateLimits(const Limits& limits, const Calibration& calibration,
                        const std::vector<Figure>& measured = {}, const UncertaintyBudget* budget = nullptr);
 

@@ -34,6 +34,8 @@
 
 namespace imufit {
 
+struct Certificate;  // certificate.h
+
 // One unit: its inputs, its fit and what became of it.
 struct UnitOutcome {
   std::string unit;    // the batch unit folder; "" for `imufit fit`
@@ -57,6 +59,9 @@ struct UnitOutcome {
   // The fit's result and the calibration (not filled for skipped units).
   std::optional<FitRunResult> fit;
   std::string calibration_yaml;  // the calibration file's text (fitted units)
+  // The files committed with the unit (calibration, certificate), by path and SHA-256: the store's
+  // attachments rows.
+  std::vector<StoredAttachment> attachments;
 
   // As the manifest, the store and lot_summary.csv write them (base/verdict.h): "fitted",
   // "not-fitted", "error"; "PASS", "FAIL", "" (no verdict).
@@ -83,6 +88,9 @@ struct CertifySettings {
   // ("" for a single fit).
   ResultsStore* store = nullptr;
   std::string lot;
+  // What the units are fitted with (FitRunOptions::Describe(), as the batch manifest records it):
+  // the store's fits.fit_options. "" for a calibration certified as it is (imufit report).
+  std::string fit_options;
   // The static stretch the noise section is measured on when the run's reading kept none
   // (imufit report's --noise-segment).
   NoiseStretchOptions noise_stretch;
@@ -118,12 +126,17 @@ struct UnitFiles {
 // answer (false: the store refused the row; then no output was written either).
 bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOutcome* unit);
 
-// The unit's key figures, and its verdict against settings.limits: `certified` (a certificate's,
-// judged with the noise it measured) when given, else the calibration's alone.
-void JudgeUnit(const CertifySettings& settings, const Calibration& calibration,
-               const std::optional<Verdict>& certified, UnitOutcome* unit);
+// The unit's key figures with their U, and its verdict against settings.limits: `certified`'s (a
+// certificate's: U from its uncertainty budget, judged with the noise and window errors it
+// measured) when given, else the calibration's alone (U = k x sigma).
+void JudgeUnit(const CertifySettings& settings, const Calibration& calibration, const Certificate* certified,
+               UnitOutcome* unit);
 
-// A key figure as the store keeps it, not yet judged: U = kCoverageFactor x sigma.
+// Whether CertifyUnit() judges the unit through its certificate (computed whether or not its page is
+// written): with a report, limits or a store, i.e. whenever a U or a verdict is stated anywhere.
+bool JudgedAsCertified(const CertifySettings& settings, const UnitFiles& files);
+
+// A key figure as the store keeps it, not yet judged: its value, 1-sigma and U (Figure::expanded).
 StoredFigure StoredFigureOf(const Figure& figure);
 
 // Records `unit`, whatever its status, in settings.store when there is one (safe from several

@@ -26,9 +26,7 @@
 
 namespace imufit {
 
-// A bias instability is read at the floor of the Allan deviation, which a MEMS gyro reaches at tens
-// to hundreds of seconds: a stretch shorter than this rarely shows it, s.
-inline constexpr double kBiasInstabilityStretchS = 1800.0;
+// kBiasInstabilityStretchS: pipeline/static_stretch.h (plan check judges plans by it too).
 
 struct NoiseAxis {
   std::string axis;

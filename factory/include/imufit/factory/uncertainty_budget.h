@@ -18,10 +18,13 @@
 #ifndef IMUFIT_FACTORY_UNCERTAINTY_BUDGET_H_
 #define IMUFIT_FACTORY_UNCERTAINTY_BUDGET_H_
 
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "imufit/io/calibration.h"
+#include "imufit/io/limits.h"
 #include "imufit/io/plan.h"
 #include "imufit/io/station.h"
 #include "imufit/run/windows.h"
@@ -61,15 +64,25 @@ struct BudgetClass {
 inline constexpr size_t kBudgetTopContributors = 3;
 
 struct UncertaintyBudget {
-  double coverage_factor = 2.0;
+  double coverage_factor = kCoverageFactor;
   std::vector<StationUncertainty> inputs;  // the Type B sources propagated (empty: Type A alone)
   bool bias_stability_included = false;    // the fit's Type A includes the bias stability
   std::vector<FigureBudget> figures;       // every coefficient key figure (KeyFigures order)
   std::vector<BudgetClass> classes;
   std::string covers, not_covered;  // what U covers and what it does not, in words
 
+  // The models the Type B contributions are differences of: the fit re-solved on the plan's truth
+  // (`resolved`), and once per component with the truth off by its u (`moved`, with the component's
+  // BudgetLine source, taken_from and input text; contribution unset). Empty without Type B sources.
+  std::optional<SensorModel> resolved;
+  std::vector<std::pair<BudgetLine, SensorModel>> moved;
+
   // The figure `name`'s budget; nullptr when it has none.
   const FigureBudget* Find(const std::string& name) const;
+  // The budget of every coefficient key figure of `calibration` at `temp_c` (the same sources, the
+  // contributions evaluated there: a statistic over a temperature range is judged with them); at
+  // 25 degC, `figures`.
+  std::vector<FigureBudget> At(const Calibration& calibration, double temp_c) const;
 };
 
 // The budget of `calibration`'s coefficient key figures: its Type A sigmas and the Type B `sources`

@@ -29,6 +29,9 @@ namespace imufit {
 
 // The Allan deviation needs a static stretch at least this long, s.
 inline constexpr double kMinAllanStretchS = 60.0;
+// A bias instability is read at the floor of the Allan deviation, which a MEMS gyro reaches at tens
+// to hundreds of seconds: a stretch shorter than this rarely shows it, s.
+inline constexpr double kBiasInstabilityStretchS = 1800.0;
 // The temperature data sheets quote noise at, degC.
 inline constexpr double kNoiseReferenceTempC = kReferenceTempC;
 

@@ -23,12 +23,15 @@
 
 namespace imufit {
 
-// The windows the fit would cut from a run of `segments` under `schedule` (the simulator's timing:
-// every pass through the plan, dwell then transition), trimmed by `windows.trim_s` (a turn is its
-// whole occurrence), with the nominal unit's raw means (raw = truth) and per-sample spreads from the
-// schedule's white noise densities. One window per dwell (a ramp's dwell at its mid temperature).
+// The windows the fit will cut from a run of `segments` under `schedule` (the simulator's timing:
+// every pass through the plan, dwell then transition): the run's time stamps, labels and
+// temperatures through the fit's own WindowBuilder with `windows` (so trims, splits on a ramp,
+// merged remainders and occurrences too short to keep are the fit's), with the nominal unit's raw
+// means (raw = truth) and per-sample spreads from the schedule's white noise densities. What the
+// windows leave out is counted in `stats` when not null.
 std::vector<Window> PlannedWindows(const std::vector<TableSegment>& segments, const TableSite& site,
-                                   const SimulationOptions& schedule, const WindowOptions& windows);
+                                   const SimulationOptions& schedule, const WindowOptions& windows,
+                                   WindowStats* stats = nullptr);
 
 struct PlanCheckOptions {
   // Coverage factor: a tolerance is met when z * sigma <= tolerance.
@@ -44,6 +47,11 @@ struct PlanCheckOptions {
   double weak_tolerance = 1e-4;
   // A segment whose removal changes every sigma by less than this fraction could be cut.
   double cut_loss = 0.01;
+  // The windows the fit will cut (run/windows.h): the same options as `imufit fit`'s.
+  WindowOptions windows;
+  // With a limits file: the least ratio of a criterion's tolerance to the expanded uncertainty
+  // U = z sigma the plan will achieve (4 for the 4:1 of metrology's test uncertainty ratio).
+  double min_ratio = 4.0;
 };
 
 // Every option of PlanCheckOptions, described once (model/option_table.h; plan_options.cc).
@@ -108,6 +116,27 @@ struct PlanCheck {
   double extrapolation_factor = 1.0;        // sigma at the spec ends / the largest over the plan
   double temperature_efficiency = 1.0;      // CubicDEfficiency of the windows' temperatures, spec range
   bool tolerance_unmet = false;             // some row's ratio above 1
+  // What the fit's windows will leave out besides transitions and the trim (occurrences shorter
+  // than the windows' minimum, ...), in words (LeftOutNote); "" when nothing.
+  std::string left_out;
+  double longest_static_s = 0.0;  // the longest dwell in a static segment (a noise stretch), s
+};
+
+// One criterion of a limits file judged against a plan (JudgeLimits).
+struct PlanCriterion {
+  std::string name;  // "accel_bias_mg x, y, z within -9.17 .. 35": the criterion in the file's terms
+  std::string unit;  // the group's display unit (PlanGroupUnit), or the noise figure's
+  bool noise = false;
+  // A coefficient criterion: its tolerance (a [min, max] limit's half-width, else the limit), the U
+  // the plan achieves (z times the largest sigma of the group's values over the spec range), and
+  // their ratio against the minimum.
+  double tolerance = 0.0;
+  double expanded = 0.0;
+  double ratio = 0.0;
+  // A noise criterion: the static stretch it needs and the plan's longest, s.
+  double needed_s = 0.0;
+  double stretch_s = 0.0;
+  bool met = false;  // ratio >= the minimum; or the stretch resolves the figure
 };
 
 // The D-efficiency for a cubic in temperature over `range_c` of a run whose windows (equal weights)
@@ -131,9 +160,9 @@ PlanCheck CheckWindows(const std::vector<Window>& windows, const std::vector<Tab
 
 // The people's table and the machines' YAML.
 std::string PlanCheckText(const PlanCheck& check, const PlanCheckOptions& options);
-std::string PlanCheckYaml(const PlanCheck& check);
+std::string PlanCheckYaml(const PlanCheck& check, const std::vector<PlanCriterion>& criteria = {});
 // The same content as the YAML, in JSON (every number finite).
-std::string PlanCheckJson(const PlanCheck& check);
+std::string PlanCheckJson(const PlanCheck& check, const std::vector<PlanCriterion>& criteria = {});
 
 }  // namespace imufit
 

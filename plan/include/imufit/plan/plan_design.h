@@ -22,6 +22,7 @@
 #define IMUFIT_PLAN_PLAN_DESIGN_H_
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,7 +50,16 @@ struct PlanDesignOptions {
   std::map<std::string, double> prior;
   // Exchange rounds at most.
   int max_exchange_rounds = 100;
+  // The station's gravity, m/s^2, written into the plan (absent: the candidates' plan's; without
+  // one, WGS84 normal gravity at --latitude; else standard gravity).
+  std::optional<double> gravity_mps2;
+  // The fit the plan is designed for (orders, groups fitted): `imufit fit`'s options of the model.
+  FitOptions fit;
 };
+
+// WGS84 normal gravity at sea level at `latitude_deg` (Somigliana), m/s^2: 9.7803 at the equator,
+// 9.8127 at 52.27 deg, 9.8322 at the poles.
+double NormalGravityMps2(double latitude_deg);
 
 // Every option of PlanDesignOptions (with PlanCheckOptionTable()'s), described once.
 const OptionTable<PlanDesignOptions>& PlanDesignOptionTable();

@@ -25,7 +25,22 @@ namespace imufit {
 // The limits file's coefficient criteria as tolerances of their groups (a limit on the value or on
 // its sigma: z sigma must fit inside it; a [min, max] limit: its half-width), in the groups'
 // display units (PlanGroupUnit); the smallest where several criteria name one group.
-void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances);
+// With min_ratio > 1 each tolerance is divided by it: a plan meets it when the criterion's
+// tolerance is at least min_ratio times the U = z sigma it achieves (plan check's --min-ratio).
+void TolerancesFromLimits(const Limits& limits, std::map<std::string, double>* tolerances,
+                          double min_ratio = 1.0);
+
+// The limits file's criteria judged against a plan's check, as metrology judges a calibration
+// procedure: each coefficient criterion by the ratio of its tolerance (TolerancesFromLimits) to
+// the U = z sigma the plan will achieve (the largest over the spec range of the criterion's
+// axes), met when at least options.min_ratio; each noise criterion (ARW, bias instability) by
+// whether the plan's longest static dwell is as long as measuring it needs (kMinAllanStretchS,
+// kBiasInstabilityStretchS). Criteria of the fit record and coverage are not a plan's: left out.
+std::vector<PlanCriterion> JudgeLimits(const Limits& limits, const PlanCheck& check,
+                                       const PlanCheckOptions& options);
+
+// The criteria for people: one line each, and a verdict line when one is not met.
+std::string PlanCriteriaText(const std::vector<PlanCriterion>& criteria, const PlanCheckOptions& options);
 
 // The windows of a fitted run as the plan check sees them: every window's raw means those of the
 // nominal unit (the truth of its segment in `plan`), its per-sample spreads divided by the fitted

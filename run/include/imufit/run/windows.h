@@ -9,6 +9,14 @@
 // after a move). Samples with segment -1 are skipped. Only running sums are kept: memory does
 // not grow with the run.
 //
+// No sample is left out in silence. A window closes by span or duration only once it holds
+// min_samples (on a ramp so fast that the span passes sooner it spans more, rather than being
+// lost whole), and the remainder of an occurrence that ends with fewer than min_samples is merged
+// into the window before it (its span grows by the remainder's: a fraction of max_temp_span_c).
+// What is still left out (transitions, the trim, whole occurrences shorter than min_samples,
+// windows at full scale, turns with a gap) is counted per reason in WindowStats, so that every
+// sample of the run is either in a window or in one of those counts (LeftOutNote()).
+//
 // A turn through a known angle (TableSegment::IsTurn) is different: its truth is the integral of
 // the rate over the whole occurrence, so each occurrence of a turn is exactly one window, neither
 // trimmed nor split by temperature or duration.
@@ -130,6 +138,11 @@ struct WindowStats {
   long long transition_samples = 0;  // segment -1
   long long trimmed_samples = 0;     // dropped by trim_s
   long long short_windows = 0;       // windows dropped for having fewer than min_samples
+  long long short_samples = 0;       // the samples in them
+  long long merged_remainders = 0;   // an occurrence's short last piece merged into its window before
+  long long saturated_samples = 0;   // samples in windows left out as saturated (below)
+  long long gap_turn_samples = 0;    // samples in turns dropped for a gap (below)
+  long long window_samples = 0;      // samples in the windows kept
   long long lost_samples = 0;        // empty slots of the time grid over the whole run
   long long gaps = 0;                // runs of them
   double longest_gap_s = 0.0;        // the longest, s
@@ -153,6 +166,16 @@ struct WindowStats {
   double first_time_s = 0.0;
   double last_time_s = 0.0;
 };
+
+// Every sample of the run is in a window or in one of the counts of what was left out:
+// transition_samples + trimmed_samples + short_samples + saturated_samples + gap_turn_samples +
+// window_samples == samples.
+long long AccountedSamples(const WindowStats& stats);
+
+// What was left out of the windows, each reason with its count, for a person ("31000 in transitions,
+// 1600 trimmed after moves, 45 in 3 windows shorter than 20 samples, ..."): every count that is not
+// zero, the options named where one changes it.
+std::string LeftOutNote(const WindowStats& stats, const WindowOptions& options);
 
 // What saturation was found, for a person; empty when none.
 std::string SaturationNote(const WindowStats& stats);
@@ -225,6 +248,9 @@ class WindowBuilder {
   void Accumulate(const Sample& sample, const Channels& value);
 
   void Close();
+  // Merges the open window (an occurrence's last piece, shorter than min_samples) into the window
+  // before it when that is of the same occurrence; false when there is none.
+  bool MergeRemainder(const Window& remainder);
   // Fills a turn's mean and noise from its kept samples; false when it is dropped for a gap.
   bool CloseTurn(Window* window);
   // Drops the windows whose output is pinned at the run's extreme (Finish()).

@@ -33,6 +33,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,6 +127,7 @@ struct TrendPoint {
   double value = 0.0;
   double sigma = -1.0;
   std::string unit;
+  double expanded_u = -1.0;  // the U the fit was stated with (StoredFigure::expanded_u); < 0: none
 };
 
 // What yield is grouped by: the lot of a batch, the station a unit was calibrated at, or the month
@@ -190,6 +192,9 @@ class ResultsStore {
 
   // Whether any fit of `unit` in `lot` is recorded.
   bool HasUnit(const std::string& lot, const std::string& unit);
+  // The lot the run of `fit` (its serial, plan and samples: RunKey) is recorded in; nullopt when the
+  // store does not hold that run. A run keeps the lot it was first recorded in.
+  std::optional<std::string> LotOfRun(const StoredFit& fit);
   // Each unit of `lot` by its latest fit in the lot (the fit Yield() counts), with figures and
   // attachments, by unit name.
   std::vector<StoredFit> LatestOfLot(const std::string& lot);
