@@ -20,9 +20,9 @@
 //                    the same with and without a certificate; a failed criterion never reads PASS;
 //   readback         every calibration written (fit's, batch's, the store's text, the JSON export)
 //                    is read by apply, export, report and simulate, and all correct the same.
-// A fixed set of seeds runs in the suite (ChainTest.Seeds); ChainTest.Campaign runs the seeds of
-// IMUFIT_CHAIN_SEEDS (bench/chain_campaign.sh) and appends one line per check and per sigma ratio
-// to IMUFIT_CHAIN_REPORT, which the script tabulates.
+// A fixed set of seeds runs in the suite (ChainSeeds/ChainSeedTest.Chain/N); ChainTest.Campaign runs the
+// seeds of IMUFIT_CHAIN_SEEDS (bench/chain_campaign.sh) and appends one line per check and per sigma ratio to
+// IMUFIT_CHAIN_REPORT, which the script tabulates.
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -731,15 +731,13 @@ void ChainTest::RunChain(int seed) {
   }
 }
 
-TEST_F(ChainTest, Seeds) {
-  for (int seed : kSuiteSeeds) {
-    const fs::path root = dir_;
-    dir_ = root / ("seed-" + std::to_string(seed));
-    fs::create_directories(dir_);
-    RunChain(seed);
-    dir_ = root;
-  }
-}
+// One seed of kSuiteSeeds per test (ChainSeeds/ChainSeedTest.Chain/N), so that ctest runs them side
+// by side: each about 6 s of CPU.
+class ChainSeedTest : public ChainTest, public ::testing::WithParamInterface<int> {};
+
+TEST_P(ChainSeedTest, Chain) { RunChain(GetParam()); }
+
+INSTANTIATE_TEST_SUITE_P(ChainSeeds, ChainSeedTest, ::testing::ValuesIn(kSuiteSeeds));
 
 // The campaign of bench/chain_campaign.sh: the seeds of IMUFIT_CHAIN_SEEDS ("FIRST-LAST").
 TEST_F(ChainTest, Campaign) {
