@@ -8,8 +8,11 @@
 //   a station with random Type B sources, and limits around the units' truth under the simple or the
 //             guarded decision rule with a random guard band;
 // and runs simulate, plan check, fit (with and without a certificate), report, batch (unsharded,
-// with --no-report, and in two shards into one store, merged with `imufit lot`), history and export
+// with --no-report, in two shards each with its own store, again as a re-run with a new store; the
+// stores merged with `imufit store merge`, the lot built with `imufit lot`), history and export
 // with re-import. It asserts, each as a named check:
+//   batch_shard      the shards, the re-run, the merge and `imufit lot` succeed; the merged store
+//                    holds each calibration once, and the lot says when it was made;
 //   plan_fits        a plan that plan check passes (exit 0) fits (every unit, fit and batch);
 //   sigma_ratio      the fit's 1-sigma of every 25 degC figure is within kSigmaRatioTolerance of
 //                    plan check's prediction;
@@ -540,7 +543,7 @@ void ChainTest::RunChain(int seed) {
           std::to_string(failed) + " failed criteria on a " + fit_verdict + " certificate");
   }
 
-  // The batch: unsharded with certificates, unsharded without, and in kShards shards into one store.
+  // The batch: unsharded with certificates, unsharded without, and in kShards shards.
   const std::vector<std::string> batch_common = {"--limits", limits, "--station", station,
                                                  "--lot",    lot,    "-q"};
   const RunResult batch =
@@ -549,15 +552,33 @@ void ChainTest::RunChain(int seed) {
         "batch exit " + std::to_string(batch.status) + ": " + batch.err);
   const RunResult bare = Imufit(Concat(
       {"batch", Path("lot"), "-o", Path("bare"), "--store", Path("bare.db"), "--no-report"}, batch_common));
+  // The shards as stations that each keep a store, sharing one output folder (docs/scale.md); then
+  // the whole lot again into that folder with a new store (every unit skipped as unchanged and
+  // recorded from its manifest); the three stores merged into one and the lot built from it.
+  std::vector<std::string> stores;
   for (int shard = 0; shard < kShards; ++shard) {
-    const RunResult s =
-        Imufit(Concat({"batch", Path("lot"), "-o", Path("shards"), "--store", Path("shards.db"), "--shard",
-                       std::to_string(shard) + "/" + std::to_string(kShards)},
-                      batch_common));
+    stores.push_back(Path("shard-" + std::to_string(shard) + ".db"));
+    const RunResult s = Imufit(Concat({"batch", Path("lot"), "-o", Path("shards"), "--store", stores.back(),
+                                       "--shard", std::to_string(shard) + "/" + std::to_string(kShards)},
+                                      batch_common));
     Check("batch_shard", s.status == 0 || s.status == kExitFailedLimits,
           "shard exit " + std::to_string(s.status) + ": " + s.err);
   }
-  const RunResult merged = Imufit({"lot", "--store", Path("shards.db"), "--lot", lot, "--limits", limits,
+  stores.push_back(Path("rerun.db"));
+  const RunResult rerun =
+      Imufit(Concat({"batch", Path("lot"), "-o", Path("shards"), "--store", stores.back()}, batch_common));
+  Check("batch_shard", rerun.status == 0 || rerun.status == kExitFailedLimits,
+        "re-run exit " + std::to_string(rerun.status) + ": " + rerun.err);
+  const RunResult merge = Imufit(Concat(Concat({"store", "merge"}, stores), {"--into", Path("merged.db")}));
+  Check("batch_shard", merge.status == 0,
+        "store merge exit " + std::to_string(merge.status) + ": " + merge.err);
+  for (const auto& f : Query(Path("merged.db"),
+                             "SELECT r.serial, count(*) AS fits FROM fits f JOIN runs r ON "
+                             "r.run_key = f.run_key GROUP BY r.serial"))
+    Check("batch_shard", f.at("fits") == "1",
+          f.at("serial") + ": one run fitted once, " + f.at("fits") + " fits in the merged store (" +
+              Join(stores, ", ") + ")");
+  const RunResult merged = Imufit({"lot", "--store", Path("merged.db"), "--lot", lot, "--limits", limits,
                                    "--csv", Path("merged.csv"), "--html", Path("merged.html")});
   Check("batch_shard", merged.status == 0,
         "imufit lot exit " + std::to_string(merged.status) + ": " + merged.err);
@@ -612,6 +633,13 @@ void ChainTest::RunChain(int seed) {
                      bare_rows[unit]["verdict"] == verdict;
     Check("one_verdict", one, unit + ": " + verdicts.str());
     if (u == 0) Check("one_verdict", verdict == fit_verdict, "batch " + verdict + ", fit " + fit_verdict);
+    // When the calibration was made: the calibration the shards wrote says it; the lot built from the
+    // merged stores must say the same.
+    const std::string made =
+        ManifestValue(ReadBytes(dir_ / "shards" / unit / "calibration.yaml"), "created_utc");
+    Check("batch_shard", merged_rows.count(unit) && merged_rows[unit]["calibrated_utc"] == made,
+          unit + ": calibration made " + made + ", imufit lot of the merged stores says " +
+              (merged_rows.count(unit) ? merged_rows[unit]["calibrated_utc"] : "<no row>"));
 
     // One figure: value, 1-sigma, U in the lot summary, the store, the certificate, imufit lot, history.
     const auto certificate = CertificateFigures(html);
