@@ -6,11 +6,55 @@
 # outside the 10 % the suite asserts).
 #
 #   bench/chain_campaign.sh BUILD_DIR FIRST LAST [JOBS]
+#   bench/chain_campaign.sh --table REPORT        (the table of a campaign's report.txt again)
 #
 # JOBS processes run seed ranges side by side (default 1). The raw lines stay in
 # BUILD_DIR/chain_campaign/report.txt, each failure's message in report.txt's `detail=`, and each
 # failed seed's folder under the system's temporary folder (named by the test), to look at.
 set -euo pipefail
+
+# The table of a report: lines "check seed=S check=C ok=0|1 [detail=...]" and
+# "ratio seed=S schedule=K unit=U figure=F ratio=R white=W chi2=X".
+table() {
+  awk '
+    /^check / {
+      split($2, sd, "="); split($3, ck, "="); split($4, o, "=")
+      runs[ck[2]]++
+      if (o[2] == 0) {
+        failed[ck[2]]++
+        if (index(" " seeds[ck[2]] " ", " " sd[2] " ") == 0) seeds[ck[2]] = seeds[ck[2]] " " sd[2]
+      }
+    }
+    END {
+      printf "%-22s %6s %7s  %s\n", "check", "runs", "failed", "seeds failing"
+      for (c in runs) printf "%-22s %6d %7d  %s\n", c, runs[c], failed[c], seeds[c]
+    }' "$1"
+  for part in ratio white; do
+    echo
+    if [ $part = ratio ]; then
+      echo "fit 1-sigma as reported / plan check 1-sigma, per schedule (every 25 degC figure of every unit):"
+    else
+      echo "its white-noise part (divided by sqrt(max(1, reduced chi-square))) / plan check 1-sigma:"
+    fi
+    printf "%-12s %7s %8s %8s %8s %8s %14s\n" schedule figures min median max sd "outside 10 %"
+    for schedule in $(awk '/^ratio /{split($3, k, "="); print k[2]}' "$1" | sort -u) all; do
+      awk -v s="$schedule" -v part="$part" '/^ratio /{
+          split($3, k, "="); split($6, r, "="); split($7, w, "=")
+          if (s == "all" || k[2] == s) print (part == "ratio" ? r[2] : w[2])
+        }' "$1" | sort -g | awk -v s="$schedule" '
+        { r[NR] = $1; sum += $1; sq += $1 * $1; if ($1 < 0.9 || $1 > 1.1) out++ }
+        END {
+          if (NR) printf "%-12s %7d %8.3f %8.3f %8.3f %8.3f %7d (%3.0f%%)\n", s, NR, r[1], r[int((NR + 1) / 2)],
+                         r[NR], sqrt(sq / NR - (sum / NR)^2), out, 100 * out / NR
+        }'
+    done
+  done
+}
+
+if [ "${1:-}" = --table ]; then
+  table "$2"
+  exit 0
+fi
 if [ $# -lt 3 ]; then
   echo "usage: $0 BUILD_DIR FIRST LAST [JOBS]" >&2
   exit 2
@@ -39,25 +83,4 @@ for pid in "${pids[@]}"; do wait "$pid" || true; done
 cat "$out"/report-*.txt >"$report"
 
 echo "chain campaign: seeds $first..$last ($count seeds)"
-awk '
-  /^check / {
-    for (i = 2; i <= NF; ++i) { split($i, kv, "="); f[kv[1]] = kv[2] }
-    runs[f["check"]]++
-    if (f["ok"] == 0) {
-      failed[f["check"]]++
-      if (index(" " seeds[f["check"]] " ", " " f["seed"] " ") == 0) seeds[f["check"]] = seeds[f["check"]] " " f["seed"]
-    }
-  }
-  END {
-    printf "%-16s %6s %7s  %s\n", "check", "runs", "failed", "seeds failing"
-    for (c in runs) printf "%-16s %6d %7d  %s\n", c, runs[c], failed[c], seeds[c]
-  }' "$report" | sort
-echo
-echo "fit 1-sigma / plan check 1-sigma, per schedule (every 25 degC figure of every unit):"
-printf "%-12s %6s %8s %8s %8s %14s\n" schedule figures min median max "outside 10 %"
-for schedule in $(awk '/^ratio /{for(i=2;i<=NF;++i){split($i,kv,"=");if(kv[1]=="schedule")print kv[2]}}' "$report" | sort -u) all; do
-  awk -v s="$schedule" '/^ratio /{for(i=2;i<=NF;++i){split($i,kv,"=");f[kv[1]]=kv[2]} if(s=="all"||f["schedule"]==s)print f["ratio"]}' \
-    "$report" | sort -g | awk -v s="$schedule" '
-      { r[NR] = $1; if ($1 < 0.9 || $1 > 1.1) out++ }
-      END { if (NR) printf "%-12s %6d %8.3f %8.3f %8.3f %8d (%3.0f%%)\n", s, NR, r[1], r[int((NR + 1) / 2)], r[NR], out, 100 * out / NR }'
-done
+table "$report"
