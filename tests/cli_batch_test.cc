@@ -598,18 +598,24 @@ TEST_F(FactoryCliTest, ManifestReadsBackAlikeInEveryReaderAndAShardClaimsNoLotSu
   for (const char* unit : {"unit-01", "unit-04", "unit-05"}) {
     const std::string path = (dir_ / "out" / unit / "manifest.yaml").string();
     const RunResult py =
-        RunProgram("/usr/bin/python3", {"-c",
-                                        "import sys, yaml\n"
-                                        "m = yaml.safe_load(open(sys.argv[1]))\n"
-                                        "assert m['version'] == 1 and type(m['version']) is int, m\n"
-                                        "for k, v in m.items():\n"
-                                        "    assert k == 'version' or type(v) is str, (k, v)\n"
-                                        "    print('%s=%s' % (k, v))\n",
-                                        path});
+        RunProgram("/usr/bin/python3",
+                   {"-c",
+                    "import sys, yaml\n"
+                    "m = yaml.safe_load(open(sys.argv[1]))\n"
+                    "assert m['version'] == 1 and type(m['version']) is int, m\n"
+                    "for k, v in m.items():\n"
+                    "    if k == 'judged':\n"
+                    "        assert all(type(u) is float for u in v['expanded_u'].values()), v\n"
+                    "        assert all(type(c[0]) is str and type(c[2]) is bool for c in v['criteria']), v\n"
+                    "        continue\n"
+                    "    assert k == 'version' or type(v) is str, (k, v)\n"
+                    "    print('%s=%s' % (k, v))\n",
+                    path});
     ASSERT_EQ(py.status, 0) << py.err;
     const YAML::Node node = YAML::LoadFile(path);
     for (const auto& entry : node) {
       const std::string key = entry.first.as<std::string>();
+      if (key == "judged") continue;  // numbers and lists, checked by type above
       EXPECT_NE(py.out.find(key + "=" + entry.second.as<std::string>() + "\n"), std::string::npos)
           << key << " in " << py.out;
     }
@@ -654,10 +660,19 @@ std::string Query(const fs::path& path, const std::string& sql) {
 // so that merging that store back adds no second fit; a batch under a new --lot on runs recorded
 // under another lot refuses them, saying so, and records nothing under the new lot.
 TEST_F(FactoryCliTest, StoreRowsHoldTheSpecAndARunKeepsItsLot) {
+  const std::string station =
+      Write("station_u.yaml", std::string(kStation) +
+                                  "uncertainty:\n"
+                                  "  rate_accuracy: {u: 10, unit: ppm, source: table cert}\n");
   std::vector<std::string> args = BatchArgs("out");
-  args.push_back("--no-report");
+  args.insert(args.end(), {"--no-report", "--station", station});
   RunResult r = Run(args);
   ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  const std::string first_summary = ReadBytes(dir_ / "out" / "lot_summary.csv");
+  // The U of a gyro scale carries the station's 10 ppm (2 x sigma alone is far below it).
+  auto rows = Summary("out");
+  const double scale = std::stod(rows["unit-01"]["gyro_scale_per_dps.x"]);
+  EXPECT_GE(std::stod(rows["unit-01"]["gyro_scale_per_dps.x.U"]) / scale, 20e-6 * 0.999);
   const fs::path store = dir_ / "store.db";
   const std::string options =
       Query(store, "SELECT count(*) FROM fits WHERE fit_options = '' OR fit_options IS NULL");
@@ -676,10 +691,12 @@ TEST_F(FactoryCliTest, StoreRowsHoldTheSpecAndARunKeepsItsLot) {
 
   // The same lot again, into a new store: every unit unchanged, recorded there at its fit's time.
   args = WithOption(BatchArgs("out"), "--store", Path("other.db"));
-  args.push_back("--no-report");
+  args.insert(args.end(), {"--no-report", "--station", station});
   r = Run(args);
   ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
   EXPECT_NE(r.out.find("5 unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(ReadBytes(dir_ / "out" / "lot_summary.csv"), first_summary)
+      << "a unit skipped as unchanged states the U and the verdict it was judged with";
   EXPECT_EQ(
       Query(dir_ / "other.db",
             "SELECT f.time_utc FROM fits f JOIN runs r ON r.run_key = f.run_key WHERE r.serial = 'SN-01'"),
@@ -695,7 +712,7 @@ TEST_F(FactoryCliTest, StoreRowsHoldTheSpecAndARunKeepsItsLot) {
   // The same runs under a new lot: refused, said, nothing recorded under it.
   const std::string fits_before = Query(store, "SELECT count(*) FROM fits");
   args = WithOption(BatchArgs("out_b"), "--lot", "LOT-B");
-  args.push_back("--no-report");
+  args.insert(args.end(), {"--no-report", "--station", station});
   r = Run(args);
   EXPECT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
   EXPECT_NE(r.out.find("is recorded in lot \"LOT-A\""), std::string::npos) << r.out;

@@ -62,6 +62,13 @@ struct Manifest {
   std::string station_sha256;      // "" without a station file
   std::string fit_options;         // FitRunOptions::Describe(): what the unit was fitted with
   std::string issued_to;           // --customer and --order, as the certificate prints them
+  // The outcome as judged when the unit was fitted (its certificate's budget and measurements), so
+  // that a unit skipped as unchanged states the same U and criteria: each key figure's U, and each
+  // criterion's name, outcome and acceptance. `judged` is false in a manifest of an imufit that did
+  // not record them: then the unit is done again.
+  bool judged = false;
+  std::vector<std::pair<std::string, double>> expanded_u;
+  std::vector<CriterionResult> criteria;  // name, outcome and pass only
 };
 
 std::optional<Manifest> ReadManifest(const std::string& path) {
@@ -82,6 +89,18 @@ std::optional<Manifest> ReadManifest(const std::string& path) {
     // unit is done again.
     if (node["fit_options"]) m.fit_options = node["fit_options"].as<std::string>();
     if (node["issued_to"]) m.issued_to = node["issued_to"].as<std::string>();
+    if (const YAML::Node judged = node["judged"]) {
+      m.judged = true;
+      for (const auto& entry : judged["expanded_u"])
+        m.expanded_u.emplace_back(entry.first.as<std::string>(), entry.second.as<double>());
+      for (const YAML::Node& item : judged["criteria"]) {
+        CriterionResult c;
+        c.name = item[0].as<std::string>();
+        c.pass = item[2].as<bool>();
+        if (!ValueOf(kOutcomeNames, item[1].as<std::string>(), &c.outcome)) return std::nullopt;
+        m.criteria.push_back(c);
+      }
+    }
     return m;
   } catch (const YAML::Exception&) {
     return std::nullopt;  // unreadable: the unit is done again
@@ -108,6 +127,19 @@ void WriteManifest(const std::string& path, const Manifest& m, OutputTransaction
                                                                {"fit_options", &m.fit_options},
                                                                {"issued_to", &m.issued_to}};
   for (const auto& [key, value] : fields) doc.Add(key, MachineDoc::Text(*value));
+  MachineDoc judged = MachineDoc::Map();
+  MachineDoc expanded = MachineDoc::Map();
+  for (const auto& [name, u] : m.expanded_u) expanded.Add(name, MachineDoc::Number(u));
+  judged.Add("expanded_u", std::move(expanded));
+  MachineDoc criteria = MachineDoc::List(MachineDoc::Style::kBlock);
+  for (const CriterionResult& c : m.criteria) {
+    criteria.Push(std::move(MachineDoc::List()
+                                .Push(MachineDoc::Text(c.name))
+                                .Push(MachineDoc::Text(OutcomeName(c.outcome)))
+                                .Push(MachineDoc::Bool(c.pass))));
+  }
+  judged.Add("criteria", std::move(criteria));
+  doc.Add("judged", std::move(judged));
   WriteFileAtomically(path, YamlText(doc), transaction);
 }
 
@@ -282,7 +314,7 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
       previous->samples_sha256 != manifest.samples_sha256 ||
       previous->limits_sha256 != manifest.limits_sha256 ||
       previous->station_sha256 != manifest.station_sha256 || previous->fit_options != manifest.fit_options ||
-      previous->issued_to != manifest.issued_to) {
+      previous->issued_to != manifest.issued_to || !previous->judged) {
     return false;
   }
   UnitStatus status = UnitStatus::kError;
@@ -300,9 +332,19 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
     JudgeUnit(shared.certify, calibration, nullptr, unit);
     // The outcome is the one judged when the unit was fitted (with its certificate's noise, window
     // errors and uncertainty budget), as its manifest and the store hold it: not judged again from
-    // less.
-    bool pass = false;
-    if (unit->verdict && ValueOf(kVerdictNames, previous->verdict, &pass)) unit->verdict->pass = pass;
+    // less. The figures' values and sigmas are the calibration's; their U and the criteria the
+    // manifest's.
+    for (Figure& f : unit->figures) {
+      for (const auto& [name, u] : previous->expanded_u) {
+        if (name == f.name) f.expanded = u;
+      }
+    }
+    if (unit->verdict) {
+      bool pass = false;
+      if (!ValueOf(kVerdictNames, previous->verdict, &pass)) return false;  // not ours: done again
+      unit->verdict->pass = pass;
+      unit->verdict->criteria = previous->criteria;
+    }
     unit->attachments = {{"calibration", paths.calibration, previous->calibration_sha256}};
     if (shared.options->write_reports)
       unit->attachments.push_back({"certificate", paths.report, Sha256OfFile(paths.report)});
@@ -384,6 +426,10 @@ void WriteUnitManifest(const UnitPaths& paths, const UnitOutcome& unit, Manifest
   manifest.status = unit.StatusText();
   manifest.verdict = unit.VerdictText();
   manifest.message = unit.message;
+  for (const Figure& f : unit.figures) {
+    if (f.sigma >= 0.0 && f.expanded >= 0.0) manifest.expanded_u.emplace_back(f.name, f.expanded);
+  }
+  if (unit.verdict) manifest.criteria = unit.verdict->criteria;
   if (!unit.calibration_yaml.empty()) manifest.calibration_sha256 = Sha256Hex(unit.calibration_yaml);
   fs::create_directories(paths.folder);
   WriteManifest(paths.manifest, manifest, transaction);

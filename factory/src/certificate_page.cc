@@ -364,8 +364,9 @@ void Acceptance(Html* h, const Verdict& verdict) {
     HtmlAttributes row = {{"data-criterion", cr.name}, {"data-pass", cr.pass ? "1" : "0"}};
     if (!cr.pass) row.push_back({"class", "failed"});
     h->Open("tr", row).Element("td", cr.title);
-    // A value with its U is printed to U's decimal place, its margin too.
-    if (cr.expanded > 0.0 && cr.margin_text != "none") {
+    // A value with its U is printed to U's decimal place, its margin too (a value not in the
+    // calibration has no U).
+    if (cr.expanded > 0.0) {
       const RoundedValue v = RoundToUncertainty(cr.measured, cr.expanded);
       Num(h, v.value + " \xc2\xb1 " + v.uncertainty + " " + cr.unit);
       Num(h, cr.limit_text);

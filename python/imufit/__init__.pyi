@@ -269,6 +269,14 @@ class _PlanCheckOptions(TypedDict, total=False):
     latitude_deg: float | None  # deg; None: the plan's
     weak_tolerance: float
     cut_loss: float
+    min_ratio: float  # with limits: tolerance / U at least this (4: 4:1)
+    trim_s: float  # s; the fit's window options: the windows the fit will cut
+    window_temp_span_c: float  # degC
+    window_max_duration_s: float  # s
+    window_min_samples: int
+    max_turn_gap_s: float  # s
+    gyro_full_scale_raw: float  # a nominal unit never clips: no effect
+    accel_full_scale_raw: float
 
 class _PlanDesignOptions(_PlanCheckOptions, total=False):
     """plan_design()'s own keywords: the keys of plan_design_options()."""
@@ -281,6 +289,7 @@ class _PlanDesignOptions(_PlanCheckOptions, total=False):
     soak_settle_s: float  # s
     prior: str | Mapping[str, float]  # data-sheet 1-sigma per group
     max_exchange_rounds: int
+    gravity_mps2: float | None  # m/s^2, the station's, written into the plan
 
 class _PlanRows(TypedDict):
     name: list[str]  # "gyro bias x (linear term)", the limiting one first
