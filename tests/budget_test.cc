@@ -254,6 +254,33 @@ TEST_F(BudgetTest, AGuardBandWiderThanUFailsTheRowItFails) {
   EXPECT_EQ(verdict.Table().find("PASS\n"), std::string::npos) << verdict.Table();
 }
 
+// Under guard_band: 0.5 a value inside U of its limit but clear of the band (0.7 U) is accepted,
+// and its row says so: never "not accepted" beside an accepted criterion. Closer (0.3 U) it is not.
+TEST_F(BudgetTest, AGuardBandNarrowerThanUAcceptsWhatIsClearOfIt) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const std::vector<Figure> figures = KeyFigures(*fit_->calibration);
+  const Figure* bias = FindFigure(figures, "gyro_bias_dps.x");
+  ASSERT_NE(bias, nullptr);
+  Limits limits;
+  limits.decision_rule = DecisionRule::kGuarded;
+  limits.guard_band_u = 0.5;
+  LimitCriterion criterion;
+  criterion.quantity = "gyro_bias_dps";
+  criterion.unit = "deg/s";
+  criterion.axes = {"x"};
+  for (const double clear_u : {0.7, 0.3}) {
+    criterion.max_abs = std::abs(bias->value) + clear_u * bias->expanded;
+    limits.criteria = {criterion};
+    const Verdict verdict = EvaluateLimits(limits, *fit_->calibration);
+    ASSERT_EQ(verdict.criteria.size(), 1u);
+    const CriterionResult& row = verdict.criteria[0];
+    EXPECT_EQ(row.outcome, Outcome::kConditionalPass) << clear_u;
+    EXPECT_EQ(row.pass, clear_u > 0.5) << clear_u;
+    EXPECT_EQ(row.reason.find("not accepted") == std::string::npos, row.pass) << row.reason;
+    EXPECT_EQ(verdict.Table().find("not accepted") == std::string::npos, row.pass) << verdict.Table();
+  }
+}
+
 // Issue 29 item 5: a real table stays tilted in the lab. Units are simulated on a table whose axis is
 // tilted by a lab-fixed angle (drawn from the station's rectangular half width, about north and
 // east), the simulator given each static position's true up: the lab tilt seen from that position's

@@ -35,8 +35,11 @@ void Decide(const Verdict& verdict, CriterionResult* r) {
   r->pass = margin > guard;
   if (r->outcome == Outcome::kConditionalPass || r->outcome == Outcome::kConditionalFail) {
     r->reason = "within U = " + Number(u) + " " + r->unit + " of the limit";
-    if (guarded && r->outcome == Outcome::kConditionalPass)
-      r->reason += ": inside the guard band, not accepted";
+    if (guarded && r->outcome == Outcome::kConditionalPass) {
+      // Accepted only clear of the guard band w = guard_band x U (a band below 1 accepts some).
+      r->reason += r->pass ? ", clear of the guard band w = " + Number(guard) + " " + r->unit + ": accepted"
+                           : ": inside the guard band, not accepted";
+    }
   } else if (r->outcome == Outcome::kPass && !r->pass) {
     // Clear of the limit by more than U but not by the guard band (guard_band > 1): not accepted,
     // and its row says so.
@@ -361,10 +364,13 @@ std::string Verdict::Table() const {
                 "margin", "verdict");
   text += line;
   for (const CriterionResult& c : criteria) {
-    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s%s%s\n", c.name.c_str(),
-                  c.measured_text.c_str(), c.limit_text.c_str(), c.margin_text.c_str(),
-                  OutcomeName(c.outcome), c.reason.empty() ? "" : ": ", c.reason.c_str());
+    // The columns in the fixed buffer, the reason (of any length: a noise criterion's says what
+    // to record) after it, so that no row is cut or runs into the next.
+    std::snprintf(line, sizeof line, "    %-32s %22s %18s %20s  %s", c.name.c_str(), c.measured_text.c_str(),
+                  c.limit_text.c_str(), c.margin_text.c_str(), OutcomeName(c.outcome));
     text += line;
+    if (!c.reason.empty()) text += ": " + c.reason;
+    text += '\n';
   }
   return text;
 }
