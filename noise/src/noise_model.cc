@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "imufit/base/enum_names.h"
 #include "imufit/model/constants.h"
@@ -198,7 +199,8 @@ struct SegmentReadout {
   double tau_max_s = std::nan("");
 };
 template <typename Figure>
-SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double target, Figure figure) {
+SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double target, double model_error,
+                         Figure figure) {
   SegmentReadout readout;
   if (points.size() < first + 2) return readout;
   std::vector<double> slopes;
@@ -231,8 +233,9 @@ SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double 
   }
   readout.value = weighted / weights;
   // Neighbouring taus are strongly correlated: no gain from averaging is claimed, the figure is
-  // as uncertain as the best point's deviation (sqrt(1 / (2 edf)) relative).
-  readout.sigma = readout.value * std::sqrt(0.5 / most_edf);
+  // as uncertain as the best point's deviation (sqrt(1 / (2 edf)) relative), and no less than
+  // the model-error floor allows (half of it, on a deviation).
+  readout.sigma = readout.value * std::sqrt(0.5 / most_edf + 0.25 * model_error * model_error);
   readout.tau_min_s = points[first + best_begin].tau_s;
   readout.tau_max_s = points[first + best_end].tau_s;
   return readout;
@@ -240,7 +243,8 @@ SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double 
 
 // The classic read-outs of the measured curve (see noise_model.h); `filtered` short taus are not
 // on the -1/2 line.
-void ReadOut(const std::vector<Point>& points, size_t filtered, NoiseFitSummary* summary) {
+void ReadOut(const std::vector<Point>& points, size_t filtered, double model_error,
+             NoiseFitSummary* summary) {
   if (points.empty()) return;
   const size_t lowest = static_cast<size_t>(
       std::min_element(points.begin(), points.end(),
@@ -263,14 +267,14 @@ void ReadOut(const std::vector<Point>& points, size_t filtered, NoiseFitSummary*
   };
   summary->readout_bias_resolved = std::any_of(points.begin(), points.begin() + lowest, above) &&
                                    std::any_of(points.begin() + lowest + 1, points.end(), above);
-  const SegmentReadout arw =
-      ReadAlong(points, filtered, -0.5, [](const Point& p) { return std::sqrt(p.variance * p.tau_s); });
+  const SegmentReadout arw = ReadAlong(points, filtered, -0.5, model_error,
+                                       [](const Point& p) { return std::sqrt(p.variance * p.tau_s); });
   summary->readout_random_walk = arw.value;
   summary->readout_random_walk_sigma = arw.sigma;
   summary->readout_random_walk_tau_min_s = arw.tau_min_s;
   summary->readout_random_walk_tau_max_s = arw.tau_max_s;
-  const SegmentReadout rrw =
-      ReadAlong(points, filtered, 0.5, [](const Point& p) { return std::sqrt(p.variance * 3.0 / p.tau_s); });
+  const SegmentReadout rrw = ReadAlong(points, filtered, 0.5, model_error,
+                                       [](const Point& p) { return std::sqrt(p.variance * 3.0 / p.tau_s); });
   summary->readout_rate_random_walk = rrw.value;
   summary->readout_rate_random_walk_sigma = rrw.sigma;
   summary->readout_rate_random_walk_tau_min_s = rrw.tau_min_s;
@@ -419,6 +423,78 @@ double NoiseFitSummary::TermDeviation(int term, double tau_s) const {
   return std::sqrt(variance[term] * NoiseTermBasis(term, tau_s));
 }
 
+namespace {
+
+// The shortest record (seconds) whose overlapping Allan deviation at tau_s, for noise exponent
+// alpha, has edf >= 2 / precision^2 and min_clusters intervals of tau_s.
+double RecordFor(double tau_s, int alpha, double tau0_s, double precision, double min_clusters) {
+  const int64_t m = std::max<int64_t>(1, std::llround(tau_s / tau0_s));
+  const double needed_edf = 2.0 / (precision * precision);
+  const auto enough = [&](int64_t n) {
+    const std::optional<double> edf = GreenhallEdf(alpha, 2, m, false, true, n + 1);
+    return edf && *edf >= needed_edf && static_cast<double>(n) >= min_clusters * static_cast<double>(m);
+  };
+  int64_t hi = std::max<int64_t>(4 * m, static_cast<int64_t>(min_clusters * static_cast<double>(m)));
+  while (!enough(hi)) {
+    if (hi > (int64_t{1} << 52)) return std::nan("");
+    hi *= 2;
+  }
+  int64_t lo = hi / 2;
+  while (hi - lo > std::max<int64_t>(1, hi / 1000)) {  // to 0.1 %
+    const int64_t mid = lo + (hi - lo) / 2;
+    (enough(mid) ? hi : lo) = mid;
+  }
+  return static_cast<double>(hi) * tau0_s;
+}
+
+// The shortest tau (from tau0, 1/16 octave steps, up to 1e8 s) where term carries `share` of the
+// model's variance; nan when none.
+double TauWhereDominant(const NoiseFitSummary& model, int term, double share, double tau0_s) {
+  for (double tau = tau0_s; tau < 1e8; tau *= std::pow(2.0, 1.0 / 16.0)) {
+    const double total = model.ModelDeviation(tau);
+    if (model.variance[term] * NoiseTermBasis(term, tau) >= share * total * total) return tau;
+  }
+  return std::nan("");
+}
+
+}  // namespace
+
+RecordLength RecordLengthFor(double n, double b, double k, double tau0_s, double precision,
+                             double min_clusters) {
+  constexpr double kDominantShare = 0.75;
+  constexpr double kFlickerPastCrossover = 10.0;  // the floor is read where white adds a tenth
+  constexpr double kRiseBeyondMinimum = 2.0;      // a point this far past the minimum shows the rise
+  NoiseFitSummary model;
+  model.variance[kRandomWalk] = n * n;
+  model.variance[kBiasInstability] = b * b;
+  model.variance[kRateRandomWalk] = k * k;
+  RecordLength record;
+  if (n > 0.0) {
+    const double tau = TauWhereDominant(model, kRandomWalk, kDominantShare, tau0_s);
+    if (std::isfinite(tau)) record.random_walk_s = RecordFor(tau, 0, tau0_s, precision, min_clusters);
+  }
+  if (b > 0.0) {
+    double tau = kFlickerPastCrossover * n * n / (kFlickerFloor * kFlickerFloor * b * b);
+    if (k > 0.0) {  // the minimum of N^2/tau + 0.44 B^2 + K^2 tau/3
+      tau = std::sqrt(3.0) * n / k;
+      const double grid = std::pow(2.0, 1.0 / 16.0);
+      for (double t = tau0_s; t < 1e8; t *= grid) {
+        if (model.ModelDeviation(t) < model.ModelDeviation(tau)) tau = t;
+      }
+    }
+    tau = std::max(tau, tau0_s);
+    record.bias_instability_tau_s = tau;
+    record.bias_instability_s = std::max(RecordFor(tau, -1, tau0_s, precision, min_clusters),
+                                         min_clusters * kRiseBeyondMinimum * tau);
+  }
+  if (k > 0.0) {
+    const double tau = TauWhereDominant(model, kRateRandomWalk, kDominantShare, tau0_s);
+    record.rate_random_walk_tau_s = tau;
+    if (std::isfinite(tau)) record.rate_random_walk_s = RecordFor(tau, -2, tau0_s, precision, min_clusters);
+  }
+  return record;
+}
+
 NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t n_samples,
                               const NoiseFitOptions& options) {
   NoiseFitSummary summary;
@@ -428,7 +504,7 @@ NoiseFitSummary FitNoiseModel(const std::vector<AllanPoint>& all_points, int64_t
   if (filtered > 0 && static_cast<size_t>(filtered) < usable.size()) {
     summary.filtered_below_tau_s = usable[filtered].tau_s;
   }
-  ReadOut(usable, static_cast<size_t>(filtered), &summary);
+  ReadOut(usable, static_cast<size_t>(filtered), options.model_error, &summary);
   // The fit's taus: the user's range, else the usable taus past the filtered ones.
   const bool user_range = options.fit_tau_min_s > 0.0 || std::isfinite(options.fit_tau_max_s);
   std::vector<Point> points;

@@ -159,6 +159,10 @@ struct NoiseFitSummary {
   double readout_rate_random_walk_sigma = std::nan("");
   double readout_rate_random_walk_tau_min_s = std::nan("");
   double readout_rate_random_walk_tau_max_s = std::nan("");
+  // The curve's own upper bound on K: min over the usable taus of the upper 95 % bound of sigma
+  // times sqrt(3 / tau) (every point lies above K sqrt(tau / 3)), and its tau.
+  double readout_rate_random_walk_bound = std::nan("");
+  double readout_rate_random_walk_bound_tau_s = std::nan("");
   // The longest tau left out for having fewer than min_clusters intervals (nan: none), and its
   // number of intervals.
   double skipped_tau_s = std::nan("");
@@ -168,6 +172,26 @@ struct NoiseFitSummary {
   double ModelDeviation(double tau_s) const;
   double TermDeviation(int term, double tau_s) const;
 };
+
+// How long a static record must be to resolve each term (docs/allan.md "How long to record"):
+// for a sensor with white noise N, bias instability B and rate random walk K (SI; 0 for a term it
+// does not have), sampled every tau0_s, the shortest record in which the overlapping Allan
+// deviation at the tau where the term shows gives it to a relative 2-sigma interval `precision`
+// (edf >= 2 / precision^2: the deviation's relative 1-sigma is sqrt(1 / (2 edf))), with at least
+// `min_clusters` intervals of that tau in the record. Where each term shows: the random walk at the
+// shortest tau where it carries 3/4 of the variance; the bias instability at the model's minimum
+// (10 times the white/flicker crossover when there is no rate random walk), which to be resolved
+// needs the curve to rise beyond it, so the record holds min_clusters intervals of twice that tau;
+// the rate random walk where it carries 3/4 of the variance. nan: the term is 0, or no tau shows it.
+struct RecordLength {
+  double random_walk_s = std::nan("");
+  double bias_instability_s = std::nan("");
+  double bias_instability_tau_s = std::nan("");
+  double rate_random_walk_s = std::nan("");
+  double rate_random_walk_tau_s = std::nan("");
+};
+RecordLength RecordLengthFor(double n, double b, double k, double tau0_s, double precision,
+                             double min_clusters = NoiseFitOptions().min_clusters);
 
 // Fits the model to Allan-variance points (adev, oadev or totdev: the model is the Allan
 // variance's) of a record of n_samples.
