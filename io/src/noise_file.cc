@@ -466,7 +466,22 @@ NoiseRecord ReadNoiseRecord(const yaml::Located& block) {
   }
   record.vio_inflation = NumberOr(block, "vio_inflation", 1.0);
   if (!(record.vio_inflation > 0.0)) block["vio_inflation"].Fail("must be a positive number");
-  if (record.kalibr) record.kalibr->inflation = record.vio_inflation;
+  if (record.kalibr) {
+    record.kalibr->inflation = record.vio_inflation;
+    // A block that says what the columns give is theirs: derived again, with where each figure
+    // comes from. One that differs (edited by hand) is kept as the file states it.
+    NoiseRecord derived = record;
+    derived.kalibr.reset();
+    const KalibrNoiseRecord own = KalibrNoiseOf(derived);
+    const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+    if (same(own.gyroscope_noise_density, record.kalibr->gyroscope_noise_density) &&
+        same(own.gyroscope_random_walk, record.kalibr->gyroscope_random_walk) &&
+        same(own.accelerometer_noise_density, record.kalibr->accelerometer_noise_density) &&
+        same(own.accelerometer_random_walk, record.kalibr->accelerometer_random_walk) &&
+        same(own.update_rate, record.kalibr->update_rate)) {
+      record.kalibr.reset();
+    }
+  }
   KeepUnknown(
       block,
       {"format", "version", "software", "samples", "calibration", "calibration_sha256", "sample_interval_s",
