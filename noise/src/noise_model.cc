@@ -208,11 +208,20 @@ SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double 
     slopes.push_back(0.5 * std::log(points[i + 1].variance / points[i].variance) /
                      std::log(points[i + 1].tau_s / points[i].tau_s));
   }
+  // The run with the most degrees of freedom for the -1/2 line (the white noise lives at the short
+  // end; a disturbance further up the curve may show a -1/2 flank of its own), the longest for the
+  // +1/2 line (the random walk at the long end).
   size_t best_begin = 0, best_end = 0;  // segments [begin, end): points begin .. end
+  double best_weight = 0.0;
   for (size_t begin = 0; begin < slopes.size();) {
     size_t end = begin;
     while (end < slopes.size() && std::fabs(slopes[end] - target) < kReadoutSlopeRun) ++end;
-    if (end - begin > best_end - best_begin) best_begin = begin, best_end = end;
+    double weight = static_cast<double>(end - begin);
+    if (target < 0.0 && end > begin) {
+      weight = 0.0;
+      for (size_t i = begin; i <= end; ++i) weight += points[first + i].edf;
+    }
+    if (weight > best_weight) best_begin = begin, best_end = end, best_weight = weight;
     begin = end == begin ? begin + 1 : end;
   }
   if (best_end == best_begin) {  // no run: the nearest single segment
