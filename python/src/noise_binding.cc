@@ -316,6 +316,32 @@ void BindNoise(py::module_& m) {
   m.def(
       "noise_terms_options", [] { return DescribeKeywords(NoiseFitOptionTable()); },
       "{name: (default, description)} of the noise fit's options (min_clusters is noise_terms()'s).");
+  m.def(
+      "record_length",
+      [](double random_walk, double bias_instability, double rate_random_walk, double tau0_s,
+         double precision) {
+        const std::string where = "imufit.record_length";
+        if (!(tau0_s > 0.0)) ThrowBadArgument(where, "tau0_s must be positive");
+        if (!(precision > 0.0 && precision < 1.0)) ThrowBadArgument(where, "precision must lie in (0, 1)");
+        for (double figure : {random_walk, bias_instability, rate_random_walk}) {
+          if (!(figure >= 0.0) || !std::isfinite(figure))
+            ThrowBadArgument(where, "the figures must be >= 0 (SI)");
+        }
+        const RecordLength r =
+            RecordLengthFor(random_walk, bias_instability, rate_random_walk, tau0_s, precision);
+        py::dict d;
+        d["random_walk_s"] = r.random_walk_s;
+        d["bias_instability_s"] = r.bias_instability_s;
+        d["bias_instability_tau_s"] = r.bias_instability_tau_s;
+        d["rate_random_walk_s"] = r.rate_random_walk_s;
+        d["rate_random_walk_tau_s"] = r.rate_random_walk_tau_s;
+        return d;
+      },
+      py::arg("random_walk"), py::arg("bias_instability"), py::arg("rate_random_walk"), py::arg("tau0_s"),
+      py::arg("precision") = 0.25,
+      "How long a static log must be (s) to resolve each term to a relative 2-sigma interval `precision`, "
+      "from a short log's figures or a data sheet's (SI: N in rad/sqrt(s), B in rad/s, K in rad/s/sqrt(s); 0 "
+      "for a term the sensor lacks). docs/allan.md, \"How long to record\".");
 }
 
 }  // namespace imufit::python

@@ -131,6 +131,18 @@ def test_filtered_white_noise_is_detected_and_quoted():
     assert low >= terms.fit_taus_s[0] and high > low
 
 
+def test_record_length_from_data_sheet_values():
+    # ADIS16405 data sheet: ARW 2 deg/sqrt(h), in-run bias stability 25.2 deg/h.
+    n = 2.0 * math.pi / 180 / 60
+    b = 25.2 * math.pi / 180 / 3600
+    quarter = imufit.record_length(n, b, 0.0, 0.01)
+    tenth = imufit.record_length(n, b, 0.0, 0.01, precision=0.1)
+    assert 0 < quarter["bias_instability_s"] < tenth["bias_instability_s"]
+    assert math.isnan(quarter["rate_random_walk_s"])
+    with pytest.raises(imufit.InputError):
+        imufit.record_length(n, b, 0.0, 0.01, precision=1.5)
+
+
 def test_bad_arguments_raise_input_error():
     y = np.zeros(100)
     with pytest.raises(imufit.InputError, match="estimator 'xdev'|estimator \"xdev\".*oadev"):
