@@ -209,31 +209,57 @@ SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double 
                      std::log(points[i + 1].tau_s / points[i].tau_s));
   }
   // The run with the most degrees of freedom for the -1/2 line (the white noise lives at the short
-  // end; a disturbance further up the curve may show a -1/2 flank of its own), the longest for the
-  // +1/2 line (the random walk at the long end).
-  size_t best_begin = 0, best_end = 0;  // segments [begin, end): points begin .. end
-  double best_weight = 0.0;
+  // end), the longest for the +1/2 line (the random walk at the long end). A -1/2 run is on the
+  // flank of a disturbance (a tone's bump falls through -1/2) when a shorter unfiltered tau lies
+  // clearly below its line: white noise cannot put the curve below its own line; such runs are
+  // passed over.
+  struct Run {
+    size_t begin, end;  // segments [begin, end): points begin .. end (from `first`)
+    double weight;
+  };
+  std::vector<Run> runs;
   for (size_t begin = 0; begin < slopes.size();) {
     size_t end = begin;
     while (end < slopes.size() && std::fabs(slopes[end] - target) < kReadoutSlopeRun) ++end;
-    double weight = static_cast<double>(end - begin);
-    if (target < 0.0 && end > begin) {
-      weight = 0.0;
-      for (size_t i = begin; i <= end; ++i) weight += points[first + i].edf;
+    if (end > begin) {
+      double weight = static_cast<double>(end - begin);
+      if (target < 0.0) {
+        weight = 0.0;
+        for (size_t i = begin; i <= end; ++i) weight += points[first + i].edf;
+      }
+      runs.push_back({begin, end, weight});
     }
-    if (weight > best_weight) best_begin = begin, best_end = end, best_weight = weight;
     begin = end == begin ? begin + 1 : end;
   }
-  if (best_end == best_begin) {  // no run: the nearest single segment
-    double distance = kReadoutSlopeTolerance;
-    for (size_t i = 0; i < slopes.size(); ++i) {
-      if (std::fabs(slopes[i] - target) < distance) {
-        distance = std::fabs(slopes[i] - target);
-        best_begin = i, best_end = i + 1;
-      }
-    }
-    if (best_end == best_begin) return readout;
+  std::stable_sort(runs.begin(), runs.end(), [](const Run& x, const Run& y) { return x.weight > y.weight; });
+  // No run: the single segment nearest the target within kReadoutSlopeTolerance.
+  double distance = kReadoutSlopeTolerance;
+  size_t nearest = slopes.size();
+  for (size_t i = 0; i < slopes.size(); ++i) {
+    if (std::fabs(slopes[i] - target) < distance) distance = std::fabs(slopes[i] - target), nearest = i;
   }
+  if (runs.empty() && nearest < slopes.size()) runs.push_back({nearest, nearest + 1, 0.0});
+  const auto value_of = [&](const Run& run) {
+    double weighted = 0.0, weights = 0.0;
+    for (size_t i = first + run.begin; i <= first + run.end; ++i) {
+      weighted += points[i].edf * figure(points[i]);
+      weights += points[i].edf;
+    }
+    return weighted / weights;
+  };
+  const auto on_a_flank = [&](const Run& run) {
+    if (target > 0.0) return false;
+    const double value = value_of(run);
+    for (size_t i = first; i < first + run.begin; ++i) {
+      const double margin = 3.0 * std::sqrt(0.5 / points[i].edf) + model_error;
+      if (figure(points[i]) < value * (1.0 - margin)) return true;
+    }
+    return false;
+  };
+  const auto chosen =
+      std::find_if(runs.begin(), runs.end(), [&](const Run& run) { return !on_a_flank(run); });
+  if (chosen == runs.end()) return readout;
+  const size_t best_begin = chosen->begin, best_end = chosen->end;
   double weighted = 0.0, weights = 0.0, most_edf = 0.0;
   for (size_t i = first + best_begin; i <= first + best_end; ++i) {
     weighted += points[i].edf * figure(points[i]);
