@@ -518,7 +518,9 @@ NoiseColumnRecord NoiseColumn(const ColumnAnalysis& analysis) {
   column.sample_lag1 = fit.sample_lag1;
   column.filtered_below_tau_s = fit.filtered_below_tau_s;
   for (int k : {kRandomWalk, kBiasInstability, kRateRandomWalk}) {
-    const QuotedFigure quote = QuoteTerm(fit, k);
+    const NoiseTermUnits& units = UnitsOf(analysis.kind, k);  // the file's units (io/noise_file.h)
+    const QuotedFigure quote =
+        Scaled(QuoteTerm(fit, k), *units.engineer_key != '\0' ? units.engineer_per_si : 1.0);
     if (!quote.found()) continue;
     NoiseColumnRecord::Quote& q = column.quote[k];
     q.value = quote.value;

@@ -335,8 +335,8 @@ for name, column in noise['columns'].items():
     lo, hi = q[key]['interval']
     if name.startswith('gyro'):
         assert lo <= truth <= hi, (name, q[key], truth)
-    else:
-        assert 'read-out' in q[key]['from'], (name, q[key], truth)
+    else:  # the sway's flank: an upper bound, above the truth
+        assert q[key]['at_most'] >= truth and 'upper bound from the curve' in q[key]['from'], (name, q[key], truth)
     assert q[key]['from'], name
     assert column['describes_curve'] == name.startswith('gyro'), name
     if name.startswith('gyro'):

@@ -136,9 +136,12 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
       };
   ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
   std::vector<std::string> header = ProvenanceLines(calibration, options, result);
-  header.push_back("noise figures x " + FormatDouble(figures.inflation) +
-                   (figures.inflation == 1.0 ? " (as measured on a static log)" : "") +
-                   "; advised before use in motion: " + kAdvisedVioInflation);
+  // Figures imufit measured (they name their source) or inflated: the factor and the advice said.
+  if (figures.inflation != 1.0 || !figures.gyroscope_noise_density_from.empty()) {
+    header.push_back("noise figures x " + FormatDouble(figures.inflation) +
+                     (figures.inflation == 1.0 ? " (as measured on a static log)" : "") +
+                     "; advised before use in motion: " + kAdvisedVioInflation);
+  }
   const double angle_mrad = std::acos(std::clamp((c_i_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 1e3;
   char text[200];
   std::snprintf(text, sizeof text,

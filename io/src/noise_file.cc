@@ -41,9 +41,10 @@ constexpr double kUpperBoundSigmas = 2.0;
 // an older imufit) the fitted value or an unresolved term's upper bound; nan when none.
 double EstimatorFigure(const NoiseColumnRecord& column, int term, std::string* from) {
   const NoiseColumnRecord::Quote& quote = column.quote[term];
-  if (std::isfinite(quote.value)) {
+  if (std::isfinite(quote.value)) {  // in the file's units: back to SI
+    const NoiseTermUnits& units = UnitsOf(column.kind, term);
     *from = quote.from;
-    return quote.value;
+    return *units.engineer_key != '\0' ? quote.value / units.engineer_per_si : quote.value;
   }
   *from = column.resolved[term] ? "IEEE 952 fit" : "upper bound of the IEEE 952 fit (not resolved)";
   return column.resolved[term] ? column.value[term]
@@ -203,14 +204,13 @@ MachineDoc NoiseColumnDoc(const NoiseColumnRecord& fit) {
       const NoiseColumnRecord::Quote& q = fit.quote[k];
       if (!std::isfinite(q.value)) continue;
       const NoiseTermUnits& units = UnitsOf(fit.kind, k);
-      const double factor = *units.engineer_key != '\0' ? units.engineer_per_si : 1.0;
       MachineDoc figure = MachineDoc::Map();
       if (q.at_most) {
-        figure.Add("at_most", MachineDoc::Number(q.value * factor));
+        figure.Add("at_most", MachineDoc::Number(q.value));
       } else {
-        figure.Add("value", MachineDoc::Number(q.value * factor));
-        AddFinite(&figure, "sigma", q.sigma * factor);
-        AddRange(&figure, "interval", {q.interval[0] * factor, q.interval[1] * factor});
+        figure.Add("value", MachineDoc::Number(q.value));
+        AddFinite(&figure, "sigma", q.sigma);
+        AddRange(&figure, "interval", q.interval);
       }
       figure.Add("from", MachineDoc::Text(q.from));
       quote.Add(*units.engineer_key != '\0' ? units.engineer_key : units.si_key, std::move(figure));
@@ -339,13 +339,11 @@ NoiseColumnRecord ReadNoiseColumn(const std::string& name, const yaml::Located& 
       if (!quote.Has(key)) continue;
       const yaml::Located figure = quote[key];
       figure.RejectUnknownKeys({"value", "sigma", "interval", "at_most", "from"});
-      const double to_si = engineer ? 1.0 / units.engineer_per_si : 1.0;
       NoiseColumnRecord::Quote& q = column.quote[k];
       q.at_most = figure.Has("at_most");
-      q.value = NumberOr(figure, q.at_most ? "at_most" : "value", std::nan("")) * to_si;
-      q.sigma = NumberOr(figure, "sigma", std::nan("")) * to_si;
+      q.value = NumberOr(figure, q.at_most ? "at_most" : "value", std::nan(""));
+      q.sigma = NumberOr(figure, "sigma", std::nan(""));
       ReadRange(figure, "interval", &q.interval);
-      q.interval = {q.interval[0] * to_si, q.interval[1] * to_si};
       q.from = TextOr(figure, "from");
     }
   }

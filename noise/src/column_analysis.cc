@@ -98,7 +98,11 @@ QuotedFigure QuoteTerm(const NoiseFitSummary& fit, int term) {
         fit.fit_tau_max_s);
     return quote;
   }
-  if (term == kBiasInstability && std::isfinite(fit.readout_bias_upper)) {
+  if (term == kRandomWalk && std::isfinite(fit.readout_random_walk_bound)) {
+    set(QuoteSource::kCurveBound, fit.readout_random_walk_bound, std::nan(""), 0.0,
+        fit.readout_random_walk_bound, fit.readout_random_walk_bound_tau_s,
+        fit.readout_random_walk_bound_tau_s);
+  } else if (term == kBiasInstability && std::isfinite(fit.readout_bias_upper)) {
     set(QuoteSource::kCurveBound, fit.readout_bias_upper, std::nan(""), 0.0, fit.readout_bias_upper,
         fit.readout_bias_tau_s, fit.readout_bias_tau_s);
   } else if (term == kRateRandomWalk && std::isfinite(fit.readout_rate_random_walk_bound)) {

@@ -197,6 +197,8 @@ struct SegmentReadout {
   double sigma = std::nan("");
   double tau_min_s = std::nan("");
   double tau_max_s = std::nan("");
+  double bound = std::nan("");  // when the only segment is a disturbance's flank: an upper bound
+  double bound_tau_s = std::nan("");
 };
 template <typename Figure>
 SegmentReadout ReadAlong(const std::vector<Point>& points, size_t first, double target, double model_error,
@@ -308,6 +310,8 @@ void ReadOut(const std::vector<Point>& points, size_t filtered, double model_err
   summary->readout_random_walk_sigma = arw.sigma;
   summary->readout_random_walk_tau_min_s = arw.tau_min_s;
   summary->readout_random_walk_tau_max_s = arw.tau_max_s;
+  summary->readout_random_walk_bound = arw.bound;
+  summary->readout_random_walk_bound_tau_s = arw.bound_tau_s;
   const SegmentReadout rrw = ReadAlong(points, filtered, 0.5, model_error,
                                        [](const Point& p) { return std::sqrt(p.variance * 3.0 / p.tau_s); });
   summary->readout_rate_random_walk = rrw.value;

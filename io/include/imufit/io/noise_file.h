@@ -98,9 +98,10 @@ struct NoiseColumnRecord {
   double sample_lag1 = std::nan("");
   double filtered_below_tau_s = std::nan("");
 
-  // The figure to quote per term (docs/allan.md "Which figure to quote"), SI: a value with its
-  // 1-sigma and 2-sigma interval, or an upper bound (at_most); `from` says where it comes from ("" and
-  // nan: nothing to quote, not written).
+  // The figure to quote per term (docs/allan.md "Which figure to quote"), in the units the file
+  // writes it (engineer units where the kind has them, as the read-outs): a value with its 1-sigma
+  // and 2-sigma interval, or an upper bound (at_most); `from` says where it comes from (nan:
+  // nothing to quote, not written).
   struct Quote {
     double value = std::nan("");  // the figure; an upper bound when at_most
     double sigma = std::nan("");

@@ -159,6 +159,10 @@ struct NoiseFitSummary {
   double readout_rate_random_walk_sigma = std::nan("");
   double readout_rate_random_walk_tau_min_s = std::nan("");
   double readout_rate_random_walk_tau_max_s = std::nan("");
+  // When the only -1/2 segment is a disturbance's flank (a shorter tau lies clearly below its
+  // line): no read-out, but its upper 2-sigma figure bounds N from above, and its first tau.
+  double readout_random_walk_bound = std::nan("");
+  double readout_random_walk_bound_tau_s = std::nan("");
   // The curve's own upper bound on K: min over the usable taus of the upper 95 % bound of sigma
   // times sqrt(3 / tau) (every point lies above K sqrt(tau / 3)), and its tau.
   double readout_rate_random_walk_bound = std::nan("");
