@@ -114,7 +114,7 @@ QuotedFigure QuoteTerm(const NoiseFitSummary& fit, int term) {
     set(QuoteSource::kFitBound, figure.upper(), std::nan(""), 0.0, figure.upper(), fit.fit_tau_min_s,
         fit.fit_tau_max_s);
   } else if (fit.fitted && term == kRandomWalk && figure.resolved) {
-    set(QuoteSource::kFit, figure.value, figure.sigma, figure.lower(), figure.upper(),
+    set(QuoteSource::kMisfit, figure.value, figure.sigma, figure.lower(), figure.upper(),
         fit.term_tau_min_s[term], fit.term_tau_max_s[term]);
   }
   return quote;
@@ -138,6 +138,8 @@ std::string QuoteSourceText(const QuotedFigure& quote) {
       return "resolved Allan minimum / 0.664" + taus(" at ");
     case QuoteSource::kFitBound:
       return "upper bound of the IEEE 952 fit (not resolved)";
+    case QuoteSource::kMisfit:
+      return "IEEE 952 fit of a curve it does not describe (no -1/2 segment to read): check the plot";
     case QuoteSource::kCurveBound:
       return "upper bound from the curve (not resolved)" + taus(" at ");
   }

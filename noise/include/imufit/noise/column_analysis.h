@@ -64,7 +64,9 @@ std::string TermFigureText(const NoiseTermFigure& figure, const std::string& uni
 //     (every point lies above the flat floor 0.664 B and above K sqrt(tau / 3): the lowest point's
 //     upper 95 % bound / 0.664; the longest tau's upper bound times sqrt(3 / tau)).
 // Nothing to quote (no fit, no read-out): value nan.
-enum class QuoteSource { kNone, kFit, kReadout, kResolvedMinimum, kFitBound, kCurveBound };
+//   - last, for the random walk of a misfit curve without a -1/2 segment: the fit's value, said
+//     as a misfit's (kMisfit).
+enum class QuoteSource { kNone, kFit, kReadout, kResolvedMinimum, kFitBound, kCurveBound, kMisfit };
 struct QuotedFigure {
   QuoteSource source = QuoteSource::kNone;
   int term = kRandomWalk;
