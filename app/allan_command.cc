@@ -39,8 +39,12 @@ struct AllanArguments {
   std::string plot;
   std::string plot_units = "native";
   double scale = 1.0;
-  std::string calibration;      // correct the raw samples through it first (as imufit apply does)
-  SamplesInputArguments input;  // --temp-c, for a raw log without temp_c; --time-unit
+  std::string gyro_unit;   // --gyro-unit: the gyro columns' unit ("" = SI)
+  std::string accel_unit;  // --accel-unit
+  double vio_inflation = 1.0;
+  double record_precision = 0.25;  // --record-precision: "how long to record" resolves to this
+  std::string calibration;         // correct the raw samples through it first (as imufit apply does)
+  SamplesInputArguments input;     // --temp-c, for a raw log without temp_c; --time-unit
   bool quiet = false;
   bool allow_mismatch = false;  // with --calibration
   bool allow_uncalibrated = false;
@@ -61,8 +65,79 @@ constexpr double kImplausibleGyroMeanRadps = 1.0;
 // An accelerometer at rest reads about 1 g; a mean beyond 4 g is not m/s^2.
 constexpr double kImplausibleAccelMeanMps2 = 4.0 * kStandardGravityMps2;
 
+// The units a column may be given in (--gyro-unit, --accel-unit), SI per unit: one table for the
+// parser, the help and the conversion.
+struct InputUnit {
+  const char* name;
+  ColumnKind kind;
+  double si_per_unit;
+};
+constexpr InputUnit kInputUnits[] = {
+    {"rad/s", ColumnKind::kGyro, 1.0},
+    {"deg/s", ColumnKind::kGyro, kDegToRad},
+    {"deg/h", ColumnKind::kGyro, kDegToRad / 3600.0},
+    {"mrad/s", ColumnKind::kGyro, 1e-3},
+    {"m/s^2", ColumnKind::kAccel, 1.0},
+    {"g", ColumnKind::kAccel, kStandardGravityMps2},
+    {"mg", ColumnKind::kAccel, 1e-3 * kStandardGravityMps2},
+    {"ug", ColumnKind::kAccel, 1e-6 * kStandardGravityMps2},
+};
+
+std::string InputUnitNames(ColumnKind kind) {
+  std::string names;
+  for (const InputUnit& unit : kInputUnits) {
+    if (unit.kind == kind) names += (names.empty() ? "" : ", ") + std::string(unit.name);
+  }
+  return names;
+}
+
+// SI per unit of `name` for columns of `kind` (1 for ""); a name not in the table is a bad invocation.
+double SiPerUnit(const std::string& name, ColumnKind kind, const char* option) {
+  if (name.empty()) return 1.0;
+  for (const InputUnit& unit : kInputUnits) {
+    if (unit.kind == kind && name == unit.name) return unit.si_per_unit;
+  }
+  BadInvocation(std::string(option) + " " + QuoteForMessage(name) +
+                " is not one of: " + InputUnitNames(kind));
+}
+
+// At rest the accelerometer's mean vector has the norm of gravity; this far from it (relative) it
+// is not in m/s^2: about 1 means g, about 1000 mg.
+constexpr double kAccelNormTolerance = 0.2;
+
+// The norm of the accelerometer columns' means when there are three of them (a vector), else nan.
+double AccelNorm(const std::vector<ColumnAnalysis>& results) {
+  double sum = 0.0;
+  int count = 0;
+  for (const ColumnAnalysis& r : results) {
+    if (r.kind != ColumnKind::kAccel) continue;
+    sum += r.curve.mean * r.curve.mean;
+    ++count;
+  }
+  return count == 3 ? std::sqrt(sum) : std::nan("");
+}
+
+void AccelNormWarning(const AllanArguments& args, const std::vector<ColumnAnalysis>& results) {
+  const double norm = AccelNorm(results);
+  if (!std::isfinite(norm) || std::abs(norm / kStandardGravityMps2 - 1.0) <= kAccelNormTolerance) return;
+  // A log in g usually has its gyros in deg/s.
+  const std::string gyro_too = args.gyro_unit.empty() && args.calibration.empty()
+                                   ? " (and its gyros probably in deg/s: --gyro-unit deg/s)"
+                                   : "";
+  std::string guess = "are the columns raw counts, or not the accelerometer's?";
+  if (std::abs(norm - 1.0) <= kAccelNormTolerance) guess = "it looks like g: give --accel-unit g" + gyro_too;
+  if (std::abs(norm / 1000.0 - 1.0) <= kAccelNormTolerance)
+    guess = "it looks like mg: give --accel-unit mg" + gyro_too;
+  std::fprintf(
+      stderr,
+      "imufit: warning: %s: the accelerometer's mean vector has a norm of %s m/s^2 where a unit at rest "
+      "reads gravity, 9.81 m/s^2: %s; every figure below is in the wrong unit otherwise\n",
+      args.samples.c_str(), Number(norm).c_str(), guess.c_str());
+}
+
 void PlausibilityWarnings(const AllanArguments& args, const UniformSeries& series,
                           const std::vector<ColumnAnalysis>& results) {
+  AccelNormWarning(args, results);
   // A static log may be long and slow: a warning here, where a run against a plan is refused
   // (SamplesReader).
   if (!args.input.options.Given("time_unit") && series.sample_interval_s >= kMaxSampleIntervalS) {
@@ -112,8 +187,167 @@ std::string Analysed(const AllanArguments& args) {
   return args.calibration.empty() ? args.samples : args.samples + " corrected by " + args.calibration;
 }
 
+// "0.08 to 20.5 s", "655.4 s", or "" when unknown.
+std::string TauRange(double lo, double hi) {
+  if (!std::isfinite(lo) || !std::isfinite(hi)) return "";
+  return lo == hi ? Number(lo) + " s" : Number(lo) + " to " + Number(hi) + " s";
+}
+
+// The misfit said out loud, on stderr (the summary says it again at the column).
+void MisfitWarnings(const AllanArguments& args, const std::vector<ColumnAnalysis>& results) {
+  for (const ColumnAnalysis& r : results) {
+    if (!r.fit.fitted || r.fit.describes_curve) continue;
+    std::fprintf(
+        stderr,
+        "imufit: warning: %s: %s: the IEEE 952 model does not describe the curve (reduced chi-square %s > "
+        "%s): its fitted terms are not figures of this sensor; quote the read-outs (docs/allan.md, "
+        "\"Which figure to quote\")\n",
+        args.samples.c_str(), r.name.c_str(), Number(r.fit.reduced_chi_square, 3).c_str(),
+        Number(kMisfitReducedChiSquare).c_str());
+  }
+}
+
+// The read-out beside term k, in the unit `scale` times SI ("" when the curve has none).
+std::string ReadoutText(const NoiseFitSummary& fit, int k, double scale) {
+  if (k == kRandomWalk && std::isfinite(fit.readout_random_walk)) {
+    return "read-out " + Number(fit.readout_random_walk * scale) + " +- " +
+           Number(fit.readout_random_walk_sigma * scale, 2) + " (-1/2 line, " +
+           TauRange(fit.readout_random_walk_tau_min_s, fit.readout_random_walk_tau_max_s) + ")";
+  }
+  if (k == kBiasInstability && std::isfinite(fit.readout_bias_instability)) {
+    return "read-out " + Number(fit.readout_bias_instability * scale) + " (minimum / 0.664 at " +
+           Number(fit.readout_bias_tau_s) + " s, " + Number(fit.readout_bias_lower * scale, 3) + " to " +
+           Number(fit.readout_bias_upper * scale, 3) + " at 2 sigma, " +
+           (fit.readout_bias_resolved ? "a resolved minimum)" : "not a resolved minimum: a bound)");
+  }
+  if (k == kRateRandomWalk && std::isfinite(fit.readout_rate_random_walk)) {
+    return "read-out " + Number(fit.readout_rate_random_walk * scale) + " +- " +
+           Number(fit.readout_rate_random_walk_sigma * scale, 2) + " (+1/2 line, " +
+           TauRange(fit.readout_rate_random_walk_tau_min_s, fit.readout_rate_random_walk_tau_max_s) + ")";
+  }
+  return "";
+}
+
+// A quoted figure in words: "2.42 +- 0.034 deg/sqrt(h)" or "at most 57 deg/h".
+std::string QuoteText(const QuotedFigure& quote, const char* unit) {
+  if (quote.bound()) return "at most " + Number(quote.value, 3) + " " + unit;
+  if (std::isfinite(quote.sigma)) return Number(quote.value) + " +- " + Number(quote.sigma, 2) + " " + unit;
+  return Number(quote.value) + " " + unit + " (" + Number(quote.lower, 3) + " to " + Number(quote.upper, 3) +
+         " at 2 sigma)";
+}
+
+// A duration for people: "40 min", "5.2 h", "3.1 days".
+std::string Duration(double seconds) {
+  if (!std::isfinite(seconds)) return "n/a";
+  if (seconds < 120.0) return Number(seconds, 2) + " s";
+  if (seconds < 7200.0) return Number(seconds / 60.0, 2) + " min";
+  if (seconds < 3.0 * 86400.0) return Number(seconds / 3600.0, 2) + " h";
+  return Number(seconds / 86400.0, 2) + " days";
+}
+
+void PrintColumn(const AllanArguments& args, const ColumnAnalysis& r, double duration_s, double tau0_s,
+                 double min_clusters) {
+  const NoiseFitSummary& fit = r.fit;
+  std::printf("%s (%s, %s)", r.name.c_str(), ToString(r.kind), SiUnit(r.kind));
+  if (!fit.fitted) {
+    std::printf(": no noise fit: %s\n", fit.message.c_str());
+    return;
+  }
+  std::printf(": IEEE 952 fit to oadev, %d points (%s), reduced chi-square %s\n", fit.points_used,
+              TauRange(fit.fit_tau_min_s, fit.fit_tau_max_s).c_str(),
+              Number(fit.reduced_chi_square, 3).c_str());
+  if (!fit.describes_curve) {
+    std::printf(
+        "  MISFIT: the model does not describe this curve (reduced chi-square above %s): the fitted terms "
+        "below are not figures of this sensor; quote the read-outs\n",
+        Number(kMisfitReducedChiSquare).c_str());
+  }
+  if (fit.filter_detected) {
+    std::printf(
+        "  output filter: consecutive samples correlate (lag-1 %s): %d short tau(s) bent below the -1/2 line "
+        "%s; the fit models the filter's 1/tau^2 deficit\n",
+        Number(fit.sample_lag1, 2).c_str(), fit.filtered_points,
+        std::isfinite(fit.filtered_below_tau_s)
+            ? ("left out (below " + Number(fit.filtered_below_tau_s) + " s)").c_str()
+            : "left out");
+  }
+  for (int k = 0; k < kNoiseTerms; ++k) {
+    const NoiseTermUnits& units = UnitsOf(r.kind, k);
+    const bool engineer = *units.engineer_key != '\0';
+    const double scale = engineer ? units.engineer_per_si : 1.0;
+    const char* unit = engineer ? units.engineer_unit : units.si_unit;
+    const NoiseTermFigure figure = TermFigure(fit, k, scale);
+    if (figure.resolved) {
+      std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(figure.value).c_str(),
+                  Number(figure.sigma, 2).c_str(), unit);
+    } else {  // its estimate, interval and the figure to quote (column_analysis.h)
+      std::printf("  %-26s %s", units.label, TermFigureText(figure, unit).c_str());
+    }
+    if (k == kQuantization && fit.filter_variance < 0.0) std::printf(" (masked by the output filter)");
+    const std::string taus = TauRange(fit.term_tau_min_s[k], fit.term_tau_max_s[k]);
+    if (!taus.empty()) std::printf("  fitted on %s", taus.c_str());
+    const std::string readout = ReadoutText(fit, k, scale);
+    if (!readout.empty()) std::printf("  %s", readout.c_str());
+    std::printf("\n");
+  }
+  if (std::isfinite(fit.skipped_tau_s)) {
+    std::printf(
+        "  left out of the fit and the read-outs: tau %s s (%s intervals in the record, fewer than "
+        "--min-clusters %s)\n",
+        Number(fit.skipped_tau_s).c_str(), Number(fit.skipped_clusters, 3).c_str(),
+        Number(min_clusters).c_str());
+  }
+  if (r.kind == ColumnKind::kOther) return;
+  std::array<QuotedFigure, kNoiseTerms> quotes;
+  for (int k : {kRandomWalk, kBiasInstability, kRateRandomWalk}) {
+    quotes[k] = QuoteTerm(fit, k);
+    if (!quotes[k].found()) continue;
+    const NoiseTermUnits& units = UnitsOf(r.kind, k);
+    std::printf("  quote %-20s %s  from %s\n", units.label,
+                QuoteText(Scaled(quotes[k], units.engineer_per_si), units.engineer_unit).c_str(),
+                QuoteSourceText(quotes[k]).c_str());
+  }
+  // How long to record, from the figures quoted (a bound stands in for its term: a smaller term
+  // needs longer).
+  const auto figure = [&](int k) { return quotes[k].found() ? quotes[k].value : 0.0; };
+  const RecordLength length =
+      RecordLengthFor(figure(kRandomWalk), figure(kBiasInstability), figure(kRateRandomWalk), tau0_s,
+                      args.record_precision, min_clusters);
+  std::printf("  record for +-%s %% (2 sigma): bias instability %s%s, %s %s%s (this log: %s)\n",
+              Number(100.0 * args.record_precision).c_str(), Duration(length.bias_instability_s).c_str(),
+              quotes[kBiasInstability].bound() ? " or more (its figure is a bound)" : "",
+              UnitsOf(r.kind, kRateRandomWalk).label, Duration(length.rate_random_walk_s).c_str(),
+              quotes[kRateRandomWalk].bound() ? " or more (its figure is a bound)" : "",
+              Duration(duration_s).c_str());
+}
+
+// The estimators' blocks to paste (the noise YAML has them too, with where each figure comes from).
+void PrintEstimatorBlocks(const NoiseRecord& record) {
+  const KalibrNoiseRecord k = KalibrNoiseOf(record);
+  if (!std::isfinite(k.gyroscope_noise_density) && !std::isfinite(k.accelerometer_noise_density)) return;
+  std::printf("noise blocks (worst axis of each sensor's quoted figures, x %s%s; advised: %s):\n",
+              Number(k.inflation).c_str(), k.inflation == 1.0 ? " as measured" : "", kAdvisedVioInflation);
+  const auto line = [](const char* key, double value, const std::string& from) {
+    if (std::isfinite(value))
+      std::printf("  %-28s %-12s # %s\n", (std::string(key) + ":").c_str(), Number(value).c_str(),
+                  from.c_str());
+  };
+  std::printf(" Kalibr imu.yaml, OpenVINS kalibr_imu_chain.yaml (imu0):\n");
+  line("accelerometer_noise_density", k.accelerometer_noise_density, k.accelerometer_noise_density_from);
+  line("accelerometer_random_walk", k.accelerometer_random_walk, k.accelerometer_random_walk_from);
+  line("gyroscope_noise_density", k.gyroscope_noise_density, k.gyroscope_noise_density_from);
+  line("gyroscope_random_walk", k.gyroscope_random_walk, k.gyroscope_random_walk_from);
+  line("update_rate", k.update_rate, "Hz");
+  std::printf(" VINS-Mono / VINS-Fusion config:\n");
+  line("acc_n", k.accelerometer_noise_density, "m/s^2/sqrt(Hz)");
+  line("gyr_n", k.gyroscope_noise_density, "rad/s/sqrt(Hz)");
+  line("acc_w", k.accelerometer_random_walk, "m/s^3/sqrt(Hz)");
+  line("gyr_w", k.gyroscope_random_walk, "rad/s^2/sqrt(Hz)");
+}
+
 void PrintSummary(const AllanArguments& args, const AllanSettings& settings, const UniformSeries& series,
-                  int64_t sample_count, const std::vector<ColumnAnalysis>& results) {
+                  int64_t sample_count, const std::vector<ColumnAnalysis>& results,
+                  const NoiseRecord& record) {
   std::printf("%s: %lld samples at %s s (%s s), %s, %zu taus, %.3g %% confidence\n", Analysed(args).c_str(),
               static_cast<long long>(sample_count), Number(series.sample_interval_s, 6).c_str(),
               Number(series.end_time_s - series.start_time_s - series.bridged_time_s, 6).c_str(),
@@ -124,46 +358,9 @@ void PrintSummary(const AllanArguments& args, const AllanSettings& settings, con
                 Number(series.bridged_time_s).c_str());
   }
   for (const ColumnAnalysis& r : results) {
-    const NoiseFitSummary& fit = r.fit;
-    std::printf("%s (%s, %s)", r.name.c_str(), ToString(r.kind), SiUnit(r.kind));
-    if (!fit.fitted) {
-      std::printf(": no noise fit: %s\n", fit.message.c_str());
-      continue;
-    }
-    std::printf(": IEEE 952 fit to oadev, %d points, reduced chi-square %s\n", fit.points_used,
-                Number(fit.reduced_chi_square, 3).c_str());
-    for (int k = 0; k < kNoiseTerms; ++k) {
-      const NoiseTermUnits& units = UnitsOf(r.kind, k);
-      const bool engineer = *units.engineer_key != '\0';
-      const double scale = engineer ? units.engineer_per_si : 1.0;
-      const char* unit = engineer ? units.engineer_unit : units.si_unit;
-      const NoiseTermFigure figure = TermFigure(fit, k, scale);
-      if (figure.resolved) {
-        std::printf("  %-26s %10s +- %-9s %-14s", units.label, Number(figure.value).c_str(),
-                    Number(figure.sigma, 2).c_str(), unit);
-      } else {  // its estimate, interval and the figure to quote (column_analysis.h)
-        std::printf("  %-26s %s", units.label, TermFigureText(figure, unit).c_str());
-      }
-      double readout = std::nan("");
-      std::string where;
-      if (k == kRandomWalk) readout = fit.readout_random_walk, where = "-1/2 line at 1 s";
-      if (k == kBiasInstability) {
-        readout = fit.readout_bias_instability;
-        where = "floor/0.664 at " + Number(fit.readout_bias_tau_s) + " s";
-      }
-      if (k == kRateRandomWalk) readout = fit.readout_rate_random_walk, where = "+1/2 line at 3 s";
-      if (std::isfinite(readout))
-        std::printf("  read-out %s (%s)", Number(readout * scale).c_str(), where.c_str());
-      std::printf("\n");
-    }
-    if (r.kind != ColumnKind::kOther) {
-      const bool gyro = r.kind == ColumnKind::kGyro;
-      std::printf("  Kalibr: %s_noise_density %s %s/sqrt(Hz), %s_random_walk %s %s/sqrt(Hz)\n",
-                  gyro ? "gyroscope" : "accelerometer", Number(TermFigure(fit, kRandomWalk).quoted()).c_str(),
-                  gyro ? "rad/s" : "m/s^2", gyro ? "gyroscope" : "accelerometer",
-                  Number(TermFigure(fit, kRateRandomWalk).quoted()).c_str(), gyro ? "rad/s^2" : "m/s^3");
-    }
+    PrintColumn(args, r, record.duration_s, series.sample_interval_s, settings.fit_options.min_clusters);
   }
+  PrintEstimatorBlocks(record);
 }
 
 AllanSettings ParseSettings(const AllanArguments& args) {
@@ -180,6 +377,15 @@ AllanSettings ParseSettings(const AllanArguments& args) {
   for (const std::string& problem :
        {settings.options.Validate(), settings.fit_options.Validate(), settings.series_options.Validate()}) {
     if (!problem.empty()) BadInvocation(problem);
+  }
+  SiPerUnit(args.gyro_unit, ColumnKind::kGyro, "--gyro-unit");  // checked before anything is read
+  SiPerUnit(args.accel_unit, ColumnKind::kAccel, "--accel-unit");
+  if (!(args.vio_inflation >= 1.0) || !std::isfinite(args.vio_inflation)) {
+    BadInvocation("--vio-inflation must be a number of at least 1 (1: the figures as measured)");
+  }
+  if (!(args.record_precision > 0.0 && args.record_precision < 1.0)) {
+    BadInvocation(
+        "--record-precision must lie in (0, 1): the relative 2-sigma interval to resolve each term to");
   }
   return settings;
 }
@@ -253,12 +459,18 @@ std::vector<ColumnAnalysis> AnalyseColumns(const AllanArguments& args, const All
   for (size_t c = 0; c < series->names.size(); ++c) {
     std::vector<double> rates = std::move(series->columns[c]);
     series->columns[c] = std::vector<double>();
+    const ColumnKind kind = ColumnKindOf(series->names[c], args.kind);
     if (args.scale != 1.0) {
       for (double& rate : rates) rate /= args.scale;
     }
-    results.push_back(AnalyseColumn(series->names[c], ColumnKindOf(series->names[c], args.kind),
-                                    std::move(rates), series->sample_interval_s, factors, settings.options,
-                                    settings.fit_options));
+    const double si_per_unit = kind == ColumnKind::kGyro    ? SiPerUnit(args.gyro_unit, kind, "--gyro-unit")
+                               : kind == ColumnKind::kAccel ? SiPerUnit(args.accel_unit, kind, "--accel-unit")
+                                                            : 1.0;
+    if (si_per_unit != 1.0) {
+      for (double& rate : rates) rate *= si_per_unit;
+    }
+    results.push_back(AnalyseColumn(series->names[c], kind, std::move(rates), series->sample_interval_s,
+                                    factors, settings.options, settings.fit_options));
   }
   return results;
 }
@@ -293,30 +505,63 @@ NoiseColumnRecord NoiseColumn(const ColumnAnalysis& analysis) {
   column.readout_bias_instability = written(kBiasInstability, fit.readout_bias_instability);
   column.readout_bias_tau_s = fit.readout_bias_tau_s;
   column.readout_rate_random_walk = written(kRateRandomWalk, fit.readout_rate_random_walk);
+  column.readout_random_walk_taus_s = {fit.readout_random_walk_tau_min_s, fit.readout_random_walk_tau_max_s};
+  column.readout_rate_random_walk_taus_s = {fit.readout_rate_random_walk_tau_min_s,
+                                            fit.readout_rate_random_walk_tau_max_s};
+  column.readout_bias_interval = {written(kBiasInstability, fit.readout_bias_lower),
+                                  written(kBiasInstability, fit.readout_bias_upper)};
+  column.readout_bias_resolved = fit.readout_bias_resolved;
+  column.skipped_tau_s = fit.skipped_tau_s;
+  column.describes_curve = fit.describes_curve;
+  column.fit_taus_s = {fit.fit_tau_min_s, fit.fit_tau_max_s};
+  for (int k = 0; k < kNoiseTerms; ++k)
+    column.term_taus_s[k] = {fit.term_tau_min_s[k], fit.term_tau_max_s[k]};
+  column.filter_detected = fit.filter_detected;
+  column.sample_lag1 = fit.sample_lag1;
+  column.filtered_below_tau_s = fit.filtered_below_tau_s;
+  for (int k : {kRandomWalk, kBiasInstability, kRateRandomWalk}) {
+    const NoiseTermUnits& units = UnitsOf(analysis.kind, k);  // the file's units (io/noise_file.h)
+    const QuotedFigure quote =
+        Scaled(QuoteTerm(fit, k), *units.engineer_key != '\0' ? units.engineer_per_si : 1.0);
+    if (!quote.found()) continue;
+    NoiseColumnRecord::Quote& q = column.quote[k];
+    q.value = quote.value;
+    q.at_most = quote.bound();
+    if (!q.at_most) {
+      q.sigma = quote.sigma;
+      q.interval = {quote.lower, quote.upper};
+    }
+    q.from = QuoteSourceText(quote);
+  }
   return column;
 }
 
 // The curves, the noise YAML and the plot: together, or none.
+NoiseRecord MakeNoiseRecord(const AllanArguments& args, const UniformSeries& series, int64_t sample_count,
+                            const std::vector<ColumnAnalysis>& results) {
+  NoiseRecord record;
+  record.software = SoftwareVersion();
+  record.samples = args.samples;
+  if (!args.calibration.empty()) {
+    record.calibration = args.calibration;
+    record.calibration_sha256 = Sha256OfFile(args.calibration);
+  }
+  record.sample_interval_s = series.sample_interval_s;
+  record.sample_count = sample_count;
+  record.duration_s = series.end_time_s - series.start_time_s - series.bridged_time_s;
+  record.vio_inflation = args.vio_inflation;
+  for (const ColumnAnalysis& analysis : results) record.columns.push_back(NoiseColumn(analysis));
+  return record;
+}
+
 void WriteOutputs(const AllanArguments& args, const AllanSettings& settings, const UniformSeries& series,
-                  int64_t sample_count, const std::vector<ColumnAnalysis>& results) {
+                  int64_t sample_count, const std::vector<ColumnAnalysis>& results,
+                  const NoiseRecord& record) {
   OutputTransaction written;
   std::vector<AllanCurveRecord> curves;
   for (const ColumnAnalysis& analysis : results) curves.push_back(CurveRecord(analysis));
   WriteAllanCsv(args.output, curves, &written);
-  if (!args.noise_yaml.empty()) {
-    NoiseRecord record;
-    record.software = SoftwareVersion();
-    record.samples = args.samples;
-    if (!args.calibration.empty()) {
-      record.calibration = args.calibration;
-      record.calibration_sha256 = Sha256OfFile(args.calibration);
-    }
-    record.sample_interval_s = series.sample_interval_s;
-    record.sample_count = sample_count;
-    record.duration_s = series.end_time_s - series.start_time_s - series.bridged_time_s;
-    for (const ColumnAnalysis& analysis : results) record.columns.push_back(NoiseColumn(analysis));
-    WriteNoiseYaml(args.noise_yaml, record, &written);
-  }
+  if (!args.noise_yaml.empty()) WriteNoiseYaml(args.noise_yaml, record, &written);
   if (!args.plot.empty()) {
     char title[512];
     std::snprintf(title, sizeof title, "%s: %s, tau0 = %g s, %lld samples, %.3g %% confidence",
@@ -334,8 +579,10 @@ int RunAllan(const AllanArguments& args) {
   const int64_t n = static_cast<int64_t>(series.columns[0].size());
   const std::vector<ColumnAnalysis> results = AnalyseColumns(args, settings, &series);
   PlausibilityWarnings(args, series, results);
-  WriteOutputs(args, settings, series, n, results);
-  if (!args.quiet) PrintSummary(args, settings, series, n, results);
+  MisfitWarnings(args, results);
+  const NoiseRecord record = MakeNoiseRecord(args, series, n, results);
+  WriteOutputs(args, settings, series, n, results, record);
+  if (!args.quiet) PrintSummary(args, settings, series, n, results, record);
   return 0;
 }
 
@@ -369,12 +616,27 @@ CommandRunner AddAllanCommand(CliCommand command) {
       "--scale", &args->scale,
       "divide every column by this (raw per SI unit, e.g. 939.65 for 16.4 LSB per deg/s) when the "
       "columns are raw counts (default 1)");
+  const CliOption gyro_unit =
+      command.Option("--gyro-unit", &args->gyro_unit,
+                     "unit of the gyro columns: " + InputUnitNames(ColumnKind::kGyro) + " (default rad/s)");
+  const CliOption accel_unit = command.Option(
+      "--accel-unit", &args->accel_unit,
+      "unit of the accelerometer columns: " + InputUnitNames(ColumnKind::kAccel) + " (default m/s^2)");
+  command.Option(
+      "--vio-inflation", &args->vio_inflation,
+      "multiply the figures of the Kalibr, OpenVINS and VINS-Mono blocks by this (default 1: as measured; "
+      "the factor is written beside them)");
+  command.Option(
+      "--record-precision", &args->record_precision,
+      "how long to record: the relative 2-sigma interval each term is to be resolved to (default 0.25)");
   CliOption calibration =
       command
           .Option("--calibration", &args->calibration,
                   "the unit's calibration YAML: correct the raw samples through it first, as imufit apply "
                   "does (then the columns are among gyro_*, accel_* and temp_c)")
-          .Excludes(scale);
+          .Excludes(scale)
+          .Excludes(gyro_unit)
+          .Excludes(accel_unit);
   AddTempOption(command, &args->input);
   AddAllowMismatchFlag(command, &args->allow_mismatch);
   AddAllowUncalibratedFlag(command, &args->allow_uncalibrated);

@@ -16,7 +16,9 @@
 
 #include <gtest/gtest.h>
 
+#include "imufit/model/constants.h"
 #include "imufit/noise/allan.h"
+#include "imufit/noise/column_analysis.h"
 #include "imufit/noise/noise_model.h"
 #include "imufit/noise/statistics.h"
 #include "test_util.h"
@@ -507,6 +509,248 @@ TEST(NoiseFitTest, UncertaintyMatchesTheMonteCarloSpread) {
   EXPECT_LT(rms_n, kMaxRmsZ);
   EXPECT_GT(rms_k, kMinRmsZ);
   EXPECT_LT(rms_k, kMaxRmsZ);
+}
+
+// ---------------------------------------------------------------- effects of real sensors, known truth
+//
+// Each simulated effect of a real sensor (an output filter, quantization, a building's sway, bias
+// instability, random walks): the figure the analysis says to quote (QuoteTerm) holds the truth,
+// either as a value whose 2-sigma interval contains it or as an upper bound above it.
+
+// The figure to quote for `term` contains `truth`: in its 2-sigma interval, or below its bound.
+void ExpectQuoteHolds(const NoiseFitSummary& fit, int term, double truth) {
+  const QuotedFigure quote = QuoteTerm(fit, term);
+  ASSERT_TRUE(quote.found()) << NoiseTermName(term);
+  if (quote.bound()) {
+    EXPECT_GE(quote.value, truth) << NoiseTermName(term) << ": bound " << quote.value << " from "
+                                  << QuoteSourceText(quote);
+  } else {
+    EXPECT_LE(quote.lower, truth) << NoiseTermName(term) << ": " << quote.value << " +- " << quote.sigma
+                                  << " from " << QuoteSourceText(quote) << ", truth " << truth;
+    EXPECT_GE(quote.upper, truth) << NoiseTermName(term) << ": " << quote.value << " +- " << quote.sigma
+                                  << " from " << QuoteSourceText(quote) << ", truth " << truth;
+  }
+}
+
+// The fitted angle random walk lies within 2 of its sigmas of the truth, and is informative.
+constexpr double kTruthSigmas = 2.0;
+void ExpectArwWithinTwoSigma(const NoiseFitSummary& fit, double truth) {
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  EXPECT_NEAR(fit.value[kRandomWalk], truth, kTruthSigmas * fit.sigma[kRandomWalk])
+      << "fitted " << fit.value[kRandomWalk] << " +- " << fit.sigma[kRandomWalk] << ", truth " << truth;
+  EXPECT_LT(fit.sigma[kRandomWalk], kMaxRelativeUncertainty * truth);
+}
+
+// A white-noise-only sensor has no bias instability: the quote must be a bound (or an interval
+// reaching down to 0), never a resolved figure away from 0.
+void ExpectNoPhantomBiasInstability(const NoiseFitSummary& fit) {
+  ExpectQuoteHolds(fit, kBiasInstability, 0.0);
+}
+
+// White noise of density `arw` (rad/sqrt(s)) through a first-order low-pass y_k = a y_{k-1} +
+// (1 - a) w_k (DC gain 1: the density is unchanged). a = 0.45 gives consecutive samples a
+// correlation of 0.45 (the ADIS16405's are 0.17 to 0.36). Without the filter handling the fit gave
+// an ARW 20 to 30 % low and a phantom bias instability (issue 33).
+TEST(NoiseEffectsTest, FirstOrderFilteredWhiteNoise) {
+  const double tau0 = 0.01, arw = 2e-4, a = 0.45;
+  std::vector<double> y = WhiteNoise(400000, arw / std::sqrt(tau0), 31);
+  for (size_t i = 1; i < y.size(); ++i) y[i] = a * y[i - 1] + (1.0 - a) * y[i];
+  const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+  EXPECT_TRUE(fit.filter_detected);
+  EXPECT_GT(fit.filtered_points, 0);
+  EXPECT_TRUE(fit.describes_curve) << fit.reduced_chi_square;
+  EXPECT_LT(fit.filter_variance, 0.0);  // the filter's 1/tau^2 deficit is modelled
+  ExpectArwWithinTwoSigma(fit, arw);
+  ExpectQuoteHolds(fit, kRandomWalk, arw);
+  ExpectNoPhantomBiasInstability(fit);
+  // The fit starts past the filtered taus, and says so.
+  EXPECT_GT(fit.fit_tau_min_s, tau0);
+  EXPECT_EQ(fit.fit_tau_min_s, fit.filtered_below_tau_s);
+}
+
+// A moving average of 8 samples (a boxcar FIR filter, DC gain 1).
+TEST(NoiseEffectsTest, MovingAverageOfWhiteNoise) {
+  const double tau0 = 0.01, arw = 2e-4;
+  constexpr int kTaps = 8;
+  const std::vector<double> w = WhiteNoise(400000 + kTaps, arw / std::sqrt(tau0), 32);
+  std::vector<double> y(400000);
+  double window = 0.0;
+  for (int i = 0; i < kTaps; ++i) window += w[i];
+  for (size_t i = 0; i < y.size(); ++i) {
+    y[i] = window / kTaps;
+    window += w[i + kTaps] - w[i];
+  }
+  const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+  EXPECT_TRUE(fit.filter_detected);
+  ExpectArwWithinTwoSigma(fit, arw);
+  ExpectQuoteHolds(fit, kRandomWalk, arw);
+  ExpectNoPhantomBiasInstability(fit);
+}
+
+// A decimating second-order CIC-like filter: white noise at 1 kHz, each output sample the
+// triangular-weighted sum of 2R - 1 inputs (a boxcar of R convolved with itself, gain 1), one output
+// per R inputs. Adjacent outputs share inputs: correlated at the output rate.
+TEST(NoiseEffectsTest, DecimatingCicFilteredWhiteNoise) {
+  const double tau0_in = 0.001, arw = 2e-4;
+  constexpr int kDecimation = 8;
+  const int64_t outputs = 100000;
+  const std::vector<double> w =
+      WhiteNoise(outputs * kDecimation + 2 * kDecimation, arw / std::sqrt(tau0_in), 33);
+  std::vector<double> y(outputs);
+  for (int64_t k = 0; k < outputs; ++k) {
+    double sum = 0.0;
+    for (int j = 0; j < 2 * kDecimation - 1; ++j) {
+      const double weight = j < kDecimation ? j + 1 : 2 * kDecimation - 1 - j;
+      sum += weight * w[k * kDecimation + j];
+    }
+    y[k] = sum / (kDecimation * kDecimation);
+  }
+  const NoiseFitSummary fit = FitRates(y, tau0_in * kDecimation, "octave");
+  EXPECT_TRUE(fit.filter_detected);
+  ExpectArwWithinTwoSigma(fit, arw);
+  ExpectQuoteHolds(fit, kRandomWalk, arw);
+  ExpectNoPhantomBiasInstability(fit);
+}
+
+// A rate output rounded to an LSB about the size of the noise (the ADIS16405's accelerometer: 1.2
+// LSB rms): the rounding adds white noise of LSB / sqrt(12) per sample, so the truth is
+// sqrt(N^2 + LSB^2 tau0 / 12).
+TEST(NoiseEffectsTest, CoarselyQuantizedRate) {
+  const double tau0 = 0.01, arw = 2e-4;
+  const double lsb = 1.2 * arw / std::sqrt(tau0);
+  std::vector<double> y = WhiteNoise(400000, arw / std::sqrt(tau0), 34);
+  for (double& v : y) v = lsb * std::round(v / lsb + 0.37);  // an offset: the rounding is not centred
+  const double truth = std::sqrt(arw * arw + lsb * lsb * tau0 / 12.0);
+  const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+  EXPECT_FALSE(fit.filter_detected);  // rounding decorrelates, it does not correlate
+  ExpectArwWithinTwoSigma(fit, truth);
+  ExpectQuoteHolds(fit, kRandomWalk, truth);
+  ExpectNoPhantomBiasInstability(fit);
+}
+
+// A slow sinusoid (a building's sway, 0.5 Hz) three times the white noise's deviation at 1 s: a
+// bump the IEEE 952 model cannot describe. The misfit is said, and what is quoted still holds.
+TEST(NoiseEffectsTest, SlowSinusoidIsAMisfitSaidOutLoud) {
+  const double tau0 = 0.01, arw = 2e-4, period_s = 2.0;
+  const double amplitude = 3.0 * arw;  // sigma(1 s) of the white noise is arw
+  std::vector<double> y = WhiteNoise(400000, arw / std::sqrt(tau0), 35);
+  for (size_t i = 0; i < y.size(); ++i) y[i] += amplitude * std::sin(2.0 * kPi * tau0 * i / period_s);
+  const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+  ASSERT_TRUE(fit.fitted);
+  EXPECT_FALSE(fit.describes_curve) << fit.reduced_chi_square;
+  EXPECT_GT(fit.reduced_chi_square, kMisfitReducedChiSquare);
+  ExpectQuoteHolds(fit, kRandomWalk, arw);
+  EXPECT_EQ(QuoteTerm(fit, kRandomWalk).source, QuoteSource::kReadout);  // the -1/2 line, not the fit
+  EXPECT_LT(fit.readout_random_walk_tau_max_s, 0.5 * period_s);          // read before the bump
+  ExpectNoPhantomBiasInstability(fit);
+}
+
+// Flicker (bias instability) as a sum of first-order Gauss-Markov processes of equal variance s^2
+// with correlation times an octave apart: its one-sided spectrum is s^2 / (ln 2 f), i.e.
+// B^2 = pi s^2 / ln 2 in IEEE 952's terms (sigma floor 0.664 B), within a few per cent between the
+// shortest and longest correlation times.
+std::vector<double> Flicker(int64_t n, double tau0, double b, uint32_t seed) {
+  const double s = b * std::sqrt(std::log(2.0) / kPi);
+  std::vector<double> y(n, 0.0);
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (double t_c = 0.05; t_c < 2e5; t_c *= 2.0) {
+    const double phi = std::exp(-tau0 / t_c);
+    const double drive = s * std::sqrt(1.0 - phi * phi);
+    double x = s * normal(random);
+    for (int64_t i = 0; i < n; ++i) {
+      x = phi * x + drive * normal(random);
+      y[i] += x;
+    }
+  }
+  return y;
+}
+
+// White noise, bias instability and a rate random walk, the three terms a real gyro shows: the
+// minimum between the flicker floor and the random walk is resolved and quoted.
+TEST(NoiseEffectsTest, BiasInstabilityAndRandomWalk) {
+  const double tau0 = 0.1, arw = 1e-4, b = 3e-5, rrw = 1e-6;
+  const int64_t n = 400000;  // 11 h
+  std::vector<double> y = WhiteNoise(n, arw / std::sqrt(tau0), 36);
+  const std::vector<double> flicker = Flicker(n, tau0, b, 37);
+  const std::vector<double> walk = RandomWalk(n, rrw * std::sqrt(tau0), 38);
+  for (int64_t i = 0; i < n; ++i) y[i] += flicker[i] + walk[i];
+  const NoiseFitSummary fit = FitRates(y, tau0, "octave");
+  ASSERT_TRUE(fit.fitted) << fit.message;
+  EXPECT_TRUE(fit.describes_curve) << fit.reduced_chi_square;
+  ExpectArwWithinTwoSigma(fit, arw);
+  EXPECT_NEAR(fit.value[kBiasInstability], b, kTruthSigmas * fit.sigma[kBiasInstability]);
+  ExpectQuoteHolds(fit, kRandomWalk, arw);
+  ExpectQuoteHolds(fit, kBiasInstability, b);
+  ExpectQuoteHolds(fit, kRateRandomWalk, rrw);
+  // Every term is given the taus it shapes, in order: white first, the random walk last.
+  EXPECT_LT(fit.term_tau_min_s[kRandomWalk], fit.term_tau_min_s[kBiasInstability]);
+  EXPECT_LT(fit.term_tau_max_s[kBiasInstability], fit.term_tau_max_s[kRateRandomWalk] + 1e-9);
+}
+
+// How long to record: a record of the advised length resolves the bias instability to the stated
+// precision, and a record a quarter as long does not (the minimum's interval is wider).
+TEST(NoiseEffectsTest, RecordLengthIsMonotoneAndScales) {
+  const double tau0 = 0.01, arw = 1e-4, b = 3e-5, rrw = 1e-6;
+  const RecordLength quarter = RecordLengthFor(arw, b, rrw, tau0, 0.25);
+  const RecordLength tenth = RecordLengthFor(arw, b, rrw, tau0, 0.10);
+  ASSERT_TRUE(std::isfinite(quarter.bias_instability_s));
+  ASSERT_TRUE(std::isfinite(quarter.rate_random_walk_s));
+  EXPECT_GT(tenth.bias_instability_s, quarter.bias_instability_s);
+  EXPECT_GT(tenth.rate_random_walk_s, quarter.rate_random_walk_s);
+  // The rate random walk shows after the minimum: it needs the longer record.
+  EXPECT_GT(quarter.rate_random_walk_s, quarter.bias_instability_s);
+  EXPECT_GT(quarter.rate_random_walk_tau_s, quarter.bias_instability_tau_s);
+  // Without a rate random walk there is nothing to record for it.
+  EXPECT_TRUE(std::isnan(RecordLengthFor(arw, b, 0.0, tau0, 0.25).rate_random_walk_s));
+  // A 2-sigma relative interval p on sigma(tau) needs edf >= 2 / p^2: checked against the edf the
+  // analysis computes for a record of the advised length.
+  const int64_t m = std::llround(quarter.bias_instability_tau_s / tau0);
+  const int64_t n = std::llround(quarter.bias_instability_s / tau0);
+  const std::optional<double> edf = GreenhallEdf(-1, 2, m, false, true, n + 1);
+  ASSERT_TRUE(edf.has_value());
+  EXPECT_GE(*edf, 2.0 / (0.25 * 0.25) * (1.0 - 1e-3));
+}
+
+// --fit-taus: the user's range is the fit's, even over a detected filter.
+TEST(NoiseEffectsTest, FitTausOverrulesTheFilterDetection) {
+  const double tau0 = 0.01, arw = 2e-4, a = 0.45;
+  std::vector<double> y = WhiteNoise(200000, arw / std::sqrt(tau0), 39);
+  for (size_t i = 1; i < y.size(); ++i) y[i] = a * y[i - 1] + (1.0 - a) * y[i];
+  TauSpec spec;
+  ASSERT_EQ(ParseTauSpec("octave", &spec), "");
+  std::vector<int64_t> factors;
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 200000, tau0, &factors), "");
+  const AllanResult result = ComputeAllanFromRates(y, tau0, factors, AllanOptions());
+  NoiseFitOptions options;
+  ASSERT_EQ(NoiseFitOptionTable().Find("fit_taus") != nullptr, true);
+  options.fit_tau_min_s = 0.5;
+  options.fit_tau_max_s = 50.0;
+  const NoiseFitSummary fit = FitNoiseModel(result.points, 200000, options);
+  ASSERT_TRUE(fit.fitted);
+  EXPECT_TRUE(fit.filter_detected);  // still said
+  EXPECT_GE(fit.fit_tau_min_s, 0.5);
+  EXPECT_LE(fit.fit_tau_max_s, 50.0);
+  ExpectArwWithinTwoSigma(fit, arw);
+}
+
+// The read-outs say where they are: the -1/2 line's tau range; the skipped last tau is named.
+TEST(NoiseEffectsTest, ReadoutsSayWhereTheyAre) {
+  const double tau0 = 0.01, arw = 2e-4;
+  const std::vector<double> y = WhiteNoise(100000, arw / std::sqrt(tau0), 40);
+  TauSpec spec;
+  ASSERT_EQ(ParseTauSpec("octave", &spec), "");
+  std::vector<int64_t> factors;
+  ASSERT_EQ(AveragingFactors(spec, AllanEstimator::kOadev, 100000, tau0, &factors), "");
+  const AllanResult result = ComputeAllanFromRates(y, tau0, factors, AllanOptions());
+  const NoiseFitSummary fit = FitNoiseModel(result.points, 100000);
+  ASSERT_TRUE(fit.fitted);
+  EXPECT_NEAR(fit.readout_random_walk, arw, kTruthSigmas * 2.0 * fit.readout_random_walk_sigma + 0.02 * arw);
+  EXPECT_EQ(fit.readout_random_walk_tau_min_s, tau0);
+  EXPECT_GT(fit.readout_random_walk_tau_max_s, 100.0 * tau0);
+  // octave taus stop at n/4: the last one has 4 < 8 intervals and is named.
+  EXPECT_EQ(fit.skipped_tau_s, result.points.back().tau_s);
+  EXPECT_NEAR(fit.skipped_clusters, 100000.0 / result.points.back().m, 1e-9);
 }
 
 TEST(NoiseFitTest, TooFewPointsIsReportedNotFitted) {

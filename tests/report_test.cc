@@ -53,12 +53,18 @@ TEST(AllanPlot, ShowsArwAtOneSecondAndTheBiasInstabilityFloorInTheChosenUnits) {
   const Plot& plot = figure.panels[0];
   EXPECT_EQ(plot.x_label, "averaging time \xcf\x84 (s)");  // a real tau, not the word
   EXPECT_EQ(plot.y_label, "overlapping Allan deviation (\xc2\xb0/h)");
-  ASSERT_EQ(plot.notes.size(), 3u);  // ARW (point and words), the floor's mark, its words
+  // The ARW's mark, the floor's mark, the floor's words, the ARW's words (stacked last, from one
+  // anchor above the highest ARW mark).
+  ASSERT_EQ(plot.notes.size(), 4u);
   const PlotNote& arw = plot.notes[0];
   EXPECT_EQ(arw.x, 1.0);
   EXPECT_NEAR(arw.y, n * DphFromRadps(1.0), kModelRelative * arw.y);  // sigma(1 s) on the -1/2 line is N
   EXPECT_GE(arw.point_type, 0);
-  EXPECT_EQ(arw.text, "ARW 0.299 \xc2\xb1 0.003 \xc2\xb0/\xe2\x88\x9ah");  // N (180/pi) 60 deg/sqrt(h)
+  const PlotNote& arw_words = plot.notes[3];
+  EXPECT_EQ(arw_words.text, "ARW 0.299 \xc2\xb1 0.003 \xc2\xb0/\xe2\x88\x9ah");  // N (180/pi) 60 deg/sqrt(h)
+  EXPECT_EQ(arw_words.x, arw.x);
+  EXPECT_EQ(arw_words.y, arw.y);
+  EXPECT_GT(arw_words.dy_chars, 0.0);  // above its mark
   // The floor: sqrt(2 ln 2 / pi) B = 0.664 B, at the model's minimum (the last tau here: no rate
   // random walk), labelled with B itself.
   const PlotNote& floor = plot.notes[1];
@@ -79,7 +85,7 @@ TEST(AllanPlot, ShowsArwAtOneSecondAndTheBiasInstabilityFloorInTheChosenUnits) {
   const PlotFigure native = AllanPlot({ModelColumn("gyro_x", n, b)}, "run.csv");
   EXPECT_EQ(native.panels[0].y_label, "overlapping Allan deviation (rad/s)");
   EXPECT_NEAR(native.panels[0].notes[0].y, n, kModelRelative * n);
-  EXPECT_EQ(native.panels[0].notes[0].text, arw.text);
+  EXPECT_EQ(native.panels[0].notes[3].text, arw_words.text);
 
   // The gnuplot script writes tau and the notes as UTF-8 text, not enhanced-text escapes.
   const std::string script = GnuplotScript(figure, "svg", "out.svg");
@@ -104,10 +110,14 @@ TEST(AllanPlot, NamesColumnsWhenSeveralShareAPanelAndSaysWhatIsNotResolved) {
   // Two ARW notes (named) and gyro_x's floor: gyro_y's bias instability is not resolved.
   EXPECT_EQ(marks, 3);
   ASSERT_EQ(words.size(), 3u);
-  EXPECT_EQ(words[0]->text.rfind("gyro_x ARW ", 0), 0u);
-  EXPECT_EQ(words[1]->text.rfind("gyro_y ARW ", 0), 0u);
-  EXPECT_GT(words[0]->dy_chars, words[1]->dy_chars);  // the first column's words on top
-  EXPECT_EQ(words[2]->text.rfind("gyro_x bias instability", 0), 0u);
+  EXPECT_EQ(words[0]->text.rfind("gyro_x bias instability", 0), 0u);
+  EXPECT_EQ(words[1]->text.rfind("gyro_x ARW ", 0), 0u);
+  EXPECT_EQ(words[2]->text.rfind("gyro_y ARW ", 0), 0u);
+  // One anchor for the ARW words, one line apart, the first column's on top: they never overlap
+  // (issue 33: accel_y's VRW label was hidden under accel_z's).
+  EXPECT_EQ(words[1]->x, words[2]->x);
+  EXPECT_EQ(words[1]->y, words[2]->y);
+  EXPECT_GE(words[1]->dy_chars - words[2]->dy_chars, 1.0);
   ASSERT_EQ(plot.labels.size(), 1u);
   EXPECT_EQ(plot.labels[0].text, "gyro_y: bias instability not resolved");
 }

@@ -89,13 +89,19 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
   const KalibrNoiseRecord figures =
       calibration.noise ? KalibrNoiseOf(*calibration.noise) : KalibrNoiseRecord();
   MachineDoc doc = MachineDoc::Map();
-  for (const auto& [key, figure, unit] :
+  // Each figure says where it comes from (the noise block's figure to quote, docs/allan.md).
+  for (const auto& [key, figure, unit, from] :
        {std::tuple{"accelerometer_noise_density", &KalibrNoiseRecord::accelerometer_noise_density,
-                   "m/s^2/sqrt(Hz)"},
-        {"accelerometer_random_walk", &KalibrNoiseRecord::accelerometer_random_walk, "m/s^3/sqrt(Hz)"},
-        {"gyroscope_noise_density", &KalibrNoiseRecord::gyroscope_noise_density, "rad/s/sqrt(Hz)"},
-        {"gyroscope_random_walk", &KalibrNoiseRecord::gyroscope_random_walk, "rad/s^2/sqrt(Hz)"}}) {
-    doc.Add(key, NumberDoc(NoiseFigure(figures, figure, key), key), unit);
+                   "m/s^2/sqrt(Hz)", &KalibrNoiseRecord::accelerometer_noise_density_from},
+        {"accelerometer_random_walk", &KalibrNoiseRecord::accelerometer_random_walk, "m/s^3/sqrt(Hz)",
+         &KalibrNoiseRecord::accelerometer_random_walk_from},
+        {"gyroscope_noise_density", &KalibrNoiseRecord::gyroscope_noise_density, "rad/s/sqrt(Hz)",
+         &KalibrNoiseRecord::gyroscope_noise_density_from},
+        {"gyroscope_random_walk", &KalibrNoiseRecord::gyroscope_random_walk, "rad/s^2/sqrt(Hz)",
+         &KalibrNoiseRecord::gyroscope_random_walk_from}}) {
+    const std::string& source = figures.*from;
+    doc.Add(key, NumberDoc(NoiseFigure(figures, figure, key), key),
+            source.empty() ? std::string(unit) : std::string(unit) + "; " + source);
   }
   doc.Add("rostopic", MachineDoc::Text(options.rostopic));
   doc.Add("update_rate",
@@ -130,6 +136,12 @@ ExportResult ExportKalibr(const Calibration& calibration, const ExportOptions& o
       };
   ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
   std::vector<std::string> header = ProvenanceLines(calibration, options, result);
+  // Figures imufit measured (they name their source) or inflated: the factor and the advice said.
+  if (figures.inflation != 1.0 || !figures.gyroscope_noise_density_from.empty()) {
+    header.push_back("noise figures x " + FormatDouble(figures.inflation) +
+                     (figures.inflation == 1.0 ? " (as measured on a static log)" : "") +
+                     "; advised before use in motion: " + kAdvisedVioInflation);
+  }
   const double angle_mrad = std::acos(std::clamp((c_i_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 1e3;
   char text[200];
   std::snprintf(text, sizeof text,

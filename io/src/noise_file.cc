@@ -23,26 +23,48 @@ void AddFinite(MachineDoc* map, const std::string& key, double value, std::strin
   if (std::isfinite(value)) map->Add(key, MachineDoc::Number(value), std::move(comment));
 }
 
+// Adds `key: [low, high]` when both are finite.
+void AddRange(MachineDoc* map, const std::string& key, const std::array<double, 2>& range) {
+  if (std::isfinite(range[0]) && std::isfinite(range[1]))
+    map->Add(key, MachineDoc::Numbers({range[0], range[1]}));
+}
+
 // Adds `key: [value, sigma]` when both are finite.
 void AddPair(MachineDoc* map, const std::string& key, double value, double sigma) {
   if (std::isfinite(value) && std::isfinite(sigma)) map->Add(key, MachineDoc::Numbers({value, sigma}));
 }
 
-// The largest fitted value of `term` over the columns of `kind` (Kalibr takes one number for all
-// three axes: the worst one is the safe choice), or nan when there is none.
 // The two-sided 95 % bound's one side: an unresolved term is given as value + kUpperBoundSigmas sigma.
 constexpr double kUpperBoundSigmas = 2.0;
 
-// The largest of the fitted axes of `kind` for `term`, each an unresolved term's upper bound
-// (Kalibr's noise model takes every term as present: a random walk the log cannot resolve is given
-// as what the log allows, never 0).
-double WorstAxis(const std::vector<NoiseColumnRecord>& columns, ColumnKind kind, int term) {
+// A column's figure of `term` for an estimator's block: its quote when it has one, else (a file of
+// an older imufit) the fitted value or an unresolved term's upper bound; nan when none.
+double EstimatorFigure(const NoiseColumnRecord& column, int term, std::string* from) {
+  const NoiseColumnRecord::Quote& quote = column.quote[term];
+  if (std::isfinite(quote.value)) {  // in the file's units: back to SI
+    const NoiseTermUnits& units = UnitsOf(column.kind, term);
+    *from = quote.from;
+    return *units.engineer_key != '\0' ? quote.value / units.engineer_per_si : quote.value;
+  }
+  *from = column.resolved[term] ? "IEEE 952 fit" : "upper bound of the IEEE 952 fit (not resolved)";
+  return column.resolved[term] ? column.value[term]
+                               : column.value[term] + kUpperBoundSigmas * column.sigma[term];
+}
+
+// The largest of the fitted axes of `kind` for `term` (Kalibr takes one number for all three
+// axes: the worst one is the safe choice; its noise model takes every term as present, so a term
+// the log does not resolve is given as what the log allows, never 0), and where it comes from.
+double WorstAxis(const std::vector<NoiseColumnRecord>& columns, ColumnKind kind, int term,
+                 std::string* from) {
   double worst = std::nan("");
   for (const NoiseColumnRecord& column : columns) {
     if (column.kind != kind || !column.fitted) continue;
-    const double figure = column.resolved[term] ? column.value[term]
-                                                : column.value[term] + kUpperBoundSigmas * column.sigma[term];
-    if (std::isfinite(figure) && !(worst >= figure)) worst = figure;
+    std::string source;
+    const double figure = EstimatorFigure(column, term, &source);
+    if (std::isfinite(figure) && !(worst >= figure)) {
+      worst = figure;
+      *from = column.name + ": " + source;
+    }
   }
   return worst;
 }
@@ -144,13 +166,58 @@ MachineDoc NoiseColumnDoc(const NoiseColumnRecord& fit) {
         column.Add(std::string(UnitsOf(fit.kind, k).si_key) + "_resolved", MachineDoc::Bool(false));
       }
     }
+    column.Add(
+        "describes_curve", MachineDoc::Bool(fit.describes_curve),
+        fit.describes_curve ? "" : "reduced chi-square above the misfit threshold: quote the read-outs");
+    AddRange(&column, "fit_taus_s", fit.fit_taus_s);
+    MachineDoc term_taus = MachineDoc::Map();
+    for (int k = 0; k < kNoiseTerms; ++k)
+      AddRange(&term_taus, UnitsOf(fit.kind, k).si_key, fit.term_taus_s[k]);
+    if (!term_taus.items().empty()) {
+      column.Add("term_taus_s", std::move(term_taus),
+                 "where each term carries a quarter of the model or more");
+    }
+    if (fit.filter_detected) {
+      MachineDoc filter = MachineDoc::Map();
+      AddFinite(&filter, "lag1", fit.sample_lag1);
+      AddFinite(&filter, "filtered_below_tau_s", fit.filtered_below_tau_s);
+      column.Add("output_filter", std::move(filter),
+                 "taus below filtered_below_tau_s are left out of the fit");
+    }
     const std::array<std::string, 4> keys = ReadoutKeys(fit.kind);
     const double readouts[4] = {fit.readout_random_walk, fit.readout_bias_instability, fit.readout_bias_tau_s,
                                 fit.readout_rate_random_walk};
     MachineDoc readout = MachineDoc::Map();
     for (int i = 0; i < 4; ++i) AddFinite(&readout, keys[i], readouts[i]);
+    AddRange(&readout, keys[0] + "_taus_s", fit.readout_random_walk_taus_s);
+    AddRange(&readout, keys[1] + "_interval", fit.readout_bias_interval);
+    if (std::isfinite(fit.readout_bias_instability)) {
+      readout.Add("bias_instability_resolved", MachineDoc::Bool(fit.readout_bias_resolved));
+    }
+    AddRange(&readout, keys[3] + "_taus_s", fit.readout_rate_random_walk_taus_s);
+    AddFinite(&readout, "skipped_tau_s", fit.skipped_tau_s);
     if (!readout.items().empty()) {
       column.Add("readout", std::move(readout), "IEEE 952 graphical read-outs of the measured curve");
+    }
+    MachineDoc quote = MachineDoc::Map();
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      const NoiseColumnRecord::Quote& q = fit.quote[k];
+      if (!std::isfinite(q.value)) continue;
+      const NoiseTermUnits& units = UnitsOf(fit.kind, k);
+      MachineDoc figure = MachineDoc::Map();
+      if (q.at_most) {
+        figure.Add("at_most", MachineDoc::Number(q.value));
+      } else {
+        figure.Add("value", MachineDoc::Number(q.value));
+        AddFinite(&figure, "sigma", q.sigma);
+        AddRange(&figure, "interval", q.interval);
+      }
+      figure.Add("from", MachineDoc::Text(q.from));
+      quote.Add(*units.engineer_key != '\0' ? units.engineer_key : units.si_key, std::move(figure));
+    }
+    if (!quote.items().empty()) {
+      column.Add("quote", std::move(quote),
+                 "the figure to quote per term (docs/allan.md), interval at 2 sigma");
     }
   }
   if (fit.extra.IsMap()) {
@@ -172,6 +239,13 @@ double NumberOr(const yaml::Located& block, const char* key, double otherwise) {
 
 std::string TextOr(const yaml::Located& block, const char* key) {
   return block.Has(key) ? block[key].String() : std::string();
+}
+
+// `key: [low, high]` into `range` when present.
+void ReadRange(const yaml::Located& block, const std::string& key, std::array<double, 2>* range) {
+  if (!block.Has(key)) return;
+  const std::vector<double> pair = block[key].Doubles(2);
+  *range = {pair[0], pair[1]};
 }
 
 // Unknown keys of `block` into `extra` (a map, or left null).
@@ -225,11 +299,56 @@ NoiseColumnRecord ReadNoiseColumn(const std::string& name, const yaml::Located& 
     const yaml::Located readout = block["readout"];
     readout.RequireMap();
     const std::array<std::string, 4> keys = ReadoutKeys(column.kind);
-    readout.RejectUnknownKeys({keys[0].c_str(), keys[1].c_str(), keys[2].c_str(), keys[3].c_str()});
+    const std::string random_walk_taus = keys[0] + "_taus_s", bias_interval = keys[1] + "_interval",
+                      rate_random_walk_taus = keys[3] + "_taus_s";
+    readout.RejectUnknownKeys({keys[0].c_str(), keys[1].c_str(), keys[2].c_str(), keys[3].c_str(),
+                               random_walk_taus.c_str(), bias_interval.c_str(), "bias_instability_resolved",
+                               rate_random_walk_taus.c_str(), "skipped_tau_s"});
     double* readouts[4] = {&column.readout_random_walk, &column.readout_bias_instability,
                            &column.readout_bias_tau_s, &column.readout_rate_random_walk};
     for (int i = 0; i < 4; ++i) *readouts[i] = NumberOr(readout, keys[i].c_str(), std::nan(""));
+    ReadRange(readout, random_walk_taus, &column.readout_random_walk_taus_s);
+    ReadRange(readout, bias_interval, &column.readout_bias_interval);
+    ReadRange(readout, rate_random_walk_taus, &column.readout_rate_random_walk_taus_s);
+    column.readout_bias_resolved =
+        readout.Has("bias_instability_resolved") && readout["bias_instability_resolved"].Bool();
+    column.skipped_tau_s = NumberOr(readout, "skipped_tau_s", std::nan(""));
   }
+  column.describes_curve = !block.Has("describes_curve") || block["describes_curve"].Bool();
+  ReadRange(block, "fit_taus_s", &column.fit_taus_s);
+  if (block.Has("term_taus_s")) {
+    const yaml::Located term_taus = block["term_taus_s"];
+    term_taus.RequireMap();
+    for (int k = 0; k < kNoiseTerms; ++k)
+      ReadRange(term_taus, UnitsOf(column.kind, k).si_key, &column.term_taus_s[k]);
+  }
+  if (block.Has("output_filter")) {
+    const yaml::Located filter = block["output_filter"];
+    filter.RejectUnknownKeys({"lag1", "filtered_below_tau_s"});
+    column.filter_detected = true;
+    column.sample_lag1 = NumberOr(filter, "lag1", std::nan(""));
+    column.filtered_below_tau_s = NumberOr(filter, "filtered_below_tau_s", std::nan(""));
+  }
+  if (block.Has("quote")) {
+    const yaml::Located quote = block["quote"];
+    quote.RequireMap();
+    for (int k = 0; k < kNoiseTerms; ++k) {
+      const NoiseTermUnits& units = UnitsOf(column.kind, k);
+      const bool engineer = *units.engineer_key != '\0';
+      const char* key = engineer ? units.engineer_key : units.si_key;
+      if (!quote.Has(key)) continue;
+      const yaml::Located figure = quote[key];
+      figure.RejectUnknownKeys({"value", "sigma", "interval", "at_most", "from"});
+      NoiseColumnRecord::Quote& q = column.quote[k];
+      q.at_most = figure.Has("at_most");
+      q.value = NumberOr(figure, q.at_most ? "at_most" : "value", std::nan(""));
+      q.sigma = NumberOr(figure, "sigma", std::nan(""));
+      ReadRange(figure, "interval", &q.interval);
+      q.from = TextOr(figure, "from");
+    }
+  }
+  for (const char* key : {"describes_curve", "fit_taus_s", "term_taus_s", "output_filter", "quote"})
+    known.push_back(key);
   KeepUnknown(block, known, &column.extra);
   return column;
 }
@@ -254,16 +373,47 @@ MachineDoc NoiseDoc(const NoiseRecord& record) {
   for (const NoiseColumnRecord& column : record.columns) columns.Add(column.name, NoiseColumnDoc(column));
   if (!record.columns.empty()) noise.Add("columns", std::move(columns));
   const KalibrNoiseRecord k = KalibrNoiseOf(record);
+  // The estimators' blocks: the same four figures under each one's keys (docs/allan.md).
+  const std::string inflation =
+      "x " + FormatDouble(k.inflation) + (k.inflation == 1.0 ? " (as measured)" : "");
+  const auto from = [&](const std::string& unit, const std::string& source) {
+    return source.empty() ? unit : unit + "; " + source;
+  };
+  if (k.inflation != 1.0 || std::isfinite(k.gyroscope_noise_density) ||
+      std::isfinite(k.accelerometer_noise_density)) {
+    noise.Add("vio_inflation", MachineDoc::Number(k.inflation),
+              std::string("the estimator blocks below are the measured figures times this; advised: ") +
+                  kAdvisedVioInflation);
+  }
   MachineDoc kalibr = MachineDoc::Map();
-  AddFinite(&kalibr, "gyroscope_noise_density", k.gyroscope_noise_density, "rad/s/sqrt(Hz)");
-  AddFinite(&kalibr, "gyroscope_random_walk", k.gyroscope_random_walk, "rad/s^2/sqrt(Hz)");
-  AddFinite(&kalibr, "accelerometer_noise_density", k.accelerometer_noise_density, "m/s^2/sqrt(Hz)");
-  AddFinite(&kalibr, "accelerometer_random_walk", k.accelerometer_random_walk, "m/s^3/sqrt(Hz)");
+  AddFinite(&kalibr, "gyroscope_noise_density", k.gyroscope_noise_density,
+            from("rad/s/sqrt(Hz)", k.gyroscope_noise_density_from));
+  AddFinite(&kalibr, "gyroscope_random_walk", k.gyroscope_random_walk,
+            from("rad/s^2/sqrt(Hz)", k.gyroscope_random_walk_from));
+  AddFinite(&kalibr, "accelerometer_noise_density", k.accelerometer_noise_density,
+            from("m/s^2/sqrt(Hz)", k.accelerometer_noise_density_from));
+  AddFinite(&kalibr, "accelerometer_random_walk", k.accelerometer_random_walk,
+            from("m/s^3/sqrt(Hz)", k.accelerometer_random_walk_from));
   AddFinite(&kalibr, "update_rate", k.update_rate, "Hz");
   if (!kalibr.items().empty()) {
-    noise.Add("kalibr", std::move(kalibr),
-              "imu.yaml continuous-time values, the worst axis of each sensor (a term the log\n"
-              "does not resolve: its upper bound, value + 2 sigma)");
+    noise.Add(
+        "kalibr", std::move(kalibr),
+        "Kalibr imu.yaml, continuous time, the worst axis of each sensor's figure to quote " + inflation);
+    MachineDoc openvins = MachineDoc::Map();
+    AddFinite(&openvins, "accelerometer_noise_density", k.accelerometer_noise_density, "m/s^2/sqrt(Hz)");
+    AddFinite(&openvins, "accelerometer_random_walk", k.accelerometer_random_walk, "m/s^3/sqrt(Hz)");
+    AddFinite(&openvins, "gyroscope_noise_density", k.gyroscope_noise_density, "rad/s/sqrt(Hz)");
+    AddFinite(&openvins, "gyroscope_random_walk", k.gyroscope_random_walk, "rad/s^2/sqrt(Hz)");
+    AddFinite(&openvins, "update_rate", k.update_rate, "Hz");
+    noise.Add("openvins", std::move(openvins),
+              "OpenVINS kalibr_imu_chain.yaml, under imu0: (Kalibr's keys and units) " + inflation);
+    MachineDoc vins = MachineDoc::Map();
+    AddFinite(&vins, "acc_n", k.accelerometer_noise_density, "m/s^2/sqrt(Hz), white noise");
+    AddFinite(&vins, "gyr_n", k.gyroscope_noise_density, "rad/s/sqrt(Hz), white noise");
+    AddFinite(&vins, "acc_w", k.accelerometer_random_walk, "m/s^3/sqrt(Hz), bias random walk");
+    AddFinite(&vins, "gyr_w", k.gyroscope_random_walk, "rad/s^2/sqrt(Hz), bias random walk");
+    noise.Add("vins_mono", std::move(vins),
+              "VINS-Mono / VINS-Fusion config keys (continuous-time densities, as Kalibr's) " + inflation);
   }
   if (record.extra.IsMap()) {
     for (const auto& entry : record.extra) noise.Add(entry.first.Scalar(), MachineDocOfYaml(entry.second));
@@ -312,23 +462,48 @@ NoiseRecord ReadNoiseRecord(const yaml::Located& block) {
     k.update_rate = NumberOr(kalibr, "update_rate", std::nan(""));
     record.kalibr = k;
   }
-  KeepUnknown(block,
-              {"format", "version", "software", "samples", "calibration", "calibration_sha256",
-               "sample_interval_s", "sample_count", "duration_s", "model", "columns", "kalibr"},
-              &record.extra);
+  record.vio_inflation = NumberOr(block, "vio_inflation", 1.0);
+  if (!(record.vio_inflation > 0.0)) block["vio_inflation"].Fail("must be a positive number");
+  if (record.kalibr) {
+    record.kalibr->inflation = record.vio_inflation;
+    // A block that says what the columns give is theirs: derived again, with where each figure
+    // comes from. One that differs (edited by hand) is kept as the file states it.
+    NoiseRecord derived = record;
+    derived.kalibr.reset();
+    const KalibrNoiseRecord own = KalibrNoiseOf(derived);
+    const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+    if (same(own.gyroscope_noise_density, record.kalibr->gyroscope_noise_density) &&
+        same(own.gyroscope_random_walk, record.kalibr->gyroscope_random_walk) &&
+        same(own.accelerometer_noise_density, record.kalibr->accelerometer_noise_density) &&
+        same(own.accelerometer_random_walk, record.kalibr->accelerometer_random_walk) &&
+        same(own.update_rate, record.kalibr->update_rate)) {
+      record.kalibr.reset();
+    }
+  }
+  KeepUnknown(
+      block,
+      {"format", "version", "software", "samples", "calibration", "calibration_sha256", "sample_interval_s",
+       "sample_count", "duration_s", "model", "columns", "kalibr", "vio_inflation", "openvins", "vins_mono"},
+      &record.extra);
   return record;
 }
 
 KalibrNoiseRecord KalibrNoiseOf(const NoiseRecord& record) {
   if (record.kalibr) return *record.kalibr;
   KalibrNoiseRecord k;
+  k.inflation = record.vio_inflation;
+  const auto worst = [&](ColumnKind kind, int term, std::string* from) {
+    return WorstAxis(record.columns, kind, term, from) * record.vio_inflation;
+  };
   if (HasFitted(record, ColumnKind::kGyro)) {
-    k.gyroscope_noise_density = WorstAxis(record.columns, ColumnKind::kGyro, kRandomWalk);
-    k.gyroscope_random_walk = WorstAxis(record.columns, ColumnKind::kGyro, kRateRandomWalk);
+    k.gyroscope_noise_density = worst(ColumnKind::kGyro, kRandomWalk, &k.gyroscope_noise_density_from);
+    k.gyroscope_random_walk = worst(ColumnKind::kGyro, kRateRandomWalk, &k.gyroscope_random_walk_from);
   }
   if (HasFitted(record, ColumnKind::kAccel)) {
-    k.accelerometer_noise_density = WorstAxis(record.columns, ColumnKind::kAccel, kRandomWalk);
-    k.accelerometer_random_walk = WorstAxis(record.columns, ColumnKind::kAccel, kRateRandomWalk);
+    k.accelerometer_noise_density =
+        worst(ColumnKind::kAccel, kRandomWalk, &k.accelerometer_noise_density_from);
+    k.accelerometer_random_walk =
+        worst(ColumnKind::kAccel, kRateRandomWalk, &k.accelerometer_random_walk_from);
   }
   if (HasFitted(record, ColumnKind::kGyro) || HasFitted(record, ColumnKind::kAccel)) {
     k.update_rate = 1.0 / record.sample_interval_s;

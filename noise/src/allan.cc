@@ -584,6 +584,27 @@ std::vector<double> Deviations(const std::vector<double>& phase, double tau0_s,
   return devs;
 }
 
+namespace {
+
+// The lag-1 autocorrelation of the n / m rate averages (X_{(k+1)m} - X_{km}) / m (AllanPoint::lag1).
+double Lag1OfAverages(const std::vector<double>& phase, int64_t m) {
+  const int64_t count = (static_cast<int64_t>(phase.size()) - 1) / m;
+  if (count < kMinLag1Averages) return std::nan("");
+  const double mean = (phase[count * m] - phase[0]) / static_cast<double>(count * m);
+  long double lagged = 0.0L;
+  long double squares = 0.0L;
+  double previous = 0.0;
+  for (int64_t k = 0; k < count; ++k) {
+    const double average = (phase[(k + 1) * m] - phase[k * m]) / static_cast<double>(m) - mean;
+    squares += average * average;
+    if (k > 0) lagged += average * previous;
+    previous = average;
+  }
+  return squares > 0.0L ? static_cast<double>(lagged / squares) : std::nan("");
+}
+
+}  // namespace
+
 AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const std::vector<int64_t>& factors,
                          const AllanOptions& options) {
   AllanResult result;
@@ -607,6 +628,7 @@ AllanResult ComputeAllan(const std::vector<double>& phase, double tau0_s, const 
     point.tau_s = static_cast<double>(point.m) * tau0_s;
     point.terms = EstimatorTerms(options.estimator, point.m, n);
     point.dev = devs[t];
+    point.lag1 = Lag1OfAverages(phase, point.m);
     if (options.edf_noise == EdfNoise::kIdentify) {
       // Rate averages over tau from the phase: (X_{(k+1)m} - X_{km}) / m.
       const int64_t count = std::min(n / point.m, options.max_noise_id_points);

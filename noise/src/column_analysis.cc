@@ -55,6 +55,105 @@ std::string TermFigureText(const NoiseTermFigure& figure, const std::string& uni
          Significant(kNoiseIntervalSigmas, 1) + " sigma)";
 }
 
+QuotedFigure QuoteTerm(const NoiseFitSummary& fit, int term) {
+  QuotedFigure quote;
+  quote.term = term;
+  const auto set = [&](QuoteSource source, double value, double sigma, double lower, double upper,
+                       double lo_s, double hi_s) {
+    quote.source = source;
+    quote.value = value;
+    quote.sigma = sigma;
+    quote.lower = lower;
+    quote.upper = upper;
+    quote.tau_min_s = lo_s;
+    quote.tau_max_s = hi_s;
+  };
+  const NoiseTermFigure figure = TermFigure(fit, term);
+  const bool described = fit.fitted && fit.describes_curve;
+  if (described && figure.resolved) {
+    set(QuoteSource::kFit, figure.value, figure.sigma, figure.lower(), figure.upper(),
+        fit.term_tau_min_s[term], fit.term_tau_max_s[term]);
+    return quote;
+  }
+  const double two_sigma = kNoiseIntervalSigmas;
+  if (term == kRandomWalk && std::isfinite(fit.readout_random_walk)) {
+    const double n = fit.readout_random_walk, s = fit.readout_random_walk_sigma;
+    set(QuoteSource::kReadout, n, s, std::max(0.0, n - two_sigma * s), n + two_sigma * s,
+        fit.readout_random_walk_tau_min_s, fit.readout_random_walk_tau_max_s);
+    return quote;
+  }
+  if (term == kBiasInstability && fit.readout_bias_resolved) {
+    set(QuoteSource::kResolvedMinimum, fit.readout_bias_instability, std::nan(""), fit.readout_bias_lower,
+        fit.readout_bias_upper, fit.readout_bias_tau_s, fit.readout_bias_tau_s);
+    return quote;
+  }
+  if (term == kRateRandomWalk && std::isfinite(fit.readout_rate_random_walk)) {
+    const double k = fit.readout_rate_random_walk, s = fit.readout_rate_random_walk_sigma;
+    set(QuoteSource::kReadout, k, s, std::max(0.0, k - two_sigma * s), k + two_sigma * s,
+        fit.readout_rate_random_walk_tau_min_s, fit.readout_rate_random_walk_tau_max_s);
+    return quote;
+  }
+  if (described && std::isfinite(figure.upper())) {
+    set(QuoteSource::kFitBound, figure.upper(), std::nan(""), 0.0, figure.upper(), fit.fit_tau_min_s,
+        fit.fit_tau_max_s);
+    return quote;
+  }
+  if (term == kRandomWalk && std::isfinite(fit.readout_random_walk_bound)) {
+    set(QuoteSource::kCurveBound, fit.readout_random_walk_bound, std::nan(""), 0.0,
+        fit.readout_random_walk_bound, fit.readout_random_walk_bound_tau_s,
+        fit.readout_random_walk_bound_tau_s);
+  } else if (term == kBiasInstability && std::isfinite(fit.readout_bias_upper)) {
+    set(QuoteSource::kCurveBound, fit.readout_bias_upper, std::nan(""), 0.0, fit.readout_bias_upper,
+        fit.readout_bias_tau_s, fit.readout_bias_tau_s);
+  } else if (term == kRateRandomWalk && std::isfinite(fit.readout_rate_random_walk_bound)) {
+    set(QuoteSource::kCurveBound, fit.readout_rate_random_walk_bound, std::nan(""), 0.0,
+        fit.readout_rate_random_walk_bound, fit.readout_rate_random_walk_bound_tau_s,
+        fit.readout_rate_random_walk_bound_tau_s);
+  } else if (fit.fitted && std::isfinite(figure.upper()) && term != kRandomWalk) {
+    // A misfit, and the curve gives nothing better: the fit's bound, said as such.
+    set(QuoteSource::kFitBound, figure.upper(), std::nan(""), 0.0, figure.upper(), fit.fit_tau_min_s,
+        fit.fit_tau_max_s);
+  } else if (fit.fitted && term == kRandomWalk && figure.resolved) {
+    set(QuoteSource::kMisfit, figure.value, figure.sigma, figure.lower(), figure.upper(),
+        fit.term_tau_min_s[term], fit.term_tau_max_s[term]);
+  }
+  return quote;
+}
+
+std::string QuoteSourceText(const QuotedFigure& quote) {
+  const auto taus = [&](const std::string& prefix) {
+    if (!std::isfinite(quote.tau_min_s)) return std::string();
+    if (quote.tau_min_s == quote.tau_max_s) return prefix + Significant(quote.tau_min_s, 3) + " s";
+    return prefix + Significant(quote.tau_min_s, 3) + " to " + Significant(quote.tau_max_s, 3) + " s";
+  };
+  switch (quote.source) {
+    case QuoteSource::kNone:
+      return "nothing to quote";
+    case QuoteSource::kFit:
+      return "IEEE 952 fit" + (std::isfinite(quote.tau_min_s) ? " (dominant at " + taus("") + ")" : "");
+    case QuoteSource::kReadout:
+      return std::string("read-out along the ") + (quote.term == kRateRandomWalk ? "+1/2" : "-1/2") +
+             " line" + taus(", ");
+    case QuoteSource::kResolvedMinimum:
+      return "resolved Allan minimum / 0.664" + taus(" at ");
+    case QuoteSource::kFitBound:
+      return "upper bound of the IEEE 952 fit (not resolved)";
+    case QuoteSource::kMisfit:
+      return "IEEE 952 fit of a curve it does not describe (no -1/2 segment to read): check the plot";
+    case QuoteSource::kCurveBound:
+      return "upper bound from the curve (not resolved)" + taus(" at ");
+  }
+  return "";
+}
+
+QuotedFigure Scaled(QuotedFigure quote, double scale) {
+  quote.value *= scale;
+  quote.sigma *= scale;
+  quote.lower *= scale;
+  quote.upper *= scale;
+  return quote;
+}
+
 ColumnAnalysis AnalyseColumn(std::string name, ColumnKind kind, std::vector<double> rates, double tau0_s,
                              const std::vector<int64_t>& factors, const AllanOptions& options,
                              const NoiseFitOptions& fit_options) {

@@ -454,9 +454,26 @@ class NoiseTerms:
     @property
     def rrw_sigma(self) -> float: ...
     @property
-    def readouts(self) -> dict[str, float]:
-        """IEEE 952 read-outs from the curve: random_walk (at 1 s), bias_instability, bias_tau_s,
-        rate_random_walk (at 3 s); nan where the curve has no such region."""
+    def readouts(self) -> dict[str, Any]:
+        """IEEE 952 read-outs from the curve: random_walk (along the -1/2 segment, random_walk_sigma,
+        random_walk_taus_s), bias_instability (minimum / 0.664, bias_tau_s, bias_interval at 95 %,
+        bias_resolved), rate_random_walk (along the +1/2 segment, its sigma and taus), skipped_tau_s;
+        nan where the curve has no such region."""
+    @property
+    def describes_curve(self) -> bool:
+        """False when the reduced chi-square exceeds the misfit threshold (5): quote the read-outs."""
+    @property
+    def filter_detected(self) -> bool: ...
+    @property
+    def filtered_points(self) -> int: ...
+    @property
+    def sample_lag1(self) -> float: ...
+    @property
+    def fit_taus_s(self) -> tuple[float, float]: ...
+    @property
+    def term_taus_s(self) -> dict[str, tuple[float, float]]: ...
+    def quote(self, term: str) -> dict[str, Any]:
+        """The figure to quote for a term: value, sigma, interval (2 sigma), at_most, from."""
     @overload
     def model_deviation(self, tau_s: float) -> float: ...
     @overload
@@ -476,3 +493,15 @@ def noise_terms(
 
 def noise_terms_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of the noise fit's options from the library's option table."""
+
+def record_length(
+    random_walk: float,
+    bias_instability: float,
+    rate_random_walk: float,
+    tau0_s: float,
+    precision: float = 0.25,
+) -> dict[str, float]:
+    """How long a static log must be (s) to resolve each term to a relative 2-sigma interval
+    `precision`, from a first log's or a data sheet's figures (SI; 0 for a term the sensor lacks):
+    random_walk_s, bias_instability_s, bias_instability_tau_s, rate_random_walk_s,
+    rate_random_walk_tau_s (nan: nothing to resolve)."""

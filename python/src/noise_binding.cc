@@ -9,6 +9,7 @@
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
 #include "imufit/noise/allan.h"
+#include "imufit/noise/column_analysis.h"
 #include "imufit/noise/noise_model.h"
 #include "keyword_options.h"
 
@@ -212,10 +213,55 @@ void BindNoiseTerms(py::module_& m) {
             d["bias_instability"] = s.readout_bias_instability;
             d["bias_tau_s"] = s.readout_bias_tau_s;
             d["rate_random_walk"] = s.readout_rate_random_walk;
+            d["random_walk_sigma"] = s.readout_random_walk_sigma;
+            d["random_walk_taus_s"] =
+                py::make_tuple(s.readout_random_walk_tau_min_s, s.readout_random_walk_tau_max_s);
+            d["bias_interval"] = py::make_tuple(s.readout_bias_lower, s.readout_bias_upper);
+            d["bias_resolved"] = s.readout_bias_resolved;
+            d["rate_random_walk_sigma"] = s.readout_rate_random_walk_sigma;
+            d["rate_random_walk_taus_s"] =
+                py::make_tuple(s.readout_rate_random_walk_tau_min_s, s.readout_rate_random_walk_tau_max_s);
+            d["skipped_tau_s"] = s.skipped_tau_s;
             return d;
           },
-          "IEEE 952's classic read-outs from the curve: N at 1 s, B = min / 0.664, K at 3 s (nan: no such "
-          "region)")
+          "IEEE 952's classic read-outs from the curve: N along the -1/2 segment and K along the +1/2 "
+          "segment (with their taus), B = min / 0.664 with its 95 % interval and whether the minimum is "
+          "resolved (nan: no such region); the tau left out for too few intervals")
+      .def_readonly("describes_curve", &NoiseFitSummary::describes_curve,
+                    "False when the reduced chi-square exceeds the misfit threshold: quote the read-outs")
+      .def_readonly("filter_detected", &NoiseFitSummary::filter_detected,
+                    "an output filter bends the short taus (left out of the fit)")
+      .def_readonly("filtered_points", &NoiseFitSummary::filtered_points)
+      .def_readonly("sample_lag1", &NoiseFitSummary::sample_lag1)
+      .def_property_readonly(
+          "fit_taus_s",
+          [](const NoiseFitSummary& s) { return py::make_tuple(s.fit_tau_min_s, s.fit_tau_max_s); },
+          "the taus the fit used (s)")
+      .def_property_readonly(
+          "term_taus_s",
+          [](const NoiseFitSummary& s) {
+            py::dict d;
+            for (int k = 0; k < kNoiseTerms; ++k)
+              d[NoiseTermName(k)] = py::make_tuple(s.term_tau_min_s[k], s.term_tau_max_s[k]);
+            return d;
+          },
+          "per term, the used taus where it carries a quarter of the model or more (nan: nowhere)")
+      .def(
+          "quote",
+          [](const NoiseFitSummary& s, const std::string& term) {
+            int k = 0;
+            if (!ParseNoiseTerm(term, &k))
+              ThrowBadArgument("imufit.NoiseTerms.quote", "no term \"" + term + "\"");
+            const QuotedFigure q = QuoteTerm(s, k);
+            py::dict d;
+            d["value"] = q.value;
+            d["sigma"] = q.sigma;
+            d["interval"] = py::make_tuple(q.lower, q.upper);
+            d["at_most"] = q.bound();
+            d["from"] = QuoteSourceText(q);
+            return d;
+          },
+          py::arg("term"), "The figure to quote for a term and where it comes from (docs/allan.md).")
       .def(
           "model_deviation",
           [](const NoiseFitSummary& s, const py::object& tau_s) {
@@ -270,6 +316,32 @@ void BindNoise(py::module_& m) {
   m.def(
       "noise_terms_options", [] { return DescribeKeywords(NoiseFitOptionTable()); },
       "{name: (default, description)} of the noise fit's options (min_clusters is noise_terms()'s).");
+  m.def(
+      "record_length",
+      [](double random_walk, double bias_instability, double rate_random_walk, double tau0_s,
+         double precision) {
+        const std::string where = "imufit.record_length";
+        if (!(tau0_s > 0.0)) ThrowBadArgument(where, "tau0_s must be positive");
+        if (!(precision > 0.0 && precision < 1.0)) ThrowBadArgument(where, "precision must lie in (0, 1)");
+        for (double figure : {random_walk, bias_instability, rate_random_walk}) {
+          if (!(figure >= 0.0) || !std::isfinite(figure))
+            ThrowBadArgument(where, "the figures must be >= 0 (SI)");
+        }
+        const RecordLength r =
+            RecordLengthFor(random_walk, bias_instability, rate_random_walk, tau0_s, precision);
+        py::dict d;
+        d["random_walk_s"] = r.random_walk_s;
+        d["bias_instability_s"] = r.bias_instability_s;
+        d["bias_instability_tau_s"] = r.bias_instability_tau_s;
+        d["rate_random_walk_s"] = r.rate_random_walk_s;
+        d["rate_random_walk_tau_s"] = r.rate_random_walk_tau_s;
+        return d;
+      },
+      py::arg("random_walk"), py::arg("bias_instability"), py::arg("rate_random_walk"), py::arg("tau0_s"),
+      py::arg("precision") = 0.25,
+      "How long a static log must be (s) to resolve each term to a relative 2-sigma interval `precision`, "
+      "from a short log's figures or a data sheet's (SI: N in rad/sqrt(s), B in rad/s, K in rad/s/sqrt(s); 0 "
+      "for a term the sensor lacks). docs/allan.md, \"How long to record\".");
 }
 
 }  // namespace imufit::python

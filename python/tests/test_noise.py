@@ -109,6 +109,40 @@ def test_noise_terms_recover_simulated_arw_and_rrw():
     assert abs(only_white.arw - arw) < RECOVERY_SIGMAS * only_white.arw_sigma
 
 
+def test_filtered_white_noise_is_detected_and_quoted():
+    # White noise through a first-order low-pass (DC gain 1): the filter is detected, its taus left
+    # out, and the fitted and quoted ARW hold the truth (issue 33).
+    arw, tau0, a = 2e-3, 0.01, 0.45
+    w = np.random.default_rng(21).normal(0.0, arw / math.sqrt(tau0), 200000)
+    y = np.empty_like(w)
+    y[0] = w[0]
+    for i in range(1, len(w)):
+        y[i] = a * y[i - 1] + (1.0 - a) * w[i]
+    terms = imufit.noise_terms(y, tau0, taus="octave")
+    assert terms.filter_detected and terms.filtered_points > 0
+    assert terms.describes_curve
+    assert terms.fit_taus_s[0] > tau0
+    assert abs(terms.arw - arw) < RECOVERY_SIGMAS * terms.arw_sigma, (terms.arw, terms.arw_sigma)
+    quote = terms.quote("random_walk")
+    assert quote["interval"][0] <= arw <= quote["interval"][1], quote
+    assert quote["from"].startswith("IEEE 952 fit")
+    assert terms.quote("bias_instability")["interval"][0] == 0.0  # no phantom bias instability
+    low, high = terms.readouts["random_walk_taus_s"]
+    assert low >= terms.fit_taus_s[0] and high > low
+
+
+def test_record_length_from_data_sheet_values():
+    # ADIS16405 data sheet: ARW 2 deg/sqrt(h), in-run bias stability 25.2 deg/h.
+    n = 2.0 * math.pi / 180 / 60
+    b = 25.2 * math.pi / 180 / 3600
+    quarter = imufit.record_length(n, b, 0.0, 0.01)
+    tenth = imufit.record_length(n, b, 0.0, 0.01, precision=0.1)
+    assert 0 < quarter["bias_instability_s"] < tenth["bias_instability_s"]
+    assert math.isnan(quarter["rate_random_walk_s"])
+    with pytest.raises(imufit.InputError):
+        imufit.record_length(n, b, 0.0, 0.01, precision=1.5)
+
+
 def test_bad_arguments_raise_input_error():
     y = np.zeros(100)
     with pytest.raises(imufit.InputError, match="estimator 'xdev'|estimator \"xdev\".*oadev"):

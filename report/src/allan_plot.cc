@@ -97,6 +97,7 @@ struct Panel {
   int columns = 0;               // columns of this kind in the panel
   double lowest = INFINITY, highest = 0.0, shortest = INFINITY, longest = 0.0;
   std::vector<PlotNote> floor_words;  // the bias instabilities in words, placed at the end
+  std::vector<PlotNote> walk_words;   // the random walks in words, placed at the end
 };
 
 // The axes and titles of the panel of `kind`, for the curves of `estimator`.
@@ -176,8 +177,7 @@ double DrawModel(const ColumnAnalysis& r, const PlotSeries& curve, Panel* panel)
 
 // N where it is read: the -1/2 line at tau = 1 s (at the curve's end when 1 s is beyond it); the
 // first column's note on top.
-void MarkRandomWalk(const ColumnAnalysis& r, const PlotSeries& curve, const std::string& who, int column,
-                    Panel* panel) {
+void MarkRandomWalk(const ColumnAnalysis& r, const PlotSeries& curve, const std::string& who, Panel* panel) {
   if (!IsResolved(r.fit, kRandomWalk)) {
     panel->plot.labels.push_back({r.name + ": " + panel->random_walk + " not resolved"});
     return;
@@ -185,14 +185,32 @@ void MarkRandomWalk(const ColumnAnalysis& r, const PlotSeries& curve, const std:
   PlotNote n;
   n.x = std::clamp(1.0, curve.x.front(), curve.x.back());
   n.y = r.fit.TermDeviation(kRandomWalk, n.x) * panel->scale;
-  n.text = who + TermText(r, kRandomWalk, panel->random_walk);
   n.color = curve.color;
   n.point_type = 7;
   n.point_size = 1.3;
+  panel->plot.notes.push_back(n);  // the mark where it is read; its words are stacked later
+  n.point_type = -1;
+  n.text = who + TermText(r, kRandomWalk, panel->random_walk);
   n.opaque = true;
-  n.dx_chars = 1.5;
-  n.dy_chars = 1.2 + 1.4 * (panel->columns - 1 - column);
-  panel->plot.notes.push_back(n);
+  panel->walk_words.push_back(n);
+}
+
+// The random walks in words: anchored above the highest of their marks, one above the other in
+// column order, so that neighbouring axes' words never overlap (each anchored at its own mark,
+// two marks a line apart put one label on the other: issue 33, accel_y under accel_z).
+void PlaceWalkWords(Panel* panel) {
+  if (panel->walk_words.empty()) return;
+  double x = 0.0, y = 0.0;
+  for (const PlotNote& n : panel->walk_words) x = std::max(x, n.x), y = std::max(y, n.y);
+  const size_t count = panel->walk_words.size();
+  for (size_t i = 0; i < count; ++i) {
+    PlotNote& n = panel->walk_words[i];
+    n.x = x;
+    n.y = y;
+    n.dx_chars = 1.5;
+    n.dy_chars = 1.2 + 1.4 * static_cast<double>(count - 1 - i);
+    panel->plot.notes.push_back(n);
+  }
 }
 
 // The bias-instability floor, 0.664 B, marked at the model's minimum; its words are stacked below
@@ -217,9 +235,17 @@ void MarkBiasInstability(const ColumnAnalysis& r, const PlotSeries& curve, const
   panel->lowest = std::min(panel->lowest, b.y);
 }
 
+// A number for a label: 3 significant digits.
+std::string ShortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
 // One column of the panel: its curve, and over an Allan-variance curve its noise fit drawn and
 // annotated (otherwise said in words).
-void AddColumn(const ColumnAnalysis& r, int color, int column, bool draw_model, Panel* panel) {
+
+void AddColumn(const ColumnAnalysis& r, int color, bool draw_model, Panel* panel) {
   const PlotSeries curve = Curve(r, color, panel);
   panel->plot.series.push_back(curve);
   if (!r.fit.fitted) {
@@ -237,7 +263,11 @@ void AddColumn(const ColumnAnalysis& r, int color, int column, bool draw_model, 
   }
   const double floor_tau = DrawModel(r, curve, panel);
   const std::string who = panel->columns > 1 ? r.name + " " : "";
-  MarkRandomWalk(r, curve, who, column, panel);
+  MarkRandomWalk(r, curve, who, panel);
+  if (!r.fit.describes_curve) {
+    panel->plot.labels.push_back({r.name + ": fit does not describe the curve (reduced chi-sq. " +
+                                  ShortNumber(r.fit.reduced_chi_square) + ")"});
+  }
   MarkBiasInstability(r, curve, who, floor_tau, panel);
 }
 
@@ -316,11 +346,11 @@ PlotFigure AllanPlot(const std::vector<ColumnAnalysis>& results, const std::stri
                           estimator == AllanEstimator::kTotdev;
   for (ColumnKind kind : kinds) {
     Panel panel = OpenPanel(results, kind, estimator, units);
-    int column = 0;  // this column's place in the panel: its labels stack in that order
-    for (size_t c = 0; c < results.size(); ++c) {
-      if (results[c].kind == kind) AddColumn(results[c], static_cast<int>(c), column++, draw_model, &panel);
+    for (size_t c = 0; c < results.size(); ++c) {  // labels stack in column order
+      if (results[c].kind == kind) AddColumn(results[c], static_cast<int>(c), draw_model, &panel);
     }
     PlaceFloorWords(&panel);
+    PlaceWalkWords(&panel);
     if (draw_model) KeyTheLines(&panel.plot);
     FrameTheAxes(&panel);
     figure.panels.push_back(std::move(panel.plot));

@@ -78,17 +78,64 @@ struct NoiseColumnRecord {
   double readout_bias_instability = std::nan("");
   double readout_bias_tau_s = std::nan("");
   double readout_rate_random_walk = std::nan("");
+  // Where the read-outs were read (seconds): the -1/2 and +1/2 segments; the minimum's 95 %
+  // interval (units of the bias read-out) and whether it is resolved (a rise on both sides).
+  std::array<double, 2> readout_random_walk_taus_s = {std::nan(""), std::nan("")};
+  std::array<double, 2> readout_rate_random_walk_taus_s = {std::nan(""), std::nan("")};
+  std::array<double, 2> readout_bias_interval = {std::nan(""), std::nan("")};
+  bool readout_bias_resolved = false;
+  // The longest tau left out of the fit and the read-outs for too few intervals (nan: none).
+  double skipped_tau_s = std::nan("");
+
+  // Whether the fitted model describes the curve (reduced chi-square at most the threshold of
+  // docs/allan.md); the taus the fit used, and per term where it carries a share of the model.
+  bool describes_curve = true;
+  std::array<double, 2> fit_taus_s = {std::nan(""), std::nan("")};
+  std::array<std::array<double, 2>, kNoiseTerms> term_taus_s = {};
+  // An output filter detected in the samples: the samples' lag-1 autocorrelation and the first tau
+  // the fit used past the filtered ones (nan when no filter).
+  bool filter_detected = false;
+  double sample_lag1 = std::nan("");
+  double filtered_below_tau_s = std::nan("");
+
+  // The figure to quote per term (docs/allan.md "Which figure to quote"), in the units the file
+  // writes it (engineer units where the kind has them, as the read-outs): a value with its 1-sigma
+  // and 2-sigma interval, or an upper bound (at_most); `from` says where it comes from (nan:
+  // nothing to quote, not written).
+  struct Quote {
+    double value = std::nan("");  // the figure; an upper bound when at_most
+    double sigma = std::nan("");
+    std::array<double, 2> interval = {std::nan(""), std::nan("")};
+    bool at_most = false;
+    std::string from;
+  };
+  std::array<Quote, kNoiseTerms> quote;
   YAML::Node extra;  // keys of the column this reader does not know (a map, or null)
+
+  NoiseColumnRecord() {
+    for (auto& taus : term_taus_s) taus = {std::nan(""), std::nan("")};
+  }
 };
 
-// Kalibr's imu.yaml continuous-time figures (nan: unknown, not written).
+// Kalibr's imu.yaml continuous-time figures (nan: unknown, not written). OpenVINS reads the same
+// keys (kalibr_imu_chain.yaml, imu0); VINS-Mono's acc_n, gyr_n, acc_w, gyr_w are the same figures.
 struct KalibrNoiseRecord {
   double gyroscope_noise_density = std::nan("");      // rad/s/sqrt(Hz)
   double gyroscope_random_walk = std::nan("");        // rad/s^2/sqrt(Hz)
   double accelerometer_noise_density = std::nan("");  // m/s^2/sqrt(Hz)
   double accelerometer_random_walk = std::nan("");    // m/s^3/sqrt(Hz)
   double update_rate = std::nan("");                  // Hz
+  // Where each of the four figures comes from ("gyro_y: IEEE 952 fit ..."; "" when not known), and
+  // the factor the figures were multiplied by (NoiseRecord::vio_inflation).
+  std::string gyroscope_noise_density_from, gyroscope_random_walk_from, accelerometer_noise_density_from,
+      accelerometer_random_walk_from;
+  double inflation = 1.0;
 };
+// The inflation of static noise figures advised before an estimator uses them in motion
+// (docs/allan.md "Noise blocks for estimators"), as text.
+inline constexpr const char* kAdvisedVioInflation =
+    "2 to 10 in motion (vibration, temperature change and model error raise the noise over a static "
+    "log; check with your estimator's consistency)";
 
 // The noise block: what it says about the record the columns came from, and the columns. Written
 // and read by io (NoiseYaml, ReadNoiseFile, and a calibration's `noise:` key, Calibration::noise);
@@ -109,10 +156,16 @@ struct NoiseRecord {
   // Kalibr's figures as a file states them; when not set, KalibrNoiseOf() derives them from the
   // columns (what `imufit allan` writes).
   std::optional<KalibrNoiseRecord> kalibr;
+  // The factor the estimator blocks (kalibr, openvins, vins_mono) multiply the measured figures by
+  // (`imufit allan --vio-inflation`; 1: as measured).
+  double vio_inflation = 1.0;
   YAML::Node extra;  // keys of the block this reader does not know (a map, or null)
 };
-// The block's Kalibr figures: `record.kalibr` when set, else the worst fitted axis of each sensor
-// (an unresolved term: its upper bound, value + 2 sigma) and 1 / sample_interval_s.
+// The block's Kalibr figures: `record.kalibr` when set, else the worst axis of each sensor of the
+// figures to quote (NoiseColumnRecord::quote: the fit where it describes the curve, else the
+// read-out, an unresolved term's upper bound), times vio_inflation, and 1 / sample_interval_s. A
+// column without quotes (a file of an older imufit) gives its fitted value, an unresolved term its
+// upper bound (value + 2 sigma).
 KalibrNoiseRecord KalibrNoiseOf(const NoiseRecord& record);
 // The text of the noise block (top-level key `noise:`), with a comment saying what it is.
 std::string NoiseYaml(const NoiseRecord& record);

@@ -37,6 +37,7 @@
 #ifndef IMUFIT_NOISE_ALLAN_H_
 #define IMUFIT_NOISE_ALLAN_H_
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -130,7 +131,14 @@ struct AllanPoint {
   double edf = 0.0;               // equivalent degrees of freedom (nan when unknown)
   int alpha = 0;                  // noise exponent used for the edf
   bool alpha_identified = false;  // identified at this m (else assumed or carried from below)
+  // Lag-1 autocorrelation of the non-overlapping rate averages over tau (mean removed; nan with
+  // fewer than kMinLag1Averages averages). White noise gives 0 +- 1/sqrt(n/m), quantization
+  // (white PM) -1/2, an output filter a positive value that decays as 1/m once m exceeds the
+  // filter's memory; flicker and random walks a value that does not decay (noise_model.h).
+  double lag1 = std::nan("");
 };
+// The fewest averages a lag-1 autocorrelation is computed from.
+inline constexpr int64_t kMinLag1Averages = 30;
 
 struct AllanResult {
   AllanEstimator estimator = AllanEstimator::kOadev;

@@ -54,6 +54,38 @@ NoiseTermFigure TermFigure(const NoiseFitSummary& fit, int term, double scale = 
 std::string TermFigureText(const NoiseTermFigure& figure, const std::string& unit,
                            const char* plus_minus = "+-");
 
+// Which figure of a term to quote (docs/allan.md, "Which figure to quote"), for the random walk,
+// the bias instability and the rate random walk; the other terms are the fit's figure.
+//   - the fit's value when the model describes the curve (NoiseFitSummary::describes_curve) and
+//     resolves the term;
+//   - else the read-out where the curve shows the term: the random walk along the -1/2 segment,
+//     the bias instability at a resolved minimum, the rate random walk along the +1/2 segment;
+//   - else an upper bound ("at most"): the fit's when it describes the curve, else the curve's own
+//     (every point lies above the flat floor 0.664 B and above K sqrt(tau / 3): the lowest point's
+//     upper 95 % bound / 0.664; the longest tau's upper bound times sqrt(3 / tau)).
+// Nothing to quote (no fit, no read-out): value nan.
+//   - last, for the random walk of a misfit curve without a -1/2 segment: the fit's value, said
+//     as a misfit's (kMisfit).
+enum class QuoteSource { kNone, kFit, kReadout, kResolvedMinimum, kFitBound, kCurveBound, kMisfit };
+struct QuotedFigure {
+  QuoteSource source = QuoteSource::kNone;
+  int term = kRandomWalk;
+  double value = std::nan("");  // the figure to quote (an upper bound when bound())
+  double sigma = std::nan("");  // 1-sigma (nan for a bound)
+  double lower = std::nan("");  // the 2-sigma (95 %) interval
+  double upper = std::nan("");
+  double tau_min_s = std::nan("");  // where on the curve the figure comes from
+  double tau_max_s = std::nan("");
+  bool bound() const { return source == QuoteSource::kFitBound || source == QuoteSource::kCurveBound; }
+  bool found() const { return source != QuoteSource::kNone; }
+};
+QuotedFigure QuoteTerm(const NoiseFitSummary& fit, int term);
+// Where a quoted figure comes from, in words: "IEEE 952 fit (dominant at 0.08 to 20 s)",
+// "read-out along the -1/2 line, 0.16 to 2.6 s", "resolved Allan minimum at 655 s", ...
+std::string QuoteSourceText(const QuotedFigure& quote);
+// A figure in a unit `scale` times the fit's.
+QuotedFigure Scaled(QuotedFigure quote, double scale);
+
 struct ColumnAnalysis {
   std::string name;
   ColumnKind kind = ColumnKind::kOther;
