@@ -46,6 +46,22 @@ class UndeterminedError(FitError):
 class PlanMismatchError(FitError):
     """A samples file without a segment column does not match its plan (the message says where)."""
 
+class FieldRecord:
+    """A calibration by hand (`imufit fit --field`): the session's own figures, the `fit: field:`
+    block. Read-only; SI units as the names say."""
+
+    poses: int | None  # rests the fit used
+    turns: int | None  # turns between them the fit used
+    gravity_mps2: float | None  # the local gravity the fit used, m/s^2
+    accel_norm_rms_mps2: float | None  # RMS over the rests of |a| - g after correction, m/s^2
+    gyro_static_rms_radps: float | None  # RMS of the corrected gyro at rest, over rests and axes, rad/s
+    gravity_direction_rms_rad: float | None  # RMS over the turns of the gravity direction's error, rad
+    reduced_chi2: float | None  # reduced chi-square of the weighted residuals
+    noise_scale_accel_rests: float | None  # the rests' accelerometer noise as a multiple of the log's white noise
+    noise_scale_gyro_rests: float | None  # the rests' gyro noise as a multiple of the log's white noise
+    noise_scale_turns: float | None  # the turns' noise as a multiple of the log's white noise
+    saturated_turns: int | None  # turns left out because a gyro axis touched its converter's rail
+
 class FitRecord:
     """What the fit did and on which files: the calibration's `fit:` block, each key an attribute
     (None when the file does not say). Read-only; SI units as the names say."""
@@ -84,6 +100,7 @@ class FitRecord:
     segments_without_windows: list[int] | None  # plan segments without a single usable window
     missing_segments: int | None  # how many segments that is
     inconsistent: str | None  # written with --write-inconsistent: why the fit is inconsistent
+    field: FieldRecord | None  # a calibration by hand (fit --field): the session's own figures
 
 class CheckRecord:
     """The errors on a held-out run (`imufit fit --check-samples`): the `check:` block."""
@@ -99,6 +116,7 @@ class Calibration:
     created_utc: str  # ISO 8601 UTC
     software: str
     fit_temp_range_c: tuple[float, float]  # degC, the temperatures the fit saw
+    body_frame: str | None  # a calibration by hand: its body frame's convention ('accelerometer_xy'); None: the fixture's axes
 
     def __init__(self) -> None:
         """The identity calibration: unit scale, no bias, misalignment or g-sensitivity."""

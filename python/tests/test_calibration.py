@@ -155,7 +155,7 @@ def test_the_fit_record_is_typed_and_the_stub_names_every_key(fixtures, tmp_path
     assert imufit.Calibration.load(fixtures / "mems_truth.yaml").fit is None
     # The stub declares the module's attributes, no more, no fewer.
     stub = ast.parse((pathlib.Path(imufit.__file__).parent / "__init__.pyi").read_text())
-    for name in ("FitRecord", "CheckRecord"):
+    for name in ("FitRecord", "FieldRecord", "CheckRecord"):
         declared = next(node for node in stub.body if isinstance(node, ast.ClassDef) and node.name == name)
         annotated = {n.target.id for n in declared.body if isinstance(n, ast.AnnAssign)}
         assert annotated == {a for a in dir(getattr(imufit, name)) if not a.startswith("_")}, name
