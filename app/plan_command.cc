@@ -18,6 +18,7 @@
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
+#include "imufit/model/local_gravity.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/plan/plan_check.h"
 #include "imufit/plan/plan_design.h"
@@ -132,7 +133,7 @@ TableSite DesignSite(const Plan& candidates, bool candidates_given, const PlanDe
   } else if (candidates_given) {
     *gravity_note = "gravity_mps2: the candidates' plan's.";
   } else if (options.check.latitude_deg) {
-    site.gravity_mps2 = NormalGravityMps2(*options.check.latitude_deg);
+    site.gravity_mps2 = NormalGravityMps2(*options.check.latitude_deg * kDegToRad, 0.0);  // sea level
     *gravity_note = "gravity_mps2: WGS84 normal gravity at " + FormatDouble(*options.check.latitude_deg) +
                     " deg, sea level; replace it by the station's measured gravity (--gravity-mps2).";
   } else {

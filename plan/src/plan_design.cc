@@ -308,15 +308,6 @@ const std::map<std::string, double>& DefaultPlanPrior() {
   return prior;
 }
 
-double NormalGravityMps2(double latitude_deg) {
-  // WGS84: equatorial gravity, Somigliana's k and the first eccentricity squared.
-  constexpr double kEquatorMps2 = 9.7803253359;
-  constexpr double kSomiglianaK = 0.00193185265241;
-  constexpr double kEccentricity2 = 0.00669437999013;
-  const double sin2 = std::pow(std::sin(latitude_deg * kDegToRad), 2);
-  return kEquatorMps2 * (1.0 + kSomiglianaK * sin2) / std::sqrt(1.0 - kEccentricity2 * sin2);
-}
-
 double PlanDesignHours(size_t segments, size_t soaks, const SimulationOptions& schedule,
                        const PlanDesignOptions& options) {
   const double per_segment = schedule.transition_s + schedule.dwell_s;

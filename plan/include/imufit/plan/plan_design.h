@@ -57,10 +57,6 @@ struct PlanDesignOptions {
   FitOptions fit;
 };
 
-// WGS84 normal gravity at sea level at `latitude_deg` (Somigliana), m/s^2: 9.7803 at the equator,
-// 9.8127 at 52.27 deg, 9.8322 at the poles.
-double NormalGravityMps2(double latitude_deg);
-
 // Every option of PlanDesignOptions (with PlanCheckOptionTable()'s), described once.
 const OptionTable<PlanDesignOptions>& PlanDesignOptionTable();
 
