@@ -228,13 +228,7 @@ class FieldPoseAccelCost {
 
   static ceres::CostFunction* Create(const FieldLayout* layout, const PoseDirection* pose,
                                      const Eigen::Vector3d& accel_mean, double x, double gravity_mps2,
-                                     const Eigen::Vector3d& sigma_raw) {
-    return new FieldTermsCost(
-        layout,
-        new ceres::AutoDiffCostFunction<FieldPoseAccelCost, 3, FieldLayout::kAccelFree, 2>(
-            new FieldPoseAccelCost(layout, pose, accel_mean, gravity_mps2, sigma_raw)),
-        /*gyro=*/false, /*accel=*/true, x);
-  }
+                                     const Eigen::Vector3d& sigma_raw);
 
   template <typename T>
   bool operator()(const T* accel_at, const T* pose_q, T* residual) const {
@@ -267,13 +261,7 @@ class FieldPoseGyroCost {
 
   static ceres::CostFunction* Create(const FieldLayout* layout, const Eigen::Vector3d& gyro_mean,
                                      const Eigen::Vector3d& accel_mean, double x,
-                                     const Eigen::Vector3d& sigma_raw) {
-    return new FieldTermsCost(
-        layout,
-        new ceres::AutoDiffCostFunction<FieldPoseGyroCost, 3, kGyroCoefficients, FieldLayout::kAccelFree>(
-            new FieldPoseGyroCost(layout, gyro_mean, accel_mean, sigma_raw)),
-        /*gyro=*/true, /*accel=*/true, x);
-  }
+                                     const Eigen::Vector3d& sigma_raw);
 
   template <typename T>
   bool operator()(const T* gyro_at, const T* accel_at, T* residual) const {
@@ -340,13 +328,7 @@ class FieldTurnCost {
 
   static ceres::CostFunction* Create(const FieldLayout* layout, const PoseDirection* from,
                                      const PoseDirection* to, std::vector<TurnSample> samples, double x,
-                                     double sigma_rad) {
-    return new FieldTermsCost(
-        layout,
-        new ceres::AutoDiffCostFunction<FieldTurnCost, 2, kGyroCoefficients, FieldLayout::kAccelFree, 2, 2>(
-            new FieldTurnCost(layout, from, to, std::move(samples), sigma_rad)),
-        /*gyro=*/true, /*accel=*/true, x);
-  }
+                                     double sigma_rad);
 
   template <typename T>
   bool operator()(const T* gyro_at, const T* accel_at, const T* from_q, const T* to_q, T* residual) const {
