@@ -201,7 +201,10 @@ TemperatureFinding CheckRunTemperatures(const std::vector<Window>& windows,
     }
     return finding;
   }
-  const auto [cold_soak, warm_soak] = std::minmax_element(soak_temps_c.begin(), soak_temps_c.end());
+  // Iterators, not a structured binding: a lambda may not capture one before C++20 (clang refuses).
+  const auto soak_range = std::minmax_element(soak_temps_c.begin(), soak_temps_c.end());
+  const auto cold_soak = soak_range.first;
+  const auto warm_soak = soak_range.second;
   const auto agrees = [&](double cold, double warm) {
     return std::abs(cold - *cold_soak) <= kSoakToleranceC && std::abs(warm - *warm_soak) <= kSoakToleranceC;
   };
