@@ -23,6 +23,7 @@
 #include "imufit/io/plan.h"
 #include "imufit/io/samples.h"
 #include "imufit/io/station.h"
+#include "imufit/model/check.h"
 #include "imufit/pipeline/fit_run.h"
 #include "imufit/sim/simulator.h"
 #include "imufit/store/store.h"
@@ -229,23 +230,29 @@ TEST_F(BudgetTest, OneUAndOneVerdictWhateverIsPrinted) {
   EXPECT_TRUE(found) << header;
 }
 
-// Under guard_band: 2 a value clear of its limit by 1.5 U is not accepted: its row says FAIL, not
-// PASS, with the guard band as the reason.
-TEST_F(BudgetTest, AGuardBandWiderThanUFailsTheRowItFails) {
-  ASSERT_TRUE(fit_->calibration.has_value());
-  const std::vector<Figure> figures = KeyFigures(*fit_->calibration);
+// The verdict on one criterion, |gyro bias x| under the guarded rule with guard band
+// `guard_band_u`, its limit `clear_u` x U beyond the fitted value.
+Verdict JudgeGyroBiasX(const Calibration& calibration, double guard_band_u, double clear_u) {
+  const std::vector<Figure> figures = KeyFigures(calibration);
   const Figure* bias = FindFigure(figures, "gyro_bias_dps.x");
-  ASSERT_NE(bias, nullptr);
+  IMUFIT_CHECK(bias != nullptr, "no gyro_bias_dps.x among the key figures");
   Limits limits;
   limits.decision_rule = DecisionRule::kGuarded;
-  limits.guard_band_u = 2.0;
+  limits.guard_band_u = guard_band_u;
   LimitCriterion criterion;
   criterion.quantity = "gyro_bias_dps";
   criterion.unit = "deg/s";
   criterion.axes = {"x"};
-  criterion.max_abs = std::abs(bias->value) + 1.5 * bias->expanded;
+  criterion.max_abs = std::abs(bias->value) + clear_u * bias->expanded;
   limits.criteria = {criterion};
-  const Verdict verdict = EvaluateLimits(limits, *fit_->calibration);
+  return EvaluateLimits(limits, calibration);
+}
+
+// Under guard_band: 2 a value clear of its limit by 1.5 U is not accepted: its row says FAIL, not
+// PASS, with the guard band as the reason.
+TEST_F(BudgetTest, AGuardBandWiderThanUFailsTheRowItFails) {
+  ASSERT_TRUE(fit_->calibration.has_value());
+  const Verdict verdict = JudgeGyroBiasX(*fit_->calibration, 2.0, 1.5);
   ASSERT_EQ(verdict.criteria.size(), 1u);
   EXPECT_FALSE(verdict.pass);
   EXPECT_FALSE(verdict.criteria[0].pass);
@@ -258,20 +265,8 @@ TEST_F(BudgetTest, AGuardBandWiderThanUFailsTheRowItFails) {
 // and its row says so: never "not accepted" beside an accepted criterion. Closer (0.3 U) it is not.
 TEST_F(BudgetTest, AGuardBandNarrowerThanUAcceptsWhatIsClearOfIt) {
   ASSERT_TRUE(fit_->calibration.has_value());
-  const std::vector<Figure> figures = KeyFigures(*fit_->calibration);
-  const Figure* bias = FindFigure(figures, "gyro_bias_dps.x");
-  ASSERT_NE(bias, nullptr);
-  Limits limits;
-  limits.decision_rule = DecisionRule::kGuarded;
-  limits.guard_band_u = 0.5;
-  LimitCriterion criterion;
-  criterion.quantity = "gyro_bias_dps";
-  criterion.unit = "deg/s";
-  criterion.axes = {"x"};
   for (const double clear_u : {0.7, 0.3}) {
-    criterion.max_abs = std::abs(bias->value) + clear_u * bias->expanded;
-    limits.criteria = {criterion};
-    const Verdict verdict = EvaluateLimits(limits, *fit_->calibration);
+    const Verdict verdict = JudgeGyroBiasX(*fit_->calibration, 0.5, clear_u);
     ASSERT_EQ(verdict.criteria.size(), 1u);
     const CriterionResult& row = verdict.criteria[0];
     EXPECT_EQ(row.outcome, Outcome::kConditionalPass) << clear_u;
