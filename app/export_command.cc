@@ -54,7 +54,8 @@ int RunExport(const ExportArguments& args) {
   // folder that is missing or not writable fails first. Not committed, it leaves nothing behind.
   OutputFile output(args.output);
   const ExportResult result = ExportCalibration(calibration, options);
-  if (!result.warning.empty()) std::fprintf(stderr, "imufit: warning: %s\n", result.warning.c_str());
+  for (const std::string& warning : result.warnings)
+    std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
   if (!args.quiet) std::printf("%s", DescribeLoss(result, "").c_str());
   if (const std::optional<std::string> excess =
           LossBeyondBounds(result.loss, args.max_loss[0], args.max_loss[1])) {

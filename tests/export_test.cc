@@ -690,6 +690,38 @@ TEST_F(ExportTest, ArduPilotInstanceIdsAndTemperatureRange) {
   EXPECT_LT(narrow.accel_mg.maxCoeff(), full.accel_mg.maxCoeff());
 }
 
+// ArduPilot takes INS_ACCOFFS that are all exactly 0 for an accelerometer never calibrated and
+// refuses to arm: a calibration whose accelerometer bias is 0 at every temperature is exported with
+// a warning, on stderr and in the file; one with a bias is not.
+TEST_F(ExportTest, ArduPilotWarnsWhenTheAccelerometerOffsetsAreAllZero) {
+  std::string yaml = ReadBytes(kFixtures + "/mems_truth.yaml");
+  const size_t accel = yaml.find("\naccel:");
+  ASSERT_NE(accel, std::string::npos);
+  const size_t bias = yaml.find("  bias:\n", accel);
+  ASSERT_NE(bias, std::string::npos);
+  const size_t end = yaml.find("  scale:", bias);
+  yaml.replace(bias, end - bias, "  bias:\n    x: [0, 0, 0, 0]\n    y: [0, 0, 0, 0]\n    z: [0, 0, 0, 0]\n");
+  std::ofstream(Path("zero_bias.yaml"), std::ios::binary) << yaml;
+  const char* kWarning =
+      "INS_ACCOFFS_X/Y/Z are all exactly 0: ArduPilot reads that as an accelerometer never "
+      "calibrated and refuses to arm";
+  const RunResult zero = Run(Plus(
+      Plus({"export", "-c", Path("zero_bias.yaml"), "-f", "ardupilot", "-o", Path("zero.parm")}, kDriver),
+      {"--force", "--device-id", "7"}));
+  EXPECT_EQ(zero.status, 0) << zero.err;
+  EXPECT_NE(zero.err.find(std::string("imufit: warning: ") + kWarning), std::string::npos) << zero.err;
+  EXPECT_NE(ReadBytes(Path("zero.parm")).find(std::string("# warning: ") + kWarning), std::string::npos);
+  std::map<std::string, long long> integers;
+  const std::map<std::string, float> p = ReadParameters(Path("zero.parm"), false, &integers);
+  EXPECT_EQ(p.at("INS_ACCOFFS_X"), 0.0f);
+  const RunResult fitted = Run(Plus(
+      Plus({"export", "-c", kFixtures + "/mems_truth.yaml", "-f", "ardupilot", "-o", Path("fitted.parm")},
+           kDriver),
+      {"--force", "--device-id", "7"}));
+  EXPECT_EQ(fitted.status, 0) << fitted.err;
+  EXPECT_EQ(fitted.err.find("are all exactly 0"), std::string::npos) << fitted.err;
+}
+
 // Real fitted units through the autopilots' and Kalibr's equations, on the runs they were fitted
 // from: the MEMS unit in counts (fixtures/golden/mems_6pos_soak.yaml) and the tactical unit in
 // physical units (deg/s and g: tactical_24pos_soak.yaml), over the whole fitted range (beyond

@@ -153,14 +153,24 @@ ExportResult ExportArduPilot(const Calibration& calibration, const ExportOptions
   };
   ExportResult result = MeasuredResult(kConsumer, calibration, envelope, consumer);
   std::vector<std::string> notes = ProvenanceLines(calibration, options, result);
+  std::vector<std::string> warnings;
   if (tmin_c != calibration.fit_temp_range_c[0] || tmax_c != calibration.fit_temp_range_c[1]) {
-    result.warning = "the fitted range [" + FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
-                     FormatDouble(calibration.fit_temp_range_c[1]) + "] degC lies beyond " + names.tcal +
-                     "TMIN/TMAX's range [-70, 80] degC: written as [" + FormatDouble(tmin_c) + ", " +
-                     FormatDouble(tmax_c) +
-                     "]; ArduPilot holds the correction at the end beyond it (in the loss)";
-    notes.push_back("warning: " + result.warning);
+    warnings.push_back("the fitted range [" + FormatDouble(calibration.fit_temp_range_c[0]) + ", " +
+                       FormatDouble(calibration.fit_temp_range_c[1]) + "] degC lies beyond " + names.tcal +
+                       "TMIN/TMAX's range [-70, 80] degC: written as [" + FormatDouble(tmin_c) + ", " +
+                       FormatDouble(tmax_c) +
+                       "]; ArduPilot holds the correction at the end beyond it (in the loss)");
   }
+  // accel_calibrated_ok_all() takes offsets that are all exactly 0 for "never calibrated" (and
+  // refuses to arm: "3D Accel calibration needed"); loading them also replaces the vehicle's own.
+  if (accel.offset[0] == 0.0f && accel.offset[1] == 0.0f && accel.offset[2] == 0.0f) {
+    warnings.push_back(names.accel +
+                       "OFFS_X/Y/Z are all exactly 0: ArduPilot reads that as an accelerometer "
+                       "never calibrated and refuses to arm (\"3D Accel calibration needed\"); was the "
+                       "accelerometer's bias held rather than fitted?");
+  }
+  for (const std::string& warning : warnings) notes.push_back("warning: " + warning);
+  result.warnings = std::move(warnings);
   notes.push_back(names.tcal + "ENABLE must be 1 before the other " + names.tcal +
                   "* parameters exist: load this file, refresh the parameters, and load it again.");
   notes.push_back(names.accel + "_ID and " + names.gyro +

@@ -425,7 +425,8 @@ def export(
 ) -> dict[str, Any]:
     """The calibration in a consumer's format, as `imufit export` writes it (docs/export.md):
     {content: bytes, loss: {points, gyro_worst_dps, gyro_rms_dps, accel_worst_mg, accel_rms_mg}
-    (arrays x, y, z; deg/s and mg) or None for a lossless format, consumer, envelope, warning}.
+    (arrays x, y, z; deg/s and mg) or None for a lossless format, consumer, envelope, warnings: a list
+    of sentences, one per thing the user must know}.
     Written atomically to `output` when given. Options: export_options(). Nothing is refused for
     its loss: compare `loss` with your bound. Raises InputError for a bad option or calibration."""
 

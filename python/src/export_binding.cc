@@ -70,7 +70,7 @@ py::dict Export(const py::object& calibration, const std::string& format, const 
   d["loss"] = LossDict(result.loss);
   d["consumer"] = result.consumer;
   d["envelope"] = result.envelope;
-  d["warning"] = result.warning;
+  d["warnings"] = result.warnings;
   return d;
 }
 
@@ -81,7 +81,8 @@ void BindExport(py::module_& m) {
       "export", &Export, py::arg("calibration"), py::arg("format"), py::arg("output") = py::none(),
       "A calibration (a path or a Calibration) in a consumer's format, as `imufit export` writes it: "
       "{content: bytes, loss: {points, gyro_worst_dps, gyro_rms_dps, accel_worst_mg, accel_rms_mg} or None "
-      "when nothing is lost, consumer, envelope, warning}. Written to `output` (atomically) when given. "
+      "when nothing is lost, consumer, envelope, warnings: [str]}. Written to `output` (atomically) when "
+      "given. "
       "Options by name: export_options(). Nothing is refused for its loss: compare `loss` with your bound.");
   m.def(
       "export_options", [] { return DescribeKeywords(ExportOptionTable()); },

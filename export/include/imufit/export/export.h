@@ -106,7 +106,9 @@ struct ExportResult {
   ExportLoss loss;
   std::string consumer;  // the consumer and the version of its equations that were emulated
   std::string envelope;  // the envelope, in words
-  std::string warning;   // "" or what the user must know (a parameter range clamped); also in the file
+  // What the user must know (a parameter range clamped, offsets a consumer takes for "not
+  // calibrated"), one sentence each; also in the file.
+  std::vector<std::string> warnings;
 };
 
 // Thrown when the calibration cannot be exported to the format (exit status 1): a term the
