@@ -26,8 +26,9 @@ int RunSegment(const SegmentArguments& args) {
   if (const std::string problem = input.Validate(); !problem.empty())
     throw InputError("imufit segment", problem);
   const Plan plan = ReadPlan(args.plan);
-  const Segmentation segmentation = SegmentSamplesFile(plan, args.samples, input);
-  const LabelledFileReport report = WriteLabelledSamples(segmentation, args.samples, args.output, input);
+  const LabelledFile labelled = LabelSamplesFile(plan, args.samples, args.output, input);
+  const Segmentation& segmentation = labelled.segmentation;
+  const LabelledFileReport& report = labelled.report;
   if (args.quiet) return 0;
   std::printf(
       "imufit segment: %zu segments found in %d pass%s through the plan; %lld of %lld samples labelled -> "

@@ -814,6 +814,43 @@ TEST_F(CliInputTest, AnUnlabelledLogThroughAPipeIsReadOnce) {
             YAML::LoadFile(Path("cal.yaml"))["fit"]["samples_sha256"].as<std::string>());
 }
 
+// imufit segment on a pipe reads it once too (its samples kept for the two passes): the same labelled
+// file as from the file, with and without a temp_c column.
+TEST_F(CliInputTest, SegmentOfAPipeIsReadOnce) {
+  ASSERT_EQ(
+      Run({"simulate", "--plan=" + Fixture("plan_6pos.yaml"), "--calibration=" + Fixture("mems_truth.yaml"),
+           "--output=" + Path("unlabelled.csv"), "--rate=50", "--dwell=5", "--transition=1", "--temps=-20,30",
+           "--gyro-noise-density=2e-4", "--accel-noise-density=2e-3", "--no-segment-column", "-q"})
+          .status,
+      0);
+  // The same run without its temp_c column: segment needs no temperature.
+  std::istringstream lines(ReadBytes(Path("unlabelled.csv")));
+  std::ofstream no_temp(Path("no_temp.csv"), std::ios::binary);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') {
+      no_temp << line << "\n";
+      continue;
+    }
+    const size_t first = line.find(','), second = line.find(',', first + 1);
+    no_temp << line.substr(0, first) << line.substr(second) << "\n";
+  }
+  no_temp.close();
+  for (const std::string name : {"unlabelled.csv", "no_temp.csv"}) {
+    SCOPED_TRACE(name);
+    ASSERT_EQ(
+        Run({"segment", "-p", Fixture("plan_6pos.yaml"), "-s", Path(name), "-o", Path("from_file.csv"), "-q"})
+            .status,
+        0);
+    const RunResult r = RunProgram(
+        "/bin/sh", {"-c", "cat '" + Path(name) + "' | '" + IMUFIT_EXE + "' segment -p '" +
+                              Fixture("plan_6pos.yaml") + "' -s /dev/stdin -o '" + Path("piped.csv") + "'"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("6 segments found"), std::string::npos) << r.out;
+    EXPECT_EQ(ReadBytes(Path("piped.csv")), ReadBytes(Path("from_file.csv")));
+  }
+  EXPECT_EQ(ReadBytes(Path("piped.csv")).find("temp_c"), std::string::npos);
+}
+
 // fit --check-samples with another unit's run is refused as apply refuses it (its header's serial),
 // unless --allow-mismatch.
 TEST_F(CliInputTest, CheckSamplesOfAnotherUnitAreRefusedAsApplyRefusesThem) {

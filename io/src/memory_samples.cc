@@ -38,7 +38,7 @@ bool MemorySamplesReader::Next(Sample* sample) {
     if (!std::isfinite(value)) Fail(column, FormatDouble(value) + " is not a finite number");
   };
   finite("time_s", sample->time_s);
-  finite("temp_c", sample->temp_c);
+  if (run_.has_temp) finite("temp_c", sample->temp_c);
   for (int axis = 0; axis < 3; ++axis) {
     finite("gyro", sample->gyro(axis));
     finite("accel", sample->accel(axis));
@@ -54,7 +54,8 @@ bool MemorySamplesReader::Next(Sample* sample) {
       Fail("time_s", problem);
     }
   }
-  if (const std::string problem = TemperatureProblem(sample->temp_c, next_ == 1); !problem.empty()) {
+  if (const std::string problem = TemperatureProblem(sample->temp_c, next_ == 1);
+      run_.has_temp && !problem.empty()) {
     Fail("temp_c", problem);
   }
   if (sample->segment < kTransitionSegment) {

@@ -89,14 +89,15 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, const Sampl
       seconds_per_time_unit_(format.seconds_per_time_unit),
       serial_(SerialInHeader(csv_)) {
   const std::optional<double>& temp_c = format.temp_c;
+  const bool has_temp = FindColumn("temp_c").has_value();
+  const bool read_temp = !temp_c && (has_temp || !format.temp_c_optional);
   // Every column needed, so that all that are absent are named at once.
   std::vector<std::string> names = {"time_s"};
   names.insert(names.end(), std::begin(kGyroNames), std::end(kGyroNames));
   names.insert(names.end(), std::begin(kAccelNames), std::end(kAccelNames));
-  if (!temp_c) names.push_back("temp_c");
+  if (read_temp) names.push_back("temp_c");
   if (require_segment) names.push_back("segment");
   for (std::string& name : names) name = format.InFile(name);
-  const bool has_temp = FindColumn("temp_c").has_value();
   const std::vector<int> columns = csv_.RequireColumns(
       names, temp_c || has_temp ? "" : "; for a run without a thermometer give its temperature (--temp-c)");
   CheckDistinct(columns);
@@ -105,8 +106,10 @@ SamplesReader::SamplesReader(std::string path, bool require_segment, const Sampl
     gyro_columns_[axis] = columns[1 + axis];
     accel_columns_[axis] = columns[4 + axis];
   }
-  if (!temp_c) {
+  if (read_temp) {
     temp_column_ = columns[7];
+  } else if (!temp_c) {
+    fixed_temp_c_ = std::nan("");  // temp_c_optional
   } else if (has_temp) {
     throw InputError(csv_.path(),
                      "has a temp_c column: a fixed temperature (--temp-c) is only for samples "

@@ -1,12 +1,11 @@
 #include "imufit/pipeline/run_windows.h"
 
-#include <filesystem>
 #include <set>
-#include <system_error>
 #include <utility>
 
 #include "imufit/io/error.h"
 #include "imufit/io/parallel_samples.h"
+#include "imufit/io/path.h"
 #include "imufit/model/check.h"
 
 namespace imufit {
@@ -34,13 +33,6 @@ void ReadSamples(const Plan& plan, Reader* reader, Labeller* labeller, WindowBui
     builder->Add(sample);
     if (stretch != nullptr) stretch->Add(sample);
   }
-}
-
-// Whether `path` can be opened again from its start: a regular file (also through /dev/stdin
-// redirected from one), not a pipe.
-bool IsRereadable(const std::string& path) {
-  std::error_code error;
-  return std::filesystem::is_regular_file(path, error);
 }
 
 }  // namespace

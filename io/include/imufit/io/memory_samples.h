@@ -19,6 +19,7 @@ struct SamplesInMemory {
   std::string name;  // stands for the file's path in messages and records
   std::vector<Sample> samples;
   bool has_segment = false;  // false: the segments are found in the data
+  bool has_temp = true;      // false: no temperature is known (temp_c NaN, imufit segment's)
   SamplesSerial serial;      // the unit's serial, if known (line and column 0)
 
   // SHA-256 of the samples' values (time, temperature, segment, gyro, accel of each, as

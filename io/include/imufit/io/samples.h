@@ -62,6 +62,9 @@ struct SamplesFormat {
   CsvDialect dialect;
   // Columns under the file's own names (--column); the others are found by their names.
   std::vector<ColumnName> column_names;
+  // Without temp_c above: a file without a temp_c column is read with NaN in its place (imufit segment,
+  // which needs no temperature) instead of being refused.
+  bool temp_c_optional = false;
 
   // The name of column `name` in the file.
   std::string InFile(const std::string& name) const;

@@ -1,6 +1,6 @@
 // imufit — an unlabelled samples file labelled with its plan's segments: the two passes of
 // fit/segmentation.h over a file (pass 1 finds the segments, pass 2 labels the samples by time).
-// The file is read twice, never held in memory.
+// A file is read twice, never held in memory; a pipe, which can be read once, is kept in memory.
 #ifndef IMUFIT_PIPELINE_SEGMENT_RUN_H_
 #define IMUFIT_PIPELINE_SEGMENT_RUN_H_
 
@@ -53,11 +53,17 @@ struct LabelledFileReport {
   long long agreeing = 0;  // with input_had_segment: samples whose old and new labels agree
 };
 
-// Pass 2: writes the samples of `samples_path` with the segment column of `segmentation` to
-// `output_path` (atomically; an input segment column is replaced), keeping temp_c when the input has
-// it or `input.temp_c` gives it.
-LabelledFileReport WriteLabelledSamples(const Segmentation& segmentation, const std::string& samples_path,
-                                        const std::string& output_path, const SamplesInput& input);
+struct LabelledFile {
+  Segmentation segmentation;
+  LabelledFileReport report;
+};
+
+// Both passes: finds the segments of `samples_path` (SegmentSamplesFile) and writes its samples
+// with their segment column to `output_path` (atomically; an input segment column is replaced),
+// keeping temp_c when the input has it or `input.temp_c` gives it. A path that cannot be read
+// twice (a pipe: io/path.h IsRereadable) is read once and its samples kept in memory.
+LabelledFile LabelSamplesFile(const Plan& plan, const std::string& samples_path,
+                              const std::string& output_path, const SamplesInput& input);
 
 }  // namespace imufit
 
