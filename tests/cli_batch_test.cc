@@ -639,22 +639,6 @@ TEST_F(FactoryCliTest, ManifestReadsBackAlikeInEveryReaderAndAShardClaimsNoLotSu
   EXPECT_EQ(r.out.find("lot_summary.csv"), std::string::npos) << r.out;
 }
 
-// Runs `sql` on the SQLite store at `path` with Python's sqlite3 (another reader than ours): one
-// line per row, cells joined by "|".
-std::string Query(const fs::path& path, const std::string& sql) {
-  const std::string log =
-      (path.parent_path().parent_path() / ("query." + std::to_string(::getpid()))).string();
-  const RunResult r = testing::RunProgram("/usr/bin/python3",
-                                          {"-c",
-                                           "import sqlite3, sys\n"
-                                           "for row in sqlite3.connect(sys.argv[1]).execute(sys.argv[2]):\n"
-                                           "    print('|'.join(str(c) for c in row))\n",
-                                           path.string(), sql},
-                                          log + ".out", log + ".err");
-  EXPECT_EQ(r.status, 0) << r.err;
-  return r.out;
-}
-
 // Issue 29 item 6 end to end: the store's rows of a batch hold the fit options and the files
 // committed; a unit skipped as unchanged and recorded in another store keeps its calibration's time,
 // so that merging that store back adds no second fit; a batch under a new --lot on runs recorded

@@ -57,6 +57,20 @@ std::string ReportFigure(const std::string& html, const std::string& name) {
   return std::regex_search(html, match, pattern) ? match[1].str() : "<none>";
 }
 
+std::string Query(const fs::path& path, const std::string& sql) {
+  const std::string log =
+      (path.parent_path().parent_path() / ("query." + std::to_string(::getpid()))).string();
+  const RunResult r = testing::RunProgram("/usr/bin/python3",
+                                          {"-c",
+                                           "import sqlite3, sys\n"
+                                           "for row in sqlite3.connect(sys.argv[1]).execute(sys.argv[2]):\n"
+                                           "    print('|'.join(str(c) for c in row))\n",
+                                           path.string(), sql},
+                                          log + ".out", log + ".err");
+  EXPECT_EQ(r.status, 0) << r.err;
+  return r.out;
+}
+
 void ExecuteSql(const std::string& path, const std::string& sql) {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);

@@ -68,6 +68,10 @@ std::vector<std::map<std::string, std::string>> ReadCsv(const std::string& text)
 // The value of data-value on the element with data-figure="name" in a report.
 std::string ReportFigure(const std::string& html, const std::string& name);
 
+// Runs `sql` on the SQLite store at `path` with Python's sqlite3 (another reader than ours): one
+// line per row, cells joined by "|".
+std::string Query(const std::filesystem::path& path, const std::string& sql);
+
 // Runs `sql` on the SQLite database at `path` (the test's own change to a store).
 void ExecuteSql(const std::string& path, const std::string& sql);
 

@@ -1,6 +1,7 @@
 // `imufit report` and the certificate end to end on the lot of cli_factory_util.h: the noise of a static
 // stretch, the station file, the run, item and laboratory named, printing to PDF (headless Chromium, checked
 // with poppler-utils; skipped without them).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -132,6 +133,21 @@ TEST_F(FactoryCliTest, PdfOptionPrintsTheCertificateAndTheLotPage) {
   EXPECT_NE(info(Path("out/lot.pdf")).find("(A4)"), std::string::npos);
   EXPECT_NE(text(Path("out/lot.pdf")).find("Lot LOT-A"), std::string::npos);
   EXPECT_FALSE(fs::exists(Path("out/unit-05/report.pdf")));  // the unit that could not be read
+  // The store names each printed certificate among the fit's attachments, with the PDF's SHA-256,
+  // also for a unit skipped as unchanged and recorded in another store.
+  const std::string pdf = Path("out/unit-04/report.pdf");
+  const std::string attachment = "certificate_pdf|" + pdf + "|" + Sha256OfFile(pdf) + "\n";
+  const std::string sql =
+      "SELECT a.kind, a.path, a.sha256 FROM attachments a JOIN fits f ON f.id = a.fit_id JOIN runs r ON "
+      "r.run_key = f.run_key WHERE r.serial = 'SN-04' AND a.kind = 'certificate_pdf'";
+  EXPECT_EQ(Query(Path("store.db"), sql), attachment);
+  args = BatchArgs("out");
+  *(std::find(args.begin(), args.end(), "--store") + 1) = Path("again.db");
+  args.push_back("--pdf");
+  r = Run(args);
+  ASSERT_EQ(r.status, kExitFailedLimits) << r.out << r.err;
+  EXPECT_NE(r.out.find("unchanged and skipped"), std::string::npos) << r.out;
+  EXPECT_EQ(Query(Path("again.db"), sql), attachment);
 }
 // The standard simulated 6-position soak (fixtures/mems_6pos_soak.csv.gz: 18 segments at five
 // temperatures), fitted with validation and certified with limits and a station file: a passing

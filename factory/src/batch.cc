@@ -348,6 +348,8 @@ bool TakeUnchanged(const Shared& shared, const Manifest& manifest, const UnitPat
     unit->attachments = {{"calibration", paths.calibration, previous->calibration_sha256}};
     if (shared.options->write_reports)
       unit->attachments.push_back({"certificate", paths.report, Sha256OfFile(paths.report)});
+    if (shared.options->write_reports && !paths.pdf.empty())
+      unit->attachments.push_back({"certificate_pdf", paths.pdf, Sha256OfFile(paths.pdf)});
   }
   unit->message = previous->message;
   return true;

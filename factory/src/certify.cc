@@ -98,7 +98,9 @@ bool CertifyUnit(const CertifySettings& settings, const UnitFiles& files, UnitOu
     const std::string html = CertificateHtml(*certificate);
     WriteFileAtomically(files.report, html, &outputs);
     unit->attachments.push_back({"certificate", files.report, Sha256Hex(html)});
-    if (!files.pdf.empty()) WritePdf(html, files.pdf, files.paper, &outputs);
+    if (!files.pdf.empty())
+      unit->attachments.push_back(
+          {"certificate_pdf", files.pdf, WritePdf(html, files.pdf, files.paper, &outputs)});
   }
   if (files.more) files.more(*unit, &outputs);
   return RecordUnit(settings, unit, &outputs);

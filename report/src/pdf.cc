@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "imufit/io/path.h"
+#include "imufit/io/sha256.h"
 #include "temp_folder.h"
 
 extern char** environ;
@@ -100,8 +101,8 @@ std::string PdfPathFor(const std::string& html_path) {
   return html_path + ".pdf";
 }
 
-void WritePdf(const std::string& html, const std::string& pdf_path, Paper paper,
-              OutputTransaction* transaction) {
+std::string WritePdf(const std::string& html, const std::string& pdf_path, Paper paper,
+                     OutputTransaction* transaction) {
   const std::string chromium = FindChromium();
   if (chromium.empty()) throw std::runtime_error(pdf_path + ": " + PdfProblem());
   internal::TempFolder folder("imufit-pdf");
@@ -120,7 +121,9 @@ void WritePdf(const std::string& html, const std::string& pdf_path, Paper paper,
   written.read(magic, 4);
   if (std::string(magic) != "%PDF")
     throw std::runtime_error("cannot print " + pdf_path + ": Chromium wrote no PDF");
+  std::string sha256 = Sha256OfFile(out.temp_path());
   out.Commit();
+  return sha256;
 }
 
 }  // namespace imufit

@@ -29,10 +29,11 @@ std::string PdfProblem();
 // "out/report.html" -> "out/report.pdf" (any other name: ".pdf" appended).
 std::string PdfPathFor(const std::string& html_path);
 
-// Prints `html` (a self-contained page) to `pdf_path` on `paper`. Throws std::runtime_error when
-// Chromium is missing, fails or writes no PDF (then nothing is written at `pdf_path`).
-void WritePdf(const std::string& html, const std::string& pdf_path, Paper paper,
-              OutputTransaction* transaction = nullptr);
+// Prints `html` (a self-contained page) to `pdf_path` on `paper`; returns the PDF's SHA-256 (hex),
+// what names it among a fit's attachments in the store. Throws std::runtime_error when Chromium is
+// missing, fails or writes no PDF (then nothing is written at `pdf_path`).
+std::string WritePdf(const std::string& html, const std::string& pdf_path, Paper paper,
+                     OutputTransaction* transaction = nullptr);
 
 }  // namespace imufit
 
