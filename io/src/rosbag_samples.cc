@@ -1,0 +1,277 @@
+#include "imufit/io/rosbag_samples.h"
+
+#include <console_bridge/console.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/Temperature.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <map>
+#include <new>
+
+#include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
+#include "imufit/io/samples.h"
+
+namespace imufit {
+namespace {
+
+constexpr int64_t kNsPerS = 1000000000;
+
+// A header stamp in nanoseconds, from its fields as stored (a fuzzed nsec beyond 1e9 is summed, not
+// normalised by ros::Time, which throws on overflow).
+int64_t StampNs(const ros::Time& stamp) {
+  return static_cast<int64_t>(stamp.sec) * kNsPerS + static_cast<int64_t>(stamp.nsec);
+}
+
+std::string StampText(int64_t ns) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%lld.%09lld s", static_cast<long long>(ns / kNsPerS),
+                static_cast<long long>(ns % kNsPerS));
+  return text;
+}
+
+// The place of message `index` (1-based) of `topic`, for an error message.
+std::string MessagePlace(const std::string& topic, long long index) {
+  return "topic " + QuoteForMessage(topic) + ", message " + std::to_string(index);
+}
+
+// The topics of `types` in the bag, each once, in the bag's order, and the whole list as text.
+struct Topics {
+  std::map<std::string, std::string> type_of;  // topic -> datatype
+  std::vector<std::string> Of(const std::string& type) const {
+    std::vector<std::string> topics;
+    for (const auto& entry : type_of) {
+      if (entry.second == type) topics.push_back(entry.first);
+    }
+    return topics;
+  }
+  std::string Listed() const {
+    std::string text;
+    for (const auto& entry : type_of) {
+      text += (text.empty() ? "" : ", ") + QuoteForMessage(entry.first) + " (" + entry.second + ")";
+    }
+    return text.empty() ? "none" : text;
+  }
+};
+
+std::string Joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + QuoteForMessage(name);
+  return text;
+}
+
+// The topic to read: `chosen` (checked to be of `type`), else the bag's only one of `type`. "" when
+// `optional` and the bag has none.
+std::string ChooseTopic(const std::string& path, const Topics& topics, const std::string& chosen,
+                        const char* type, const char* option, bool optional) {
+  if (!chosen.empty()) {
+    const auto found = topics.type_of.find(chosen);
+    if (found == topics.type_of.end())
+      throw InputError(path, option + std::string(" ") + QuoteForMessage(chosen) +
+                                 ": no such topic in the bag; its topics: " + topics.Listed());
+    if (found->second != type)
+      throw InputError(path, option + std::string(" ") + QuoteForMessage(chosen) + ": the topic holds " +
+                                 found->second + ", not " + type);
+    return chosen;
+  }
+  const std::vector<std::string> of_type = topics.Of(type);
+  if (of_type.size() == 1) return of_type.front();
+  if (of_type.empty()) {
+    if (optional) return "";
+    throw InputError(path, std::string("no ") + type + " topic in the bag; its topics: " + topics.Listed());
+  }
+  throw InputError(path, std::to_string(of_type.size()) + " " + type + " topics (" + Joined(of_type) +
+                             "): choose one with " + option);
+}
+
+// Throws unless `value` is finite.
+void CheckFinite(const std::string& path, const std::string& place, const char* field, double value) {
+  if (!std::isfinite(value))
+    throw InputError(path, place + ": " + field + ": " + FormatDouble(value) + " is not a finite number");
+}
+
+void CheckVector(const std::string& path, const std::string& place, const char* field,
+                 const geometry_msgs::Vector3& v, const boost::array<double, 9>& covariance) {
+  // REP 145 / sensor_msgs/Imu: covariance element 0 = -1 says the driver has no such data.
+  if (covariance[0] == -1.0)
+    throw InputError(path, place + ": " + field + "_covariance[0] is -1: the driver publishes no " + field +
+                               " (sensor_msgs/Imu), so it cannot be calibrated");
+  const std::string name = field;
+  CheckFinite(path, place, (name + ".x").c_str(), v.x);
+  CheckFinite(path, place, (name + ".y").c_str(), v.y);
+  CheckFinite(path, place, (name + ".z").c_str(), v.z);
+}
+
+struct TemperatureReading {
+  int64_t stamp_ns;
+  double temp_c;
+};
+
+// The temperature at `stamp_ns`: interpolated between the readings around it, held at the nearest
+// one outside them; nullopt when the nearest is farther than kMaxTemperatureGapS.
+std::optional<double> TemperatureAt(const std::vector<TemperatureReading>& readings, int64_t stamp_ns,
+                                    size_t* cursor, int64_t* gap_ns) {
+  while (*cursor < readings.size() && readings[*cursor].stamp_ns <= stamp_ns) ++*cursor;
+  // readings[*cursor - 1] <= stamp < readings[*cursor]
+  const TemperatureReading* before = *cursor > 0 ? &readings[*cursor - 1] : nullptr;
+  const TemperatureReading* after = *cursor < readings.size() ? &readings[*cursor] : nullptr;
+  const int64_t gap_before = before ? stamp_ns - before->stamp_ns : INT64_MAX;
+  const int64_t gap_after = after ? after->stamp_ns - stamp_ns : INT64_MAX;
+  *gap_ns = std::min(gap_before, gap_after);
+  if (static_cast<double>(*gap_ns) > kMaxTemperatureGapS * static_cast<double>(kNsPerS)) return std::nullopt;
+  if (before == nullptr) return after->temp_c;
+  if (after == nullptr) return before->temp_c;
+  const double share =
+      static_cast<double>(gap_before) / static_cast<double>(after->stamp_ns - before->stamp_ns);
+  return before->temp_c + share * (after->temp_c - before->temp_c);
+}
+
+class BagReading {
+ public:
+  BagReading(const std::string& path, const RosbagOptions& options) : path_(path), options_(options) {}
+
+  RosbagSamples Read() {
+    bag_.open(path_, rosbag::bagmode::Read);
+    Topics topics;
+    {
+      rosbag::View all(bag_);
+      for (const rosbag::ConnectionInfo* connection : all.getConnections())
+        topics.type_of.emplace(connection->topic, connection->datatype);
+    }
+    result_.topic = ChooseTopic(path_, topics, options_.topic, kRosImuType, "--topic", false);
+    result_.temp_topic =
+        ChooseTopic(path_, topics, options_.temp_topic, kRosTemperatureType, "--temp-topic", true);
+    if (!result_.temp_topic.empty() && options_.temp_c)
+      throw InputError(path_, "the bag has a temperature topic " + QuoteForMessage(result_.temp_topic) +
+                                  ": a fixed temperature (--temp-c) is only for a bag without one");
+    if (result_.temp_topic.empty() && !options_.temp_c)
+      throw InputError(path_,
+                       "no sensor_msgs/Temperature topic in the bag; for a session without a "
+                       "thermometer give its temperature (--temp-c)");
+    std::vector<std::string> wanted{result_.topic};
+    if (!result_.temp_topic.empty()) wanted.push_back(result_.temp_topic);
+    rosbag::View view(bag_, rosbag::TopicQuery(wanted));
+    for (const rosbag::MessageInstance& message : view) {
+      if (message.getTopic() == result_.topic) {
+        ReadImu(message);
+      } else {
+        ReadTemperature(message);
+      }
+    }
+    if (result_.samples.empty())
+      throw InputError(path_, "topic " + QuoteForMessage(result_.topic) + ": no messages");
+    if (!result_.temp_topic.empty()) SetTemperatures();
+    return std::move(result_);
+  }
+
+ private:
+  template <typename Message>
+  boost::shared_ptr<Message> Instantiate(const rosbag::MessageInstance& message, const std::string& place) {
+    boost::shared_ptr<Message> read = message.instantiate<Message>();
+    if (!read)
+      throw InputError(path_, place + ": a " + message.getDataType() + " (definition md5 " +
+                                  message.getMD5Sum() + ") where " +
+                                  ros::message_traits::DataType<Message>::value() + " (md5 " +
+                                  ros::message_traits::MD5Sum<Message>::value() + ") was expected");
+    return read;
+  }
+
+  void ReadImu(const rosbag::MessageInstance& message) {
+    ++imu_messages_;
+    const std::string place = MessagePlace(result_.topic, imu_messages_);
+    const boost::shared_ptr<sensor_msgs::Imu> imu = Instantiate<sensor_msgs::Imu>(message, place);
+    const int64_t stamp_ns = StampNs(imu->header.stamp);
+    if (imu_messages_ == 1) first_ns_ = stamp_ns;
+    if (imu_messages_ > 1 && stamp_ns <= last_ns_)
+      throw InputError(path_, place + ": header.stamp " + StampText(stamp_ns) +
+                                  " is not after the previous message's " + StampText(last_ns_) +
+                                  " (the samples' time must increase)");
+    last_ns_ = stamp_ns;
+    CheckVector(path_, place, "angular_velocity", imu->angular_velocity, imu->angular_velocity_covariance);
+    CheckVector(path_, place, "linear_acceleration", imu->linear_acceleration,
+                imu->linear_acceleration_covariance);
+    Sample sample;
+    sample.time_s = static_cast<double>(stamp_ns - first_ns_) * 1e-9;
+    sample.gyro << imu->angular_velocity.x, imu->angular_velocity.y, imu->angular_velocity.z;
+    sample.accel << imu->linear_acceleration.x, imu->linear_acceleration.y, imu->linear_acceleration.z;
+    sample.temp_c = options_.temp_c.value_or(0.0);
+    result_.samples.push_back(sample);
+    imu_stamps_ns_.push_back(stamp_ns);
+  }
+
+  void ReadTemperature(const rosbag::MessageInstance& message) {
+    const std::string place = MessagePlace(result_.temp_topic, ++result_.temp_readings);
+    const boost::shared_ptr<sensor_msgs::Temperature> reading =
+        Instantiate<sensor_msgs::Temperature>(message, place);
+    const int64_t stamp_ns = StampNs(reading->header.stamp);
+    if (!temps_.empty() && stamp_ns <= temps_.back().stamp_ns)
+      throw InputError(path_, place + ": header.stamp " + StampText(stamp_ns) +
+                                  " is not after the previous message's " +
+                                  StampText(temps_.back().stamp_ns) + " (the readings' time must increase)");
+    CheckFinite(path_, place, "temperature", reading->temperature);
+    if (const std::string problem = TemperatureProblem(reading->temperature, temps_.empty());
+        !problem.empty())
+      throw InputError(path_, place + ": temperature: " + problem);
+    temps_.push_back({stamp_ns, reading->temperature});
+  }
+
+  void SetTemperatures() {
+    if (temps_.empty())
+      throw InputError(path_, "topic " + QuoteForMessage(result_.temp_topic) +
+                                  ": no messages (no temperature for the samples)");
+    size_t cursor = 0;
+    for (size_t i = 0; i < result_.samples.size(); ++i) {
+      int64_t gap_ns = 0;
+      const std::optional<double> temp_c = TemperatureAt(temps_, imu_stamps_ns_[i], &cursor, &gap_ns);
+      if (!temp_c)
+        throw InputError(path_, MessagePlace(result_.topic, static_cast<long long>(i) + 1) +
+                                    ": header.stamp " + StampText(imu_stamps_ns_[i]) + " is " +
+                                    FormatDouble(static_cast<double>(gap_ns) * 1e-9) +
+                                    " s from the nearest reading of " + QuoteForMessage(result_.temp_topic) +
+                                    " (at most " + FormatDouble(kMaxTemperatureGapS) +
+                                    " s): its temperature is unknown");
+      result_.samples[i].temp_c = *temp_c;
+    }
+  }
+
+  const std::string& path_;
+  const RosbagOptions& options_;
+  rosbag::Bag bag_;
+  RosbagSamples result_;
+  long long imu_messages_ = 0;
+  int64_t first_ns_ = 0;
+  int64_t last_ns_ = 0;
+  std::vector<int64_t> imu_stamps_ns_;
+  std::vector<TemperatureReading> temps_;
+};
+
+}  // namespace
+
+bool LooksLikeRosbag(std::string_view head) { return head.substr(0, kRosbagMagic.size()) == kRosbagMagic; }
+
+RosbagSamples ReadRosbagSamples(const std::string& path, const RosbagOptions& options) {
+  // The library reports through console_bridge as well as by throwing: one line is ours to print.
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+  try {
+    return BagReading(path, options).Read();
+  } catch (const InputError&) {
+    throw;
+  } catch (const rosbag::BagUnindexedException& e) {
+    throw InputError(path, std::string("the bag has no index (a recording cut short?): ") + e.what() +
+                               "; `rosbag reindex` repairs it");
+  } catch (const std::bad_alloc&) {
+    throw InputError(path, "not a readable ROS bag: a record claims more memory than there is");
+  } catch (const std::exception& e) {
+    throw InputError(path, std::string("not a readable ROS bag (rosbag: ") + e.what() + ")");
+  } catch (...) {
+    throw InputError(path, "not a readable ROS bag (rosbag failed without a message)");
+  }
+}
+
+}  // namespace imufit
