@@ -265,6 +265,9 @@ RosbagSamples ReadRosbagSamples(const std::string& path, const RosbagOptions& op
   } catch (const rosbag::BagUnindexedException& e) {
     throw InputError(path, std::string("the bag has no index (a recording cut short?): ") + e.what() +
                                "; `rosbag reindex` repairs it");
+  } catch (const rosbag::BagException& e) {
+    throw InputError(path, std::string("not a readable ROS bag (rosbag: ") + e.what() +
+                               "); if the recording was cut short, `rosbag reindex` may repair it");
   } catch (const std::bad_alloc&) {
     throw InputError(path, "not a readable ROS bag: a record claims more memory than there is");
   } catch (const std::exception& e) {
