@@ -3,7 +3,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <memory>
+#include <thread>
 
 #include "imufit/io/error.h"
 
@@ -53,8 +55,28 @@ LogSamples ReadLogSamples(const std::string& path, const LogSamplesOptions& opti
   log.format = LogFormatOf(path);
   if (log.format == LogFormat::kRosbag) {
     RefuseCsvOptions(path, options.csv);
-    RosbagSamples bag = ReadRosbagSamples(path, {options.topic, options.temp_topic, options.csv.temp_c});
-    if (digest != nullptr) HashFile(path, digest);
+    // The file is hashed by a thread of its own while rosbag parses it: a bag is about three times
+    // the size of the same samples as CSV, and its hash would cost as much as the parse.
+    std::exception_ptr hash_error;
+    std::thread hasher;
+    if (digest != nullptr) {
+      hasher = std::thread([&] {
+        try {
+          HashFile(path, digest);
+        } catch (...) {
+          hash_error = std::current_exception();
+        }
+      });
+    }
+    RosbagSamples bag;
+    try {
+      bag = ReadRosbagSamples(path, {options.topic, options.temp_topic, options.csv.temp_c});
+    } catch (...) {
+      if (hasher.joinable()) hasher.join();
+      throw;
+    }
+    if (hasher.joinable()) hasher.join();
+    if (hash_error) std::rethrow_exception(hash_error);
     log.samples = std::move(bag.samples);
     log.topic = std::move(bag.topic);
     log.temp_topic = std::move(bag.temp_topic);

@@ -36,11 +36,6 @@ std::string StampText(int64_t ns) {
   return text;
 }
 
-// The place of message `index` (1-based) of `topic`, for an error message.
-std::string MessagePlace(const std::string& topic, long long index) {
-  return "topic " + QuoteForMessage(topic) + ", message " + std::to_string(index);
-}
-
 // The topics of `types` in the bag, each once, in the bag's order, and the whole list as text.
 struct Topics {
   std::map<std::string, std::string> type_of;  // topic -> datatype
@@ -90,22 +85,33 @@ std::string ChooseTopic(const std::string& path, const Topics& topics, const std
                              "): choose one with " + option);
 }
 
-// Throws unless `value` is finite.
-void CheckFinite(const std::string& path, const std::string& place, const char* field, double value) {
+// A message of a topic: its place in error messages, built only when one is thrown (a bag has
+// millions of messages).
+struct MessageAt {
+  const std::string& path;
+  const std::string& topic;
+  long long index;  // 1-based
+  [[noreturn]] void Fail(const std::string& message) const {
+    throw InputError(
+        path, "topic " + QuoteForMessage(topic) + ", message " + std::to_string(index) + ": " + message);
+  }
+};
+
+// Fails unless `value` is finite.
+void CheckFinite(const MessageAt& at, const char* field, const char* axis, double value) {
   if (!std::isfinite(value))
-    throw InputError(path, place + ": " + field + ": " + FormatDouble(value) + " is not a finite number");
+    at.Fail(std::string(field) + axis + ": " + FormatDouble(value) + " is not a finite number");
 }
 
-void CheckVector(const std::string& path, const std::string& place, const char* field,
-                 const geometry_msgs::Vector3& v, const boost::array<double, 9>& covariance) {
-  // REP 145 / sensor_msgs/Imu: covariance element 0 = -1 says the driver has no such data.
+void CheckVector(const MessageAt& at, const char* field, const geometry_msgs::Vector3& v,
+                 const boost::array<double, 9>& covariance) {
+  // sensor_msgs/Imu: covariance element 0 = -1 says the driver has no such data.
   if (covariance[0] == -1.0)
-    throw InputError(path, place + ": " + field + "_covariance[0] is -1: the driver publishes no " + field +
-                               " (sensor_msgs/Imu), so it cannot be calibrated");
-  const std::string name = field;
-  CheckFinite(path, place, (name + ".x").c_str(), v.x);
-  CheckFinite(path, place, (name + ".y").c_str(), v.y);
-  CheckFinite(path, place, (name + ".z").c_str(), v.z);
+    at.Fail(std::string(field) + "_covariance[0] is -1: the driver publishes no " + field +
+            " (sensor_msgs/Imu), so it cannot be calibrated");
+  CheckFinite(at, field, ".x", v.x);
+  CheckFinite(at, field, ".y", v.y);
+  CheckFinite(at, field, ".z", v.z);
 }
 
 struct TemperatureReading {
@@ -156,6 +162,11 @@ class BagReading {
                        "thermometer give its temperature (--temp-c)");
     std::vector<std::string> wanted{result_.topic};
     if (!result_.temp_topic.empty()) wanted.push_back(result_.temp_topic);
+    {
+      const size_t messages = rosbag::View(bag_, rosbag::TopicQuery(result_.topic)).size();  // from the index
+      result_.samples.reserve(messages);
+      imu_stamps_ns_.reserve(messages);
+    }
     rosbag::View view(bag_, rosbag::TopicQuery(wanted));
     for (const rosbag::MessageInstance& message : view) {
       if (message.getTopic() == result_.topic) {
@@ -172,30 +183,27 @@ class BagReading {
 
  private:
   template <typename Message>
-  boost::shared_ptr<Message> Instantiate(const rosbag::MessageInstance& message, const std::string& place) {
+  boost::shared_ptr<Message> Instantiate(const rosbag::MessageInstance& message, const MessageAt& at) {
     boost::shared_ptr<Message> read = message.instantiate<Message>();
     if (!read)
-      throw InputError(path_, place + ": a " + message.getDataType() + " (definition md5 " +
-                                  message.getMD5Sum() + ") where " +
-                                  ros::message_traits::DataType<Message>::value() + " (md5 " +
-                                  ros::message_traits::MD5Sum<Message>::value() + ") was expected");
+      at.Fail("a " + message.getDataType() + " (definition md5 " + message.getMD5Sum() + ") where " +
+              ros::message_traits::DataType<Message>::value() + " (md5 " +
+              ros::message_traits::MD5Sum<Message>::value() + ") was expected");
     return read;
   }
 
   void ReadImu(const rosbag::MessageInstance& message) {
     ++imu_messages_;
-    const std::string place = MessagePlace(result_.topic, imu_messages_);
-    const boost::shared_ptr<sensor_msgs::Imu> imu = Instantiate<sensor_msgs::Imu>(message, place);
+    const MessageAt at{path_, result_.topic, imu_messages_};
+    const boost::shared_ptr<sensor_msgs::Imu> imu = Instantiate<sensor_msgs::Imu>(message, at);
     const int64_t stamp_ns = StampNs(imu->header.stamp);
     if (imu_messages_ == 1) first_ns_ = stamp_ns;
     if (imu_messages_ > 1 && stamp_ns <= last_ns_)
-      throw InputError(path_, place + ": header.stamp " + StampText(stamp_ns) +
-                                  " is not after the previous message's " + StampText(last_ns_) +
-                                  " (the samples' time must increase)");
+      at.Fail("header.stamp " + StampText(stamp_ns) + " is not after the previous message's " +
+              StampText(last_ns_) + " (the samples' time must increase)");
     last_ns_ = stamp_ns;
-    CheckVector(path_, place, "angular_velocity", imu->angular_velocity, imu->angular_velocity_covariance);
-    CheckVector(path_, place, "linear_acceleration", imu->linear_acceleration,
-                imu->linear_acceleration_covariance);
+    CheckVector(at, "angular_velocity", imu->angular_velocity, imu->angular_velocity_covariance);
+    CheckVector(at, "linear_acceleration", imu->linear_acceleration, imu->linear_acceleration_covariance);
     Sample sample;
     sample.time_s = static_cast<double>(stamp_ns - first_ns_) * 1e-9;
     sample.gyro << imu->angular_velocity.x, imu->angular_velocity.y, imu->angular_velocity.z;
@@ -206,18 +214,17 @@ class BagReading {
   }
 
   void ReadTemperature(const rosbag::MessageInstance& message) {
-    const std::string place = MessagePlace(result_.temp_topic, ++result_.temp_readings);
+    const MessageAt at{path_, result_.temp_topic, ++result_.temp_readings};
     const boost::shared_ptr<sensor_msgs::Temperature> reading =
-        Instantiate<sensor_msgs::Temperature>(message, place);
+        Instantiate<sensor_msgs::Temperature>(message, at);
     const int64_t stamp_ns = StampNs(reading->header.stamp);
     if (!temps_.empty() && stamp_ns <= temps_.back().stamp_ns)
-      throw InputError(path_, place + ": header.stamp " + StampText(stamp_ns) +
-                                  " is not after the previous message's " +
-                                  StampText(temps_.back().stamp_ns) + " (the readings' time must increase)");
-    CheckFinite(path_, place, "temperature", reading->temperature);
+      at.Fail("header.stamp " + StampText(stamp_ns) + " is not after the previous message's " +
+              StampText(temps_.back().stamp_ns) + " (the readings' time must increase)");
+    CheckFinite(at, "temperature", "", reading->temperature);
     if (const std::string problem = TemperatureProblem(reading->temperature, temps_.empty());
         !problem.empty())
-      throw InputError(path_, place + ": temperature: " + problem);
+      at.Fail("temperature: " + problem);
     temps_.push_back({stamp_ns, reading->temperature});
   }
 
@@ -230,12 +237,11 @@ class BagReading {
       int64_t gap_ns = 0;
       const std::optional<double> temp_c = TemperatureAt(temps_, imu_stamps_ns_[i], &cursor, &gap_ns);
       if (!temp_c)
-        throw InputError(path_, MessagePlace(result_.topic, static_cast<long long>(i) + 1) +
-                                    ": header.stamp " + StampText(imu_stamps_ns_[i]) + " is " +
-                                    FormatDouble(static_cast<double>(gap_ns) * 1e-9) +
-                                    " s from the nearest reading of " + QuoteForMessage(result_.temp_topic) +
-                                    " (at most " + FormatDouble(kMaxTemperatureGapS) +
-                                    " s): its temperature is unknown");
+        MessageAt{path_, result_.topic, static_cast<long long>(i) + 1}.Fail(
+            "header.stamp " + StampText(imu_stamps_ns_[i]) + " is " +
+            FormatDouble(static_cast<double>(gap_ns) * 1e-9) + " s from the nearest reading of " +
+            QuoteForMessage(result_.temp_topic) + " (at most " + FormatDouble(kMaxTemperatureGapS) +
+            " s): its temperature is unknown");
       result_.samples[i].temp_c = *temp_c;
     }
   }
