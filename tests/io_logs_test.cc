@@ -304,6 +304,15 @@ TEST_F(RosbagTest, RefusesWhatIsNotAWholeBag) {
   }
 }
 
+// fuzz/regressions/fuzz_rosbag/: a connection record's header length corrupted to 2.3 GB, which
+// rosbag allocated before reading (a libFuzzer out-of-memory); the structure check refuses it first.
+TEST_F(RosbagTest, RefusesALengthPastTheEndBeforeRosbagAllocatesIt) {
+  const std::string path = std::string(IMUFIT_FUZZ_REGRESSIONS_DIR) + "/fuzz_rosbag/header-length-2gb.bag";
+  const std::string error = ErrorOf(path, kAt25C);
+  EXPECT_TRUE(HasText(error, ": not a readable ROS bag: at byte ")) << error;
+  EXPECT_TRUE(HasText(error, "past the end of the file")) << error;
+}
+
 TEST_F(RosbagTest, LogSamplesTellABagFromACsvByItsFirstBytes) {
   const std::string bag = WriteImuBag("session.dat", 50);  // the name says nothing
   const std::string csv = Path("session.bag");             // nor here

@@ -7,12 +7,15 @@
 #include <sensor_msgs/Temperature.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <map>
 #include <new>
+#include <set>
 
 #include "imufit/io/error.h"
 #include "imufit/io/output_file.h"
@@ -138,11 +141,132 @@ std::optional<double> TemperatureAt(const std::vector<TemperatureReading>& readi
   return before->temp_c + share * (after->temp_c - before->temp_c);
 }
 
+// The structure of a bag (format 2.0, wiki.ros.org/Bags/Format/2.0) checked before rosbag reads it:
+// rosbag allocates whatever a record's length field says (a corrupted length of 2 GB is a 2 GB
+// allocation) and seeks wherever the file header and the chunk infos point. Every top-level
+// record's lengths must lie within the file, its header fields within the header, the index and
+// every chunk must start at a record, and a chunk may not claim more than kMaxChunkBytes unpacked.
+constexpr uint64_t kMaxChunkBytes = uint64_t{1} << 30;  // rosbag writes chunks of about 768 kB
+constexpr std::string_view kRosbagV2Magic = "#ROSBAG V2.0\n";
+
+class BagStructure {
+ public:
+  explicit BagStructure(const std::string& path) : path_(path), file_(std::fopen(path.c_str(), "rb")) {
+    if (file_ == nullptr) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  }
+  ~BagStructure() { std::fclose(file_); }
+  BagStructure(const BagStructure&) = delete;
+  BagStructure& operator=(const BagStructure&) = delete;
+
+  void Check() {
+    std::fseek(file_, 0, SEEK_END);
+    const long end = std::ftell(file_);
+    if (end < 0) throw InputError(path_, "cannot read its size");
+    size_ = static_cast<uint64_t>(end);
+    std::string magic(kRosbagV2Magic.size(), '\0');
+    std::fseek(file_, 0, SEEK_SET);
+    if (std::fread(magic.data(), 1, magic.size(), file_) != magic.size() || magic != kRosbagV2Magic) {
+      const size_t line = magic.find('\n');
+      throw InputError(path_, "a ROS bag of format " + QuoteForMessage(magic.substr(0, line)) +
+                                  ": imufit reads format 2.0 (#ROSBAG V2.0, every ROS 1 since 2010)");
+    }
+    uint64_t index_pos = 0;
+    std::set<uint64_t> chunk_starts;
+    std::vector<uint64_t> chunk_pointers;
+    for (uint64_t pos = kRosbagV2Magic.size(); pos < size_;) {
+      const uint64_t header_len = ReadLength(pos, "a record's header length");
+      const std::map<std::string, std::string> fields = ReadHeader(pos + 4, header_len);
+      const uint64_t data_at = pos + 4 + header_len;
+      const uint64_t data_len = ReadLength(data_at, "a record's data length");
+      const auto op = fields.find("op");
+      if (op == fields.end() || op->second.size() != 1) Fail(pos, "a record without its op field");
+      const char code = op->second[0];
+      if (code == 0x03) index_pos = Field64(fields, "index_pos", pos);
+      if (code == 0x05) {
+        chunk_starts.insert(pos);
+        if (Field32(fields, "size", pos) > kMaxChunkBytes)
+          Fail(pos, "a chunk claims " + std::to_string(Field32(fields, "size", pos)) + " bytes unpacked");
+      }
+      if (code == 0x06) chunk_pointers.push_back(Field64(fields, "chunk_pos", pos));
+      record_starts_.insert(pos);
+      pos = data_at + 4 + data_len;
+    }
+    if (index_pos != 0 && record_starts_.count(index_pos) == 0)
+      Fail(13, "the file header's index_pos " + std::to_string(index_pos) + " is not at a record");
+    for (uint64_t chunk : chunk_pointers) {
+      if (chunk_starts.count(chunk) == 0)
+        Fail(index_pos, "a chunk info points at " + std::to_string(chunk) + ", where no chunk starts");
+    }
+  }
+
+ private:
+  [[noreturn]] void Fail(uint64_t at, const std::string& message) const {
+    throw InputError(path_, "not a readable ROS bag: at byte " + std::to_string(at) + ": " + message);
+  }
+
+  // The 4-byte little-endian length at `pos`, whose bytes must follow it within the file.
+  uint64_t ReadLength(uint64_t pos, const char* what) {
+    unsigned char bytes[4];
+    if (pos + 4 > size_ || std::fseek(file_, static_cast<long>(pos), SEEK_SET) != 0 ||
+        std::fread(bytes, 1, 4, file_) != 4)
+      Fail(pos, std::string(what) +
+                    " past the end of the file (cut short? `rosbag reindex` may repair a recording that was "
+                    "not closed)");
+    const uint64_t length = bytes[0] | bytes[1] << 8 | bytes[2] << 16 | uint64_t{bytes[3]} << 24;
+    if (length > size_ - pos - 4)
+      Fail(pos, std::string(what) + " of " + std::to_string(length) +
+                    " bytes, past the end of the file (cut short? `rosbag reindex` may repair a recording "
+                    "that was not closed)");
+    return length;
+  }
+
+  std::map<std::string, std::string> ReadHeader(uint64_t pos, uint64_t length) {
+    std::string header(length, '\0');
+    if (std::fread(header.data(), 1, length, file_) != length) Fail(pos, "cannot read a record's header");
+    std::map<std::string, std::string> fields;
+    for (size_t at = 0; at < header.size();) {
+      if (header.size() - at < 4) Fail(pos + at, "a header field's length cut short");
+      const auto* b = reinterpret_cast<const unsigned char*>(header.data() + at);
+      const uint64_t field_len = b[0] | b[1] << 8 | b[2] << 16 | uint64_t{b[3]} << 24;
+      if (field_len > header.size() - at - 4) Fail(pos + at, "a header field longer than its header");
+      const std::string field = header.substr(at + 4, field_len);
+      const size_t equals = field.find('=');
+      if (equals == std::string::npos) Fail(pos + at, "a header field without '='");
+      fields[field.substr(0, equals)] = field.substr(equals + 1);
+      at += 4 + field_len;
+    }
+    return fields;
+  }
+
+  uint64_t Field(const std::map<std::string, std::string>& fields, const char* name, size_t bytes,
+                 uint64_t pos) const {
+    const auto found = fields.find(name);
+    if (found == fields.end() || found->second.size() != bytes)
+      Fail(pos, std::string("a record without its ") + name + " field");
+    uint64_t value = 0;
+    for (size_t i = 0; i < bytes; ++i)
+      value |= uint64_t{static_cast<unsigned char>(found->second[i])} << (8 * i);
+    return value;
+  }
+  uint64_t Field32(const std::map<std::string, std::string>& fields, const char* name, uint64_t pos) const {
+    return Field(fields, name, 4, pos);
+  }
+  uint64_t Field64(const std::map<std::string, std::string>& fields, const char* name, uint64_t pos) const {
+    return Field(fields, name, 8, pos);
+  }
+
+  const std::string& path_;
+  std::FILE* file_;
+  uint64_t size_ = 0;
+  std::set<uint64_t> record_starts_;
+};
+
 class BagReading {
  public:
   BagReading(const std::string& path, const RosbagOptions& options) : path_(path), options_(options) {}
 
   RosbagSamples Read() {
+    BagStructure(path_).Check();
     bag_.open(path_, rosbag::bagmode::Read);
     Topics topics;
     {
