@@ -161,6 +161,7 @@ def test_bad_bag_is_refused_with_one_located_line_and_exit_2(run_imufit, fixture
     cut.write_bytes(bag.read_bytes()[: bag.stat().st_size // 2])
     result = run_imufit("fit", "--field", "--samples", cut, "-o", out, check=False)
     assert result.returncode == 2
-    assert result.stderr.startswith(f"imufit: {cut}: not a readable ROS bag (rosbag: ")
+    assert result.stderr.startswith(f"imufit: {cut}: not a readable ROS bag")
+    assert "rosbag reindex" in result.stderr
     assert result.stderr.count("\n") == 1
     assert not out.exists()
