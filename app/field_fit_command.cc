@@ -88,6 +88,15 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
           "a second session of the same unit by hand: fitted alike and compared, coefficient by coefficient, "
           "against the two sessions' combined sigma (is the procedure repeatable?); the file is the first's")
       .Needs(field);
+  command
+      .Option("--topic", &args->topics.topic,
+              "a ROS bag's sensor_msgs/Imu topic to read (default: the bag's only one; docs/field.md)")
+      .Needs(field);
+  command
+      .Option("--temp-topic", &args->topics.temp_topic,
+              "a ROS bag's sensor_msgs/Temperature topic, interpolated at the IMU stamps (default: the bag's "
+              "only one, if it has one; without one, give --temp-c)")
+      .Needs(field);
   args->options.Add(command, FieldFitOptionTable());
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key).Needs(field);
 }
@@ -127,8 +136,8 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   options.fit_g_sensitivity = run.fit.Fits(true, kGSensitivityCoefficient);
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit --field", problem);
-  const FieldRunResult result =
-      FieldFitRun(samples, run.input, options, SoftwareVersion(), serial, run.allow_serial_mismatch);
+  const FieldRunResult result = FieldFitRun(samples, run.input, options, SoftwareVersion(), serial,
+                                            run.allow_serial_mismatch, args.topics);
   const FieldFitSummary& fit = result.fit;
   // At order 0 the coefficients are constant in temperature: a unit that warmed during the
   // session is fitted at its mean, its drift taken for noise.
@@ -148,8 +157,16 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
     return 1;
   }
   if (!quiet) {
+    if (result.format == LogFormat::kRosbag) {
+      std::printf(
+          "imufit fit --field: read the ROS bag's topic %s (sensor_msgs/Imu, SI units: raw units rad/s "
+          "and m/s^2)%s%s\n",
+          result.topic.c_str(), result.temp_topic.empty() ? "" : ", temperature from ",
+          result.temp_topic.c_str());
+    }
     if (run.input.temp_c) {
-      std::printf("imufit fit --field: note: no temp_c column, every sample at %g degC (--temp-c)\n",
+      std::printf("imufit fit --field: note: no %s, every sample at %g degC (--temp-c)\n",
+                  result.format == LogFormat::kRosbag ? "temperature topic" : "temp_c column",
                   *run.input.temp_c);
     }
     std::printf("imufit fit --field: %s\n", fit.BriefReport().c_str());
@@ -165,7 +182,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   if (!args.repeat.empty()) {
     RefuseToOverwriteInputs(output, {args.repeat});
     const FieldRunResult second = FieldFitRun(args.repeat, run.input, options, SoftwareVersion(),
-                                              result.serial, run.allow_serial_mismatch);
+                                              result.serial, run.allow_serial_mismatch, args.topics);
     if (!second.fit.IsSolutionUsable()) {
       std::fprintf(stderr, "imufit: %s (--repeat): %s, nothing written\n", args.repeat.c_str(),
                    second.fit.BriefReport().c_str());

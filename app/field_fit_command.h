@@ -8,6 +8,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "imufit/fit/field_fit.h"
+#include "imufit/pipeline/field_run.h"
 #include "imufit/pipeline/fit_run.h"
 
 namespace imufit {
@@ -16,6 +17,7 @@ struct FieldFitArguments {
   bool field = false;                   // --field: a session by hand
   CliOptions<FieldFitOptions> options;  // FieldFitOptionTable()
   std::string repeat;                   // --repeat: a second session of the unit, compared
+  LogTopics topics;                     // --topic, --temp-topic: a ROS bag's topics
 };
 
 // Adds --field and the field fit's own options (which need it) to `command`.

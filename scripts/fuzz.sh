@@ -21,7 +21,7 @@ while [[ $# -gt 0 ]]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[[ ${#targets[@]} -gt 0 ]] || targets=(fuzz_samples fuzz_plan fuzz_calibration fuzz_limits fuzz_series)
+[[ ${#targets[@]} -gt 0 ]] || targets=(fuzz_samples fuzz_plan fuzz_calibration fuzz_limits fuzz_series fuzz_rosbag)
 
 imufit_fuzz_available || imufit_die "fuzzing needs clang++ with libFuzzer (Debian: apt-get install clang libfuzzer-14-dev)"
 
@@ -33,10 +33,12 @@ CC=clang CXX=clang++ imufit_build "$dir" imufit_fuzz -- -DCMAKE_C_COMPILER=clang
 # Seeds: the fixtures (plans, calibrations; the first rows of each samples file, plain and gzip).
 seeds=$dir/seeds
 rm -rf "$seeds"
-mkdir -p "$seeds"/{fuzz_samples,fuzz_plan,fuzz_calibration,fuzz_limits,fuzz_series}
+mkdir -p "$seeds"/{fuzz_samples,fuzz_plan,fuzz_calibration,fuzz_limits,fuzz_series,fuzz_rosbag}
 cp "$IMUFIT_ROOT"/fixtures/plan_*.yaml "$seeds/fuzz_plan/"
 cp "$IMUFIT_ROOT"/fixtures/*_truth.yaml "$IMUFIT_ROOT"/fixtures/golden/*.yaml "$seeds/fuzz_calibration/"
 cp "$IMUFIT_ROOT"/fuzz/seeds/limits*.yaml "$seeds/fuzz_limits/"
+# Small bags written by ROS's own rosbag (plain, LZ4, BZ2; with and without a temperature topic).
+cp "$IMUFIT_ROOT"/fuzz/seeds/rosbag/*.bag "$seeds/fuzz_rosbag/"
 # Inputs that once failed (fuzz/regressions/TARGET/): run first, every time.
 for regressions in "$IMUFIT_ROOT"/fuzz/regressions/*/; do
   cp "$regressions"* "$seeds/$(basename "$regressions")/"
@@ -61,8 +63,11 @@ for target in "${targets[@]}"; do
   imufit_say "$target: ${seconds} s"
   log=$dir/$target.log
   # -rss_limit_mb: the readers' limits keep memory bounded; -timeout: no input may take 10 s.
+  # -max_len: a bag's header record alone is padded to 4 kB, and message definitions follow.
+  max_len=8192
+  [[ $target != fuzz_rosbag ]] || max_len=32768
   if ! (cd "$dir" && "$dir/fuzz/$target" "$corpus" "$seeds/$target" -max_total_time="$seconds" \
-          -timeout=10 -rss_limit_mb=2048 -max_len=8192 -jobs="$jobs" -workers="$jobs" \
+          -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" -jobs="$jobs" -workers="$jobs" \
           -print_final_stats=1 -artifact_prefix="$dir/artifacts/$target-" >"$log" 2>&1); then
     tail -n 60 "$log" >&2
     imufit_say "$target FAILED: see $log and $dir/artifacts/"

@@ -8,22 +8,26 @@ IMUFIT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 # What building imufit (the command, tests, benchmarks and Python module left out) and running
 # scripts/example.sh need, as Debian packages: the compiler and build tools, and every library the
 # build's CMake requires (Eigen and Ceres, yaml-cpp, CLI11, zlib, OpenSSL's libcrypto, ISA-L,
-# SQLite and PostgreSQL's libpq for the results store). scripts/example.sh configures with
+# SQLite and PostgreSQL's libpq for the results store, ROS 1's rosbag_storage and sensor_msgs for
+# sessions recorded as bags). scripts/example.sh configures with
 # IMUFIT_EXAMPLE_CMAKE_ARGS, so that GoogleTest, Google Benchmark and pybind11 are not needed;
 # scripts/test.sh turns them on again in the same build folder (IMUFIT_TEST_CMAKE_ARGS).
 IMUFIT_APT_PACKAGES=(cmake ninja-build g++ pkg-config libceres-dev libeigen3-dev libyaml-cpp-dev libcli11-dev
-                     zlib1g-dev libssl-dev libisal-dev libsqlite3-dev libpq-dev)
+                     zlib1g-dev libssl-dev libisal-dev libsqlite3-dev libpq-dev librosbag-storage-dev
+                     libsensor-msgs-dev)
 IMUFIT_EXAMPLE_CMAKE_ARGS=(-DIMUFIT_BUILD_TESTS=OFF -DIMUFIT_BUILD_BENCH=OFF -DIMUFIT_BUILD_PYTHON=OFF)
 
 # What the whole suite needs besides (scripts/test.sh): GoogleTest and Google Benchmark, the
 # Python module's build and tests, gnuplot for the plots, Chromium and poppler-utils for the
 # printed certificates, a PostgreSQL server for the store's tests, the ARM cross-compiler for the
-# C runtime's Cortex-M4 build, clang with libFuzzer and clang-format, ccache, JSON Schema.
+# C runtime's Cortex-M4 build, clang with libFuzzer and clang-format, ccache, JSON Schema, ROS's
+# Python rosbag and sensor_msgs (the tests write bags with ROS's own writer).
 IMUFIT_TEST_CMAKE_ARGS=(-DIMUFIT_BUILD_TESTS=ON -DIMUFIT_BUILD_BENCH=ON -UIMUFIT_BUILD_PYTHON -DIMUFIT_WERROR=ON)
 IMUFIT_TEST_APT_PACKAGES=(libgtest-dev libbenchmark-dev gnuplot-nox pybind11-dev python3-pybind11 python3-dev
                           python3-numpy python3-pytest python3-yaml python3-matplotlib python3-setuptools
                           python3-wheel python3-pip clang clang-format libfuzzer-14-dev chromium poppler-utils
-                          ccache gcc-arm-none-eabi libnewlib-arm-none-eabi python3-jsonschema postgresql)
+                          ccache gcc-arm-none-eabi libnewlib-arm-none-eabi python3-jsonschema postgresql
+                          python3-rosbag python3-sensor-msgs)
 
 # True when clang++ can link a libFuzzer program (scripts/fuzz.sh).
 imufit_fuzz_available() {

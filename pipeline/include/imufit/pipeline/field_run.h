@@ -15,6 +15,7 @@
 
 #include "imufit/fit/field_fit.h"
 #include "imufit/io/calibration.h"
+#include "imufit/io/log_samples.h"
 #include "imufit/pipeline/segment_run.h"
 
 namespace imufit {
@@ -26,15 +27,26 @@ struct FieldRunResult {
   std::string samples_sha256;
   std::string serial;  // `serial` given, else the samples header's (unit_serial.h)
   std::vector<std::string> serial_warnings;
+  LogFormat format = LogFormat::kSamplesCsv;  // the log's (io/log_samples.h)
+  std::string topic, temp_topic;              // a bag's topics read ("" for a CSV)
 };
 
-// Reads `samples_path` as `input` says (its segment column, if any, is not used) and fits it.
+// A bag's topics to read (--topic, --temp-topic; "" = the bag's only one).
+struct LogTopics {
+  std::string topic;
+  std::string temp_topic;
+};
+
+// Reads `samples_path` as `input` says (its segment column, if any, is not used) and fits it. The
+// file is a samples CSV or a ROS 1 bag (told by its first bytes, io/log_samples.h; `topics` choose
+// the bag's topics).
 // `software` and the unit's serial go into the calibration: `serial` as stated (--serial), else the
 // samples header's; a stated serial that contradicts the header is refused (InputError at the
 // header) unless `allow_serial_mismatch`, as for a table fit. Throws InputError for bad input.
 FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& input,
                            const FieldFitOptions& options, const std::string& software,
-                           const std::string& serial, bool allow_serial_mismatch);
+                           const std::string& serial, bool allow_serial_mismatch,
+                           const LogTopics& topics = {});
 
 // The calibration of a usable field fit (what FieldFitRun writes), without the record's file names.
 Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& options);
