@@ -34,6 +34,8 @@ FieldRecord FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& opti
     field.latitude_deg = *options.latitude_deg;
     field.height_m = options.height_m;
   } else {
+    // The default, 9.80665, is standard gravity whoever typed it (as FieldFitOptions::Validate
+    // takes it): the site unknown, its uncertainty the widest (conservative).
     field.gravity_source =
         std::string(options.gravity_mps2 == kStandardGravityMps2 ? kGravityStandard : kGravityStated);
   }
