@@ -526,6 +526,38 @@ TEST_F(CliTest, FieldCalibrationCertificate) {
   EXPECT_EQ(site["fit"]["field"]["height_m"].as<double>(), 520.0);
 }
 
+// The certificate by hand prints to PDF as a table run's does (headless Chromium): on at most
+// kMostFieldCertificatePages of A4, every page naming it a certificate by hand, the reference statement
+// in the text.
+TEST_F(CliTest, FieldCertificatePrintsToPdf) {
+  if (!std::filesystem::exists("/usr/bin/chromium") || !std::filesystem::exists("/usr/bin/pdftotext") ||
+      !std::filesystem::exists("/usr/bin/pdfinfo")) {
+    GTEST_SKIP() << "no chromium, pdftotext or pdfinfo (Debian: chromium poppler-utils)";
+  }
+  constexpr int kMostFieldCertificatePages = 3;
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--serial", "SN-HAND-3"})).status, 0);
+  const std::string cal = Path("cal.yaml");
+  ASSERT_EQ(Run({"fit", "--field", "--samples", raw, "-o", cal, "-q"}).status, 0);
+  const RunResult r = Run({"report", "-c", cal, "-s", raw, "-o", Path("hand.html"), "--pdf"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote " + Path("hand.html") + " and " + Path("hand.pdf")), std::string::npos)
+      << r.out;
+  const RunResult info = RunProgram("/usr/bin/pdfinfo", {Path("hand.pdf")});
+  ASSERT_EQ(info.status, 0) << info.err;
+  const size_t at = info.out.find("Pages:");
+  ASSERT_NE(at, std::string::npos) << info.out;
+  const int pages = std::stoi(info.out.substr(at + 6));
+  EXPECT_GE(pages, 1);
+  EXPECT_LE(pages, kMostFieldCertificatePages);
+  const RunResult text = RunProgram("/usr/bin/pdftotext", {Path("hand.pdf"), "-"});
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("IMU calibration certificate (by hand) SN-HAND-3"), std::string::npos);
+  EXPECT_NE(text.out.find("without a reference table or a known rate"), std::string::npos);
+  EXPECT_NE(text.out.find("page " + std::to_string(pages) + " of " + std::to_string(pages)),
+            std::string::npos);
+}
+
 // fit --field refuses what a certificate needs and the session does not give, before any work.
 TEST_F(CliTest, FieldCertificateOptionsAreChecked) {
   const std::string raw = Path("session.csv");
