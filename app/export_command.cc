@@ -7,6 +7,7 @@
 #include "imufit/export/export.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/error.h"
+#include "imufit/io/noise_file.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/sha256.h"
 
@@ -15,6 +16,7 @@ namespace {
 
 struct ExportArguments {
   std::string calibration;
+  std::string noise;  // --noise: a noise block (imufit allan --noise-yaml) used as if appended
   std::string output;
   std::vector<double> max_loss = {0.5, 10.0};  // worst case: deg/s, mg
   bool force = false;
@@ -39,13 +41,33 @@ ExportOptions ResolveOptions(const ExportArguments& args) {
   return options;
 }
 
+// --noise: the noise block of `noise_path` in the calibration, as if appended to its file. A
+// calibration with a block of its own is refused (one or the other); a block measured through
+// another calibration (its calibration_sha256) is warned about: its figures are that one's SI.
+void AddNoiseBlock(const std::string& noise_path, const std::string& calibration_path,
+                   Calibration* calibration) {
+  if (calibration->noise) {
+    throw InputError("--noise", "the calibration " + calibration_path +
+                                    " has a noise: block of its own: give one or the other, not both");
+  }
+  calibration->noise = ReadNoiseFile(noise_path);
+  const std::string& measured_through = calibration->noise->calibration_sha256;
+  if (!measured_through.empty() && measured_through != Sha256OfFile(calibration_path)) {
+    std::fprintf(stderr,
+                 "imufit: warning: %s: the noise was measured through another calibration (SHA-256 %s...) "
+                 "than %s: its figures are in that calibration's units\n",
+                 noise_path.c_str(), measured_through.substr(0, 16).c_str(), calibration_path.c_str());
+  }
+}
+
 int RunExport(const ExportArguments& args) {
   ExportOptions options = ResolveOptions(args);
   if (!(args.max_loss[0] >= 0.0) || !(args.max_loss[1] >= 0.0)) {
     throw InputError("--max-loss", "the bounds must be two non-negative numbers: deg/s,mg");
   }
-  RefuseToOverwriteInputs(args.output, {args.calibration});
-  const Calibration calibration = ReadCalibration(args.calibration);
+  RefuseToOverwriteInputs(args.output, {args.calibration, args.noise});
+  Calibration calibration = ReadCalibration(args.calibration);
+  if (!args.noise.empty()) AddNoiseBlock(args.noise, args.calibration, &calibration);
   CheckCalibratedSensors(calibration, args.calibration, CalibrationUse::kExport, args.allow_uncalibrated);
   options.software = SoftwareVersion();
   options.calibration_file = args.calibration;
@@ -80,6 +102,9 @@ int RunExport(const ExportArguments& args) {
 CommandRunner AddExportCommand(CliCommand command) {
   auto args = std::make_shared<ExportArguments>();
   command.Option("--calibration,-c", &args->calibration, "calibration YAML (imufit fit's output)").Required();
+  command.Option("--noise", &args->noise,
+                 "the unit's noise figures, a file of imufit allan --noise-yaml, used as if appended to the "
+                 "calibration (Kalibr needs them)");
   args->options.AddOne(command, ExportOptionTable(), "format");
   args->options.Find("format").Required().DefaultText("");
   command.Option("--output,-o", &args->output, "the file to write").Required();

@@ -101,23 +101,6 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key).Needs(field);
 }
 
-// The options of a table fit that also mean something to a session by hand: how the samples are
-// read, the serial, the g-sensitivity, and how rests are told from motion.
-bool AppliesToAFieldFit(const std::string& key) {
-  static const char* const kKeys[] = {"temp_c",
-                                      "time_unit",
-                                      "delimiter",
-                                      "decimal_comma",
-                                      "column",
-                                      "allow_serial_mismatch",
-                                      "fit_g_sensitivity",
-                                      "segment_window_s",
-                                      "segment_noise_quantile",
-                                      "segment_threshold_factor",
-                                      "min_steady_s"};
-  return std::find(std::begin(kKeys), std::end(kKeys), key) != std::end(kKeys);
-}
-
 void RefuseTableOptions(const FitRunArguments& run) {
   for (const auto& entry : FitRunOptionTable().entries()) {
     if (!entry.flag.empty() && run.options.Given(entry.key) && !AppliesToAFieldFit(entry.key)) {
@@ -128,7 +111,8 @@ void RefuseTableOptions(const FitRunArguments& run) {
 }
 
 int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
-                const std::string& serial, bool quiet, const FitRunOptions& run) {
+                const std::string& serial, bool quiet, const FitRunOptions& run,
+                const std::function<int(const FieldRunResult&)>& certify) {
   RefuseToOverwriteInputs(output, {samples});
   FieldFitOptions options;
   args.options.Apply(&options);
@@ -190,6 +174,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
     }
     if (!quiet) PrintRepeatability(args.repeat, fit, second.fit);
   }
+  if (certify) return certify(result);
   WriteCalibration(output, *result.calibration);
   if (!quiet) std::printf("  wrote %s\n", output.c_str());
   return 0;

@@ -3,6 +3,7 @@
 #ifndef IMUFIT_APP_FIELD_FIT_COMMAND_H_
 #define IMUFIT_APP_FIELD_FIT_COMMAND_H_
 
+#include <functional>
 #include <string>
 
 #include "cli_options.h"
@@ -32,8 +33,12 @@ void RefuseTableOptions(const FitRunArguments& run);
 // With --repeat, the second session is fitted alike and compared (CompareFieldFits); the file is
 // the first session's. Returns the exit status: 0, or 1 when a session does not determine the
 // model (the message says what it lacks) or the fit does not converge; nothing is written then.
+// `certify`, when given (fit --field --limits/--report/--store), takes the usable fit in place of
+// writing the calibration (it certifies, judges, writes and records it: CertifyUnit) and returns
+// the exit status.
 int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
-                const std::string& serial, bool quiet, const FitRunOptions& run);
+                const std::string& serial, bool quiet, const FitRunOptions& run,
+                const std::function<int(const FieldRunResult&)>& certify = {});
 
 }  // namespace imufit
 

@@ -241,37 +241,69 @@ int ReportCertified(const FitArguments& args, const UnitOutcome& unit, bool reco
   return judged && !unit.verdict->pass ? kExitFailedLimits : 0;
 }
 
-int RunFit(const FitArguments& args) {
-  if (args.field.field) {
-    if (!args.plan.empty()) throw InputError("--plan", "a session by hand (--field) has no plan");
-    for (const std::string* factory : {&args.limits, &args.report, &args.store, &args.station}) {
-      if (!factory->empty())
-        throw InputError("--field", "limits, certificates and the store take table runs only");
-    }
-    RefuseTableOptions(args.run);
-    return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, ResolveOptions(args));
-  }
-  if (args.plan.empty()) throw InputError("imufit fit", "--plan is required (or --field)");
-  const std::string check_plan = args.run.options.GivenText("check_plan");
-  const std::string check_samples = args.run.options.GivenText("check_samples");
-  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, check_plan, check_samples, args.limits,
-                                        args.run.options.GivenText("prior")});
-  if (!args.report.empty()) {
-    RefuseToOverwriteInputs(args.report, {args.plan, args.samples, check_plan, check_samples, args.limits,
-                                          args.output, args.station});
-  }
+// The checks of --report, --pdf, --customer and --order every fit makes; returns the PDF's path ("": none).
+std::string CheckCertificateOutputs(const FitArguments& args, const std::vector<std::string>& inputs) {
+  if (!args.report.empty()) RefuseToOverwriteInputs(args.report, inputs);
   if (args.pdf.pdf && args.report.empty())
     throw InputError("--pdf", "prints the certificate: give --report too");
   if ((!args.customer.customer.empty() || !args.customer.order.empty()) && args.report.empty())
     throw InputError(args.customer.customer.empty() ? "--order" : "--customer",
                      "is shown on the certificate: give --report too");
   args.customer.Check();
-  const Paper paper = args.pdf.Resolve();
   const std::string pdf = args.pdf.pdf ? PdfPathFor(args.report) : "";
-  if (!pdf.empty()) {
-    RefuseToOverwriteInputs(
-        pdf, {args.plan, args.samples, check_plan, check_samples, args.limits, args.output, args.station});
+  if (!pdf.empty()) RefuseToOverwriteInputs(pdf, inputs);
+  return pdf;
+}
+
+// fit --field: written as it is, or with --limits, --report or --store certified, judged and
+// recorded as a table fit is (CertifyUnit; the certificate of a calibration by hand, certificate.h).
+int RunCertifiedFieldFit(const FitArguments& args) {
+  if (!args.plan.empty()) throw InputError("--plan", "a session by hand (--field) has no plan");
+  RefuseTableOptions(args.run);
+  const FitRunOptions options = ResolveOptions(args);
+  const std::string pdf =
+      CheckCertificateOutputs(args, {args.samples, args.limits, args.output, args.station});
+  if (args.limits.empty() && args.report.empty() && args.store.empty()) {
+    if (!args.station.empty())
+      throw InputError("--station", "is shown on the certificate: give --report too");
+    return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, options);
   }
+  const Paper paper = args.pdf.Resolve();
+  std::unique_ptr<ResultsStore> store;
+  CertifySettings settings = ReadFactoryInputs(args, options, &store);
+  settings.fit_options = "field";
+  const auto certify = [&](const FieldRunResult& result) {
+    UnitOutcome unit;
+    unit.samples_path = args.samples;
+    unit.samples_sha256 = result.samples_sha256;
+    unit.serial = result.serial;
+    unit.warnings = result.serial_warnings;
+    FitRunResult& fit = unit.fit.emplace();
+    fit.calibration = result.calibration;
+    fit.serial = result.serial;
+    // What the samples header said, as the record keeps it (the store's acquisition time and model).
+    const FitRecord& record = *result.calibration->fit;
+    fit.run.header.acquired_utc = record.acquired_utc.value_or("");
+    fit.run.header.model = record.unit_model.value_or("");
+    fit.run.header.firmware = record.unit_firmware.value_or("");
+    fit.run.header.ambient = record.ambient.value_or("");
+    const bool recorded = CertifyUnit(settings, {args.output, args.report, pdf, paper, {}}, &unit);
+    if (!pdf.empty() && !args.quiet && recorded) std::printf("  wrote %s\n", pdf.c_str());
+    return ReportCertified(args, unit, recorded);
+  };
+  return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, options, certify);
+}
+
+int RunFit(const FitArguments& args) {
+  if (args.field.field) return RunCertifiedFieldFit(args);
+  if (args.plan.empty()) throw InputError("imufit fit", "--plan is required (or --field)");
+  const std::string check_plan = args.run.options.GivenText("check_plan");
+  const std::string check_samples = args.run.options.GivenText("check_samples");
+  RefuseToOverwriteInputs(args.output, {args.plan, args.samples, check_plan, check_samples, args.limits,
+                                        args.run.options.GivenText("prior")});
+  const std::string pdf = CheckCertificateOutputs(
+      args, {args.plan, args.samples, check_plan, check_samples, args.limits, args.output, args.station});
+  const Paper paper = args.pdf.Resolve();
   const FitRunOptions options = ResolveOptions(args);
   std::unique_ptr<ResultsStore> store;
   const CertifySettings settings = ReadFactoryInputs(args, options, &store);

@@ -58,19 +58,23 @@ int RunReport(const ReportArguments& args) {
   UnitOutcome unit;
   FitRunResult& fit = unit.fit.emplace();
   Calibration calibration = ReadCalibration(args.calibration);
-  // fit --field: no table run whose known truths a certificate states errors against.
-  if (calibration.body_frame) {
-    throw InputError(
-        args.calibration,
-        "a calibration by hand (body_frame: " + *calibration.body_frame +
-            ", imufit fit --field) cannot be certified against a table run: the certificate states "
-            "its errors on the rate table's known truths (docs/field.md)");
+  // fit --field: certified from its own record and its session, without a plan or a table run
+  // (docs/factory.md, "A calibration by hand").
+  const bool by_hand = calibration.body_frame.has_value();
+  if (by_hand && !args.plan.empty()) {
+    throw InputError("--plan", "a calibration by hand (body_frame: " + *calibration.body_frame +
+                                   ", imufit fit --field) has no plan: give only its samples file");
+  }
+  if (!by_hand && args.plan.empty()) {
+    throw InputError("imufit report",
+                     "--plan is required: the certificate of a table calibration states its "
+                     "errors on the plan's known truths");
   }
   // A sensor the calibration does not calibrate is marked on the certificate, never certified as fitted.
   for (std::string& note : CheckCalibratedSensors(calibration, args.calibration, CalibrationUse::kCertify,
                                                   /*allow_uncalibrated=*/true))
     unit.warnings.push_back(std::move(note));
-  fit.plan = ReadPlan(args.plan);
+  if (!by_hand) fit.plan = ReadPlan(args.plan);
   // The calibration's serial, unless --serial corrects it; a calibration fitted without one takes
   // the unit's own log's, then the plan's. Sources that disagree are warned about (unit_serial.h).
   SerialSource stated, stated_by_calibration, plan;
@@ -81,8 +85,9 @@ int RunReport(const ReportArguments& args) {
   stated_by_calibration.serial = calibration.serial;
   plan.name = "the plan " + args.plan;
   plan.serial = fit.plan.serial;
-  UnitSerial serial = ResolveSerial({stated, stated_by_calibration, SamplesHeaderSerial(args.samples), plan},
-                                    args.allow_mismatch);
+  std::vector<SerialSource> sources = {stated, stated_by_calibration, SamplesHeaderSerial(args.samples)};
+  if (!by_hand) sources.push_back(plan);
+  UnitSerial serial = ResolveSerial(sources, args.allow_mismatch);
   calibration.serial = serial.serial;
   for (const std::string& w : serial.warnings) {
     unit.warnings.push_back(w);
@@ -98,9 +103,12 @@ int RunReport(const ReportArguments& args) {
     unit.warnings.push_back(m + " (certified with --allow-mismatch)");
     std::fprintf(stderr, "imufit: warning: %s: %s\n", args.calibration.c_str(), m.c_str());
   }
-  // Read once for the windows, the hash and the noise section's static stretch.
-  RunReader reader(fit.plan, args.samples, input);
-  fit.run = reader.Read(windows, settings.noise_stretch);
+  // Read once for the windows, the hash and the noise section's static stretch; a session by hand
+  // is certified from its calibration's record (its samples file only hashed).
+  if (!by_hand) {
+    RunReader reader(fit.plan, args.samples, input);
+    fit.run = reader.Read(windows, settings.noise_stretch);
+  }
   fit.calibration = std::move(calibration);
   unit.serial = fit.calibration->serial;
   unit.plan_path = args.plan;
@@ -166,7 +174,8 @@ void WarnIfNoSerial(const std::string& serial, const std::string& file) {
 CommandRunner AddReportCommand(CliCommand command) {
   auto args = std::make_shared<ReportArguments>();
   command.Option("--calibration,-c", &args->calibration, "calibration YAML").Required();
-  command.Option("--plan,-p", &args->plan, "plan YAML of the run").Required();
+  command.Option("--plan,-p", &args->plan,
+                 "plan YAML of the run (required, except for a calibration by hand: imufit fit --field)");
   command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz) of the run").Required();
   command.Option("--limits,-l", &args->limits, "acceptance limits YAML");
   command.Option("--output,-o", &args->output, "HTML file to write").Required();

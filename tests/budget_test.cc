@@ -626,5 +626,52 @@ TEST_F(BudgetTest, StationDeclaresSources) {
   EXPECT_THROW(ReadStation(path), InputError);
 }
 
+// A calibration by hand (ComputeFieldBudget): Type A alone but for the local gravity, whose share
+// follows from the field fit's invariance under g -> g (1 + e), S_a -> S_a / (1 + e), H -> H / (1 + e):
+// every accelerometer scale factor moves by S_a (1 / (1 + u/g) - 1), no gyro bias, scale or
+// misalignment moves; by where gravity came from.
+TEST(FieldBudget, GravityShareBySourceAndNothingElse) {
+  Calibration cal = ReadCalibration(std::string(IMUFIT_FIXTURES_DIR) + "/golden/mems_field_session.yaml");
+  ASSERT_EQ(cal.fit->field->gravity_source.value_or(""), "standard");
+  constexpr double kRelative = 1e-9;  // the share against its closed form, relative
+  const auto share = [&](const UncertaintyBudget& budget, const std::string& name) {
+    const FigureBudget* f = budget.Find(name);
+    EXPECT_NE(f, nullptr) << name;
+    if (f == nullptr) return 0.0;
+    double sum = 0.0;
+    for (const BudgetLine& line : f->type_b) sum += line.contribution * line.contribution;
+    EXPECT_NEAR(f->expanded, 2.0 * std::hypot(f->type_a, std::sqrt(sum)), 1e-12 * f->expanded) << name;
+    return std::sqrt(sum);
+  };
+  for (const auto& [source, u_mps2] : {std::pair{"standard", kStandardGravityHalfWidthMps2 / std::sqrt(3.0)},
+                                       {"latitude", kNormalGravityAnomalyMps2},
+                                       {"stated", 0.0}}) {
+    cal.fit->field->gravity_source = std::string(source);
+    const UncertaintyBudget budget = ComputeFieldBudget(cal);
+    EXPECT_EQ(budget.inputs.size(), u_mps2 > 0.0 ? 1u : 0u) << source;
+    const double g = *cal.fit->field->gravity_mps2;
+    for (const char* axis : {".x", ".y", ".z"}) {
+      const std::string scale = std::string("accel_scale_per_g") + axis;
+      const double value = budget.Find(scale)->value;
+      EXPECT_NEAR(share(budget, scale), std::abs(value * (1.0 / (1.0 + u_mps2 / g) - 1.0)),
+                  kRelative * std::abs(value) * u_mps2 / g + 1e-15)
+          << source << scale;
+      for (const char* gyro : {"gyro_bias_dps", "gyro_scale_per_dps"})
+        EXPECT_EQ(share(budget, std::string(gyro) + axis), 0.0) << source << gyro << axis;
+    }
+    EXPECT_EQ(share(budget, "gyro_misalignment_mrad.xy"), 0.0) << source;
+    // The statements: what U covers by the source, and never a station's errors.
+    EXPECT_NE(budget.covers.find(u_mps2 > 0.0 ? "the uncertainty of the local gravity" : "taken as exact"),
+              std::string::npos)
+        << budget.covers;
+    EXPECT_NE(budget.not_covered.find("No reference table or known rate was used"), std::string::npos);
+    // At another temperature (a statistic over a range): the same share at order 0.
+    const std::vector<FigureBudget> at_30 = budget.At(cal, 30.0);
+    ASSERT_EQ(at_30.size(), budget.figures.size());
+    for (size_t i = 0; i < at_30.size(); ++i)
+      EXPECT_NEAR(at_30[i].expanded, budget.figures[i].expanded, 1e-9 * budget.figures[i].expanded + 1e-15);
+  }
+}
+
 }  // namespace
 }  // namespace imufit

@@ -97,6 +97,56 @@ TEST_F(CliTest, ExportBadInvocationsAndUnexportableCalibrations) {
 
 // The autopilots' device IDs and instances, the envelope's temperatures and a unit in counts
 // exported with the default driver scale: each refusal (exit 2, nothing written) names the option.
+// --noise: the noise block of `imufit allan --noise-yaml` as if appended (the same file as the block
+// appended by hand); refused with a calibration that has a block of its own, warned about when the
+// block was measured through another calibration.
+TEST_F(CliTest, ExportTakesTheNoiseBlockOfItsOwnFile) {
+  const std::string cal = Fixture("mems_truth.yaml");
+  const std::vector<std::string> kalibr = {
+      "-f", "kalibr", "--gyro-raw-per-radps", "939.65", "--accel-raw-per-mps2", "208.838", "--force", "-q"};
+  const std::string static_run = StaticRun("static.csv", 300, 25, 7);
+  const std::string noise = Path("noise.yaml");
+  ASSERT_EQ(Run({"allan", "-q", "-s", static_run, "--calibration", cal, "-o", Path("allan.csv"), "--columns",
+                 "gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z", "--noise-yaml", noise})
+                .status,
+            0);
+  std::vector<std::string> args = {"export", "-c", cal, "--noise", noise, "-o", Path("given.yaml")};
+  args.insert(args.end(), kalibr.begin(), kalibr.end());
+  RunResult r = Run(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("measured through another calibration"), std::string::npos) << r.err;
+  std::ifstream truth(cal), block(noise);
+  const std::string appended = Path("appended.yaml");
+  std::ofstream(appended) << truth.rdbuf() << block.rdbuf();
+  args = {"export", "-c", appended, "-o", Path("by_hand.yaml")};
+  args.insert(args.end(), kalibr.begin(), kalibr.end());
+  ASSERT_EQ(Run(args).status, 0);
+  // The same Kalibr content; the provenance comment names the calibration file given.
+  const auto content = [](const std::string& path) {
+    std::ifstream in(path);
+    std::string line, text;
+    while (std::getline(in, line))
+      if (line.rfind("#", 0) != 0) text += line + "\n";
+    return text;
+  };
+  EXPECT_EQ(content(Path("given.yaml")), content(Path("by_hand.yaml")));
+  EXPECT_NE(content(Path("given.yaml")).find("gyroscope_noise_density"), std::string::npos);
+  args = {"export", "-c", appended, "--noise", noise, "-o", Path("both.yaml")};
+  args.insert(args.end(), kalibr.begin(), kalibr.end());
+  r = Run(args);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--noise: the calibration " + appended + " has a noise: block of its own"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(Path("both.yaml")));
+  // Measured through another calibration of the unit: written, with a warning.
+  args = {"export", "-c", Fixture("golden/mems_6pos_soak.yaml"), "--noise", noise, "-o", Path("other.yaml")};
+  args.insert(args.end(), kalibr.begin(), kalibr.end());
+  r = Run(args);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("the noise was measured through another calibration"), std::string::npos) << r.err;
+}
+
 TEST_F(CliTest, ExportRefusalsNameTheOptionThatChangesThem) {
   const std::string cal = Fixture("mems_truth.yaml");
   const std::vector<std::string> driver = {"--gyro-raw-per-radps", "939.65", "--accel-raw-per-mps2",

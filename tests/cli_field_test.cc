@@ -343,15 +343,235 @@ TEST_F(CliTest, FieldCalibrationDownstream) {
         Run({"export", "-c", cal, "-f", format, "-o", Path(std::string("out.") + format), "-q"});
     EXPECT_EQ(r.status, 0) << format << ": " << r.err;
   }
+  // A calibration by hand has no plan: report refuses one, saying why, and writes nothing.
   const std::string html = Path("report.html");
   const RunResult r = Run({"report", "-c", cal, "-p", Fixture("plan_6pos.yaml"), "-s", raw, "-o", html});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(
-      r.err.find(
-          "a calibration by hand (body_frame: accelerometer_xy, imufit fit --field) cannot be certified"),
+      r.err.find("a calibration by hand (body_frame: accelerometer_xy, imufit fit --field) has no plan"),
       std::string::npos)
       << r.err;
   EXPECT_FALSE(std::filesystem::exists(html));
+}
+
+// The text of a certificate's element with data-key="key" (tags stripped); "" when there is none.
+std::string CertificateText(const std::string& html, const std::string& key) {
+  const size_t at = html.find("data-key=\"" + key + "\"");
+  if (at == std::string::npos) return "";
+  const size_t from = html.find('>', at) + 1;
+  std::string text;
+  int depth = 0;
+  for (size_t i = from; i < html.size(); ++i) {
+    if (html.compare(i, 2, "</") == 0) {
+      if (depth == 0) break;
+      --depth;
+      i = html.find('>', i);
+    } else if (html[i] == '<') {
+      ++depth;
+      i = html.find('>', i);
+    } else {
+      text += html[i];
+    }
+  }
+  for (const auto& [entity, character] :
+       {std::pair{"&#39;", "'"}, {"&quot;", "\""}, {"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}}) {
+    for (size_t at = text.find(entity); at != std::string::npos; at = text.find(entity, at + 1))
+      text.replace(at, std::string(entity).size(), character);
+  }
+  return text;
+}
+
+// The U printed in the certificate's coefficient table for figure `name` (the cell after its 1-sigma).
+double PrintedExpanded(const std::string& html, const std::string& name) {
+  size_t at = html.find("data-figure=\"" + name + "\"");
+  if (at == std::string::npos) return -1.0;
+  for (int cell = 0; cell < 2; ++cell) at = html.find("<td", at + 1);
+  const size_t from = html.find('>', at) + 1;
+  return std::stod(html.substr(from, html.find('<', from) - from));
+}
+
+// One column of the figures a results store recorded, by figure name, as "name=value;...".
+std::string StoredFigures(const std::string& db, const std::string& column) {
+  return RunProgram("/usr/bin/python3",
+                    {"-c",
+                     "import sqlite3, sys\n"
+                     "rows = sqlite3.connect(sys.argv[1]).execute('SELECT name, ' + sys.argv[2] + "
+                     "' FROM figures ORDER BY name').fetchall()\n"
+                     "print(';'.join('%s=%r' % r for r in rows))\n",
+                     db, column},
+                    db + ".out", db + ".err")
+      .out;
+}
+
+double StoredFigure(const std::string& db, const std::string& name, const std::string& column) {
+  const std::string out =
+      RunProgram("/usr/bin/python3",
+                 {"-c",
+                  "import sqlite3, sys\n"
+                  "print(repr(sqlite3.connect(sys.argv[1]).execute('SELECT ' + sys.argv[3] + "
+                  "' FROM figures WHERE name = ?', (sys.argv[2],)).fetchone()[0]))\n",
+                  db, name, column},
+                 db + ".out", db + ".err")
+          .out;
+  return std::stod(out);
+}
+
+// Issue 32 item 5: the certificate of a calibration by hand says that no reference table was used,
+// states the session, and its U covers the session's noise and the gravity value's uncertainty (by
+// where gravity came from), nothing of a station. The U printed is the one the store records, and
+// the verdict is the same whether or not the page is written (fit --field --limits, with and without
+// --report; imufit report of the calibration).
+TEST_F(CliTest, FieldCalibrationCertificate) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--serial", "SN-HAND-1"})).status, 0);
+  // Accelerometer bias x is about +17.03 mg with U about 0.1 mg: 17.1 lies within the guard band.
+  const std::string limits = Path("limits.yaml");
+  std::ofstream(limits)
+      << "format: imufit-limits\nversion: 1\nname: hand limits\nnominal: {accel_scale: 210}\n"
+         "decision_rule: guarded\nguard_band: 1\ncriteria:\n"
+         "  - {quantity: gyro_bias_dps, max_abs: 5}\n"
+         "  - {quantity: accel_bias_mg, axes: [x], max_abs: 17.1}\n"
+         "  - {quantity: accel_scale_error_pct, max_abs: 5}\n";
+  const auto fit = [&](const std::string& name, const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {
+        "fit",  "--field", "--samples",       raw, "-o", Path(name + ".yaml"), "--limits",
+        limits, "--store", Path(name + ".db")};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Run(args);
+  };
+  const RunResult plain = fit("plain", {});
+  const RunResult certified = fit("certified", {"--report", Path("certified.html")});
+  EXPECT_EQ(plain.status, 3) << plain.out << plain.err;  // failed limits
+  EXPECT_EQ(certified.status, plain.status) << certified.out << certified.err;
+  const auto table = [](const std::string& out) {
+    const size_t from = out.find("  acceptance");
+    return from == std::string::npos ? std::string() : out.substr(from, out.find("  wrote", from) - from);
+  };
+  ASSERT_FALSE(table(plain.out).empty()) << plain.out;
+  EXPECT_EQ(table(plain.out), table(certified.out));
+  EXPECT_NE(table(plain.out).find("inside the guard band"), std::string::npos) << table(plain.out);
+  for (const char* column : {"expanded_u", "outcome", "judgement"})
+    EXPECT_EQ(StoredFigures(Path("plain.db"), column), StoredFigures(Path("certified.db"), column)) << column;
+
+  // imufit report of the calibration: the same verdict, no plan.
+  const std::string cal = Path("plain.yaml");
+  const std::string page = Path("report.html");
+  const RunResult report = Run({"report", "-c", cal, "-s", raw, "-l", limits, "-o", page});
+  EXPECT_EQ(report.status, 3) << report.out << report.err;
+  EXPECT_NE(report.out.find("(acceptance FAIL)"), std::string::npos) << report.out;
+  std::ifstream in(page);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // What the certificate says of its references, the frame and the session.
+  EXPECT_NE(CertificateText(html, "field_reference").find("without a reference table or a known rate"),
+            std::string::npos);
+  EXPECT_EQ(CertificateText(html, "body_frame"), "accelerometer_xy");
+  EXPECT_EQ(CertificateText(html, "field_poses"), "12");
+  EXPECT_EQ(CertificateText(html, "field_turns"), "11");
+  EXPECT_EQ(CertificateText(html, "field_saturated_turns"), "0");
+  EXPECT_NE(CertificateText(html, "field_gravity").find("standard gravity (no local gravity given)"),
+            std::string::npos);
+  EXPECT_NE(CertificateText(html, "temp_range_c").find("25.0 .. 25.0 degC"), std::string::npos);
+  EXPECT_NE(CertificateText(html, "field_accel_norm_rms_mg").find(" mg"), std::string::npos);
+  EXPECT_NE(CertificateText(html, "field_direction_rms_deg").find(" deg"), std::string::npos);
+  EXPECT_EQ(CertificateText(html, "field_noise_scales"), "1, 1, 1");
+  EXPECT_EQ(CertificateText(html, "verdict"), "FAIL");
+  EXPECT_EQ(CertificateText(html, "unit_serial"), "SN-HAND-1");
+  const std::string covers = CertificateText(html, "budget_covers");
+  EXPECT_NE(covers.find("hand tremor"), std::string::npos) << covers;
+  EXPECT_NE(covers.find("the uncertainty of the local gravity 9.80665"), std::string::npos) << covers;
+  const std::string not_covered = CertificateText(html, "budget_not_covered");
+  EXPECT_NE(not_covered.find("no table's or station's errors"), std::string::npos) << not_covered;
+  EXPECT_NE(not_covered.find("drift after the session"), std::string::npos) << not_covered;
+  EXPECT_NE(CertificateText(html, "noise_not_measured").find("imufit allan --noise-yaml"), std::string::npos);
+  EXPECT_EQ(html.find("rate table"), std::string::npos);  // no table, not even a line to fill in
+
+  // U: the fit's 2 sigma with, for standard gravity, the accelerometer scale's share of a gravity
+  // anywhere on Earth (half width 0.03 m/s^2, rectangular), computed here from the sigma recorded.
+  const Calibration calibration = ReadCalibration(cal);
+  for (const char* axis : {"x", "y", "z"}) {
+    const std::string name = std::string("accel_scale_per_g.") + axis;
+    const double value = StoredFigure(Path("plain.db"), name, "value");
+    const double sigma = StoredFigure(Path("plain.db"), name, "sigma");
+    const double u_g = 0.03 / std::sqrt(3.0) / kGravityMps2;
+    const double expected = 2.0 * std::hypot(sigma, value * (1.0 - 1.0 / (1.0 + u_g)));
+    const double stored = StoredFigure(Path("plain.db"), name, "expanded_u");
+    EXPECT_NEAR(stored, expected, 1e-9 * expected) << name;
+    EXPECT_GT(stored, 10.0 * 2.0 * sigma) << name;  // gravity dominates: about 0.35 % of the scale
+    // The page prints it to two significant digits.
+    const double printed = PrintedExpanded(html, name);
+    const double digit = std::pow(10.0, std::floor(std::log10(stored)) - 1.0);
+    EXPECT_NEAR(printed, stored, 0.5 * digit + 1e-12) << name;
+  }
+  // A gyro figure has no share of gravity: U = 2 sigma.
+  const double sigma = StoredFigure(Path("plain.db"), "gyro_bias_dps.x", "sigma");
+  EXPECT_NEAR(StoredFigure(Path("plain.db"), "gyro_bias_dps.x", "expanded_u"), 2.0 * sigma, 1e-12 * sigma);
+
+  // Gravity stated (--gravity-mps2): taken as exact, said so; the accelerometer scale's U is 2 sigma.
+  // (a value of exactly 9.80665 is standard gravity, taken as unknown: the option's default.)
+  ASSERT_EQ(fit("stated", {"--gravity-mps2", "9.8125", "--report", Path("stated.html")}).status, 3);
+  const YAML::Node stated = YAML::LoadFile(Path("stated.yaml"));
+  EXPECT_EQ(stated["fit"]["field"]["gravity_source"].as<std::string>(), "stated");
+  const double stated_sigma = StoredFigure(Path("stated.db"), "accel_scale_per_g.x", "sigma");
+  EXPECT_NEAR(StoredFigure(Path("stated.db"), "accel_scale_per_g.x", "expanded_u"), 2.0 * stated_sigma,
+              1e-12 * stated_sigma);
+  std::ifstream stated_in(Path("stated.html"));
+  const std::string stated_html((std::istreambuf_iterator<char>(stated_in)),
+                                std::istreambuf_iterator<char>());
+  EXPECT_NE(CertificateText(stated_html, "budget_covers").find("taken as exact"), std::string::npos);
+  // From the latitude: WGS-84 normal gravity, recorded with the site.
+  ASSERT_EQ(fit("site", {"--latitude", "48.1", "--height-m", "520"}).status, 3);
+  const YAML::Node site = YAML::LoadFile(Path("site.yaml"));
+  EXPECT_EQ(site["fit"]["field"]["gravity_source"].as<std::string>(), "latitude");
+  EXPECT_EQ(site["fit"]["field"]["latitude_deg"].as<double>(), 48.1);
+  EXPECT_EQ(site["fit"]["field"]["height_m"].as<double>(), 520.0);
+}
+
+// The certificate by hand prints to PDF as a table run's does (headless Chromium): on at most
+// kMostFieldCertificatePages of A4, every page naming it a certificate by hand, the reference statement
+// in the text.
+TEST_F(CliTest, FieldCertificatePrintsToPdf) {
+  if (!std::filesystem::exists("/usr/bin/chromium") || !std::filesystem::exists("/usr/bin/pdftotext") ||
+      !std::filesystem::exists("/usr/bin/pdfinfo")) {
+    GTEST_SKIP() << "no chromium, pdftotext or pdfinfo (Debian: chromium poppler-utils)";
+  }
+  constexpr int kMostFieldCertificatePages = 3;
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {"--serial", "SN-HAND-3"})).status, 0);
+  const std::string cal = Path("cal.yaml");
+  ASSERT_EQ(Run({"fit", "--field", "--samples", raw, "-o", cal, "-q"}).status, 0);
+  const RunResult r = Run({"report", "-c", cal, "-s", raw, "-o", Path("hand.html"), "--pdf"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote " + Path("hand.html") + " and " + Path("hand.pdf")), std::string::npos)
+      << r.out;
+  const RunResult info = RunProgram("/usr/bin/pdfinfo", {Path("hand.pdf")});
+  ASSERT_EQ(info.status, 0) << info.err;
+  const size_t at = info.out.find("Pages:");
+  ASSERT_NE(at, std::string::npos) << info.out;
+  const int pages = std::stoi(info.out.substr(at + 6));
+  EXPECT_GE(pages, 1);
+  EXPECT_LE(pages, kMostFieldCertificatePages);
+  const RunResult text = RunProgram("/usr/bin/pdftotext", {Path("hand.pdf"), "-"});
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("IMU calibration certificate (by hand) SN-HAND-3"), std::string::npos);
+  EXPECT_NE(text.out.find("without a reference table or a known rate"), std::string::npos);
+  EXPECT_NE(text.out.find("page " + std::to_string(pages) + " of " + std::to_string(pages)),
+            std::string::npos);
+}
+
+// fit --field refuses what a certificate needs and the session does not give, before any work.
+TEST_F(CliTest, FieldCertificateOptionsAreChecked) {
+  const std::string raw = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(raw, {})).status, 0);
+  const std::string out = Path("cal.yaml");
+  RunResult r = Run({"fit", "--field", "--samples", raw, "-o", out, "--pdf"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--pdf: prints the certificate: give --report too"), std::string::npos) << r.err;
+  r = Run({"fit", "--field", "--samples", raw, "-o", out, "--report", raw});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  r = Run({"report", "-c", Fixture("golden/mems_6pos_soak.yaml"), "-s", raw, "-o", Path("r.html")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--plan is required"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -56,8 +56,10 @@ void LowerTimesRotation(const Eigen::Matrix3d& g, Eigen::Matrix3d* lower, Eigen:
 double NoiseFigure(const KalibrNoiseRecord& figures, double KalibrNoiseRecord::*figure, const char* key) {
   const double value = figures.*figure;
   if (!(value > 0.0) || !std::isfinite(value)) {
-    throw ExportError(std::string("Kalibr needs noise.kalibr.") + key +
-                      " > 0 in the calibration (append the noise block of `imufit allan --noise-yaml`)");
+    throw ExportError(
+        std::string("Kalibr needs noise.kalibr.") + key +
+        " > 0 in the calibration (append the noise block of `imufit allan --noise-yaml`, or give it with "
+        "`imufit export --noise`)");
   }
   return value;
 }

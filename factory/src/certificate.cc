@@ -11,6 +11,7 @@
 #include "imufit/factory/report.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/sha256.h"
+#include "imufit/io/units.h"
 #include "imufit/model/check.h"
 #include "imufit/report/engineering_units.h"
 
@@ -235,7 +236,8 @@ void ReadCertificateFiles(CertificateSources* sources) {
       if (input.role == "samples" && !input.path.empty()) sources->header = ReadRunHeader(input.path);
     }
   }
-  if (sources->noise) return;
+  // A session by hand has no static stretch to measure the noise on (MakeCertificate says so).
+  if (sources->noise || sources->calibration.body_frame) return;
   // The stretch the run's reading kept (the file is not read again), else measured on the file.
   if (sources->run.static_stretch) {
     sources->noise = GyroNoise(sources->calibration, *sources->run.static_stretch);
@@ -248,8 +250,78 @@ void ReadCertificateFiles(CertificateSources* sources) {
   }
 }
 
+namespace {
+
+// The session of a calibration by hand, from its records.
+FieldSession SummariseField(const Calibration& cal) {
+  FieldSession f;
+  f.body_frame = cal.body_frame.value_or("");
+  f.temp_range_c = cal.fit_temp_range_c;
+  if (!cal.fit) return f;
+  const FitRecord& fit = *cal.fit;
+  f.samples = fit.samples_read.value_or(-1);
+  f.temp_order = std::max(fit.gyro_temp_order.value_or(0), fit.accel_temp_order.value_or(0));
+  f.g_sensitivity_fitted = fit.g_sensitivity_fitted.value_or(true);
+  f.iterations = fit.iterations.value_or(-1);
+  f.termination = fit.termination.value_or("");
+  if (const size_t end = f.termination.find(". "); end != std::string::npos) f.termination.resize(end + 1);
+  if (!fit.field) return f;
+  const FieldRecord& r = *fit.field;
+  f.poses = r.poses.value_or(-1);
+  f.turns = r.turns.value_or(-1);
+  f.saturated_turns = r.saturated_turns.value_or(-1);
+  f.gravity_mps2 = r.gravity_mps2.value_or(0.0);
+  f.gravity_source = r.gravity_source.value_or("");
+  // A calibration written before the record said where gravity came from: 9.80665 is the default.
+  if (f.gravity_source.empty() && f.gravity_mps2 == kStandardGravityMps2) f.gravity_source = kGravityStandard;
+  f.latitude_deg = r.latitude_deg;
+  f.height_m = r.height_m;
+  if (r.accel_norm_rms_mps2) f.accel_norm_rms_mg = MgFromMps2(*r.accel_norm_rms_mps2);
+  if (r.gyro_static_rms_radps) f.gyro_static_rms_dps = DpsFromRadps(*r.gyro_static_rms_radps);
+  if (r.gravity_direction_rms_rad) f.direction_rms_deg = *r.gravity_direction_rms_rad * kRadToDeg;
+  f.reduced_chi2 = r.reduced_chi2.value_or(-1.0);
+  f.noise_scale = {r.noise_scale_accel_rests.value_or(-1.0), r.noise_scale_gyro_rests.value_or(-1.0),
+                   r.noise_scale_turns.value_or(-1.0)};
+  return f;
+}
+
+// A calibration by hand: its session, its budget (no station's), its figures and verdict.
+Certificate MakeFieldCertificate(const CertificateSources& sources) {
+  const Calibration& cal = sources.calibration;
+  Certificate c;
+  Identify(sources, &c);
+  c.field = SummariseField(cal);
+  c.run.temp_range_c = c.field->temp_range_c;
+  c.run.gravity_mps2 = c.field->gravity_mps2;
+  c.run.latitude_deg = c.field->latitude_deg;
+  c.run.samples = c.field->samples;
+  c.settings = Settings(cal, sources.windows);
+  if (sources.station && !sources.station->uncertainty.empty()) {
+    c.warnings.push_back("the station file declares Type B sources (" +
+                         std::to_string(sources.station->uncertainty.size()) +
+                         "): they are a rate table's and a fixture's, and a calibration by hand used "
+                         "neither, so U does not include them");
+  }
+  if (c.field->saturated_turns > 0) {
+    c.warnings.push_back(std::to_string(c.field->saturated_turns) +
+                         " turn(s) touched the gyro's converter limit and were left out of the fit");
+  }
+  c.budget = ComputeFieldBudget(cal);
+  c.figures = FigureRows(cal, c.budget);
+  c.noise.why_not =
+      "a session by hand has no static stretch long enough for an Allan deviation (measure the noise on a "
+      "static recording: imufit allan --noise-yaml)";
+  c.verdict = sources.verdict;
+  // The calibration's own figures (a `noise:` block measured by imufit allan, if any): nothing measured here.
+  if (sources.limits) c.verdict = EvaluateLimits(*sources.limits, cal, {}, &c.budget);
+  return c;
+}
+
+}  // namespace
+
 Certificate MakeCertificate(const CertificateSources& sources) {
   const Calibration& cal = sources.calibration;
+  if (cal.body_frame) return MakeFieldCertificate(sources);
   Certificate c;
   Identify(sources, &c);
   c.run = SummariseRun(cal, sources.plan, sources.run);

@@ -55,12 +55,16 @@ void BudgetSection(Html* h, const Certificate& c) {
     h->Element("td", top.empty() ? "none declared" : top).Element("td", k.unit).Close("tr");
   }
   h->Close("tbody").Close("table");
-  h->Element(
-      "p",
-      "Each contribution is the change of the figure when the fit is solved again with the plan's truth "
-      "off by one standard uncertainty of the source (GUM 5.1.3); the contributions and the fit's own "
-      "uncertainty add in quadrature; U = 2 u_c.",
-      {{"class", "note"}});
+  h->Element("p",
+             c.field
+                 ? "The contribution of gravity is the change of the figure with gravity off by one standard "
+                   "uncertainty (GUM 5.1.3): the field fit's cost is unchanged when gravity, the "
+                   "accelerometer's scale factors and the gyro's g-sensitivity scale together, so the "
+                   "change is exact; it and the fit's own uncertainty add in quadrature; U = 2 u_c."
+                 : "Each contribution is the change of the figure when the fit is solved again with the "
+                   "plan's truth off by one standard uncertainty of the source (GUM 5.1.3); the "
+                   "contributions and the fit's own uncertainty add in quadrature; U = 2 u_c.",
+             {{"class", "note"}});
   h->Close("div");
 }
 

@@ -161,9 +161,10 @@ std::string EquipmentText(const StationEquipment& e) {
 void Station(Html* h, const Certificate& c) {
   h->Open("div").Open("table", {{"class", "fill"}});
   if (!c.station) {
-    for (const char* field : {"laboratory", "station", "location", "rate table", "chamber",
-                              "reference equipment calibrated until"})
-      Row(h, {field, ""});
+    // A calibration by hand used no rate table, chamber or reference equipment.
+    static const char* const kTableFields[] = {
+        "laboratory", "station", "location", "rate table", "chamber", "reference equipment calibrated until"};
+    for (size_t i = 0; i < (c.field ? 3 : std::size(kTableFields)); ++i) Row(h, {kTableFields[i], ""});
     h->Close("table").Close("div");
     return;
   }
@@ -417,8 +418,11 @@ void KeyFigures(Html* h, const Certificate& c) {
   h->Open("div", {{"class", "keep"}});
   h->Element("h2", "Coefficients at 25 degC");
   h->Element("p",
-             "1-sigma from the fit's covariance (Type A); U is the expanded uncertainty of the budget below "
-             "(Type A and the station's Type B sources) at k = 2 (about 95 % for a normal distribution).",
+             std::string("1-sigma from the fit's covariance (Type A); U is the expanded uncertainty of the "
+                         "budget below (") +
+                 (c.field ? "Type A and the local gravity's uncertainty"
+                          : "Type A and the station's Type B sources") +
+                 ") at k = 2 (about 95 % for a normal distribution).",
              {{"class", "note"}});
   h->Open("div", {{"class", "cols"}});
   h->Open("div");
@@ -665,23 +669,94 @@ std::vector<PlotFigure> CertificatePlots(const Certificate& c) {
   return in_page_order;
 }
 
+// A calibration by hand: what it was referred to, and the session in place of the plan and the run.
+void FieldSessionSection(Html* h, const Certificate& c) {
+  const FieldSession& f = *c.field;
+  h->Element("h2", "Calibration by hand: references");
+  h->Element("p", kFieldReferenceStatement, {{"data-key", "field_reference"}});
+  h->Open("div", {{"class", "cols"}});
+  h->Open("div").Element("h2", "Session").Open("table");
+  const auto row = [&](const std::string& name, const std::string& value, const char* key) {
+    h->Open("tr").Element("td", name).Element("td", value, {{"data-key", key}}).Close("tr");
+  };
+  const auto known = [](double v, const std::string& text) {
+    return v < 0.0 ? std::string("not recorded") : text;
+  };
+  row("body frame", f.body_frame, "body_frame");
+  row("poses at rest", f.poses < 0 ? "not recorded" : Count(f.poses), "field_poses");
+  row("turns between them", f.turns < 0 ? "not recorded" : Count(f.turns), "field_turns");
+  row("turns left out (gyro at its converter's limit)",
+      f.saturated_turns < 0 ? "not recorded" : Count(f.saturated_turns), "field_saturated_turns");
+  row("samples read", f.samples < 0 ? "not recorded" : Count(f.samples), "field_samples");
+  row("temperature range", Fmt("%.1f", f.temp_range_c[0]) + " .. " + Fmt("%.1f", f.temp_range_c[1]) + " degC",
+      "temp_range_c");
+  std::string gravity = Fmt("%.6g m/s\xc2\xb2", f.gravity_mps2);
+  if (f.gravity_source == kGravityStated) gravity += ", stated (--gravity-mps2)";
+  if (f.gravity_source == kGravityStandard) gravity += ", standard gravity (no local gravity given)";
+  if (f.gravity_source == kGravityFromLatitude) {
+    gravity += ", WGS-84 normal gravity at " + Fmt("%.4f deg", f.latitude_deg.value_or(0.0)) + ", " +
+               Fmt("%g m", f.height_m.value_or(0.0));
+  }
+  if (f.gravity_source.empty()) gravity += " (its source not recorded)";
+  row("local gravity", gravity, "field_gravity");
+  h->Close("table").Close("div");
+  h->Open("div").Element("h2", "Fit").Open("table");
+  row("|a| \xe2\x88\x92 g after correction, RMS over the poses",
+      known(f.accel_norm_rms_mg, Fmt("%.3g mg", f.accel_norm_rms_mg)), "field_accel_norm_rms_mg");
+  row("gravity direction after the turns, RMS",
+      known(f.direction_rms_deg, Fmt("%.3g deg", f.direction_rms_deg)), "field_direction_rms_deg");
+  row("gyro at rest after correction, RMS",
+      known(f.gyro_static_rms_dps, Fmt("%.3g deg/s", f.gyro_static_rms_dps)), "field_gyro_static_rms_dps");
+  row("reduced chi-square", known(f.reduced_chi2, Fmt("%.3g", f.reduced_chi2)), "field_reduced_chi2");
+  row("noise scales (accel at rest, gyro at rest, turns)",
+      known(f.noise_scale[0], Fmt("%.3g", f.noise_scale[0]) + ", " + Fmt("%.3g", f.noise_scale[1]) + ", " +
+                                  Fmt("%.3g", f.noise_scale[2])),
+      "field_noise_scales");
+  row("temperature order (biases, scale factors)",
+      f.temp_order == 0 ? "0: constant over the session" : Count(f.temp_order), "field_temp_order");
+  row("gyro g-sensitivity", f.g_sensitivity_fitted ? "fitted" : "held at 0", "field_g_sensitivity");
+  row("solver",
+      f.termination.empty() ? "not recorded" : f.termination + " (" + Count(f.iterations) + " iterations)",
+      "field_solver");
+  h->Close("table").Close("div").Close("div");
+  h->Element(
+      "p",
+      "Noise scales: each residual group's scatter as a multiple of the log's white noise; above 1 the "
+      "fit weighted the group by its larger scatter (hand tremor, drift), so the sigmas include it.",
+      {{"class", "note"}});
+}
+
 std::string CertificateHtml(const Certificate& c) {
-  const CertificateSvgs svgs = Draw(MakeCertificateFigures(c));
   const std::string serial = c.serial.empty() ? "(no serial)" : c.serial;
   Html h;
   internal::OpenPage(
-      &h, "Calibration certificate " + serial, "IMU calibration certificate " + serial,
+      &h, "Calibration certificate " + serial,
+      std::string(c.field ? "IMU calibration certificate (by hand) " : "IMU calibration certificate ") +
+          serial,
       (c.verdict ? std::string(VerdictName(c.verdict->pass)) + " \xe2\x80\x94 " : std::string()) +
           "certificate " + c.number + ", " + (c.acquired_utc.empty() ? c.calibrated_utc : c.acquired_utc));
   Identification(&h, c);
-  RunAndSettings(&h, c);
+  if (c.field) {
+    FieldSessionSection(&h, c);
+  } else {
+    RunAndSettings(&h, c);
+  }
   if (c.verdict) Acceptance(&h, *c.verdict);
   KeyFigures(&h, c);
   internal::BudgetSection(&h, c);
-  CoefficientPlots(&h, c, svgs);
-  ErrorPlots(&h, c, svgs);
-  NoisePlot(&h, c, svgs);
-  Validation(&h, c);
+  if (c.field) {
+    // A session by hand: no plan segments, window errors or static stretch to draw.
+    h.Open("div", {{"class", "keep"}}).Element("h2", "Gyro noise");
+    h.Element("p", "Not measured: " + c.noise.why_not + ".",
+              {{"class", "note"}, {"data-key", "noise_not_measured"}});
+    h.Close("div");
+  } else {
+    const CertificateSvgs svgs = Draw(MakeCertificateFigures(c));
+    CoefficientPlots(&h, c, svgs);
+    ErrorPlots(&h, c, svgs);
+    NoisePlot(&h, c, svgs);
+    Validation(&h, c);
+  }
   h.Element("p",
             "Units: angular rate in deg/s, specific force in mg (1 g = 9.80665 m/s\xc2\xb2); coefficients at "
             "25 degC. Each value is rounded to the decimal place of its expanded uncertainty U (two "

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "imufit/factory/acceptance.h"
+#include "imufit/factory/report.h"
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/fit/truth_perturbation.h"
 #include "imufit/pipeline/fit_run.h"
@@ -277,6 +278,84 @@ UncertaintyBudget ComputeBudget(const Calibration& calibration, const Plan& plan
   budget.figures = FigureBudgets(budget, calibration, kFigureTempC);
   budget.classes = Classes(budget.figures);
   Statements(&budget);
+  return budget;
+}
+
+namespace {
+
+// The local gravity of a calibration by hand as a Type B source (ComputeFieldBudget); none for a
+// stated value (taken as exact) or a record that does not say.
+std::optional<StationUncertainty> FieldGravitySource(const FieldRecord& field) {
+  const std::string source = field.gravity_source.value_or("");
+  StationUncertainty u;
+  u.influence = StationInfluence::kLocalGravity;
+  u.key = "local_gravity";
+  u.unit = "m/s^2";
+  if (source == kGravityStandard) {
+    u.written = kStandardGravityHalfWidthMps2;
+    u.rectangular = true;
+    u.u_si = kStandardGravityHalfWidthMps2 / std::sqrt(3.0);
+    u.source =
+        "standard gravity 9.80665 m/s^2 (no local gravity given): Earth's normal gravity from the equator to "
+        "the poles, sea level to 1000 m";
+  } else if (source == kGravityFromLatitude) {
+    u.written = kNormalGravityAnomalyMps2;
+    u.u_si = kNormalGravityAnomalyMps2;
+    u.source = "WGS-84 normal gravity at the latitude and height given: the site's gravity anomaly (50 mGal)";
+  } else {
+    return std::nullopt;
+  }
+  return u;
+}
+
+}  // namespace
+
+UncertaintyBudget ComputeFieldBudget(const Calibration& calibration) {
+  UncertaintyBudget budget;
+  const FieldRecord field =
+      calibration.fit && calibration.fit->field ? *calibration.fit->field : FieldRecord();
+  const double gravity = field.gravity_mps2.value_or(kStandardGravityMps2);
+  const std::optional<StationUncertainty> source = FieldGravitySource(field);
+  if (source) {
+    budget.inputs = {*source};
+    budget.resolved = calibration.model;
+    SensorModel moved = calibration.model;
+    const double shrink = 1.0 / (1.0 + source->u_si / gravity);
+    for (int c = 0; c < kPolynomialTerms * 3; ++c)
+      moved.accel[kScaleCoefficient * kPolynomialTerms + c] *= shrink;
+    for (int c = 0; c < kPolynomialTerms * 9; ++c)
+      moved.gyro[kGSensitivityCoefficient * kPolynomialTerms + c] *= shrink;
+    char input[64];
+    std::snprintf(input, sizeof input, "%.4g m/s^2%s", source->written,
+                  source->rectangular ? " (half width, rectangular)" : "");
+    budget.moved.push_back({{"Local gravity", source->source, input, 0.0}, std::move(moved)});
+  }
+  budget.figures = FigureBudgets(budget, calibration, kFigureTempC);
+  budget.classes = Classes(budget.figures);
+  const std::string gravity_text = FormatNumber("%.6g m/s^2", gravity);
+  budget.covers =
+      "U (k = 2, about 95 %) covers the fit's statistical uncertainty from this session by hand: the white "
+      "noise of the rests and the turns and, where the session scattered beyond it (hand tremor, drift "
+      "during the session), that larger scatter as the fit estimated it (its noise scales)";
+  if (!source) {
+    budget.covers += field.gravity_source.value_or("") == kGravityStated
+                         ? "; the local gravity " + gravity_text +
+                               " was stated (--gravity-mps2) and is taken as exact: its own uncertainty is "
+                               "not included"
+                         : "; the calibration does not record where its gravity " + gravity_text +
+                               " came from, so its uncertainty is not included";
+  } else {
+    budget.covers += "; and the uncertainty of the local gravity " + gravity_text + " (" + source->source +
+                     "), which the accelerometer's scale factors and the gyro's g-sensitivity are "
+                     "proportional to";
+  }
+  budget.covers += ".";
+  budget.not_covered =
+      "No reference table or known rate was used: the scale and misalignment references are gravity and "
+      "the turns the gyro integrated, so U includes no table's or station's errors (there are none to "
+      "include). U does not cover the unit's turn-on to turn-on repeatability, its drift after the "
+      "session or over time, hysteresis, Earth's rotation (up to 0.004 deg/s, not modelled), terms the "
+      "model does not have, or temperatures outside the session's.";
   return budget;
 }
 

@@ -1,6 +1,7 @@
 #include "imufit/pipeline/field_run.h"
 
 #include <algorithm>
+#include <iterator>
 
 #include "imufit/io/log_samples.h"
 #include "imufit/io/run_header.h"
@@ -27,10 +28,36 @@ FieldRecord FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& opti
   int saturated = 0;
   for (const FieldTurn& turn : fit.turns) saturated += turn.saturated ? 1 : 0;
   field.saturated_turns = saturated;
+  // Where gravity came from: the certificate's U includes its uncertainty (factory/field_budget.cc).
+  if (options.latitude_deg) {
+    field.gravity_source = std::string(kGravityFromLatitude);
+    field.latitude_deg = *options.latitude_deg;
+    field.height_m = options.height_m;
+  } else {
+    // The default, 9.80665, is standard gravity whoever typed it (as FieldFitOptions::Validate
+    // takes it): the site unknown, its uncertainty the widest (conservative).
+    field.gravity_source =
+        std::string(options.gravity_mps2 == kStandardGravityMps2 ? kGravityStandard : kGravityStated);
+  }
   return field;
 }
 
 }  // namespace
+
+bool AppliesToAFieldFit(const std::string& key) {
+  static const char* const kKeys[] = {"temp_c",
+                                      "time_unit",
+                                      "delimiter",
+                                      "decimal_comma",
+                                      "column",
+                                      "allow_serial_mismatch",
+                                      "fit_g_sensitivity",
+                                      "segment_window_s",
+                                      "segment_noise_quantile",
+                                      "segment_threshold_factor",
+                                      "min_steady_s"};
+  return std::find(std::begin(kKeys), std::end(kKeys), key) != std::end(kKeys);
+}
 
 Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& options) {
   Calibration calibration;

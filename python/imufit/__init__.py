@@ -27,10 +27,12 @@ from ._imufit import (
     UndeterminedError,
     __version__,
     _fit,
+    _fit_field,
     allan,
     allan_options,
     export,
     export_options,
+    fit_field_options,
     fit_options,
     noise_terms,
     noise_terms_options,
@@ -50,6 +52,7 @@ __all__ = [
     "AllanResult",
     "Calibration",
     "CheckRecord",
+    "FieldFitResult",
     "FieldRecord",
     "FitError",
     "FitRecord",
@@ -64,6 +67,8 @@ __all__ = [
     "export",
     "export_options",
     "fit",
+    "fit_field",
+    "fit_field_options",
     "fit_options",
     "noise_terms",
     "noise_terms_options",
@@ -105,3 +110,29 @@ def fit(plan: str | os.PathLike[str] | Mapping[str, Any], samples: str | os.Path
     if isinstance(samples, Mapping):
         samples = dict(samples)
     return FitResult(**_fit(plan, samples, options))
+
+
+@dataclasses.dataclass
+class FieldFitResult:
+    """What imufit.fit_field() returns: the calibration by hand, the 1-sigma of its coefficients and
+    the session's summary."""
+
+    calibration: Calibration
+    sigma: dict[str, dict[str, Any]]
+    summary: dict[str, Any]
+
+
+def fit_field(samples: str | os.PathLike[str] | Mapping[str, Any], **options: Any) -> FieldFitResult:
+    """Fits a session by hand, as ``imufit fit --field`` does (the same library call; docs/field.md).
+
+    ``samples`` is a samples CSV path (a log without a segment column) or arrays ({time_s, temp_c,
+    gyro, accel; serial optional}, as simulate() and read_samples() return), fitted as they are.
+    ``options``: see fit_field_options() (gravity_mps2 or latitude_deg/height_m, temp_c for a log
+    without a thermometer, bias_temp_order, ...). The calibration is in the body frame
+    ``accelerometer_xy`` and is used as any other (correct(), save(), export()). Raises InputError on
+    bad input (a table fit's option included), UndeterminedError naming what the session lacks in
+    the words ``imufit fit --field`` prints, and FitError when the solver does not converge.
+    """
+    if isinstance(samples, Mapping):
+        samples = dict(samples)
+    return FieldFitResult(**_fit_field(samples, options))

@@ -61,6 +61,9 @@ class FieldRecord:
     noise_scale_gyro_rests: float | None  # the rests' gyro noise as a multiple of the log's white noise
     noise_scale_turns: float | None  # the turns' noise as a multiple of the log's white noise
     saturated_turns: int | None  # turns left out because a gyro axis touched its converter's rail
+    gravity_source: str | None  # stated, latitude or standard: where gravity_mps2 came from
+    latitude_deg: float | None  # with gravity_source latitude: the geodetic latitude, degrees
+    height_m: float | None  # with gravity_source latitude: the height above the ellipsoid, m
 
 class FitRecord:
     """What the fit did and on which files: the calibration's `fit:` block, each key an attribute
@@ -240,6 +243,49 @@ def fit(plan: PathLike | Mapping[str, Any], samples: PathLike | Mapping[str, Any
 
 def fit_options() -> dict[str, tuple[Any, str]]:
     """{name: (default, description)} of every option of fit()."""
+
+@dataclasses.dataclass
+class FieldFitResult:
+    calibration: Calibration  # body_frame "accelerometer_xy"; fit.field holds the session's figures
+    sigma: dict[str, dict[str, FloatArray]]  # 1-sigma, layout of Calibration.gyro / .accel
+    summary: dict[str, Any]
+    """status, brief_report (the line `imufit fit --field` prints), undetermined (what the session
+    lacks, in words), samples_read, serial, iterations, termination, temp_range_c,
+    pose_temp_range_c, gyro_noise_raw, accel_noise_raw (one sample's noise per axis, raw),
+    accel_norm_rms_mps2, gyro_static_rms_radps, direction_rms_rad, reduced_chi2, noise_scale
+    (accel at rest, gyro at rest, turns), poses {first, last, start_s, end_s, temp_c, gyro_mean,
+    accel_mean (raw), up (body frame), accel_norm_error_mps2}, turns {from, to, saturated,
+    angle_rad, direction_error_rad}."""
+
+class _FieldFitOptions(TypedDict, total=False):
+    """The keyword options of fit_field(): the keys of fit_field_options(), SI (tests/test_options.py
+    checks that the two agree)."""
+
+    gravity_mps2: float  # m/s^2, local gravity
+    latitude_deg: float | None  # deg: local gravity from the site instead (WGS-84 normal gravity)
+    height_m: float  # m, with latitude_deg: above the WGS-84 ellipsoid
+    min_pose_s: float  # s
+    bias_temp_order: int  # 0..3
+    scale_temp_order: int  # 0..3
+    fit_g_sensitivity: bool
+    temp_c: float | None  # degC, for a log without a temp_c column
+    time_unit: str
+    delimiter: str
+    decimal_comma: bool
+    column: str
+    segment_window_s: float  # s; this and the next three: telling rests from motion
+    segment_noise_quantile: float
+    segment_threshold_factor: float
+    min_steady_s: float  # s
+    allow_serial_mismatch: bool
+
+def fit_field(samples: PathLike | Mapping[str, Any], **options: Unpack[_FieldFitOptions]) -> FieldFitResult:
+    """Fits a session by hand, as `imufit fit --field` does: samples a path or arrays as
+    read_samples() returns. Raises InputError (a table fit's option too), UndeterminedError (what the
+    session lacks, in the command's words), FitError."""
+
+def fit_field_options() -> dict[str, tuple[Any, str]]:
+    """{name: (default, description)} of every option of fit_field()."""
 
 class _SimulateOptions(TypedDict, total=False):
     """The keyword options of simulate(): the keys of simulate_options() (tests/test_options.py

@@ -45,11 +45,16 @@ Exceptions& GetExceptions();
 // ("imufit.fit") the way the command locates a bad option at "imufit fit".
 [[noreturn]] void ThrowBadArgument(const std::string& where, const std::string& message);
 
+// Raises `type`(message) with the attributes given (an UndeterminedError's `missing`, ...).
+[[noreturn]] void Raise(const py::object& type, const std::string& message, const py::dict& attributes);
+
 // str(os.fspath(path)): a str or an os.PathLike.
 std::string PathString(const py::handle& path);
 
 // A new (rows, cols) or (rows,) float64 array; cols == 0 means one dimension.
 py::array_t<double> NewArray(py::ssize_t rows, py::ssize_t cols = 0);
+// A copy of `vectors` as an (N, 3) array.
+py::array_t<double> Triads(const std::vector<Eigen::Vector3d>& vectors);
 // A copy of `values` as a 1-D array.
 py::array_t<double> ToArray(const std::vector<double>& values);
 
@@ -67,6 +72,7 @@ SamplesInMemory SamplesFromArrays(const py::dict& samples, const std::string& wh
 
 void BindCalibration(py::module_& m);
 void BindFit(py::module_& m);
+void BindField(py::module_& m);
 void BindNoise(py::module_& m);
 void BindPlan(py::module_& m);
 void BindExport(py::module_& m);

@@ -13,9 +13,6 @@
 #include "keyword_options.h"
 
 namespace imufit::python {
-namespace {
-
-// --------------------------------------------------------------------------------------- fit
 
 py::array_t<double> Triads(const std::vector<Eigen::Vector3d>& vectors) {
   py::array_t<double> array = NewArray(static_cast<py::ssize_t>(vectors.size()), 3);
@@ -23,6 +20,17 @@ py::array_t<double> Triads(const std::vector<Eigen::Vector3d>& vectors) {
     std::copy(vectors[i].data(), vectors[i].data() + 3, array.mutable_data() + 3 * i);
   return array;
 }
+
+[[noreturn]] void Raise(const py::object& type, const std::string& message, const py::dict& attributes) {
+  py::object error = type(message);
+  for (const auto& [key, value] : attributes) error.attr(key) = value;
+  PyErr_SetObject(type.ptr(), error.ptr());
+  throw py::error_already_set();
+}
+
+namespace {
+
+// --------------------------------------------------------------------------------------- fit
 
 py::dict ErrorStatsDict(const ErrorStats& s) {
   py::dict d;
@@ -141,14 +149,6 @@ py::dict Diagnostics(const FitRunResult& result) {
   for (const ErrorStats& s : result.check_errors) check.append(ErrorStatsDict(s));
   d["check_errors"] = check;
   return d;
-}
-
-// Raises `type`(message) with the attributes given.
-[[noreturn]] void Raise(const py::object& type, const std::string& message, const py::dict& attributes) {
-  py::object error = type(message);
-  for (const auto& [key, value] : attributes) error.attr(key) = value;
-  PyErr_SetObject(type.ptr(), error.ptr());
-  throw py::error_already_set();
 }
 
 // imufit.fit(plan, samples, **options) -> {calibration, sigma, diagnostics}. `plan` is a path or

@@ -116,6 +116,7 @@ PYBIND11_MODULE(_imufit, m) {
 
   BindCalibration(m);
   BindFit(m);
+  BindField(m);
   BindNoise(m);
   BindExport(m);
   BindPlan(m);

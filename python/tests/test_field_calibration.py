@@ -20,7 +20,7 @@ FIELD_KEYS = {
     "poses": int, "turns": int, "gravity_mps2": float, "accel_norm_rms_mps2": float,
     "gyro_static_rms_radps": float, "gravity_direction_rms_rad": float, "reduced_chi2": float,
     "noise_scale_accel_rests": (int, float), "noise_scale_gyro_rests": (int, float),
-    "noise_scale_turns": (int, float), "saturated_turns": int,
+    "noise_scale_turns": (int, float), "saturated_turns": int, "gravity_source": str,
 }
 
 

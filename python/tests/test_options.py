@@ -21,6 +21,7 @@ def stub_keys(class_name):
 
 
 @pytest.mark.parametrize("class_name, described", [("_FitOptions", imufit.fit_options),
+                                                   ("_FieldFitOptions", imufit.fit_field_options),
                                                    ("_SimulateOptions", imufit.simulate_options)])
 def test_stub_lists_every_option_of_the_table(class_name, described):
     keys = stub_keys(class_name)
@@ -29,7 +30,7 @@ def test_stub_lists_every_option_of_the_table(class_name, described):
 
 
 def test_every_option_has_a_description():
-    for described in (imufit.fit_options(), imufit.simulate_options()):
+    for described in (imufit.fit_options(), imufit.fit_field_options(), imufit.simulate_options()):
         for key, (_, description) in described.items():
             assert description, key
 

@@ -198,6 +198,37 @@ struct RunSummary {
   std::vector<double> time_s, window_temp_c;  // temperature against time, per window
 };
 
+// A calibration by hand (fit --field, docs/field.md): the session, in place of a plan and a table run.
+// From the calibration's `fit:` and `fit: field:` records (a number the record lacks stays < 0).
+struct FieldSession {
+  std::string body_frame;  // kBodyFrameAccelerometerXy
+  int poses = -1, turns = -1, saturated_turns = -1;
+  double gravity_mps2 = 0.0;
+  std::string gravity_source;  // kGravityStated, kGravityFromLatitude, kGravityStandard; "" not recorded
+  std::optional<double> latitude_deg, height_m;
+  long long samples = -1;
+  std::array<double, 2> temp_range_c{0.0, 0.0};  // the session's readings, degC
+  int temp_order = 0;                            // of the biases and scale factors (0: constant)
+  bool g_sensitivity_fitted = true;
+  // After correction: | |a| - g | RMS over the poses (mg), the corrected gyro at rest (RMS over poses
+  // and axes, deg/s), gravity's direction after the turns (RMS, deg), reduced chi-square.
+  double accel_norm_rms_mg = -1.0, gyro_static_rms_dps = -1.0, direction_rms_deg = -1.0, reduced_chi2 = -1.0;
+  // The rests' accelerometer, the rests' gyro and the turns' noise as multiples of the log's white noise.
+  std::array<double, 3> noise_scale{-1.0, -1.0, -1.0};
+  int iterations = -1;
+  std::string termination;
+};
+
+// What a certificate of a calibration by hand says of its references, in words (on the page and in
+// the tests): no table, no known rate; gravity and the integrated turns instead.
+inline constexpr const char* kFieldReferenceStatement =
+    "Calibrated by hand, without a reference table or a known rate: the accelerometer's scale and "
+    "misalignment are referred to local gravity (|a| = g in every pose), the gyro's scale and misalignment "
+    "to the turns between the poses as the gyro integrated them (gravity's direction before and after each "
+    "turn), its bias and g-sensitivity to the poses at rest. The body frame is a convention, "
+    "accelerometer_xy: x along the accelerometer's x axis, y in the plane of its x and y axes (docs/spec.md "
+    "section 1); it is not a fixture's or a vehicle's frame.";
+
 // The statement every certificate carries (ISO/IEC 17025 7.8.2.1 k).
 inline constexpr const char* kItemOnlyStatement =
     "The results in this certificate apply only to the item calibrated, as received. This certificate "
@@ -238,10 +269,16 @@ struct Certificate {
   int residual_rows_omitted = 0;
   NoiseSection noise;
   std::vector<ValidationRow> validation;  // empty: not run
+  // A calibration by hand: its session, in place of the run, the plan, the residuals and the curves
+  // (empty) and the noise section (not measured: a session by hand has no long static stretch).
+  std::optional<FieldSession> field;
 };
 
-// Computes the certificate from `sources` alone (no file is read). A listed input without its
-// SHA-256, or a samples input without the noise section, is a programmer error (aborts): call
+// Computes the certificate from `sources` alone (no file is read). A calibration by hand (its
+// body_frame set) is certified from its own records: sources.plan and sources.run are not used, its
+// U is ComputeFieldBudget()'s (a station's Type B sources are a table's: not applied, a warning says
+// so), and limits are judged with the calibration's figures (its `noise:` block, if any). A listed input
+// without its SHA-256, or a samples input without the noise section, is a programmer error (aborts): call
 // ReadCertificateFiles() first.
 Certificate MakeCertificate(const CertificateSources& sources);
 

@@ -92,6 +92,21 @@ UncertaintyBudget ComputeBudget(const Calibration& calibration, const Plan& plan
                                 const std::vector<Window>& windows,
                                 const std::vector<StationUncertainty>& sources);
 
+// The budget of a calibration by hand (fit --field, its `body_frame` set): no station, no table,
+// no plan. Type A: the fit's sigmas (the session's noise and, through the fit's noise scales, the
+// hand's tremor and drift during the session). Type B: the local gravity the fit took |a| = g from,
+// by where it came from (`fit: field: gravity_source`): kGravityStandard, 9.80665 m/s^2 for a site
+// not given, is anywhere on Earth's surface from the equator to the poles and from sea level to
+// 1000 m: kStandardGravityHalfWidthMps2, rectangular; kGravityFromLatitude, WGS-84 normal gravity,
+// is off by the site's gravity anomaly: kNormalGravityAnomalyMps2 (standard uncertainty);
+// kGravityStated, the user's value, is taken as exact (its own uncertainty is not known here: the
+// certificate says so). Propagation is exact: the field fit's cost is invariant under
+// g -> g (1 + e), S_a -> S_a / (1 + e), H -> H / (1 + e), so the moved model is the calibration's
+// with those terms scaled (every other coefficient unchanged).
+inline constexpr double kStandardGravityHalfWidthMps2 = 0.03;
+inline constexpr double kNormalGravityAnomalyMps2 = 5e-4;  // 50 mGal
+UncertaintyBudget ComputeFieldBudget(const Calibration& calibration);
+
 // GUM Supplement 1: `trials` fits, each with every component of `sources` drawn from its
 // distribution (normal, or rectangular for a half width; seeded), and the standard deviation of
 // each coefficient key figure (KeyFigures order) over them: the Type B part alone.

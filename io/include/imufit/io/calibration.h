@@ -32,6 +32,11 @@ inline constexpr int kCalibrationFormatVersion = 1;
 // axis, y in the plane of its x and y axes.
 inline constexpr const char* kBodyFrameAccelerometerXy = "accelerometer_xy";
 
+// Where a calibration by hand's gravity came from (`fit: field: gravity_source:`).
+inline constexpr const char* kGravityStated = "stated";          // --gravity-mps2
+inline constexpr const char* kGravityFromLatitude = "latitude";  // --latitude, --height-m
+inline constexpr const char* kGravityStandard = "standard";      // 9.80665 m/s^2, none given
+
 struct Calibration {
   std::string serial;
   std::string created_utc;  // ISO 8601, e.g. "2026-11-22T06:00:00Z"

@@ -73,7 +73,12 @@
     "the rests' accelerometer noise as a multiple of the log's white noise")                        \
   X(double, noise_scale_gyro_rests, "the rests' gyro noise as a multiple of the log's white noise") \
   X(double, noise_scale_turns, "the turns' noise as a multiple of the log's white noise")           \
-  X(int, saturated_turns, "turns left out because a gyro axis touched its converter's rail")
+  X(int, saturated_turns, "turns left out because a gyro axis touched its converter's rail")        \
+  X(std::string, gravity_source,                                                                    \
+    "where gravity_mps2 came from: stated (--gravity-mps2), latitude (WGS-84 normal gravity at "    \
+    "latitude_deg, height_m), standard (9.80665 m/s^2: no local gravity given)")                    \
+  X(double, latitude_deg, "with gravity_source latitude: the geodetic latitude, degrees")           \
+  X(double, height_m, "with gravity_source latitude: the height above the ellipsoid, m")
 
 // X(type, key, description): the `check:` block, with `imufit fit --check-samples`.
 #define IMUFIT_CHECK_RECORD_FIELDS(X)                                      \

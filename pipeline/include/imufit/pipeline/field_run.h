@@ -48,6 +48,11 @@ FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& 
                            const std::string& serial, bool allow_serial_mismatch,
                            const LogTopics& topics = {});
 
+// Whether the table fit's option `key` (FitRunOptionTable()) also means something to a session by
+// hand: how the samples are read, the serial, the g-sensitivity, how rests are told from motion.
+// `imufit fit --field` refuses the others; the Python fit_field() takes these as keywords.
+bool AppliesToAFieldFit(const std::string& key);
+
 // The calibration of a usable field fit (what FieldFitRun writes), without the record's file names.
 Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& options);
 
