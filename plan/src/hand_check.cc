@@ -127,6 +127,7 @@ HandCheck CheckHandProcedure(const HandSetup& setup, const PlanCheckOptions& opt
   }
   static const char* const kTermNames[] = {"", " (linear term)", " (quadratic term)", " (cubic term)"};
   std::vector<PlanRow> rows;
+  std::vector<double> worsts;
   for (const bool gyro : {true, false}) {
     const int coefficients = gyro ? kGyroCoefficients : kAccelCoefficients;
     for (int c = 0; c < coefficients; ++c) {
@@ -139,6 +140,7 @@ HandCheck CheckHandProcedure(const HandSetup& setup, const PlanCheckOptions& opt
         double range2 = 0.0;
         double low = 1e300;
         double high = 0.0;
+        double worst = 0.0;
         for (const FieldFitSummary& fit : fits) {
           const double sigma = Values(fit.sigma, gyro)[i];
           sum2 += sigma * sigma;
@@ -149,6 +151,7 @@ HandCheck CheckHandProcedure(const HandSetup& setup, const PlanCheckOptions& opt
                   ? std::max({sigma, Values(fit.sigma_at_low, gyro)[i], Values(fit.sigma_at_high, gyro)[i]})
                   : sigma;
           range2 += ends * ends;
+          worst = std::max(worst, ends);
         }
         if (!(high > 0.0)) continue;  // held (the body frame's convention, or an order not fitted)
         PlanRow row;
@@ -170,12 +173,18 @@ HandCheck CheckHandProcedure(const HandSetup& setup, const PlanCheckOptions& opt
         }
         if (low > 0.0) check.sigma_variation = std::max(check.sigma_variation, high / low - 1.0);
         rows.push_back(row);
+        worsts.push_back(worst * factor);
       }
     }
   }
-  std::stable_sort(rows.begin(), rows.end(),
-                   [](const PlanRow& a, const PlanRow& b) { return a.ratio > b.ratio; });
-  check.rows = std::move(rows);
+  std::vector<size_t> order_by_ratio(rows.size());
+  for (size_t r = 0; r < rows.size(); ++r) order_by_ratio[r] = r;
+  std::stable_sort(order_by_ratio.begin(), order_by_ratio.end(),
+                   [&rows](size_t a, size_t b) { return rows[a].ratio > rows[b].ratio; });
+  for (size_t r : order_by_ratio) {
+    check.rows.push_back(rows[r]);
+    check.sigma_worst.push_back(worsts[r]);
+  }
   if (!advise || !check.tolerance_unmet || !check.undetermined.empty()) return check;
   // Longer dwells (white noise on the rests averages down) and more poses (more rests and turns).
   for (const double dwell_factor : {2.0, 4.0}) {
@@ -221,14 +230,15 @@ std::string HandCheckText(const HandCheck& check, const HandSetup& setup, const 
   for (const std::string& finding : check.undetermined) out += "undetermined: " + finding + "\n";
   if (check.rows.empty()) return out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-44s %12s %12s %10s %7s  %s\n", "coefficient", "sigma", "sigma_range",
-                "tolerance", "ratio", "unit");
+  std::snprintf(line, sizeof line, "%-44s %12s %12s %12s %10s %7s  %s\n", "coefficient", "sigma",
+                "sigma_range", "worst", "tolerance", "ratio", "unit");
   out += line;
-  for (const PlanRow& row : check.rows) {
+  for (size_t r = 0; r < check.rows.size(); ++r) {
+    const PlanRow& row = check.rows[r];
     const std::string tolerance = row.tolerance > 0.0 ? Text("%.4g", row.tolerance) : "-";
     const std::string ratio = row.tolerance > 0.0 ? Text("%.3g", row.ratio) : "-";
-    std::snprintf(line, sizeof line, "%-44s %12.4g %12.4g %10s %7s  %s\n", row.name.c_str(), row.sigma,
-                  row.sigma_range, tolerance.c_str(), ratio.c_str(), row.unit.c_str());
+    std::snprintf(line, sizeof line, "%-44s %12.4g %12.4g %12.4g %10s %7s  %s\n", row.name.c_str(), row.sigma,
+                  row.sigma_range, check.sigma_worst[r], tolerance.c_str(), ratio.c_str(), row.unit.c_str());
     out += line;
   }
   out += "limiting: " + check.rows.front().name + "\n";
@@ -236,6 +246,16 @@ std::string HandCheckText(const HandCheck& check, const HandSetup& setup, const 
     out += "advice: " + a.option +
            Text(": a session of %.1f min, worst ratio %.3g", a.session_s / 60.0, a.worst_ratio) +
            (a.meets ? ": meets the tolerances\n" : ": still short (limiting: " + a.limiting + ")\n");
+  }
+  const HandCheck::Alternative* shortest = nullptr;
+  for (const HandCheck::Alternative& a : check.alternatives) {
+    if (a.meets && (shortest == nullptr || a.session_s < shortest->session_s)) shortest = &a;
+  }
+  if (shortest != nullptr) {
+    out += "advice: the shortest session that meets the tolerances: " + shortest->option +
+           Text(" (%.1f min)\n", shortest->session_s / 60.0);
+  } else if (!check.alternatives.empty()) {
+    out += "advice: none of these meets the tolerances: a quieter unit, or a table (imufit plan design)\n";
   }
   return out;
 }
@@ -249,11 +269,13 @@ std::string HandCheckYaml(const HandCheck& check, const std::vector<PlanCriterio
   doc.Add("sigma_variation", MachineDoc::Number(check.sigma_variation));
   doc.Add("undetermined", MachineDoc::Texts(check.undetermined, MachineDoc::Style::kBlock));
   MachineDoc rows = MachineDoc::List(MachineDoc::Style::kBlock);
-  for (const PlanRow& row : check.rows) {
+  for (size_t i = 0; i < check.rows.size(); ++i) {
+    const PlanRow& row = check.rows[i];
     MachineDoc r = MachineDoc::Map(MachineDoc::Style::kFlow);
     r.Add("name", MachineDoc::Text(row.name)).Add("group", MachineDoc::Text(row.group));
     r.Add("term", MachineDoc::Integer(row.term)).Add("unit", MachineDoc::Text(row.unit));
     r.Add("sigma", MachineDoc::Number(row.sigma)).Add("sigma_range", MachineDoc::Number(row.sigma_range));
+    r.Add("sigma_worst", MachineDoc::Number(check.sigma_worst[i]));
     if (row.tolerance > 0.0) {
       r.Add("tolerance", MachineDoc::Number(row.tolerance)).Add("ratio", MachineDoc::Number(row.ratio));
     }

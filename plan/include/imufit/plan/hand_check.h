@@ -47,6 +47,9 @@ struct HandCheck {
   // (term 0) the largest over the session's temperatures, sigma_spec the same. Sorted by ratio
   // (z sigma_range / tolerance), then in the model's order.
   std::vector<PlanRow> rows;
+  // Per row, the largest sigma of one session (term 0: over its temperatures): the poses and turns
+  // a hand gives are random, and one session may fall short of the RMS.
+  std::vector<double> sigma_worst;
   int sessions = 0;  // simulated
   int fitted = 0;    // of them, accepted by the fit (the rows' basis)
   // The largest relative difference of a row's sigma between two sessions (max / min - 1).
