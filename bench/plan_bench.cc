@@ -95,9 +95,9 @@ int Main() {
       "plan check, 24 positions x 7 soaks:   %7.3f s (target < 1 s)   %.2f x one fit of the run (%.3f s)\n",
       check_s, check_s / fit_s, fit_s);
   std::printf(
-      "hand check, 12 poses x %d sessions:  %7.3f s (target < 1 s)   %.3f s a session (simulated, "
-      "fitted)%s\n",
-      kHandCheckSessions, hand_s, hand_s / kHandCheckSessions,
+      "hand check, 12 poses x %d sessions:  %7.3f s (target < 1 s; processor %.3f s)   %.3f s a session "
+      "(simulated, fitted)%s\n",
+      kHandCheckSessions, hand_s, hand_cpu_s, hand_s / kHandCheckSessions,
       hand_check.tolerance_unmet ? "; advice computed too" : "");
   std::printf(
       "plan design, %d candidates x %d set-points: %7.3f s (target < 10 s): %zu segments x %zu soaks, "
