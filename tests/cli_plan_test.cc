@@ -480,6 +480,25 @@ TEST_F(CliHandPlanTest, AnUnmetToleranceExitsThreeWithAdviceThatItAccepts) {
   EXPECT_EQ(again.status, 0) << advised << "\n" << again.out << again.err;
 }
 
+TEST_F(CliHandPlanTest, TroubleshootingQuotesTheMessages) {
+  const std::string page = ReadBytes(Fixture("../docs/troubleshooting.md"));
+  const std::string hand = Hand();
+  for (const std::vector<std::string>& extra : std::vector<std::vector<std::string>>{{"--temps", "25"}}) {
+    const RunResult r = Check(hand, extra);
+    EXPECT_EQ(r.status, 2);
+    std::string said = r.err.substr(0, r.err.find('\n'));
+    said.replace(said.find(hand), hand.size(), "hand.yaml");
+    EXPECT_NE(page.find("`" + said + "`"), std::string::npos) << said;
+  }
+  const RunResult r = Run({"plan", "check", Hand("up: [+x, -x, +y, +z, -z]\n"), "--gyro-noise-density",
+                           "1e-4", "--accel-noise-density", "1e-3"});  // the default 3 sessions
+  EXPECT_NE(page.find("`undetermined: no pose with gravity near +y (the y axis down) (3 of 3 sessions)`"),
+            std::string::npos);
+  EXPECT_NE(r.out.find("undetermined: no pose with gravity near +y (the y axis down) (3 of 3 sessions)"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST_F(CliHandPlanTest, BadInputExitsTwoNamingFileLineAndColumn) {
   const RunResult unknown = Check(Hand("poses_per_face: 2\n"), {});
   EXPECT_EQ(unknown.status, 2);

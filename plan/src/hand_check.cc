@@ -225,8 +225,10 @@ std::string HandCheckText(const HandCheck& check, const HandSetup& setup, const 
   out += "predicted by the field fit of " + std::to_string(check.sessions) + " simulated session" +
          (check.sessions == 1 ? "" : "s");
   out += check.fitted == check.sessions ? "" : " (" + std::to_string(check.fitted) + " accepted)";
-  out += check.fitted > 1 ? Text(": their sigmas differ by up to %.0f %%\n", 100.0 * check.sigma_variation)
-                          : "\n";
+  out += check.fitted > 1
+             ? Text(": a sigma differs by up to %.0f %% between them (worst: one session's largest)\n",
+                    100.0 * check.sigma_variation)
+             : "\n";
   for (const std::string& finding : check.undetermined) out += "undetermined: " + finding + "\n";
   if (check.rows.empty()) return out;
   char line[256];
