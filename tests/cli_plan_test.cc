@@ -499,6 +499,29 @@ TEST_F(CliHandPlanTest, TroubleshootingQuotesTheMessages) {
       << r.out;
 }
 
+TEST_F(CliHandPlanTest, LimitsAreJudgedByTheirRatioToU) {
+  const auto limits = [this](const std::string& max_abs) {
+    return Write("limits.yaml",
+                 "format: imufit-limits\nversion: 1\nname: hand\ncriteria:\n"
+                 "  - {quantity: gyro_bias_dps, max_abs: " +
+                     max_abs +
+                     "}\n"
+                     "  - {quantity: accel_misalignment_mrad, axes: [xy], max_abs: 3}\n");
+  };
+  // 12 rests of 4 s: the gyro's bias to about 0.0008 deg/s, U = 0.0017 deg/s.
+  const RunResult tight = Check(Hand(), {"--limits", limits("0.004")});
+  EXPECT_EQ(tight.status, 3) << tight.out << tight.err;
+  EXPECT_NE(tight.out.find("criterion gyro_bias_dps x, y, z within +-0.004: tolerance 0.004 deg/s / U "),
+            std::string::npos)
+      << tight.out;
+  EXPECT_NE(tight.out.find("(at least 4:1): NOT MET"), std::string::npos) << tight.out;
+  // The accelerometer's misalignment xy is the body frame's (held): nothing to judge.
+  EXPECT_EQ(tight.out.find("criterion accel_misalignment_mrad"), std::string::npos) << tight.out;
+  const RunResult loose = Check(Hand(), {"--limits", limits("0.05")});
+  EXPECT_EQ(loose.status, 0) << loose.out << loose.err;
+  EXPECT_NE(loose.out.find("(at least 4:1): met"), std::string::npos) << loose.out;
+}
+
 TEST_F(CliHandPlanTest, BadInputExitsTwoNamingFileLineAndColumn) {
   const RunResult unknown = Check(Hand("poses_per_face: 2\n"), {});
   EXPECT_EQ(unknown.status, 2);
