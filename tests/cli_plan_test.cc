@@ -346,7 +346,7 @@ TEST_F(CliPlanTest, EveryAdvisedOptionIsAccepted) {
       EXPECT_NE(help.find(option), std::string::npos) << option << " advised:\n" << advised.out;
     }
     args.insert(args.end(), remedies[i].begin(), remedies[i].end());
-    if (plans[i][0].find("hand") != std::string::npos) {
+    if (plans[i][0].find("plan_hand") != std::string::npos) {  // the file, not a folder named hand...
       args.insert(args.end(), {"--gyro-temp-order", "0", "--accel-temp-order", "0"});
     }
     const RunResult checked = Run(args);
