@@ -14,12 +14,14 @@
 #include "commands.h"
 #include "imufit/base/text.h"
 #include "imufit/io/error.h"
+#include "imufit/io/hand_procedure.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/output_file.h"
 #include "imufit/io/plan.h"
 #include "imufit/model/constants.h"
 #include "imufit/model/local_gravity.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/plan/hand_check.h"
 #include "imufit/plan/plan_check.h"
 #include "imufit/plan/plan_design.h"
 #include "imufit/plan/plan_prediction.h"
@@ -55,6 +57,11 @@ struct PlanCheckArguments {
   std::string format = "text";
   CliOptions<PlanCheckOptions> check;  // PlanCheckOptionTable()
   ScheduleArguments schedule;
+  // A hand procedure's (io/hand_procedure.h): its poses overridden, and the sessions simulated.
+  int poses = 0;
+  int sessions = kHandCheckSessions;
+  CliOption poses_option;
+  CliOption sessions_option;
 };
 
 struct PlanDesignArguments {
@@ -96,7 +103,70 @@ std::optional<Limits> AddLimitTolerances(const ScheduleArguments& args, PlanChec
   return limits;
 }
 
+// The options of a table plan's check that a hand procedure's does not take (its file says them, or
+// they are a table's): refused by name, so that nothing given is silently ignored.
+template <typename Options>
+void RefuseTableOptions(const CliOptions<Options>& given, const OptionTable<Options>& table,
+                        const std::set<std::string>& allowed, const std::string& path) {
+  for (const auto& entry : table.entries()) {
+    if (allowed.count(entry.key) == 0 && given.Given(entry.key)) {
+      throw InputError("imufit plan check",
+                       entry.flag + " is an option of a table plan's check; " + path +
+                           " is a hand procedure (its file describes the session: docs/plan.md)");
+    }
+  }
+}
+
+// `plan check HAND.yaml`: the hand procedure's predicted sigmas (plan/hand_check.h).
+int RunHandCheck(const PlanCheckArguments& args) {
+  RefuseTableOptions(args.schedule.options, SimulationOptionTable(),
+                     {"dwell_s", "rate_hz", "gyro_noise_density", "accel_noise_density",
+                      "gyro_bias_instability", "accel_bias_instability", "bias_correlation_s"},
+                     args.plan);
+  RefuseTableOptions(args.check, PlanCheckOptionTable(), {"tolerance", "z", "min_ratio"}, args.plan);
+  RefuseTableOptions(args.schedule.fit, FitRunOptionTable(), {}, args.plan);
+  HandProcedure hand = ReadHandProcedure(args.plan);
+  const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan check");
+  if (args.schedule.options.Given("dwell_s")) hand.dwell_s = schedule.dwell_s;
+  if (args.schedule.options.Given("rate_hz")) hand.rate_hz = schedule.rate_hz;
+  if (args.poses_option.Given()) {
+    if (args.poses < 9)
+      throw InputError("imufit plan check", "--poses " + std::to_string(args.poses) + ": at least 9");
+    hand.poses = args.poses;
+  }
+  if (args.sessions < 1 || args.sessions > 100) {
+    throw InputError("imufit plan check", "--sessions " + std::to_string(args.sessions) + ": give 1..100");
+  }
+  PlanCheckOptions check_options = OptionsOf(args.check, PlanCheckOptionTable(), "imufit plan check");
+  const std::optional<Limits> limits = AddLimitTolerances(args.schedule, &check_options);
+  const HandSetup setup = HandSetupOf(hand, schedule);
+  if (const std::string problem = setup.session.Validate(); !problem.empty()) {
+    throw InputError(args.plan, problem);
+  }
+  const HandCheck check = CheckHandProcedure(setup, check_options, args.sessions);
+  std::vector<PlanCriterion> criteria;
+  if (limits && check.fitted > 0) criteria = JudgeLimits(*limits, HandPlanCheck(check, setup), check_options);
+  const std::string text = args.format == "text" ? HandCheckText(check, setup, check_options) +
+                                                       PlanCriteriaText(criteria, check_options)
+                                                 : HandCheckYaml(check, criteria, args.format == "json");
+  std::fputs(text.c_str(), stdout);
+  if (!check.undetermined.empty()) {
+    std::fprintf(stderr, "imufit: the hand procedure does not reliably determine the model (%zu finding%s)\n",
+                 check.undetermined.size(), check.undetermined.size() == 1 ? "" : "s");
+    return kExitNotDone;
+  }
+  const bool unmet =
+      std::any_of(criteria.begin(), criteria.end(), [](const PlanCriterion& c) { return !c.met; });
+  return check.tolerance_unmet || unmet ? kExitFailedLimits : kExitDone;
+}
+
 int RunPlanCheck(const PlanCheckArguments& args) {
+  if (IsHandProcedureFile(args.plan)) return RunHandCheck(args);
+  if (args.poses_option.Given() || args.sessions_option.Given()) {
+    throw InputError("imufit plan check", std::string(args.poses_option.Given() ? "--poses" : "--sessions") +
+                                              " is an option of a hand procedure's check; " + args.plan +
+                                              " is a table plan");
+  }
   const SimulationOptions schedule = ScheduleOf(args.schedule, "imufit plan check");
   PlanCheckOptions check_options = OptionsOf(args.check, PlanCheckOptionTable(), "imufit plan check");
   FitOptions fit = OptionsOf(args.schedule.fit, FitRunOptionTable(), "imufit plan check").fit;
@@ -209,9 +279,13 @@ CommandRunner AddPlanCommand(CliCommand command) {
   CliCommand check = command.Subcommand(
       "check",
       "Predict the 1-sigma of every coefficient a run of PLAN will give the fit (its own Jacobians and "
-      "weights, no noise simulated), against tolerances; name what limits the plan. Exit 3 when a "
+      "weights, no noise simulated), against tolerances; name what limits the plan. For a hand procedure, "
+      "the field fit's sigmas over simulated sessions of it, and what it cannot determine. Exit 3 when a "
       "tolerance cannot be met.");
-  check.Option("plan", &check_args->plan, "plan YAML").Required();
+  check
+      .Option("plan", &check_args->plan,
+              "plan YAML, or a hand procedure YAML (format: imufit-hand-procedure, docs/plan.md)")
+      .Required();
   AddScheduleOptions(check, &check_args->schedule);
   check_args->schedule.options.Find("ramp_c").Excludes(check_args->schedule.options.Find("soak_temps_c"));
   check_args->check.Add(check, PlanCheckOptionTable(), kPlanWindowExceptions);
@@ -219,6 +293,11 @@ CommandRunner AddPlanCommand(CliCommand command) {
                                   "prior");  // design's --prior is the data sheet's
   check.Option("--format", &check_args->format, "text (a table), yaml or json")
       .OneOf({"text", "yaml", "json"});
+  check_args->poses_option = check.Option(
+      "--poses", &check_args->poses, "a hand procedure: the number of poses (overrides its file's poses)");
+  check_args->sessions_option =
+      check.Option("--sessions", &check_args->sessions,
+                   "a hand procedure: the simulated sessions whose field fits the prediction averages");
 
   CliCommand design = command.Subcommand(
       "design",

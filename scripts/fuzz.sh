@@ -34,7 +34,7 @@ CC=clang CXX=clang++ imufit_build "$dir" imufit_fuzz -- -DCMAKE_C_COMPILER=clang
 seeds=$dir/seeds
 rm -rf "$seeds"
 mkdir -p "$seeds"/{fuzz_samples,fuzz_plan,fuzz_calibration,fuzz_limits,fuzz_series,fuzz_rosbag}
-cp "$IMUFIT_ROOT"/fixtures/plan_*.yaml "$seeds/fuzz_plan/"
+cp "$IMUFIT_ROOT"/fixtures/plan_*.yaml "$IMUFIT_ROOT"/fixtures/hand_*.yaml "$seeds/fuzz_plan/"
 cp "$IMUFIT_ROOT"/fixtures/*_truth.yaml "$IMUFIT_ROOT"/fixtures/golden/*.yaml "$seeds/fuzz_calibration/"
 cp "$IMUFIT_ROOT"/fuzz/seeds/limits*.yaml "$seeds/fuzz_limits/"
 # Small bags written by ROS's own rosbag (plain, LZ4, BZ2; with and without a temperature topic).

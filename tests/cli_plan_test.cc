@@ -346,7 +346,7 @@ TEST_F(CliPlanTest, EveryAdvisedOptionIsAccepted) {
       EXPECT_NE(help.find(option), std::string::npos) << option << " advised:\n" << advised.out;
     }
     args.insert(args.end(), remedies[i].begin(), remedies[i].end());
-    if (plans[i][0].find("hand") != std::string::npos) {
+    if (plans[i][0].find("plan_hand") != std::string::npos) {  // the file, not a folder named hand...
       args.insert(args.end(), {"--gyro-temp-order", "0", "--accel-temp-order", "0"});
     }
     const RunResult checked = Run(args);
@@ -397,6 +397,150 @@ TEST_F(CliPlanTest, DesignWritesTheStationsGravity) {
   r = Run(args);
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   EXPECT_EQ(YAML::LoadFile(Path("b.yaml"))["gravity_mps2"].as<double>(), 9.81274);
+}
+
+// ---- A hand procedure (io/hand_procedure.h; docs/plan.md, "A hand procedure") ----
+
+// A quick hand procedure (12 rests of 4 s at 50 Hz) with `extra` lines, written as hand.yaml, checked
+// over 2 simulated sessions.
+class CliHandPlanTest : public CliTest {
+ protected:
+  std::string Hand(const std::string& extra = "") const {
+    return Write(
+        "hand.yaml",
+        "format: imufit-hand-procedure\nversion: 1\nposes: 12\ndwell_s: 4\nturn_s: 1.5\nrate_hz: 50\n" +
+            extra);
+  }
+  RunResult Check(const std::string& hand, std::vector<std::string> extra) const {
+    std::vector<std::string> args = {
+        "plan", "check",      hand, "--gyro-noise-density", "1e-4", "--accel-noise-density",
+        "1e-3", "--sessions", "2"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Run(args);
+  }
+};
+
+TEST_F(CliHandPlanTest, PredictsEveryFittedCoefficientAndParsesAsYaml) {
+  const RunResult r = Check(Hand(), {"--tolerance", "gyro.bias=0.01"});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("hand procedure: 12 poses, dwell 4 s, turns 1.5 s, 50 Hz"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("gyro g_sensitivity zz"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("accel misalignment xy"), std::string::npos) << r.out;  // held: the body frame
+  EXPECT_NE(r.out.find("limiting: gyro bias"), std::string::npos) << r.out;
+  const RunResult y = Check(Hand(), {"--format", "yaml"});
+  ASSERT_EQ(y.status, 0) << y.err;
+  const YAML::Node doc = YAML::Load(y.out);
+  EXPECT_EQ(doc["kind"].as<std::string>(), "hand procedure");
+  EXPECT_EQ(doc["rows"].size(), 30u);  // gyro 3+3+6+9, accel 3+3+3 (xy, xz, yz held)
+  const RunResult j = Check(Hand(), {"--format", "json"});
+  ASSERT_EQ(j.status, 0) << j.err;
+  EXPECT_EQ(YAML::Load(j.out)["rows"].size(), 30u);
+}
+
+TEST_F(CliHandPlanTest, LongerDwellsShrinkTheRestsSigmasAsOneOverRootDwell) {
+  const auto accel_bias = [this](const std::string& dwell) {
+    const RunResult r = Check(Hand(), {"--format", "yaml", "--dwell", dwell});
+    EXPECT_EQ(r.status, 0) << r.err;
+    double sum = 0.0;
+    for (const YAML::Node& row : YAML::Load(r.out)["rows"]) {
+      if (row["group"].as<std::string>() == "accel.bias") sum += row["sigma"].as<double>();
+    }
+    return sum;
+  };
+  // White noise averaged over a rest: 16 s against 4 s halves the accelerometer's bias sigma
+  // (the poses and turns of the sessions are the same: the seed is).
+  constexpr double kRootDwellTolerance = 0.1;  // relative
+  EXPECT_NEAR(accel_bias("16") / accel_bias("4"), 0.5, 0.5 * kRootDwellTolerance);
+}
+
+TEST_F(CliHandPlanTest, AMissingDirectionExitsOneInTheFitsWords) {
+  const RunResult r = Check(Hand("up: [+x, -x, +y, +z, -z]\n"), {});
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("undetermined: no pose with gravity near +y (the y axis down) (2 of 2 sessions)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.err.find("imufit: the hand procedure does not reliably determine the model (1 finding)"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST_F(CliHandPlanTest, AnUnmetToleranceExitsThreeWithAdviceThatItAccepts) {
+  const RunResult r = Check(Hand(), {"--tolerance", "accel.bias=0.06"});
+  ASSERT_EQ(r.status, 3) << r.out << r.err;
+  const std::string said = "advice: the shortest session that meets the tolerances: ";
+  const size_t at = r.out.find(said);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  // "--dwell 16 (...)": the option and its value, accepted by the check, which then meets it.
+  const size_t from = at + said.size();
+  const std::string advised = r.out.substr(from, r.out.find(" (", from) - from);
+  const size_t space = advised.find(' ');
+  const RunResult again =
+      Check(Hand(), {"--tolerance", "accel.bias=0.06", advised.substr(0, space), advised.substr(space + 1)});
+  EXPECT_EQ(again.status, 0) << advised << "\n" << again.out << again.err;
+}
+
+TEST_F(CliHandPlanTest, TroubleshootingQuotesTheMessages) {
+  const std::string page = ReadBytes(Fixture("../docs/troubleshooting.md"));
+  const std::string hand = Hand();
+  for (const std::vector<std::string>& extra : std::vector<std::vector<std::string>>{{"--temps", "25"}}) {
+    const RunResult r = Check(hand, extra);
+    EXPECT_EQ(r.status, 2);
+    std::string said = r.err.substr(0, r.err.find('\n'));
+    said.replace(said.find(hand), hand.size(), "hand.yaml");
+    EXPECT_NE(page.find("`" + said + "`"), std::string::npos) << said;
+  }
+  const RunResult r = Run({"plan", "check", Hand("up: [+x, -x, +y, +z, -z]\n"), "--gyro-noise-density",
+                           "1e-4", "--accel-noise-density", "1e-3"});  // the default 3 sessions
+  EXPECT_NE(page.find("`undetermined: no pose with gravity near +y (the y axis down) (3 of 3 sessions)`"),
+            std::string::npos);
+  EXPECT_NE(r.out.find("undetermined: no pose with gravity near +y (the y axis down) (3 of 3 sessions)"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliHandPlanTest, LimitsAreJudgedByTheirRatioToU) {
+  const auto limits = [this](const std::string& max_abs) {
+    return Write("limits.yaml",
+                 "format: imufit-limits\nversion: 1\nname: hand\ncriteria:\n"
+                 "  - {quantity: gyro_bias_dps, max_abs: " +
+                     max_abs +
+                     "}\n"
+                     "  - {quantity: accel_misalignment_mrad, axes: [xy], max_abs: 3}\n");
+  };
+  // 12 rests of 4 s: the gyro's bias to about 0.0008 deg/s, U = 0.0017 deg/s.
+  const RunResult tight = Check(Hand(), {"--limits", limits("0.004")});
+  EXPECT_EQ(tight.status, 3) << tight.out << tight.err;
+  EXPECT_NE(tight.out.find("criterion gyro_bias_dps x, y, z within +-0.004: tolerance 0.004 deg/s / U "),
+            std::string::npos)
+      << tight.out;
+  EXPECT_NE(tight.out.find("(at least 4:1): NOT MET"), std::string::npos) << tight.out;
+  // The accelerometer's misalignment xy is the body frame's (held): nothing to judge.
+  EXPECT_EQ(tight.out.find("criterion accel_misalignment_mrad"), std::string::npos) << tight.out;
+  const RunResult loose = Check(Hand(), {"--limits", limits("0.05")});
+  EXPECT_EQ(loose.status, 0) << loose.out << loose.err;
+  EXPECT_NE(loose.out.find("(at least 4:1): met"), std::string::npos) << loose.out;
+}
+
+TEST_F(CliHandPlanTest, BadInputExitsTwoNamingFileLineAndColumn) {
+  const RunResult unknown = Check(Hand("poses_per_face: 2\n"), {});
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_NE(unknown.err.find("hand.yaml:7:1"), std::string::npos) << unknown.err;
+  const RunResult direction = Check(Hand("up: [+x, up]\n"), {});
+  EXPECT_EQ(direction.status, 2);
+  EXPECT_NE(direction.err.find("hand.yaml:7:10"), std::string::npos) << direction.err;
+  EXPECT_NE(direction.err.find("\"up\": give +x, -x, +y, -y, +z, -z, corners"), std::string::npos)
+      << direction.err;
+  // A table plan's options are refused, not ignored; the hand's are refused on a table plan.
+  const RunResult temps = Check(Hand(), {"--temps=-20,60"});
+  EXPECT_EQ(temps.status, 2);
+  EXPECT_NE(temps.err.find("--temps is an option of a table plan's check"), std::string::npos) << temps.err;
+  const RunResult poses = Run(Args({"--poses", "12"}));
+  EXPECT_EQ(poses.status, 2);
+  EXPECT_NE(poses.err.find("--poses is an option of a hand procedure's check"), std::string::npos)
+      << poses.err;
+  EXPECT_EQ(Check(Hand(), {"--poses", "5"}).status, 2);
+  EXPECT_EQ(Check(Hand("twist_axes: none\ntwist_deg: [10, 20]\n"), {}).status, 2);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "imufit/io/calibration.h"
 #include "imufit/io/csv_reader.h"
 #include "imufit/io/error.h"
+#include "imufit/io/hand_procedure.h"
 #include "imufit/io/limits.h"
 #include "imufit/io/machine_text.h"
 #include "imufit/io/noise_file.h"
@@ -1488,6 +1489,46 @@ TEST(RunHeader, AcquiredIsAUtcTimeInOneForm) {
     ADD_FAILURE() << "two models";
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "run.csv:5:10: a second model \"B\" after \"A\"");
+  }
+}
+
+// The hand procedure file (io/hand_procedure.h): its keys, their defaults, and located refusals.
+TEST(HandProcedureTest, ReadsEveryKeyAndRefusesWhatIsWrongWhereItIs) {
+  const HandProcedure fixture = ReadHandProcedure(testing::Fixture("hand_12poses.yaml"));
+  EXPECT_EQ(fixture.poses, 12);
+  EXPECT_EQ(fixture.dwell_s, 10.0);
+  EXPECT_TRUE(fixture.up.empty());  // any
+  EXPECT_TRUE(fixture.twist_axes.empty());
+  EXPECT_TRUE(IsHandProcedureFile(testing::Fixture("hand_12poses.yaml")));
+  EXPECT_FALSE(IsHandProcedureFile(testing::Fixture("plan_24pos.yaml")));
+  const std::string head = "format: imufit-hand-procedure\nversion: 1\n";
+  const HandProcedure hand = ReadHandProcedureText(
+      head + "up: [+x, -z, corners, [1, 1, 0]]\ntwist_axes: [z, x]\nlatitude_deg: 52.27\nheight_m: 80\n",
+      "h.yaml");
+  ASSERT_EQ(hand.up.size(), 11u);
+  EXPECT_EQ(hand.up[0], Eigen::Vector3d::UnitX());
+  EXPECT_EQ(hand.up[1], -Eigen::Vector3d::UnitZ());
+  EXPECT_NEAR(hand.up[10].dot(Eigen::Vector3d(1, 1, 0).normalized()), 1.0, 1e-15);
+  EXPECT_EQ(hand.twist_axes, (std::vector<int>{2, 0}));
+  EXPECT_EQ(*hand.latitude_deg, 52.27);
+  EXPECT_EQ(ReadHandProcedureText(head + "twist_axes: none\n", "h.yaml").twist_deg,
+            (std::array<double, 2>{0, 0}));
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"poses: 8\n", "h.yaml:3:8: poses: 8 is outside 9..10000"},
+      {"up: [+w]\n", "h.yaml:3:6"},
+      {"twist_axes: [q]\n", "h.yaml:3:14"},
+      {"tilt_deg: [30, 10]\n", "h.yaml:3:11"},
+      {"gravity_mps2: 9.81\nlatitude_deg: 50\n", "give gravity_mps2 or latitude_deg, not both"},
+      {"height_m: 10\n", "height_m goes with latitude_deg"},
+      {"rate_hz: 100 Hz\n", "h.yaml:3:10"},
+  };
+  for (const auto& [text, said] : refused) {
+    try {
+      ReadHandProcedureText(head + text, "h.yaml");
+      ADD_FAILURE() << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(said), std::string::npos) << e.what();
+    }
   }
 }
 

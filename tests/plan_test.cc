@@ -17,10 +17,12 @@
 #include "imufit/fit/thermal_fit.h"
 #include "imufit/model/constants.h"
 #include "imufit/pipeline/fit_run.h"
+#include "imufit/plan/hand_check.h"
 #include "imufit/plan/plan_check.h"
 #include "imufit/plan/plan_design.h"
 #include "imufit/plan/plan_prediction.h"
 #include "imufit/run/windows.h"
+#include "imufit/sim/field_session.h"
 #include "imufit/sim/simulator.h"
 #include "test_models.h"
 
@@ -615,6 +617,102 @@ TEST(PlanFits, TheDesignOfTheDocsExampleFitsAndHitsTruth) {
   }
   EXPECT_TRUE(corners) << "the design holds corner positions";
   for (const bool noisy : {false, true}) ExpectFitsAndHitsTruth("the designed plan", design.segments, noisy);
+}
+
+// A hand procedure (io/hand_procedure.h) quick to simulate: 12 rests of 4 s, 50 Hz.
+HandProcedure QuickHand() {
+  HandProcedure hand;
+  hand.poses = 12;
+  hand.dwell_s = 4.0;
+  hand.turn_s = 1.5;
+  hand.rate_hz = 50.0;
+  return hand;
+}
+
+SimulationOptions HandNoise() {
+  SimulationOptions noise;
+  noise.gyro_noise_density = 1e-4;
+  noise.accel_noise_density = 1e-3;
+  return noise;
+}
+
+// The hand check's prediction against the spread of the field fit's values over many sessions of
+// the procedure (other seeds, so other poses, turns and noise): per class of coefficient, the RMS
+// of (fitted - truth) / predicted sigma. The prediction averages the fit's sigmas over
+// kHandPredictionSessions sessions, whose poses differ: the spread over random sessions is what it
+// predicts.
+constexpr int kHandPredictionSessions = 8;
+constexpr int kHandMonteCarloSessions = 40;
+// The RMS z of a class within [1 / kHandSpreadRatio, kHandSpreadRatio] (relative): 40 sessions of
+// 3..9 coefficients a class, the RMS's sampling error is 4..7 %; the prediction's own (8 sessions
+// of random poses), a few per cent more.
+constexpr double kHandSpreadRatio = 1.25;
+
+TEST(HandCheckTest, PredictsTheSpreadOfFieldFitsOverSessionsOfTheProcedure) {
+  const HandSetup setup = HandSetupOf(QuickHand(), HandNoise());
+  PlanCheckOptions options;
+  const HandCheck check = CheckHandProcedure(setup, options, kHandPredictionSessions);
+  ASSERT_TRUE(check.undetermined.empty()) << check.undetermined.front();
+  ASSERT_EQ(check.fitted, kHandPredictionSessions);
+  std::map<std::string, double> predicted;  // row name -> sigma, SI
+  for (const PlanRow& row : check.rows) {
+    if (row.term == 0) predicted[row.name] = row.sigma / PlanGroupFactor(row.group);
+  }
+  const SensorModel truth = SensorModel::Identity();
+  std::map<std::string, std::pair<double, int>> classes;  // group -> sum of z^2, count
+  int fitted = 0;
+  for (int s = 0; s < kHandMonteCarloSessions; ++s) {
+    SimulationOptions schedule = setup.schedule;
+    schedule.seed = 1000 + static_cast<std::uint64_t>(s);
+    std::vector<Sample> samples;
+    SimulateFieldSession(schedule, setup.session, truth,
+                         [&samples](const Sample& raw, const SegmentTruth&) { samples.push_back(raw); });
+    const FieldFitSummary fit = FitField(samples, setup.fit);
+    if (!fit.IsSolutionUsable()) continue;
+    ++fitted;
+    for (const PlanRow& row : check.rows) {
+      if (row.term != 0) continue;
+      const int i = row.coefficient * kPolynomialTerms;
+      const double error = row.gyro ? fit.model.gyro[i] - truth.gyro[i] : fit.model.accel[i] - truth.accel[i];
+      const double z = error / predicted[row.name];
+      classes[row.group].first += z * z;
+      ++classes[row.group].second;
+    }
+  }
+  EXPECT_EQ(fitted, kHandMonteCarloSessions);
+  EXPECT_EQ(classes.size(), 7u);  // every group: biases, scales, misalignments, g-sensitivity
+  for (const auto& [group, sum] : classes) {
+    const double rms = std::sqrt(sum.first / sum.second);
+    std::printf("%-20s RMS z %.3f over %d\n", group.c_str(), rms, sum.second);
+    EXPECT_GT(rms, 1.0 / kHandSpreadRatio) << group;
+    EXPECT_LT(rms, kHandSpreadRatio) << group;
+  }
+}
+
+TEST(HandCheckTest, AProcedureWithoutAPoseNearADirectionIsReportedSo) {
+  HandProcedure hand = QuickHand();
+  hand.up = {Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+             Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ()};  // never the y axis down
+  const HandCheck check = CheckHandProcedure(HandSetupOf(hand, HandNoise()), PlanCheckOptions(), 2);
+  ASSERT_EQ(check.undetermined.size(), 1u);
+  EXPECT_EQ(check.undetermined[0], "no pose with gravity near +y (the y axis down) (2 of 2 sessions)");
+  EXPECT_EQ(check.fitted, 0);
+  EXPECT_TRUE(check.rows.empty());
+}
+
+TEST(HandCheckTest, AnUnmetToleranceGetsMeasuredAlternatives) {
+  PlanCheckOptions options;
+  options.tolerances["accel.bias"] = 0.02;  // mg: tighter than 4 s rests give
+  const HandCheck check = CheckHandProcedure(HandSetupOf(QuickHand(), HandNoise()), options, 2);
+  ASSERT_TRUE(check.tolerance_unmet);
+  ASSERT_EQ(check.alternatives.size(), 4u);
+  EXPECT_EQ(check.alternatives[0].option, "--dwell 8");
+  EXPECT_EQ(check.alternatives[1].option, "--dwell 16");
+  EXPECT_EQ(check.alternatives[2].option, "--poses 18");
+  EXPECT_EQ(check.alternatives[3].option, "--poses 24");
+  // White noise on the rests: four times the dwell halves the accelerometer's bias sigma.
+  EXPECT_LT(check.alternatives[1].worst_ratio, 0.6 * check.rows.front().ratio);
+  EXPECT_GT(check.alternatives[1].session_s, check.session_s);
 }
 
 }  // namespace

@@ -59,7 +59,11 @@ std::vector<Eigen::Vector3d> NominalDirections() {
 // Gravity's direction (up, body frame) at every pose: the nominal directions in turn (faces first),
 // each tilted, then shuffled (Fisher-Yates with the session's generator).
 std::vector<Eigen::Vector3d> PoseDirections(const FieldSessionOptions& session, SessionRandom* random) {
-  const std::vector<Eigen::Vector3d> nominal = NominalDirections();
+  std::vector<Eigen::Vector3d> nominal = NominalDirections();
+  if (!session.directions.empty()) {
+    nominal.clear();
+    for (const Eigen::Vector3d& d : session.directions) nominal.push_back(d.normalized());
+  }
   std::vector<Eigen::Vector3d> ups;
   for (int p = 0; p < session.poses; ++p) {
     const Eigen::Vector3d& d = nominal[static_cast<size_t>(p) % nominal.size()];
@@ -115,8 +119,12 @@ struct Turn {
 Turn TurnBetween(const Eigen::Vector3d& up, const Eigen::Vector3d& up_next,
                  const FieldSessionOptions& session, SessionRandom* random) {
   Turn turn;
-  turn.n2 = random->UnitVector();
-  turn.theta2 = kDegToRad * random->Uniform(20.0, 90.0) * (random->Uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0);
+  turn.n2 = session.twist_axes.empty()
+                ? random->UnitVector()
+                : Eigen::Vector3d::Unit(
+                      session.twist_axes[random->Index(static_cast<int>(session.twist_axes.size()))]);
+  turn.theta2 = kDegToRad * random->Uniform(session.min_twist_deg, session.max_twist_deg) *
+                (random->Uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0);
   const Eigen::Vector3d v = Eigen::AngleAxisd(turn.theta2, turn.n2) * up_next;
   const Eigen::Vector3d axis = up.cross(v);
   const double angle = std::atan2(axis.norm(), up.dot(v));

@@ -1,6 +1,8 @@
 // FieldSessionOptions: its option table (base/option_table.h) and its checks.
 #include "imufit/sim/field_session.h"
 
+#include <string>
+
 namespace imufit {
 namespace {
 
@@ -38,6 +40,16 @@ std::string FieldSessionOptions::Validate() const {
   if (min_tilt_deg > max_tilt_deg) {
     return "min_tilt_deg = " + OptionNumberText(min_tilt_deg) +
            ": more than max_tilt_deg = " + OptionNumberText(max_tilt_deg);
+  }
+  if (!(min_twist_deg >= 0.0 && min_twist_deg <= max_twist_deg && max_twist_deg <= 180.0)) {
+    return "twist angles " + OptionNumberText(min_twist_deg) + ".." + OptionNumberText(max_twist_deg) +
+           " deg: give 0 <= least <= largest <= 180";
+  }
+  for (int axis : twist_axes) {
+    if (axis < 0 || axis > 2) return "twist axis " + std::to_string(axis) + ": give 0 (x), 1 (y) or 2 (z)";
+  }
+  for (const Eigen::Vector3d& d : directions) {
+    if (!(d.norm() > 0.0) || !d.allFinite()) return "a pose direction must be a finite non-zero vector";
   }
   return "";
 }
