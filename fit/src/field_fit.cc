@@ -622,16 +622,21 @@ std::string FieldFitSummary::BriefReport() const {
       return "the fit did not converge (" + counts + "): " + termination;
     case FieldFitStatus::kInconsistent: {
       std::string text = "the sessions disagree (" + counts + "): ";
-      std::string named;
+      // The sessions and sensors beyond chance, the most discrepant first.
+      std::vector<std::pair<double, std::string>> beyond;
       for (const FieldSessionShare& session : sessions) {
         for (const auto& [sensor, offset] :
              {std::pair{"gyro", &session.gyro_bias}, std::pair{"accelerometer", &session.accel_bias}}) {
           if (!offset->beyond) continue;
-          named += (named.empty() ? "" : "; ") + session.name + ": its " + sensor +
-                   " bias is off the joint fit" +
-                   Format(" (chi-square %.3g for 3, beyond %.3g)", offset->chi2, kFieldSessionChi2);
+          beyond.emplace_back(offset->chi2, session.name + ": its " + sensor + " bias is off the joint fit" +
+                                                Format(" (chi-square %.3g for 3, beyond %.3g)", offset->chi2,
+                                                       kFieldSessionChi2));
         }
       }
+      std::stable_sort(beyond.begin(), beyond.end(),
+                       [](const auto& a, const auto& b) { return a.first > b.first; });
+      std::string named;
+      for (const auto& item : beyond) named += (named.empty() ? "" : "; ") + item.second;
       return text + named +
              ": a bias that changed from one power-on to the next (turn-on repeatability), or another unit; "
              "fit the sessions one by one (--repeat compares two), or record over one power-on";
