@@ -4,6 +4,7 @@
 #define IMUFIT_APP_FIELD_FIT_COMMAND_H_
 
 #include <string>
+#include <vector>
 
 #include "cli_options.h"
 #include "commands.h"
@@ -16,6 +17,7 @@ struct FieldFitArguments {
   bool field = false;                   // --field: a session by hand
   CliOptions<FieldFitOptions> options;  // FieldFitOptionTable()
   std::string repeat;                   // --repeat: a second session of the unit, compared
+  std::vector<double> session_temps_c;  // --session-temp-c: each session's temperature, in order
 };
 
 // Adds --field and the field fit's own options (which need it) to `command`.
@@ -25,13 +27,15 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args);
 // session by hand (--validate, --prior, --fit, ...).
 void RefuseTableOptions(const FitRunArguments& run);
 
-// The field fit of `samples` written to `output`; `run` gives how the samples are read (--temp-c,
-// --time-unit, columns, rest detection) and whether the g-sensitivity is fitted (--no-g-sensitivity).
-// With --repeat, the second session is fitted alike and compared (CompareFieldFits); the file is
-// the first session's. Returns the exit status: 0, or 1 when a session does not determine the
-// model (the message says what it lacks) or the fit does not converge; nothing is written then.
-int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
-                const std::string& serial, bool quiet, const FitRunOptions& run);
+// The field fit of `samples` (one session, or several of one unit fitted jointly) written to
+// `output`; `run` gives how the samples are read (--temp-c, --time-unit, columns, rest detection)
+// and whether the g-sensitivity is fitted (--no-g-sensitivity). With --repeat (one session only),
+// the second session is fitted alike and compared (CompareFieldFits); the file is the first
+// session's. Returns the exit status: 0, or 1 when the sessions do not determine the model (the
+// message says what they lack), disagree (a session's biases off the joint fit), or the fit does
+// not converge; nothing is written then.
+int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& samples,
+                const std::string& output, const std::string& serial, bool quiet, const FitRunOptions& run);
 
 }  // namespace imufit
 

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "commands.h"
 #include "field_fit_command.h"
@@ -20,7 +22,8 @@ namespace {
 
 struct FitArguments {
   std::string plan;
-  std::string samples;
+  std::string samples;                     // the first --samples (a table run: the only one)
+  std::vector<std::string> samples_given;  // every --samples (--field: several sessions of one unit)
   std::string output;
   bool quiet = false;
   std::string limits;          // acceptance limits: verdict table, exit 3 when they fail
@@ -249,7 +252,14 @@ int RunFit(const FitArguments& args) {
         throw InputError("--field", "limits, certificates and the store take table runs only");
     }
     RefuseTableOptions(args.run);
-    return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, ResolveOptions(args));
+    return RunFieldFit(args.field, args.samples_given, args.output, args.serial, args.quiet,
+                       ResolveOptions(args));
+  }
+  if (args.samples_given.size() > 1) {
+    throw InputError("--samples",
+                     "given " + std::to_string(args.samples_given.size()) +
+                         " times: a table fit takes one run (several sessions by hand of one unit "
+                         "are fitted jointly with --field)");
   }
   if (args.plan.empty()) throw InputError("imufit fit", "--plan is required (or --field)");
   const std::string check_plan = args.run.options.GivenText("check_plan");
@@ -319,7 +329,11 @@ int RunFit(const FitArguments& args) {
 CommandRunner AddFitCommand(CliCommand command) {
   auto args = std::make_shared<FitArguments>();
   command.Option("--plan,-p", &args->plan, "plan YAML of the run (required, but with --field)");
-  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
+  command
+      .Option(
+          "--samples,-s", &args->samples_given,
+          "raw samples CSV (or .csv.gz); with --field, given once per session of one unit: fitted jointly")
+      .Required();
   command.Option("--output,-o", &args->output, "calibration YAML to write").Required();
   AddFitRunOptions(command, &args->run);
   command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
@@ -341,7 +355,10 @@ CommandRunner AddFitCommand(CliCommand command) {
       "--store", &args->store,
       "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");
   AddFieldFitOptions(command, &args->field);
-  return [args] { return RunFit(*args); };
+  return [args] {
+    args->samples = args->samples_given.front();
+    return RunFit(*args);
+  };
 }
 
 }  // namespace imufit

@@ -61,6 +61,16 @@ class FieldRecord:
     noise_scale_gyro_rests: float | None  # the rests' gyro noise as a multiple of the log's white noise
     noise_scale_turns: float | None  # the turns' noise as a multiple of the log's white noise
     saturated_turns: int | None  # turns left out because a gyro axis touched its converter's rail
+    session_samples: list[str] | None  # several sessions fitted jointly: the samples files, as given, in order (one session: absent)
+    session_samples_sha256: list[str] | None  # SHA-256 of each session's samples file
+    session_samples_read: list[int] | None  # samples in each session's file
+    session_poses: list[int] | None  # rests each session contributed
+    session_turns: list[int] | None  # turns within each session (none joins two sessions)
+    session_temp_min_c: list[float] | None  # each session's coldest reading, degC
+    session_temp_max_c: list[float] | None  # each session's warmest reading, degC
+    session_biases_tested: bool | None  # whether each session's biases could be tested against the joint fit (false: the curve in temperature absorbs a session's offset, a turn-on offset is taken for temperature unseen)
+    session_gyro_bias_chi2: list[float] | None  # when tested: each session's gyro bias offset from the joint fit, chi-square for 3
+    session_accel_bias_chi2: list[float] | None  # when tested: each session's accelerometer bias offset from the joint fit, chi-square for 3
 
 class FitRecord:
     """What the fit did and on which files: the calibration's `fit:` block, each key an attribute
