@@ -230,8 +230,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& s
   for (const std::string& warning : result.serial_warnings)
     std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
   const std::string name = several ? std::to_string(samples.size()) + " sessions" : samples.front();
-  if (several && (fit.IsSolutionUsable() || fit.status == FieldFitStatus::kInconsistent))
-    PrintSessions(result, quiet);
+  if (several && fit.status == FieldFitStatus::kInconsistent) PrintSessions(result, quiet);
   if (!fit.IsSolutionUsable()) {
     std::fprintf(stderr, "imufit: %s: %s, nothing written\n", name.c_str(), fit.BriefReport().c_str());
     return 1;
@@ -252,6 +251,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& s
                 scaled ? "the session's scatter, beyond its white noise (tremor, drift)"
                        : "the session's white noise");
   }
+  if (several) PrintSessions(result, quiet);
   if (!args.repeat.empty()) {
     RefuseToOverwriteInputs(output, {args.repeat});
     const FieldRunResult second = FieldFitRun(args.repeat, run.input, options, SoftwareVersion(),

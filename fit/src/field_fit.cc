@@ -638,7 +638,8 @@ std::string FieldFitSummary::BriefReport() const {
       std::string named;
       for (const auto& item : beyond) named += (named.empty() ? "" : "; ") + item.second;
       return text + named +
-             ": a bias that changed from one power-on to the next (turn-on repeatability), or another unit; "
+             ": a bias that changed from one power-on to the next (turn-on repeatability), a curve in "
+             "temperature of too low an order (--bias-temp-order), or another unit; "
              "fit the sessions one by one (--repeat compares two), or record over one power-on";
     }
     case FieldFitStatus::kConverged:
