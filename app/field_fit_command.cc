@@ -155,16 +155,20 @@ std::vector<SamplesInput> SessionInputs(const FieldFitArguments& args,
 // when the curve in temperature absorbs a session's offset (nothing could be tested).
 void PrintSessions(const FieldRunResult& result, bool quiet) {
   const FieldFitSummary& fit = result.fit;
-  bool untested = false;
-  for (const FieldSessionShare& share : fit.sessions)
-    untested = untested || !share.gyro_bias.tested || !share.accel_bias.tested;
-  if (untested && fit.status != FieldFitStatus::kInconsistent) {
-    std::fprintf(stderr,
-                 "imufit: warning: the sessions' biases cannot be tested against each other: the curve in "
-                 "temperature passes through each session's bias (as many sessions as the bias order has "
-                 "terms, each at one temperature), so a bias that changed from one power-on to the next "
-                 "(turn-on repeatability) is taken for temperature: record a further session, or the "
-                 "warm-up in one power-on (docs/field.md)\n");
+  std::string untested;
+  for (const FieldSessionShare& share : fit.sessions) {
+    if (!share.gyro_bias.tested || !share.accel_bias.tested)
+      untested += (untested.empty() ? "" : ", ") + share.name;
+  }
+  if (!untested.empty() && fit.status != FieldFitStatus::kInconsistent) {
+    std::fprintf(
+        stderr,
+        "imufit: warning: the sessions' biases cannot be tested against each other (%s): the joint fit "
+        "follows such a session's bias wholly (a curve in temperature with as many terms as sessions, "
+        "each at one temperature, or a session of too few rests), so a bias that changed from one "
+        "power-on to the next (turn-on repeatability) is taken for temperature unseen: record a further "
+        "session, or the warm-up in one power-on (docs/field.md)\n",
+        untested.c_str());
   }
   if (quiet && fit.status != FieldFitStatus::kInconsistent) return;
   FILE* out = fit.status == FieldFitStatus::kInconsistent ? stderr : stdout;
