@@ -173,7 +173,8 @@ void PrintSessions(const FieldRunResult& result, bool quiet) {
   if (quiet && fit.status != FieldFitStatus::kInconsistent) return;
   FILE* out = fit.status == FieldFitStatus::kInconsistent ? stderr : stdout;
   std::fprintf(out,
-               "  sessions (%zu), each's bias against the joint fit (offset +- 1 sigma, chi-square for 3):\n",
+               "  sessions (%zu): what each contributed, and its biases' offset from the joint fit (+- 1 "
+               "sigma; chi-square for 3):\n",
                fit.sessions.size());
   const auto offset_text = [&](const FieldSessionOffset& o, Sensor sensor, double temp_c) {
     if (!o.tested) return std::string("untested (the curve absorbs it)");

@@ -405,7 +405,9 @@ TEST_F(CliTest, FieldSessionsFittedJointly) {
   const RunResult fit = Run(args);
   ASSERT_EQ(fit.status, 0) << fit.err;
   EXPECT_NE(fit.out.find("converged (4 sessions, 40 poses, 36 turns"), std::string::npos) << fit.out;
-  EXPECT_NE(fit.out.find("sessions (4), each's bias against the joint fit"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("sessions (4): what each contributed, and its biases' offset from the joint fit"),
+            std::string::npos)
+      << fit.out;
   EXPECT_NE(fit.out.find("s30.csv: "), std::string::npos) << fit.out;
   EXPECT_EQ(fit.out.find("beyond chance"), std::string::npos) << fit.out;
   EXPECT_EQ(fit.err.find("cannot be tested"), std::string::npos) << fit.err;
