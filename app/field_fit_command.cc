@@ -8,6 +8,8 @@
 
 #include "commands.h"
 #include "imufit/io/error.h"
+#include "imufit/io/output_file.h"
+#include "imufit/io/samples.h"
 #include "imufit/io/units.h"
 #include "imufit/pipeline/field_run.h"
 #include "imufit/report/engineering_units.h"
@@ -97,6 +99,12 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
               "a ROS bag's sensor_msgs/Temperature topic, interpolated at the IMU stamps (default: the bag's "
               "only one, if it has one; without one, give --temp-c)")
       .Needs(field);
+  command
+      .Option("--session-temp-c", &args->session_temps_c,
+              "several sessions without a temp_c column: each session's temperature, degC, in the order of "
+              "--samples (given once per session, or as a list T1,T2,...)")
+      .Delimiter(',')
+      .Needs(field);
   args->options.Add(command, FieldFitOptionTable());
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key).Needs(field);
 }
@@ -110,18 +118,102 @@ void RefuseTableOptions(const FitRunArguments& run) {
   }
 }
 
-int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
-                const std::string& serial, bool quiet, const FitRunOptions& run,
+// How each session is read: as `run` says, with its own --session-temp-c when given.
+std::vector<SamplesInput> SessionInputs(const FieldFitArguments& args,
+                                        const std::vector<std::string>& samples, const FitRunOptions& run) {
+  std::vector<SamplesInput> inputs(samples.size(), run.input);
+  if (args.session_temps_c.empty()) return inputs;
+  if (run.input.temp_c) {
+    throw InputError(
+        "--session-temp-c",
+        "and --temp-c both given: --temp-c is every session's temperature, --session-temp-c each one's");
+  }
+  if (args.session_temps_c.size() != samples.size()) {
+    throw InputError("--session-temp-c", "gives " + std::to_string(args.session_temps_c.size()) +
+                                             " temperatures for " + std::to_string(samples.size()) +
+                                             " sessions (--samples): one per session, in order");
+  }
+  for (size_t s = 0; s < samples.size(); ++s) {
+    const double temp_c = args.session_temps_c[s];
+    if (!(temp_c >= kMinPlausibleTempC && temp_c <= kMaxPlausibleTempC)) {
+      throw InputError("--session-temp-c", FormatDouble(temp_c) + " degC is not a plausible temperature");
+    }
+    inputs[s].temp_c = temp_c;
+  }
+  return inputs;
+}
+
+// Several sessions: what each contributed and how its biases compare with the joint fit; a warning
+// when the curve in temperature absorbs a session's offset (nothing could be tested).
+void PrintSessions(const FieldRunResult& result, bool quiet) {
+  const FieldFitSummary& fit = result.fit;
+  std::string untested;
+  for (const FieldSessionShare& share : fit.sessions) {
+    if (!share.gyro_bias.tested || !share.accel_bias.tested)
+      untested += (untested.empty() ? "" : ", ") + share.name;
+  }
+  if (!untested.empty() && fit.status != FieldFitStatus::kInconsistent) {
+    std::fprintf(
+        stderr,
+        "imufit: warning: the sessions' biases cannot be tested against each other (%s): the joint fit "
+        "follows such a session's bias wholly (a curve in temperature with as many terms as sessions, "
+        "each at one temperature, or a session of too few rests), so a bias that changed from one "
+        "power-on to the next (turn-on repeatability) is taken for temperature unseen: record a further "
+        "session, or the warm-up in one power-on (docs/field.md)\n",
+        untested.c_str());
+  }
+  if (quiet && fit.status != FieldFitStatus::kInconsistent) return;
+  FILE* out = fit.status == FieldFitStatus::kInconsistent ? stderr : stdout;
+  std::fprintf(out,
+               "  sessions (%zu): what each contributed, and its biases' offset from the joint fit (+- 1 "
+               "sigma; chi-square for 3):\n",
+               fit.sessions.size());
+  const auto offset_text = [&](const FieldSessionOffset& o, Sensor sensor, double temp_c) {
+    if (!o.tested) return std::string("untested (the curve absorbs it)");
+    char text[160];
+    double v[3];
+    double e[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      const double factor = EngineeringFactor(fit.model, sensor, kBiasCoefficient + axis, temp_c);
+      v[axis] = factor * o.offset(axis);
+      e[axis] = std::abs(factor) * o.sigma(axis);
+    }
+    std::snprintf(text, sizeof text, "%+.4g %+.4g %+.4g +- %.2g %.2g %.2g %s, chi-square %.3g%s", v[0], v[1],
+                  v[2], e[0], e[1], e[2], EngineeringUnit(sensor, kBiasCoefficient), o.chi2,
+                  o.beyond ? " (beyond chance)" : "");
+    return std::string(text);
+  };
+  for (size_t s = 0; s < fit.sessions.size(); ++s) {
+    const FieldSessionShare& share = fit.sessions[s];
+    const double temp_c = 0.5 * (share.temp_range_c[0] + share.temp_range_c[1]);
+    std::fprintf(out, "    %zu %s: %lld samples, %.1f .. %.1f degC, %d poses, %d turns\n", s + 1,
+                 share.name.c_str(), share.samples, share.temp_range_c[0], share.temp_range_c[1], share.poses,
+                 share.turns);
+    std::fprintf(out, "        gyro  %s\n", offset_text(share.gyro_bias, Sensor::kGyro, temp_c).c_str());
+    std::fprintf(out, "        accel %s\n", offset_text(share.accel_bias, Sensor::kAccel, temp_c).c_str());
+  }
+}
+
+int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& samples,
+                const std::string& output, const std::string& serial, bool quiet, const FitRunOptions& run,
                 const std::function<int(const FieldRunResult&)>& certify) {
-  RefuseToOverwriteInputs(output, {samples});
+  RefuseToOverwriteInputs(output, samples);
+  const bool several = samples.size() > 1;
+  if (several && !args.repeat.empty()) {
+    throw InputError("--repeat",
+                     "compares one session with another; several --samples are fitted jointly and each "
+                     "session's biases checked against the joint fit (fit the sessions one by one to compare "
+                     "two)");
+  }
   FieldFitOptions options;
   args.options.Apply(&options);
   options.detection = run.input.segmentation;
   options.fit_g_sensitivity = run.fit.Fits(true, kGSensitivityCoefficient);
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit --field", problem);
-  const FieldRunResult result = FieldFitRun(samples, run.input, options, SoftwareVersion(), serial,
-                                            run.allow_serial_mismatch, args.topics);
+  const FieldRunResult result =
+      FieldFitSessionsRun(samples, SessionInputs(args, samples, run), options, SoftwareVersion(), serial,
+                          run.allow_serial_mismatch, args.topics);
   const FieldFitSummary& fit = result.fit;
   // At order 0 the coefficients are constant in temperature: a unit that warmed during the
   // session is fitted at its mean, its drift taken for noise.
@@ -129,15 +221,17 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   if (options.bias_temp_order == 0 && options.scale_temp_order == 0 &&
       fit.temp_range_c[1] - fit.temp_range_c[0] > kConstantTempSpanC) {
     std::fprintf(stderr,
-                 "imufit: warning: the session spans %.3g .. %.3g degC; at --bias-temp-order 0 a field "
+                 "imufit: warning: the %s %.3g .. %.3g degC; at --bias-temp-order 0 a field "
                  "calibration is constant in temperature: let the unit warm up before the session, or fit "
                  "the warm-up (--bias-temp-order, docs/field.md)\n",
-                 fit.temp_range_c[0], fit.temp_range_c[1]);
+                 several ? "sessions span" : "session spans", fit.temp_range_c[0], fit.temp_range_c[1]);
   }
   for (const std::string& warning : result.serial_warnings)
     std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  const std::string name = several ? std::to_string(samples.size()) + " sessions" : samples.front();
+  if (several && fit.status == FieldFitStatus::kInconsistent) PrintSessions(result, quiet);
   if (!fit.IsSolutionUsable()) {
-    std::fprintf(stderr, "imufit: %s: %s, nothing written\n", samples.c_str(), fit.BriefReport().c_str());
+    std::fprintf(stderr, "imufit: %s: %s, nothing written\n", name.c_str(), fit.BriefReport().c_str());
     return 1;
   }
   if (!quiet) {
@@ -154,8 +248,9 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
                   *run.input.temp_c);
     }
     std::printf("imufit fit --field: %s\n", fit.BriefReport().c_str());
-    std::printf("  session: %lld samples, %.1f .. %.1f degC; body frame: %s (docs/spec.md section 1)\n",
-                result.samples_read, fit.temp_range_c[0], fit.temp_range_c[1], kBodyFrameAccelerometerXy);
+    std::printf("  %s: %lld samples, %.1f .. %.1f degC; body frame: %s (docs/spec.md section 1)\n",
+                several ? "sessions" : "session", result.samples_read, fit.temp_range_c[0],
+                fit.temp_range_c[1], kBodyFrameAccelerometerXy);
     std::printf("  static gyro RMS %.5f deg/s over the poses\n", DpsFromRadps(fit.gyro_static_rms_radps));
     PrintFieldCoefficients(fit);
     const bool scaled = fit.noise_scale[0] > 1.0 || fit.noise_scale[1] > 1.0 || fit.noise_scale[2] > 1.0;
@@ -163,6 +258,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
                 scaled ? "the session's scatter, beyond its white noise (tremor, drift)"
                        : "the session's white noise");
   }
+  if (several) PrintSessions(result, quiet);
   if (!args.repeat.empty()) {
     RefuseToOverwriteInputs(output, {args.repeat});
     const FieldRunResult second = FieldFitRun(args.repeat, run.input, options, SoftwareVersion(),

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "cli_options.h"
 #include "commands.h"
@@ -19,6 +20,7 @@ struct FieldFitArguments {
   CliOptions<FieldFitOptions> options;  // FieldFitOptionTable()
   std::string repeat;                   // --repeat: a second session of the unit, compared
   LogTopics topics;                     // --topic, --temp-topic: a ROS bag's topics
+  std::vector<double> session_temps_c;  // --session-temp-c: each session's temperature, in order
 };
 
 // Adds --field and the field fit's own options (which need it) to `command`.
@@ -28,16 +30,18 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args);
 // session by hand (--validate, --prior, --fit, ...).
 void RefuseTableOptions(const FitRunArguments& run);
 
-// The field fit of `samples` written to `output`; `run` gives how the samples are read (--temp-c,
-// --time-unit, columns, rest detection) and whether the g-sensitivity is fitted (--no-g-sensitivity).
-// With --repeat, the second session is fitted alike and compared (CompareFieldFits); the file is
-// the first session's. Returns the exit status: 0, or 1 when a session does not determine the
-// model (the message says what it lacks) or the fit does not converge; nothing is written then.
+// The field fit of `samples` (one session, or several of one unit fitted jointly) written to
+// `output`; `run` gives how the samples are read (--temp-c, --time-unit, columns, rest detection)
+// and whether the g-sensitivity is fitted (--no-g-sensitivity). With --repeat (one session only),
+// the second session is fitted alike and compared (CompareFieldFits); the file is the first
+// session's. Returns the exit status: 0, or 1 when the sessions do not determine the model (the
+// message says what they lack), disagree (a session's biases off the joint fit), or the fit does
+// not converge; nothing is written then.
 // `certify`, when given (fit --field --limits/--report/--store), takes the usable fit in place of
 // writing the calibration (it certifies, judges, writes and records it: CertifyUnit) and returns
 // the exit status.
-int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const std::string& output,
-                const std::string& serial, bool quiet, const FitRunOptions& run,
+int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& samples,
+                const std::string& output, const std::string& serial, bool quiet, const FitRunOptions& run,
                 const std::function<int(const FieldRunResult&)>& certify = {});
 
 }  // namespace imufit

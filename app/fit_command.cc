@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "commands.h"
 #include "field_fit_command.h"
@@ -20,7 +22,8 @@ namespace {
 
 struct FitArguments {
   std::string plan;
-  std::string samples;
+  std::string samples;                     // the first --samples (a table run: the only one)
+  std::vector<std::string> samples_given;  // every --samples (--field: several sessions of one unit)
   std::string output;
   bool quiet = false;
   std::string limits;          // acceptance limits: verdict table, exit 3 when they fail
@@ -261,12 +264,13 @@ int RunCertifiedFieldFit(const FitArguments& args) {
   if (!args.plan.empty()) throw InputError("--plan", "a session by hand (--field) has no plan");
   RefuseTableOptions(args.run);
   const FitRunOptions options = ResolveOptions(args);
-  const std::string pdf =
-      CheckCertificateOutputs(args, {args.samples, args.limits, args.output, args.station});
+  std::vector<std::string> inputs = args.samples_given;
+  inputs.insert(inputs.end(), {args.limits, args.output, args.station});
+  const std::string pdf = CheckCertificateOutputs(args, inputs);
   if (args.limits.empty() && args.report.empty() && args.store.empty()) {
     if (!args.station.empty())
       throw InputError("--station", "is shown on the certificate: give --report too");
-    return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, options);
+    return RunFieldFit(args.field, args.samples_given, args.output, args.serial, args.quiet, options);
   }
   const Paper paper = args.pdf.Resolve();
   std::unique_ptr<ResultsStore> store;
@@ -291,11 +295,17 @@ int RunCertifiedFieldFit(const FitArguments& args) {
     if (!pdf.empty() && !args.quiet && recorded) std::printf("  wrote %s\n", pdf.c_str());
     return ReportCertified(args, unit, recorded);
   };
-  return RunFieldFit(args.field, args.samples, args.output, args.serial, args.quiet, options, certify);
+  return RunFieldFit(args.field, args.samples_given, args.output, args.serial, args.quiet, options, certify);
 }
 
 int RunFit(const FitArguments& args) {
   if (args.field.field) return RunCertifiedFieldFit(args);
+  if (args.samples_given.size() > 1) {
+    throw InputError("--samples",
+                     "given " + std::to_string(args.samples_given.size()) +
+                         " times: a table fit takes one run (several sessions by hand of one unit "
+                         "are fitted jointly with --field)");
+  }
   if (args.plan.empty()) throw InputError("imufit fit", "--plan is required (or --field)");
   const std::string check_plan = args.run.options.GivenText("check_plan");
   const std::string check_samples = args.run.options.GivenText("check_samples");
@@ -351,7 +361,11 @@ int RunFit(const FitArguments& args) {
 CommandRunner AddFitCommand(CliCommand command) {
   auto args = std::make_shared<FitArguments>();
   command.Option("--plan,-p", &args->plan, "plan YAML of the run (required, but with --field)");
-  command.Option("--samples,-s", &args->samples, "raw samples CSV (or .csv.gz)").Required();
+  command
+      .Option(
+          "--samples,-s", &args->samples_given,
+          "raw samples CSV (or .csv.gz); with --field, given once per session of one unit: fitted jointly")
+      .Required();
   command.Option("--output,-o", &args->output, "calibration YAML to write").Required();
   AddFitRunOptions(command, &args->run);
   command.Flag("--quiet,-q", &args->quiet, "print nothing but errors");
@@ -373,7 +387,10 @@ CommandRunner AddFitCommand(CliCommand command) {
       "--store", &args->store,
       "record the fit in this results store (an SQLite file, created when missing, or a PostgreSQL URL)");
   AddFieldFitOptions(command, &args->field);
-  return [args] { return RunFit(*args); };
+  return [args] {
+    args->samples = args->samples_given.front();
+    return RunFit(*args);
+  };
 }
 
 }  // namespace imufit

@@ -572,6 +572,192 @@ TEST_F(CliTest, FieldCertificateOptionsAreChecked) {
   r = Run({"report", "-c", Fixture("golden/mems_6pos_soak.yaml"), "-s", raw, "-o", Path("r.html")});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--plan is required"), std::string::npos) << r.err;
+
+// ---------------------------------------------------------------- several sessions of one unit
+
+// A session of the MEMS unit (`truth`, default fixtures/mems_truth.yaml) at `temp_c`: ten rests of
+// about 3 s at 50 Hz, the unit's `serial`; `extra` adds.
+std::vector<std::string> SessionAt(const std::string& out, int temp_c, int seed,
+                                   const std::string& truth = "", const std::vector<std::string>& extra = {},
+                                   const std::string& serial = "SN0001") {
+  std::vector<std::string> args = {"simulate",
+                                   "--field",
+                                   "--calibration",
+                                   truth.empty() ? Fixture("mems_truth.yaml") : truth,
+                                   "-o",
+                                   out,
+                                   "--temps",
+                                   std::to_string(temp_c),
+                                   "--poses",
+                                   "10",
+                                   "--dwell",
+                                   "3",
+                                   "--rate",
+                                   "50",
+                                   "--gyro-noise-density",
+                                   "2e-4",
+                                   "--accel-noise-density",
+                                   "1e-3",
+                                   "--serial",
+                                   serial,
+                                   "--seed",
+                                   std::to_string(seed),
+                                   "-q"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return args;
+}
+
+// Four sessions (0, 15, 30, 45 degC, each its own power-on) fitted jointly, biases quadratic and
+// scale factors linear in temperature: each session's share printed and recorded in the file as
+// PyYAML-like readers see it (yaml-cpp here; the schema and PyYAML in python/tests), every session's
+// bias tested and consistent.
+TEST_F(CliTest, FieldSessionsFittedJointly) {
+  std::vector<std::string> sessions;
+  for (const int temp_c : {0, 15, 30, 45}) {
+    sessions.push_back(Path("s" + std::to_string(temp_c) + ".csv"));
+    ASSERT_EQ(Run(SessionAt(sessions.back(), temp_c, 40 + temp_c)).status, 0);
+  }
+  const std::string calibration = Path("joint.yaml");
+  std::vector<std::string> args = {"fit", "--field", "--bias-temp-order", "2", "--scale-temp-order",
+                                   "1",   "-o",      calibration};
+  for (const std::string& session : sessions) args.insert(args.end(), {"--samples", session});
+  const RunResult fit = Run(args);
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("converged (4 sessions, 40 poses, 36 turns"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("sessions (4): what each contributed, and its biases' offset from the joint fit"),
+            std::string::npos)
+      << fit.out;
+  EXPECT_NE(fit.out.find("s30.csv: "), std::string::npos) << fit.out;
+  EXPECT_EQ(fit.out.find("beyond chance"), std::string::npos) << fit.out;
+  EXPECT_EQ(fit.err.find("cannot be tested"), std::string::npos) << fit.err;
+  const YAML::Node record = YAML::LoadFile(calibration)["fit"];
+  EXPECT_FALSE(record["samples"]);  // names one file: the sessions are listed under field
+  EXPECT_FALSE(record["samples_sha256"]);
+  const YAML::Node field = record["field"];
+  ASSERT_EQ(field["session_samples"].size(), 4u);
+  long long samples = 0;
+  for (size_t s = 0; s < 4; ++s) {
+    EXPECT_EQ(field["session_samples"][s].as<std::string>(), sessions[s]);
+    EXPECT_EQ(field["session_samples_sha256"][s].as<std::string>().size(), 64u);
+    EXPECT_EQ(field["session_poses"][s].as<int>(), 10);
+    EXPECT_EQ(field["session_turns"][s].as<int>(), 9);
+    EXPECT_NEAR(field["session_temp_min_c"][s].as<double>(), 15.0 * s, 0.5);
+    EXPECT_LT(field["session_gyro_bias_chi2"][s].as<double>(), 21.11);
+    samples += field["session_samples_read"][s].as<long long>();
+  }
+  EXPECT_EQ(samples, record["samples_read"].as<long long>());
+  EXPECT_EQ(field["poses"].as<int>(), 40);
+  EXPECT_TRUE(field["session_biases_tested"].as<bool>());
+  EXPECT_EQ(YAML::LoadFile(calibration)["serial"].as<std::string>(), "SN0001");
+  // The calibration is an ordinary one: apply corrects a session with it.
+  EXPECT_EQ(Run({"apply", "-q", "--calibration", calibration, "--samples", sessions[1], "-o",
+                 Path("corrected.csv")})
+                .status,
+            0);
+
+  // Three of them with a quadratic: the curve passes through every session's bias, nothing can
+  // be tested, and the user is told so; the file says so too.
+  const RunResult three = Run({"fit", "--field", "--bias-temp-order", "2", "--samples", sessions[0],
+                               "--samples", sessions[2], "--samples", sessions[3], "-o", Path("three.yaml")});
+  ASSERT_EQ(three.status, 0) << three.err;
+  EXPECT_NE(three.err.find("warning: the sessions' biases cannot be tested against each other"),
+            std::string::npos)
+      << three.err;
+  const YAML::Node untested = YAML::LoadFile(Path("three.yaml"))["fit"]["field"];
+  EXPECT_FALSE(untested["session_biases_tested"].as<bool>());
+  EXPECT_FALSE(untested["session_gyro_bias_chi2"]);
+}
+
+// Three sessions at 25 degC, one recorded after a power-on that moved the gyro bias by 0.05 deg/s
+// (a MEMS unit's turn-on repeatability): refused, exit 1, nothing written; the session with the
+// offset named first (the other two are off the mean it pulls, by half as much).
+TEST_F(CliTest, FieldSessionsWithATurnOnOffsetAreRefused) {
+  YAML::Node truth = YAML::LoadFile(Fixture("mems_truth.yaml"));
+  for (const char* axis : {"x", "y", "z"}) {
+    const double scale = truth["gyro"]["scale"][axis][0].as<double>();
+    truth["gyro"]["bias"][axis][0] = truth["gyro"]["bias"][axis][0].as<double>() + 0.05 * kDegToRad * scale;
+  }
+  const std::string turned_on = Path("turned_on.yaml");
+  std::ofstream(turned_on) << truth;
+  std::vector<std::string> args = {"fit", "--field", "-o", Path("joint.yaml")};
+  for (const int s : {1, 2, 3}) {
+    const std::string session = Path("s" + std::to_string(s) + ".csv");
+    ASSERT_EQ(Run(SessionAt(session, 25, 60 + s, s == 2 ? turned_on : "")).status, 0);
+    args.insert(args.end(), {"--samples", session});
+  }
+  const RunResult fit = Run(args);
+  EXPECT_EQ(fit.status, 1) << fit.err;
+  EXPECT_NE(fit.err.find("disagree (3 sessions, 30 poses, 27 turns): " + Path("s2.csv") + ": its gyro bias"),
+            std::string::npos)
+      << fit.err;
+  EXPECT_NE(fit.err.find("turn-on repeatability"), std::string::npos) << fit.err;
+  EXPECT_NE(fit.err.find("(beyond chance)"), std::string::npos) << fit.err;
+  EXPECT_FALSE(std::filesystem::exists(Path("joint.yaml")));
+}
+
+// Each session's temperature for logs without one; what cannot be done with several sessions.
+TEST_F(CliTest, FieldSessionsTemperaturesSerialsAndRefusals) {
+  const std::string cold = Path("cold.csv");
+  const std::string warm = Path("warm.csv");
+  const std::string hot = Path("hot.csv");
+  ASSERT_EQ(Run(SessionAt(cold, 10, 81, "", {"--no-temp-column"})).status, 0);
+  ASSERT_EQ(Run(SessionAt(warm, 25, 82, "", {"--no-temp-column"})).status, 0);
+  ASSERT_EQ(Run(SessionAt(hot, 40, 83, "", {"--no-temp-column"})).status, 0);
+  const std::vector<std::string> three = {"fit", "--field",   "--samples", cold, "--samples",
+                                          warm,  "--samples", hot,         "-o", Path("cal.yaml")};
+  const auto with = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = three;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Run(args);
+  };
+  const RunResult fit = with({"--session-temp-c", "10,25,40", "--bias-temp-order", "2"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("sessions: "), std::string::npos);
+  EXPECT_NE(fit.out.find("10.0 .. 40.0 degC"), std::string::npos) << fit.out;
+  const YAML::Node field = YAML::LoadFile(Path("cal.yaml"))["fit"]["field"];
+  EXPECT_EQ(field["session_temp_min_c"][2].as<double>(), 40.0);
+  // Given once per session, as a list: the same.
+  EXPECT_EQ(with({"--session-temp-c", "10", "--session-temp-c", "25", "--session-temp-c", "40",
+                  "--bias-temp-order", "2", "-q"})
+                .status,
+            0);
+
+  for (const auto& [extra, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--session-temp-c", "10,25"}, "gives 2 temperatures for 3 sessions"},
+           {{"--session-temp-c", "10,25,40", "--temp-c", "20"}, "and --temp-c both given"},
+           {{"--session-temp-c", "10,25,400"}, "is not a plausible temperature"},
+           {{"--temp-c", "25", "--repeat", cold}, "--repeat: compares one session with another"},
+       }) {
+    const RunResult refused = with(extra);
+    EXPECT_EQ(refused.status, 2) << message;
+    EXPECT_NE(refused.err.find(message), std::string::npos) << refused.err;
+  }
+  // A table fit takes one run.
+  const RunResult table = Run({"fit", "--plan", Fixture("mems_truth.yaml"), "--samples", cold, "--samples",
+                               warm, "-o", Path("table.yaml")});
+  EXPECT_EQ(table.status, 2);
+  EXPECT_NE(table.err.find("--samples: given 2 times: a table fit takes one run"), std::string::npos)
+      << table.err;
+  // Sessions of two units.
+  const std::string other = Path("other.csv");
+  ASSERT_EQ(Run(SessionAt(other, 40, 84, "", {"--no-temp-column"}, "SN0002")).status, 0);
+  const RunResult units = Run(
+      {"fit", "--field", "--temp-c", "25", "--samples", cold, "--samples", other, "-o", Path("units.yaml")});
+  EXPECT_EQ(units.status, 2);
+  EXPECT_NE(units.err.find("the sessions of a joint fit are of one unit"), std::string::npos) << units.err;
+  EXPECT_FALSE(std::filesystem::exists(Path("units.yaml")));
+  // A session that holds no rest, by name.
+  const std::string moving = Path("moving.csv");
+  {
+    std::ifstream in(cold);
+    std::ofstream out(moving);
+    std::string line;
+    for (int i = 0; i < 30 && std::getline(in, line); ++i) out << line << "\n";  // 0.5 s
+  }
+  const RunResult no_rest = Run({"fit", "--field", "--temp-c", "25", "--samples", cold, "--samples", moving,
+                                 "-o", Path("moving.yaml")});
+  EXPECT_EQ(no_rest.status, 1);
+  EXPECT_NE(no_rest.err.find(moving + ": no pose at rest found"), std::string::npos) << no_rest.err;
 }
 
 }  // namespace

@@ -216,6 +216,15 @@ void SetSteps(const SensorModel& start, FieldLayout* layout) {
   }
 }
 
+// The session pose `pose` (an index into summary.poses) belongs to.
+const FieldSessionShare& SessionOfPose(const FieldFitSummary& summary, int pose) {
+  for (const FieldSessionShare& session : summary.sessions) {
+    if (pose >= session.first_pose && pose < session.first_pose + session.poses) return session;
+  }
+  IMUFIT_CHECK(false, "every pose belongs to a session");
+  return summary.sessions.front();
+}
+
 // The residuals of field_fit.h step 3, one block each per pose and per turn.
 void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTurn>& turns,
                   std::vector<std::vector<TurnSample>> turn_samples,
@@ -235,20 +244,22 @@ void BuildProblem(const std::vector<FieldPose>& poses, const std::vector<FieldTu
     const double n = static_cast<double>(poses[p].last - poses[p].first + 1);
     fp->directions.emplace_back(CorrectSensor(c.accel, poses[p].accel_mean, Eigen::Vector3d::Zero().eval()));
     const double x = basis.Argument(poses[p].temp_c);
+    const FieldSessionShare& session = SessionOfPose(summary, static_cast<int>(p));
     fp->groups[FieldLayout::kAccelGroup].push_back(fp->problem.AddResidualBlock(
         FieldPoseAccelCost::Create(&fp->layout, &fp->directions[p], poses[p].accel_mean, x,
-                                   options.gravity_mps2, summary.accel_noise_raw / std::sqrt(n)),
+                                   options.gravity_mps2, session.accel_noise_raw / std::sqrt(n)),
         nullptr, fp->accel_q.data(), fp->pose_q[p].data()));
     fp->groups[FieldLayout::kGyroGroup].push_back(fp->problem.AddResidualBlock(
         FieldPoseGyroCost::Create(&fp->layout, poses[p].gyro_mean, poses[p].accel_mean, x,
-                                  summary.gyro_noise_raw / std::sqrt(n)),
+                                  session.gyro_noise_raw / std::sqrt(n)),
         nullptr, fp->gyro_q.data(), fp->accel_q.data()));
   }
-  // The gyro's white noise in rad/s (at the start's scales), integrated over a turn: the angle's
-  // random walk, per axis perpendicular to gravity.
-  const Eigen::Vector3d gyro_noise_radps = summary.gyro_noise_raw.cwiseQuotient(c.gyro.scale.cwiseAbs());
-  const double noise_radps = std::sqrt(gyro_noise_radps.squaredNorm() / 3.0);
+  // The gyro's white noise in rad/s (at the start's scales; its session's), integrated over a turn:
+  // the angle's random walk, per axis perpendicular to gravity.
   for (size_t t = 0; t < turns.size(); ++t) {
+    const Eigen::Vector3d gyro_noise_radps =
+        SessionOfPose(summary, turns[t].from).gyro_noise_raw.cwiseQuotient(c.gyro.scale.cwiseAbs());
+    const double noise_radps = std::sqrt(gyro_noise_radps.squaredNorm() / 3.0);
     const double temp_c = 0.5 * (poses[turns[t].from].temp_c + poses[turns[t].to].temp_c);
     const double sigma_rad = noise_radps * turn_noise_weight_s[t];
     fp->groups[FieldLayout::kTurnGroup].push_back(fp->problem.AddResidualBlock(
@@ -595,18 +606,42 @@ std::string FieldFitSummary::BriefReport() const {
   const int saturated = static_cast<int>(
       std::count_if(turns.begin(), turns.end(), [](const FieldTurn& t) { return t.saturated; }));
   const std::string counts =
+      (sessions.size() > 1 ? std::to_string(sessions.size()) + " sessions, " : std::string()) +
       std::to_string(poses.size()) + " poses, " + std::to_string(turns.size()) + " turns" +
       (saturated > 0 ? " (" + std::to_string(saturated) + " saturated, left out)" : "");
   switch (status) {
     case FieldFitStatus::kNotRun:
       return "not run";
     case FieldFitStatus::kUndetermined: {
-      std::string text = "the session does not determine the model (" + counts + "): ";
+      std::string text = (sessions.size() > 1 ? "the sessions do not" : "the session does not") +
+                         std::string(" determine the model (") + counts + "): ";
       for (size_t i = 0; i < undetermined.size(); ++i) text += (i > 0 ? "; " : "") + undetermined[i];
       return text;
     }
     case FieldFitStatus::kFailed:
       return "the fit did not converge (" + counts + "): " + termination;
+    case FieldFitStatus::kInconsistent: {
+      std::string text = "the sessions disagree (" + counts + "): ";
+      // The sessions and sensors beyond chance, the most discrepant first.
+      std::vector<std::pair<double, std::string>> beyond;
+      for (const FieldSessionShare& session : sessions) {
+        for (const auto& [sensor, offset] :
+             {std::pair{"gyro", &session.gyro_bias}, std::pair{"accelerometer", &session.accel_bias}}) {
+          if (!offset->beyond) continue;
+          beyond.emplace_back(offset->chi2, session.name + ": its " + sensor + " bias is off the joint fit" +
+                                                Format(" (chi-square %.3g for 3, beyond %.3g)", offset->chi2,
+                                                       kFieldSessionChi2));
+        }
+      }
+      std::stable_sort(beyond.begin(), beyond.end(),
+                       [](const auto& a, const auto& b) { return a.first > b.first; });
+      std::string named;
+      for (const auto& item : beyond) named += (named.empty() ? "" : "; ") + item.second;
+      return text + named +
+             ": a bias that changed from one power-on to the next (turn-on repeatability), a curve in "
+             "temperature of too low an order (--bias-temp-order), or another unit; "
+             "fit the sessions one by one (--repeat compares two), or record over one power-on";
+    }
     case FieldFitStatus::kConverged:
       break;
   }
@@ -647,19 +682,166 @@ FieldRepeatability CompareFieldFits(const FieldFitSummary& first, const FieldFit
   return out;
 }
 
-FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& given) {
+namespace {
+
+// Step 1 over every session (FitFieldSessions): each session's poses, turns and noise floor, found
+// on its own samples, appended with their indices offset (poses, turns and samples counting
+// through the sessions), so that a turn never joins two sessions; each session's share; the
+// turns' samples. The summary's noise floor is the sessions' pooled over their rests.
+TurnSets GatherSessions(const std::vector<const std::vector<Sample>*>& sessions,
+                        const std::vector<std::string>& names, const FieldFitOptions& options,
+                        FieldFitSummary* summary) {
+  TurnSets all;
+  long long first_sample = 0;
+  Eigen::Vector3d gyro_variance = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_variance = Eigen::Vector3d::Zero();
+  double degrees_of_freedom = 0.0;
+  for (size_t s = 0; s < sessions.size(); ++s) {
+    const std::vector<Sample>& samples = *sessions[s];
+    FieldSessionShare share;
+    share.name = s < names.size() ? names[s] : "session " + std::to_string(s + 1);
+    share.samples = static_cast<long long>(samples.size());
+    share.first_pose = static_cast<int>(summary->poses.size());
+    share.first_turn = static_cast<int>(summary->turns.size());
+    std::vector<FieldPose> poses;
+    std::vector<FieldTurn> turns;
+    FindFieldPoses(samples, options, &poses, &turns, &share.gyro_noise_raw, &share.accel_noise_raw);
+    if (!samples.empty()) {
+      const auto [low, high] =
+          std::minmax_element(samples.begin(), samples.end(),
+                              [](const Sample& a, const Sample& b) { return a.temp_c < b.temp_c; });
+      share.temp_range_c = {low->temp_c, high->temp_c};
+    }
+    TurnSets sets = SplitTurns(samples, turns);
+    for (size_t t = 0; t < sets.all_samples.size(); ++t)
+      all.all_samples.push_back(std::move(sets.all_samples[t]));
+    for (size_t t = 0; t < sets.fitted.size(); ++t) {
+      FieldTurn turn = sets.fitted[t];
+      turn.from += share.first_pose;
+      turn.to += share.first_pose;
+      turn.first += first_sample;
+      turn.last += first_sample;
+      all.fitted.push_back(turn);
+      all.fitted_samples.push_back(std::move(sets.fitted_samples[t]));
+      all.fitted_noise_weight_s.push_back(sets.fitted_noise_weight_s[t]);
+    }
+    for (FieldTurn turn : turns) {
+      turn.from += share.first_pose;
+      turn.to += share.first_pose;
+      turn.first += first_sample;
+      turn.last += first_sample;
+      summary->turns.push_back(turn);
+    }
+    for (FieldPose pose : poses) {
+      const double n = static_cast<double>(pose.last - pose.first);
+      gyro_variance += n * share.gyro_noise_raw.cwiseAbs2();
+      accel_variance += n * share.accel_noise_raw.cwiseAbs2();
+      degrees_of_freedom += n;
+      pose.first += first_sample;
+      pose.last += first_sample;
+      summary->poses.push_back(pose);
+    }
+    share.poses = static_cast<int>(poses.size());
+    share.turns = static_cast<int>(turns.size());
+    summary->sessions.push_back(share);
+    first_sample += share.samples;
+  }
+  const FieldSessionShare& first = summary->sessions.front();
+  const bool pooled = sessions.size() > 1 && degrees_of_freedom > 0.0;
+  summary->gyro_noise_raw =
+      pooled ? (gyro_variance / degrees_of_freedom).cwiseSqrt().eval() : first.gyro_noise_raw;
+  summary->accel_noise_raw =
+      pooled ? (accel_variance / degrees_of_freedom).cwiseSqrt().eval() : first.accel_noise_raw;
+  summary->temp_range_c = first.temp_range_c;
+  for (const FieldSessionShare& share : summary->sessions) {
+    summary->temp_range_c = {std::min(summary->temp_range_c[0], share.temp_range_c[0]),
+                             std::max(summary->temp_range_c[1], share.temp_range_c[1])};
+  }
+  return all;
+}
+
+// Each session's biases against the joint fit (field_fit.h, FieldSessionOffset): the score test of
+// an offset of its own, per sensor, from the Jacobian at the solution. `fitted_turns` are the
+// turns in the problem (their poses name their session).
+void SessionOffsets(const std::vector<FieldTurn>& fitted_turns, FieldProblem* fp, FieldFitSummary* summary) {
+  Eigen::VectorXd residuals;
+  std::array<int, 4> group_rows{};
+  const Eigen::MatrixXd jacobian = Jacobian(fp, &residuals, &group_rows);
+  Eigen::MatrixXd covariance;
+  if (!Covariance(jacobian, fp->columns, &covariance).empty()) return;
+  // The session of every row (groups: accel 3 a pose, gyro 3 a pose, turns 2 each).
+  std::vector<int> row_session(static_cast<size_t>(jacobian.rows()), -1);
+  const auto session_of_pose = [&](int pose) {
+    return static_cast<int>(&SessionOfPose(*summary, pose) - summary->sessions.data());
+  };
+  for (int p = 0; p < static_cast<int>(summary->poses.size()); ++p) {
+    for (int axis = 0; axis < 3; ++axis) {
+      row_session[group_rows[FieldLayout::kAccelGroup] + 3 * p + axis] = session_of_pose(p);
+      row_session[group_rows[FieldLayout::kGyroGroup] + 3 * p + axis] = session_of_pose(p);
+    }
+  }
+  for (size_t t = 0; t < fitted_turns.size(); ++t) {
+    for (int k = 0; k < 2; ++k)
+      row_session[group_rows[FieldLayout::kTurnGroup] + 2 * t + k] = session_of_pose(fitted_turns[t].from);
+  }
+  // A session whose offset keeps less than this share of its information on the bias, once the
+  // joint fit has taken what it can (the smallest eigenvalue of A against G^T G, Jacobi-scaled),
+  // cannot be told from the curve in temperature.
+  constexpr double kMinTestableShare = 1e-3;
+  for (const bool gyro : {true, false}) {
+    std::array<int, 3> columns{-1, -1, -1};
+    for (size_t i = 0; i < fp->columns.size(); ++i) {
+      const FieldColumn& c = fp->columns[i];
+      if (c.gyro == gyro && c.coefficient < kScaleCoefficient && c.term == 0)
+        columns[c.coefficient] = static_cast<int>(i);
+    }
+    if (*std::min_element(columns.begin(), columns.end()) < 0) continue;
+    for (size_t s = 0; s < summary->sessions.size(); ++s) {
+      Eigen::MatrixXd g = Eigen::MatrixXd::Zero(jacobian.rows(), 3);
+      for (Eigen::Index row = 0; row < jacobian.rows(); ++row) {
+        if (row_session[static_cast<size_t>(row)] != static_cast<int>(s)) continue;
+        for (int axis = 0; axis < 3; ++axis) g(row, axis) = jacobian(row, columns[axis]);
+      }
+      const Eigen::MatrixXd projected = g - jacobian * (covariance * (jacobian.transpose() * g));
+      const Eigen::Matrix3d a = g.transpose() * projected;
+      const Eigen::Vector3d d = (g.transpose() * g).diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(d.asDiagonal() * a * d.asDiagonal());
+      FieldSessionOffset& out = gyro ? summary->sessions[s].gyro_bias : summary->sessions[s].accel_bias;
+      out.tested = eigen.eigenvalues()(0) > kMinTestableShare;
+      if (!out.tested) continue;
+      const Eigen::Matrix3d a_inverse = a.inverse();
+      const Eigen::Vector3d offset_q = -a_inverse * (g.transpose() * residuals);
+      out.chi2 = offset_q.dot(a * offset_q);
+      out.beyond = out.chi2 > kFieldSessionChi2;
+      for (int axis = 0; axis < 3; ++axis) {
+        const int q = fp->columns[columns[axis]].q;
+        const double step = gyro ? fp->layout.gyro_step[q] : fp->layout.accel_step[q];
+        out.offset(axis) = step * offset_q(axis);
+        out.sigma(axis) = step * std::sqrt(std::max(0.0, a_inverse(axis, axis)));
+      }
+    }
+  }
+}
+
+FieldFitSummary FitSessions(const std::vector<const std::vector<Sample>*>& sessions,
+                            const FieldFitOptions& given, const std::vector<std::string>& names) {
   IMUFIT_CHECK(given.Validate().empty(), "FieldFitOptions::Validate() first");
+  IMUFIT_CHECK(!sessions.empty(), "at least one session");
+  IMUFIT_CHECK(names.empty() || names.size() == sessions.size(), "a name for every session, or none");
   FieldFitOptions options = given;  // gravity resolved once: every stage reads gravity_mps2
   options.gravity_mps2 = given.GravityMps2();
   options.latitude_deg.reset();
   options.height_m = 0.0;
   FieldFitSummary summary;
-  FindFieldPoses(samples, options, &summary.poses, &summary.turns, &summary.gyro_noise_raw,
-                 &summary.accel_noise_raw);
-  if (!samples.empty()) {
-    const auto [low, high] = std::minmax_element(
-        samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.temp_c < b.temp_c; });
-    summary.temp_range_c = {low->temp_c, high->temp_c};
+  TurnSets turns = GatherSessions(sessions, names, options, &summary);
+  if (sessions.size() > 1) {
+    for (const FieldSessionShare& session : summary.sessions) {
+      if (session.poses > 0) continue;
+      summary.undetermined.push_back(
+          session.name + ": no pose at rest found" +
+          Format(" (a rest lasts %.3g s or longer): not a session by hand, or the wrong file",
+                 options.min_pose_s + options.detection.window_s));
+    }
   }
   if (static_cast<int>(summary.poses.size()) < options.min_poses) {
     summary.status = FieldFitStatus::kUndetermined;
@@ -669,9 +851,11 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
         Format(" (rest %.3g s or longer in each)", options.min_pose_s + options.detection.window_s));
     return summary;
   }
-  TurnSets turns = SplitTurns(samples, summary.turns);
   const SensorModel start = FieldStart(summary.poses, turns.fitted, turns.fitted_samples, options);
-  summary.undetermined = CoverageProblems(summary.poses, turns.fitted, turns.fitted_samples, start, options);
+  for (std::string& problem :
+       CoverageProblems(summary.poses, turns.fitted, turns.fitted_samples, start, options)) {
+    summary.undetermined.push_back(std::move(problem));
+  }
   for (std::string& problem :
        TemperatureProblems(summary.poses, turns.fitted, turns.fitted_samples, start, options)) {
     summary.undetermined.push_back(std::move(problem));
@@ -685,6 +869,7 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
     return summary;
   }
   FieldProblem fp;
+  const std::vector<FieldTurn> fitted_turns = turns.fitted;
   BuildProblem(summary.poses, turns.fitted, std::move(turns.fitted_samples), turns.fitted_noise_weight_s,
                summary, start, options, &fp);
   Eigen::MatrixXd covariance;
@@ -699,7 +884,27 @@ FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptio
   Residuals(fp, turns.all_samples, options, &summary);
   summary.undetermined = LooseCoefficients(summary, options);
   summary.status = summary.undetermined.empty() ? FieldFitStatus::kConverged : FieldFitStatus::kUndetermined;
+  if (summary.status == FieldFitStatus::kConverged && sessions.size() > 1) {
+    SessionOffsets(fitted_turns, &fp, &summary);
+    for (const FieldSessionShare& session : summary.sessions) {
+      if (session.gyro_bias.beyond || session.accel_bias.beyond)
+        summary.status = FieldFitStatus::kInconsistent;
+    }
+  }
   return summary;
+}
+
+}  // namespace
+
+FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options) {
+  return FitSessions({&samples}, options, {});
+}
+
+FieldFitSummary FitFieldSessions(const std::vector<std::vector<Sample>>& sessions,
+                                 const FieldFitOptions& options, const std::vector<std::string>& names) {
+  std::vector<const std::vector<Sample>*> pointers;
+  for (const std::vector<Sample>& session : sessions) pointers.push_back(&session);
+  return FitSessions(pointers, options, names);
 }
 
 }  // namespace imufit

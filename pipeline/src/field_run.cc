@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <iterator>
+#include <limits>
 
+#include "imufit/io/error.h"
 #include "imufit/io/log_samples.h"
 #include "imufit/io/run_header.h"
 #include "imufit/io/sha256.h"
+#include "imufit/model/check.h"
 #include "imufit/pipeline/unit_serial.h"
 
 namespace imufit {
@@ -40,6 +43,38 @@ FieldRecord FieldFigures(const FieldFitSummary& fit, const FieldFitOptions& opti
         std::string(options.gravity_mps2 == kStandardGravityMps2 ? kGravityStandard : kGravityStated);
   }
   return field;
+}
+
+// Several sessions: each one's file and share, and how its biases compare with the joint fit.
+void SessionFigures(const FieldRunResult& result, FieldRecord* field) {
+  field->session_samples.emplace();
+  field->session_samples_sha256.emplace();
+  field->session_samples_read.emplace();
+  field->session_poses.emplace();
+  field->session_turns.emplace();
+  field->session_temp_min_c.emplace();
+  field->session_temp_max_c.emplace();
+  std::vector<double> gyro_chi2;
+  std::vector<double> accel_chi2;
+  bool tested = true;
+  for (size_t s = 0; s < result.sessions.size(); ++s) {
+    const FieldSessionShare& share = result.fit.sessions[s];
+    field->session_samples->push_back(result.sessions[s].path);
+    field->session_samples_sha256->push_back(result.sessions[s].samples_sha256);
+    field->session_samples_read->push_back(static_cast<int>(
+        std::min<long long>(result.sessions[s].samples_read, std::numeric_limits<int>::max())));
+    field->session_poses->push_back(share.poses);
+    field->session_turns->push_back(share.turns);
+    field->session_temp_min_c->push_back(share.temp_range_c[0]);
+    field->session_temp_max_c->push_back(share.temp_range_c[1]);
+    tested = tested && share.gyro_bias.tested && share.accel_bias.tested;
+    gyro_chi2.push_back(share.gyro_bias.chi2);
+    accel_chi2.push_back(share.accel_bias.chi2);
+  }
+  field->session_biases_tested = tested;
+  if (!tested) return;
+  field->session_gyro_bias_chi2 = gyro_chi2;
+  field->session_accel_bias_chi2 = accel_chi2;
 }
 
 }  // namespace
@@ -90,36 +125,74 @@ Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& 
 FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& input,
                            const FieldFitOptions& options, const std::string& software,
                            const std::string& serial, bool allow_serial_mismatch, const LogTopics& topics) {
+  return FieldFitSessionsRun({samples_path}, {input}, options, software, serial, allow_serial_mismatch,
+                             topics);
+}
+
+FieldRunResult FieldFitSessionsRun(const std::vector<std::string>& samples_paths,
+                                   const std::vector<SamplesInput>& inputs, const FieldFitOptions& options,
+                                   const std::string& software, const std::string& serial,
+                                   bool allow_serial_mismatch, const LogTopics& topics) {
+  IMUFIT_CHECK(!samples_paths.empty() && inputs.size() == samples_paths.size(), "an input for every session");
   FieldRunResult result;
-  Sha256 digest;
-  LogSamples log = ReadLogSamples(samples_path, {input.Format(), topics.topic, topics.temp_topic}, &digest);
-  const std::vector<Sample> samples = std::move(log.samples);
-  result.format = log.format;
-  result.topic = log.topic;
-  result.temp_topic = log.temp_topic;
-  result.samples_read = static_cast<long long>(samples.size());
-  result.samples_sha256 = digest.HexDigest();
-  const UnitSerial unit =
-      ResolveSerial({SerialSource{SerialSource::Kind::kStated, "--serial", serial, "", 0, 0},
-                     SamplesHeaderSerial(samples_path, log.serial)},
-                    allow_serial_mismatch);
+  std::vector<std::vector<Sample>> sessions(samples_paths.size());
+  std::vector<SerialSource> serials = {
+      SerialSource{SerialSource::Kind::kStated, "--serial", serial, "", 0, 0}};
+  RunHeader header;  // the first session's, as far as it goes for all
+  for (size_t s = 0; s < samples_paths.size(); ++s) {
+    Sha256 digest;
+    LogSamples log =
+        ReadLogSamples(samples_paths[s], {inputs[s].Format(), topics.topic, topics.temp_topic}, &digest);
+    sessions[s] = std::move(log.samples);
+    if (s == 0) {
+      result.format = log.format;
+      result.topic = log.topic;
+      result.temp_topic = log.temp_topic;
+      header = RunHeaderOf(samples_paths[s], log.header_comments);
+    }
+    result.sessions.push_back(
+        {samples_paths[s], static_cast<long long>(sessions[s].size()), digest.HexDigest()});
+    result.samples_read += result.sessions.back().samples_read;
+    const SerialSource source = SamplesHeaderSerial(samples_paths[s], log.serial);
+    for (const SerialSource& other : serials) {  // two headers naming two units
+      if (other.kind != SerialSource::Kind::kHeader || other.serial.empty() || source.serial.empty() ||
+          other.serial == source.serial || allow_serial_mismatch) {
+        continue;
+      }
+      throw InputError(
+          source.file, source.line, source.column,
+          "serial " + QuoteForMessage(source.serial) + ", but " + other.name + " names " +
+              QuoteForMessage(other.serial) +
+              ": the sessions of a joint fit are of one unit (--allow-mismatch fits them anyway)");
+    }
+    serials.push_back(source);
+  }
+  result.samples_sha256 = result.sessions.front().samples_sha256;
+  const UnitSerial unit = ResolveSerial(serials, allow_serial_mismatch);
   result.serial = unit.serial;
   result.serial_warnings = unit.warnings;
-  result.fit = FitField(samples, options);
+  const bool several = sessions.size() > 1;
+  result.fit =
+      several ? FitFieldSessions(sessions, options, samples_paths) : FitField(sessions.front(), options);
   if (!result.fit.IsSolutionUsable()) return result;
   Calibration calibration = FieldCalibration(result.fit, options);
   calibration.serial = result.serial;
   calibration.software = software;
   FitRecord& record = *calibration.fit;
-  record.samples = samples_path;
-  record.samples_sha256 = result.samples_sha256;
   record.samples_read = result.samples_read;
-  const RunHeader header = RunHeaderOf(samples_path, log.header_comments);
+  if (several) {
+    SessionFigures(result, &*record.field);
+  } else {
+    record.samples = samples_paths.front();
+    record.samples_sha256 = result.samples_sha256;
+  }
+  // Per session when several: what one file's header says of its run, the unit's only from the first.
   for (const auto& [value, key] : {std::pair{&header.acquired_utc, &record.acquired_utc},
                                    {&header.model, &record.unit_model},
                                    {&header.firmware, &record.unit_firmware},
                                    {&header.ambient, &record.ambient}}) {
-    if (!value->empty()) *key = *value;
+    const bool of_the_run = key == &record.acquired_utc || key == &record.ambient;
+    if (!value->empty() && !(several && of_the_run)) *key = *value;
   }
   result.calibration = std::move(calibration);
   return result;

@@ -64,6 +64,16 @@ class FieldRecord:
     gravity_source: str | None  # stated, latitude or standard: where gravity_mps2 came from
     latitude_deg: float | None  # with gravity_source latitude: the geodetic latitude, degrees
     height_m: float | None  # with gravity_source latitude: the height above the ellipsoid, m
+    session_samples: list[str] | None  # several sessions fitted jointly: the samples files, as given, in order (one session: absent)
+    session_samples_sha256: list[str] | None  # SHA-256 of each session's samples file
+    session_samples_read: list[int] | None  # samples in each session's file
+    session_poses: list[int] | None  # rests each session contributed
+    session_turns: list[int] | None  # turns within each session (none joins two sessions)
+    session_temp_min_c: list[float] | None  # each session's coldest reading, degC
+    session_temp_max_c: list[float] | None  # each session's warmest reading, degC
+    session_biases_tested: bool | None  # whether each session's biases could be tested against the joint fit (false: the curve in temperature absorbs a session's offset, a turn-on offset is taken for temperature unseen)
+    session_gyro_bias_chi2: list[float] | None  # when tested: each session's gyro bias offset from the joint fit, chi-square for 3
+    session_accel_bias_chi2: list[float] | None  # when tested: each session's accelerometer bias offset from the joint fit, chi-square for 3
 
 class FitRecord:
     """What the fit did and on which files: the calibration's `fit:` block, each key an attribute

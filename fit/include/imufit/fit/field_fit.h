@@ -143,6 +143,44 @@ enum class FieldFitStatus {
   kConverged,     // solved; the calibration is usable
   kUndetermined,  // the session does not determine the model; see `undetermined`
   kFailed,        // the solver did not converge; see `termination`
+  kInconsistent,  // several sessions: one's biases disagree with the joint fit; see `sessions`
+};
+
+// Several sessions of one unit fitted jointly (FitFieldSessions): a session's biases against the
+// joint fit. A MEMS unit's bias changes from one power-on to the next (turn-on repeatability); a
+// joint fit of sessions recorded on separate power-ons would take that change for temperature. So
+// every session is tested: were the session's bias (gyro, accelerometer: 3 raw offsets each) free of
+// the joint curve, by how much would it move, with what covariance? That is the score (Lagrange
+// multiplier) test of an offset of its own, from the joint fit's Jacobian J and residuals r (rows of
+// other sessions zero in G, the bias columns of J restricted to the session's rows):
+//   A = G^T (I - J (J^T J)^-1 J^T) G,  offset = -A^-1 G^T r,  covariance A^-1,
+//   chi2 = offset^T A offset  (3 degrees of freedom when the session agrees).
+// Where the joint curve absorbs a session's offset wholly (N sessions, each at one temperature,
+// fitted with a bias of order N - 1), A vanishes and the session cannot be tested (`tested` false):
+// the fit says so, because a turn-on offset is then taken for temperature unseen.
+struct FieldSessionOffset {
+  bool tested = false;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // raw units, as the model's bias
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();   // 1-sigma of each axis's offset
+  double chi2 = 0.0;
+  // Beyond chance (chi2 > kFieldSessionChi2: 1 in 10 000 for a session that agrees).
+  bool beyond = false;
+};
+inline constexpr double kFieldSessionChi2 = 21.11;  // chi-square, 3 degrees of freedom, p = 1e-4
+
+// What one session contributed to a fit (one session: all of it).
+struct FieldSessionShare {
+  std::string name;  // as the caller named it ("a.csv"), else "session N" (1-based)
+  long long samples = 0;
+  int first_pose = 0;  // its poses are summary.poses[first_pose, first_pose + poses)
+  int poses = 0;
+  int first_turn = 0;  // its turns are summary.turns[first_turn, first_turn + turns)
+  int turns = 0;
+  std::array<double, 2> temp_range_c{0.0, 0.0};                      // of its samples, degC
+  Eigen::Vector3d gyro_noise_raw = Eigen::Vector3d::Constant(-1.0);  // its own noise floor
+  Eigen::Vector3d accel_noise_raw = Eigen::Vector3d::Constant(-1.0);
+  FieldSessionOffset gyro_bias;  // several sessions, after the fit
+  FieldSessionOffset accel_bias;
 };
 
 struct FieldFitSummary {
@@ -177,6 +215,10 @@ struct FieldFitSummary {
   // chance (hand tremor, drift, correlated noise); then its variance-component estimate, by which
   // the group is weighted and its sigmas grow (field_fit.cc, NoiseScales()).
   std::array<double, 3> noise_scale{1.0, 1.0, 1.0};
+  // The sessions fitted, in the order given (one for FitField). Pose and turn indices (FieldPose
+  // first/last, FieldTurn from/to/first/last) count through the sessions one after the other: a
+  // session's sample indices are offset by the samples of the sessions before it.
+  std::vector<FieldSessionShare> sessions;
 
   bool IsSolutionUsable() const { return status == FieldFitStatus::kConverged; }
   // One line: the outcome, poses, turns and residuals.
@@ -185,6 +227,19 @@ struct FieldFitSummary {
 
 // Fits the model to a session by hand, `samples` in time order (raw; temp_c as read).
 FieldFitSummary FitField(const std::vector<Sample>& samples, const FieldFitOptions& options);
+
+// Several sessions of one unit (each in time order) fitted jointly (`imufit fit --field --samples A
+// --samples B ...`, docs/field.md "Over temperature"): every session's rests are poses of one
+// problem, turns join two successive rests of one session only (never the last of one session to
+// the first of the next), each pose is weighted by its own session's noise floor, and the
+// coefficients (with the temperature orders of `options`) are shared. The observability checks
+// judge the poses and turns of all sessions together; a session without a pose at rest is
+// refused by name. With two sessions or more, each session's biases are tested against the joint
+// fit (FieldSessionOffset); one beyond chance makes the status kInconsistent (nothing to write:
+// the sessions disagree, a turn-on offset or another unit), the coefficients still reported.
+// `names` (empty, or one per session) name the sessions in the findings.
+FieldFitSummary FitFieldSessions(const std::vector<std::vector<Sample>>& sessions,
+                                 const FieldFitOptions& options, const std::vector<std::string>& names = {});
 
 // Two sessions of one unit compared (`imufit fit --field --repeat`): for every coefficient both
 // fitted, the difference of their values at 25 degC (c0) against the combined 1-sigma of two

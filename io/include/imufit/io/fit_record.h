@@ -78,7 +78,22 @@
     "where gravity_mps2 came from: stated (--gravity-mps2), latitude (WGS-84 normal gravity at "    \
     "latitude_deg, height_m), standard (9.80665 m/s^2: no local gravity given)")                    \
   X(double, latitude_deg, "with gravity_source latitude: the geodetic latitude, degrees")           \
-  X(double, height_m, "with gravity_source latitude: the height above the ellipsoid, m")
+  X(double, height_m, "with gravity_source latitude: the height above the ellipsoid, m")            \
+  X(std::vector<std::string>, session_samples,                                                      \
+    "several sessions fitted jointly: the samples files, as given, in order (one session: absent)") \
+  X(std::vector<std::string>, session_samples_sha256, "SHA-256 of each session's samples file")     \
+  X(std::vector<int>, session_samples_read, "samples in each session's file")                       \
+  X(std::vector<int>, session_poses, "rests each session contributed")                              \
+  X(std::vector<int>, session_turns, "turns within each session (none joins two sessions)")         \
+  X(std::vector<double>, session_temp_min_c, "each session's coldest reading, degC")                \
+  X(std::vector<double>, session_temp_max_c, "each session's warmest reading, degC")                \
+  X(bool, session_biases_tested,                                                                    \
+    "whether each session's biases could be tested against the joint fit (false: the curve in "     \
+    "temperature absorbs a session's offset, a turn-on offset is taken for temperature unseen)")    \
+  X(std::vector<double>, session_gyro_bias_chi2,                                                    \
+    "when tested: each session's gyro bias offset from the joint fit, chi-square for 3")            \
+  X(std::vector<double>, session_accel_bias_chi2,                                                   \
+    "when tested: each session's accelerometer bias offset from the joint fit, chi-square for 3")
 
 // X(type, key, description): the `check:` block, with `imufit fit --check-samples`.
 #define IMUFIT_CHECK_RECORD_FIELDS(X)                                      \

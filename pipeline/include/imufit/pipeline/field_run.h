@@ -20,12 +20,20 @@
 
 namespace imufit {
 
+// One session's file as read.
+struct FieldSessionFile {
+  std::string path;
+  long long samples_read = 0;
+  std::string samples_sha256;
+};
+
 struct FieldRunResult {
   FieldFitSummary fit;
   std::optional<Calibration> calibration;  // when fit.IsSolutionUsable()
-  long long samples_read = 0;
-  std::string samples_sha256;
-  std::string serial;  // `serial` given, else the samples header's (unit_serial.h)
+  long long samples_read = 0;              // over every session
+  std::string samples_sha256;              // the first session's
+  std::vector<FieldSessionFile> sessions;  // in the order given
+  std::string serial;                      // `serial` given, else the samples header's (unit_serial.h)
   std::vector<std::string> serial_warnings;
   LogFormat format = LogFormat::kSamplesCsv;  // the log's (io/log_samples.h)
   std::string topic, temp_topic;              // a bag's topics read ("" for a CSV)
@@ -52,6 +60,19 @@ FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& 
 // hand: how the samples are read, the serial, the g-sensitivity, how rests are told from motion.
 // `imufit fit --field` refuses the others; the Python fit_field() takes these as keywords.
 bool AppliesToAFieldFit(const std::string& key);
+
+// Several sessions of one unit (`imufit fit --field --samples A --samples B ...`, docs/field.md):
+// each file read as its `inputs` entry says (one per path: a session's own --temp-c), fitted
+// jointly (FitFieldSessions, the sessions named by their paths). The unit's serial as for one
+// session, and the headers must agree with each other: two that name different serials are two
+// units, refused (InputError at the later header) unless `allow_serial_mismatch`. The calibration's
+// `fit: field:` block lists each session (session_samples, ..., io/fit_record.h); `fit: samples`
+// and its SHA-256 are absent (they name one file), `samples_read` counts all. One path is
+// FieldFitRun. Every session is a CSV or a bag, as FieldFitRun reads one (`topics` for each bag).
+FieldRunResult FieldFitSessionsRun(const std::vector<std::string>& samples_paths,
+                                   const std::vector<SamplesInput>& inputs, const FieldFitOptions& options,
+                                   const std::string& software, const std::string& serial,
+                                   bool allow_serial_mismatch, const LogTopics& topics = {});
 
 // The calibration of a usable field fit (what FieldFitRun writes), without the record's file names.
 Calibration FieldCalibration(const FieldFitSummary& fit, const FieldFitOptions& options);
