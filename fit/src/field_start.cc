@@ -14,15 +14,21 @@ double& C0(std::array<double, kGyroParameters>& p, int i) { return p[i * kPolyno
 double& C0(std::array<double, kAccelParameters>& p, int i) { return p[i * kPolynomialTerms]; }
 
 // Stage 1: bias and scale of the accelerometer from the axis-aligned ellipsoid through the poses
-// (raw means divided by their mean length, for conditioning). False when the poses do not make an
-// ellipsoid (a negative axis), leaving the model as it was.
+// (raw means less their centroid, divided by their mean distance from it, for conditioning: raw
+// counts of an unsigned converter sit around 32768, far from zero, where A^2 and A are nearly
+// collinear). False when the poses do not make an ellipsoid (a negative axis), leaving the model as
+// it was.
 bool AccelEllipsoid(const std::vector<FieldPose>& poses, double gravity_mps2, SensorModel* model) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const FieldPose& pose : poses) centroid += pose.accel_mean;
+  centroid /= static_cast<double>(poses.size());
   double length = 0.0;
-  for (const FieldPose& pose : poses) length += pose.accel_mean.norm();
+  for (const FieldPose& pose : poses) length += (pose.accel_mean - centroid).norm();
   length /= static_cast<double>(poses.size());
+  if (!(length > 0.0)) return false;
   Eigen::MatrixXd design(poses.size(), 6);
   for (size_t p = 0; p < poses.size(); ++p) {
-    const Eigen::Vector3d a = poses[p].accel_mean / length;
+    const Eigen::Vector3d a = (poses[p].accel_mean - centroid) / length;
     design.row(p) << a.x() * a.x(), a.y() * a.y(), a.z() * a.z(), a.x(), a.y(), a.z();
   }
   const Eigen::VectorXd theta = design.colPivHouseholderQr().solve(Eigen::VectorXd::Ones(poses.size()));
@@ -32,7 +38,7 @@ bool AccelEllipsoid(const std::vector<FieldPose>& poses, double gravity_mps2, Se
     r += theta(3 + i) * theta(3 + i) / (4.0 * theta(i));
   }
   for (int i = 0; i < 3; ++i) {
-    C0(model->accel, kBiasCoefficient + i) = -length * theta(3 + i) / (2.0 * theta(i));
+    C0(model->accel, kBiasCoefficient + i) = centroid(i) - length * theta(3 + i) / (2.0 * theta(i));
     C0(model->accel, kScaleCoefficient + i) = length * std::sqrt(r / theta(i)) / gravity_mps2;
   }
   return true;
