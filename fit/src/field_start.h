@@ -9,7 +9,7 @@
 //     the mean of B_p when H is not fitted);
 //  3. gyro scale: one scale s for the three axes, misalignment 0, the s that best turns gravity's
 //     direction across every turn (a scan over hand rates from 0.2 to 30 rad/s at the largest raw
-//     rate of the session, then golden-section refinement).
+//     rate of the session, 80 points, then golden-section refinement).
 #ifndef IMUFIT_FIT_SRC_FIELD_START_H_
 #define IMUFIT_FIT_SRC_FIELD_START_H_
 
