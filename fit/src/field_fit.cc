@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -304,11 +305,18 @@ std::string ColumnName(int column, const std::vector<FieldColumn>& columns) {
                         : " (its dT^" + std::to_string(c.term) + " term in temperature)");
 }
 
+// Threads for evaluating the residuals: the machine's, at most kMaxEvaluationThreads.
+int EvaluationThreads() {
+  constexpr unsigned kMaxEvaluationThreads = 4;
+  return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, kMaxEvaluationThreads));
+}
+
 // The residuals and their Jacobian at the current q, dense, rows in group order (accel, gyro,
 // turns), columns in the solver's q (tangent) order; `group_rows` the first row of each group and
 // the end.
 Eigen::MatrixXd Jacobian(FieldProblem* fp, Eigen::VectorXd* residuals, std::array<int, 4>* group_rows) {
   ceres::Problem::EvaluateOptions evaluate;
+  evaluate.num_threads = EvaluationThreads();
   evaluate.parameter_blocks = fp->Blocks();
   (*group_rows)[0] = 0;
   for (int g = 0; g < 3; ++g) {
@@ -561,7 +569,9 @@ bool Solve(const FieldFitOptions& options, FieldProblem* fp, FieldFitSummary* su
   solver.function_tolerance = 1e-12;
   solver.parameter_tolerance = 1e-12;
   solver.gradient_tolerance = 1e-14;
-  solver.num_threads = 1;
+  // The residuals and their Jacobians (the turns' integrals, most of the time) evaluated on
+  // several threads: each block alone, so the solution is the same within the solver's tolerance.
+  solver.num_threads = EvaluationThreads();
   constexpr int kMaxNoisePasses = 4;
   summary->iterations = 0;
   for (int pass = 0; pass < kMaxNoisePasses; ++pass) {

@@ -74,7 +74,9 @@ void FindFieldPoses(const std::vector<Sample>& samples, const FieldFitOptions& o
   *gyro_noise_raw = Eigen::Vector3d::Zero();
   *accel_noise_raw = Eigen::Vector3d::Zero();
   if (samples.size() < 2) return;
-  MotionDetector detector(options.detection);
+  SegmentationOptions detection = options.detection;
+  detection.rests_held_by_hand = true;  // the threshold between the rests' tremor and the turns
+  MotionDetector detector(detection);
   for (const Sample& sample : samples) detector.Add(sample);
   const DetectedRun run = detector.Finish();
   for (const MotionPiece& piece : run.pieces) {

@@ -14,15 +14,21 @@ double& C0(std::array<double, kGyroParameters>& p, int i) { return p[i * kPolyno
 double& C0(std::array<double, kAccelParameters>& p, int i) { return p[i * kPolynomialTerms]; }
 
 // Stage 1: bias and scale of the accelerometer from the axis-aligned ellipsoid through the poses
-// (raw means divided by their mean length, for conditioning). False when the poses do not make an
-// ellipsoid (a negative axis), leaving the model as it was.
+// (raw means less their centroid, divided by their mean distance from it, for conditioning: raw
+// counts of an unsigned converter sit around 32768, far from zero, where A^2 and A are nearly
+// collinear). False when the poses do not make an ellipsoid (a negative axis), leaving the model as
+// it was.
 bool AccelEllipsoid(const std::vector<FieldPose>& poses, double gravity_mps2, SensorModel* model) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const FieldPose& pose : poses) centroid += pose.accel_mean;
+  centroid /= static_cast<double>(poses.size());
   double length = 0.0;
-  for (const FieldPose& pose : poses) length += pose.accel_mean.norm();
+  for (const FieldPose& pose : poses) length += (pose.accel_mean - centroid).norm();
   length /= static_cast<double>(poses.size());
+  if (!(length > 0.0)) return false;
   Eigen::MatrixXd design(poses.size(), 6);
   for (size_t p = 0; p < poses.size(); ++p) {
-    const Eigen::Vector3d a = poses[p].accel_mean / length;
+    const Eigen::Vector3d a = (poses[p].accel_mean - centroid) / length;
     design.row(p) << a.x() * a.x(), a.y() * a.y(), a.z() * a.z(), a.x(), a.y(), a.z();
   }
   const Eigen::VectorXd theta = design.colPivHouseholderQr().solve(Eigen::VectorXd::Ones(poses.size()));
@@ -32,7 +38,7 @@ bool AccelEllipsoid(const std::vector<FieldPose>& poses, double gravity_mps2, Se
     r += theta(3 + i) * theta(3 + i) / (4.0 * theta(i));
   }
   for (int i = 0; i < 3; ++i) {
-    C0(model->accel, kBiasCoefficient + i) = -length * theta(3 + i) / (2.0 * theta(i));
+    C0(model->accel, kBiasCoefficient + i) = centroid(i) - length * theta(3 + i) / (2.0 * theta(i));
     C0(model->accel, kScaleCoefficient + i) = length * std::sqrt(r / theta(i)) / gravity_mps2;
   }
   return true;
@@ -96,7 +102,10 @@ void GyroScale(const std::vector<FieldPose>& poses, const std::vector<FieldTurn>
   };
   constexpr double kSlowestPeakRadps = 0.2;
   constexpr double kFastestPeakRadps = 30.0;
-  constexpr int kGrid = 240;
+  // Grid points over the 150:1 range of scales: 6.5 % apart, far inside the basin of the true
+  // scale (a hand turn's angle is off by a whole turn only at a scale error of order 1), and each
+  // point integrates every turn, so the grid is what the start costs.
+  constexpr int kGrid = 80;
   const double low = std::log(largest_raw / kFastestPeakRadps);
   const double high = std::log(largest_raw / kSlowestPeakRadps);
   const double step = (high - low) / kGrid;
@@ -109,16 +118,25 @@ void GyroScale(const std::vector<FieldPose>& poses, const std::vector<FieldTurn>
       best = i;
     }
   }
+  // Golden section between the best point's neighbours, one new evaluation per iteration, to a
+  // bracket of 1e-7 in the logarithm of the scale (the solver refines it from there).
   double a = low + step * (best - 1);
   double b = low + step * (best + 1);
   const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  for (int iteration = 0; iteration < 40; ++iteration) {
-    const double c = b - ratio * (b - a);
-    const double d = a + ratio * (b - a);
-    if (mismatch_at(c) < mismatch_at(d)) {
-      b = d;
+  double c = b - ratio * (b - a);
+  double d = a + ratio * (b - a);
+  double mismatch_c = mismatch_at(c);
+  double mismatch_d = mismatch_at(d);
+  constexpr double kLogScaleBracket = 1e-7;
+  while (b - a > kLogScaleBracket) {
+    if (mismatch_c < mismatch_d) {
+      b = d, d = c, mismatch_d = mismatch_c;
+      c = b - ratio * (b - a);
+      mismatch_c = mismatch_at(c);
     } else {
-      a = c;
+      a = c, c = d, mismatch_c = mismatch_d;
+      d = a + ratio * (b - a);
+      mismatch_d = mismatch_at(d);
     }
   }
   for (int axis = 0; axis < 3; ++axis) C0(model->gyro, kScaleCoefficient + axis) = std::exp(0.5 * (a + b));

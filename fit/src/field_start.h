@@ -1,14 +1,15 @@
 // imufit — the field fit's starting point (field_fit.h), in closed form from the poses and turns,
 // before the Ceres problem refines everything at once (imu_tk's stages, as a start only):
 //
-//  1. accelerometer: the axis-aligned ellipsoid through the poses' raw means, sum_i a_i A_i^2 +
+//  1. accelerometer: the axis-aligned ellipsoid through the poses' raw means (less their centroid,
+//     for conditioning: an unsigned converter's counts sit near 32768), sum_i a_i A_i^2 +
 //     b_i A_i = 1 by linear least squares, gives bias V_i = -b_i / (2 a_i) and scale S_i =
 //     sqrt(r / a_i) / g (r = 1 + sum b_i^2 / (4 a_i)); misalignment 0;
 //  2. gyro bias and g-sensitivity: B_p = V + H a_hat_p by linear least squares over the poses (V
 //     the mean of B_p when H is not fitted);
 //  3. gyro scale: one scale s for the three axes, misalignment 0, the s that best turns gravity's
 //     direction across every turn (a scan over hand rates from 0.2 to 30 rad/s at the largest raw
-//     rate of the session, then golden-section refinement).
+//     rate of the session, 80 points, then golden-section refinement).
 #ifndef IMUFIT_FIT_SRC_FIELD_START_H_
 #define IMUFIT_FIT_SRC_FIELD_START_H_
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -85,6 +86,42 @@ double Quantile(std::vector<double> values, double q) {
       std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())));
   std::nth_element(values.begin(), values.begin() + static_cast<long>(index), values.end());
   return values[index];
+}
+
+// The threshold of rests held by hand (SegmentationOptions::rests_held_by_hand): the log's windows
+// split into a quiet and a moving class where the split of their log variances minimises the
+// spread within the classes (Otsu); the quiet class's upper noise_quantile quantile, the level of
+// its noisier rests, times threshold_factor, but never beyond the split itself. 0 when the log has
+// too few windows to split.
+double HandRestThreshold(const std::vector<double>& variances, const SegmentationOptions& options) {
+  std::vector<double> logs;
+  for (const double v : variances) {
+    if (v > 0.0) logs.push_back(std::log(v));
+  }
+  if (logs.size() < 4) return 0.0;
+  std::sort(logs.begin(), logs.end());
+  // Prefix sums: the within-class spread of the split after element k in O(1).
+  const size_t n = logs.size();
+  std::vector<double> sum(n + 1, 0.0);
+  std::vector<double> sum2(n + 1, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    sum[k + 1] = sum[k] + logs[k];
+    sum2[k + 1] = sum2[k] + logs[k] * logs[k];
+  }
+  const auto spread = [&](size_t first, size_t end) {  // sum of squared deviations of [first, end)
+    const double count = static_cast<double>(end - first);
+    const double s = sum[end] - sum[first];
+    return sum2[end] - sum2[first] - s * s / count;
+  };
+  size_t quiet = 1;  // elements [0, quiet) are the quiet class
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t k = 1; k < n; ++k) {
+    const double within = spread(0, k) + spread(k, n);
+    if (within < best) best = within, quiet = k;
+  }
+  const double split = std::exp(0.5 * (logs[quiet - 1] + logs[quiet]));
+  const size_t noisier = std::min(quiet - 1, static_cast<size_t>((1.0 - options.noise_quantile) * quiet));
+  return std::min(split, options.threshold_factor * std::exp(logs[noisier]));
 }
 
 std::string KindOf(const TableSegment& segment) {
@@ -548,6 +585,9 @@ void MotionDetector::SetNoiseLevels(const std::vector<double>& gyro_var, const s
   run->accel_noise_var = std::max(Quantile(accel_var, options_.noise_quantile), accel_floor);
   run->gyro_threshold_var = options_.threshold_factor * run->gyro_noise_var;
   run->accel_threshold_var = options_.threshold_factor * run->accel_noise_var;
+  if (!options_.rests_held_by_hand) return;
+  run->gyro_threshold_var = std::max(run->gyro_threshold_var, HandRestThreshold(gyro_var, options_));
+  run->accel_threshold_var = std::max(run->accel_threshold_var, HandRestThreshold(accel_var, options_));
 }
 
 std::vector<MotionPiece> MotionDetector::Pieces(const std::vector<PieceKind>& kinds) const {

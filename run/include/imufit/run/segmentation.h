@@ -67,6 +67,13 @@ struct SegmentationOptions {
   double noise_quantile = 0.1;
   // A window is steady when its variance is below this multiple of the noise level.
   double threshold_factor = 8.0;
+  // Rests held by hand (the field fit, fit/field_fit.h): their tremor lies far above the log's
+  // quietest windows (a rest on a table) yet far below its turns. When set, each sensor's threshold
+  // is raised, where that is higher, to threshold_factor times the level of the noisier rests: the
+  // (1 - noise_quantile) quantile of the quiet class of windows, the log's windows split in two
+  // where the spread of their log variances within the two classes is least (Otsu), and never
+  // beyond that split. Not an option of `imufit segment`: the field fit sets it.
+  bool rests_held_by_hand = false;
   // Steady stretches shorter than this count as motion, s. The centred window already trims half a
   // window off each end, so a rest must last about min_steady_s + window_s to count.
   double min_steady_s = 0.5;
