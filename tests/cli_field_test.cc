@@ -572,6 +572,7 @@ TEST_F(CliTest, FieldCertificateOptionsAreChecked) {
   r = Run({"report", "-c", Fixture("golden/mems_6pos_soak.yaml"), "-s", raw, "-o", Path("r.html")});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--plan is required"), std::string::npos) << r.err;
+}
 
 // ---------------------------------------------------------------- several sessions of one unit
 
