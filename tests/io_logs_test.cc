@@ -304,6 +304,47 @@ TEST_F(RosbagTest, RefusesWhatIsNotAWholeBag) {
   }
 }
 
+// Each message's bytes are decoded in a buffer reused from message to message: a message cut short
+// after a longer one is refused as rosbag refuses it, never completed with the longer one's bytes.
+TEST_F(RosbagTest, RefusesAMessageShorterThanItsTypeAfterALongerOne) {
+  const std::string path = Path("short.bag");
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    sensor_msgs::Imu imu = ImuMessage(0);
+    imu.header.frame_id = std::string(300, 'f');
+    bag.write("/imu/data", imu.header.stamp, imu);
+    // Without a connection header rosbag files it under the topic's connection: a sensor_msgs/Imu
+    // of 2 doubles after the header.
+    const sensor_msgs::Temperature reading = TemperatureMessage(1.0, 25.0);
+    bag.write("/imu/data", reading.header.stamp, reading);
+  }
+  EXPECT_EQ(ErrorOf(path, kAt25C), path + ": not a readable ROS bag (rosbag: Buffer Overrun)");
+}
+
+TEST_F(RosbagTest, RefusesAMessageOfAnotherTypeOnTheImuTopicAtItsMessage) {
+  const std::string path = Path("mixed.bag");
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    for (int i = 0; i < 3; ++i) {
+      const sensor_msgs::Imu imu = ImuMessage(i);
+      bag.write("/imu/data", imu.header.stamp, imu);
+    }
+    // A second connection of the topic (another publisher) with another type, as a recorder writes it.
+    const sensor_msgs::Temperature reading = TemperatureMessage(1.0, 25.0);
+    const auto header = boost::make_shared<ros::M_string>();
+    (*header)["callerid"] = "/thermometer";
+    (*header)["type"] = ros::message_traits::datatype(reading);
+    (*header)["md5sum"] = ros::message_traits::md5sum(reading);
+    (*header)["message_definition"] = ros::message_traits::definition(reading);
+    bag.write("/imu/data", reading.header.stamp, reading, header);
+  }
+  EXPECT_EQ(ErrorOf(path, kAt25C),
+            path + ": topic \"/imu/data\", message 4: a sensor_msgs/Temperature (definition md5 " +
+                ros::message_traits::MD5Sum<sensor_msgs::Temperature>::value() +
+                ") where sensor_msgs/Imu (md5 " + ros::message_traits::MD5Sum<sensor_msgs::Imu>::value() +
+                ") was expected");
+}
+
 // fuzz/regressions/fuzz_rosbag/: a connection record's header length corrupted to 2.3 GB, which
 // rosbag allocated before reading (a libFuzzer out-of-memory); the structure check refuses it first.
 TEST_F(RosbagTest, RefusesALengthPastTheEndBeforeRosbagAllocatesIt) {
