@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iterator>
 
 #include "commands.h"
@@ -75,6 +76,17 @@ void PrintRepeatability(const std::string& repeat, const FieldFitSummary& first,
                               "the hand)");
 }
 
+// `input` with the ULog instance `instance` (--instance, "" for none); throws InputError unless 0..255.
+SamplesInput WithUlogInstance(SamplesInput input, const std::string& instance) {
+  if (instance.empty()) return input;
+  char* end = nullptr;
+  const long id = std::strtol(instance.c_str(), &end, 10);
+  if (*end != '\0' || id < 0 || id > 255)
+    throw InputError("--instance", QuoteForMessage(instance) + " is not a ULog multi_id (0..255)");
+  input.ulog_instance = static_cast<int>(id);
+  return input;
+}
+
 }  // namespace
 
 void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
@@ -87,6 +99,11 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
           "--repeat", &args->repeat,
           "a second session of the same unit by hand: fitted alike and compared, coefficient by coefficient, "
           "against the two sessions' combined sigma (is the procedure repeatable?); the file is the first's")
+      .Needs(field);
+  command
+      .Option("--instance", &args->instance,
+              "a PX4 ULog's IMU instance: the multi_id of sensor_accel and sensor_gyro to read (default: the "
+              "only one; docs/field.md)")
       .Needs(field);
   args->options.Add(command, FieldFitOptionTable());
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key).Needs(field);
@@ -127,8 +144,9 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   options.fit_g_sensitivity = run.fit.Fits(true, kGSensitivityCoefficient);
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit --field", problem);
+  const SamplesInput input = WithUlogInstance(run.input, args.instance);
   const FieldRunResult result =
-      FieldFitRun(samples, run.input, options, SoftwareVersion(), serial, run.allow_serial_mismatch);
+      FieldFitRun(samples, input, options, SoftwareVersion(), serial, run.allow_serial_mismatch);
   const FieldFitSummary& fit = result.fit;
   // At order 0 the coefficients are constant in temperature: a unit that warmed during the
   // session is fitted at its mean, its drift taken for noise.
@@ -143,6 +161,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   }
   for (const std::string& warning : result.serial_warnings)
     std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
+  for (const std::string& note : result.read_notes) std::fprintf(stderr, "imufit: note: %s\n", note.c_str());
   if (!fit.IsSolutionUsable()) {
     std::fprintf(stderr, "imufit: %s: %s, nothing written\n", samples.c_str(), fit.BriefReport().c_str());
     return 1;
@@ -164,8 +183,8 @@ int RunFieldFit(const FieldFitArguments& args, const std::string& samples, const
   }
   if (!args.repeat.empty()) {
     RefuseToOverwriteInputs(output, {args.repeat});
-    const FieldRunResult second = FieldFitRun(args.repeat, run.input, options, SoftwareVersion(),
-                                              result.serial, run.allow_serial_mismatch);
+    const FieldRunResult second =
+        FieldFitRun(args.repeat, input, options, SoftwareVersion(), result.serial, run.allow_serial_mismatch);
     if (!second.fit.IsSolutionUsable()) {
       std::fprintf(stderr, "imufit: %s (--repeat): %s, nothing written\n", args.repeat.c_str(),
                    second.fit.BriefReport().c_str());

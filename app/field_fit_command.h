@@ -16,6 +16,7 @@ struct FieldFitArguments {
   bool field = false;                   // --field: a session by hand
   CliOptions<FieldFitOptions> options;  // FieldFitOptionTable()
   std::string repeat;                   // --repeat: a second session of the unit, compared
+  std::string instance;                 // --instance: a PX4 ULog's sensor instance (multi_id)
 };
 
 // Adds --field and the field fit's own options (which need it) to `command`.

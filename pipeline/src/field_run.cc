@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
+#include "imufit/io/log_samples.h"
 #include "imufit/io/run_header.h"
-#include "imufit/io/samples.h"
 #include "imufit/io/sha256.h"
 #include "imufit/pipeline/unit_serial.h"
 
@@ -65,15 +65,15 @@ FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& 
                            const std::string& serial, bool allow_serial_mismatch) {
   FieldRunResult result;
   Sha256 digest;
-  SamplesReader reader(samples_path, /*require_segment=*/false, input.Format(), &digest);
-  std::vector<Sample> samples;
-  Sample sample;
-  while (reader.Next(&sample)) samples.push_back(sample);
+  LogSamples log = ReadLogSamples(samples_path, LogOptions{input.Format(), input.ulog_instance}, &digest);
+  std::vector<Sample>& samples = log.samples;
   result.samples_read = static_cast<long long>(samples.size());
   result.samples_sha256 = digest.HexDigest();
-  const UnitSerial unit = ResolveSerial(
-      {SerialSource{SerialSource::Kind::kStated, "--serial", serial, "", 0, 0}, SamplesHeaderSerial(reader)},
-      allow_serial_mismatch);
+  result.read_notes = log.notes;
+  const UnitSerial unit =
+      ResolveSerial({SerialSource{SerialSource::Kind::kStated, "--serial", serial, "", 0, 0},
+                     SamplesHeaderSerial(samples_path, log.serial)},
+                    allow_serial_mismatch);
   result.serial = unit.serial;
   result.serial_warnings = unit.warnings;
   result.fit = FitField(samples, options);
@@ -85,7 +85,7 @@ FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& 
   record.samples = samples_path;
   record.samples_sha256 = result.samples_sha256;
   record.samples_read = result.samples_read;
-  const RunHeader header = RunHeaderOf(samples_path, reader.header_comments());
+  const RunHeader header = RunHeaderOf(samples_path, log.header_comments);
   for (const auto& [value, key] : {std::pair{&header.acquired_utc, &record.acquired_utc},
                                    {&header.model, &record.unit_model},
                                    {&header.firmware, &record.unit_firmware},

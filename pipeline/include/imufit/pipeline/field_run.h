@@ -26,12 +26,14 @@ struct FieldRunResult {
   std::string samples_sha256;
   std::string serial;  // `serial` given, else the samples header's (unit_serial.h)
   std::vector<std::string> serial_warnings;
+  std::vector<std::string> read_notes;  // what reading the log noted (a ULog's dropouts, ...)
 };
 
-// Reads `samples_path` as `input` says (its segment column, if any, is not used) and fits it.
-// `software` and the unit's serial go into the calibration: `serial` as stated (--serial), else the
-// samples header's; a stated serial that contradicts the header is refused (InputError at the
-// header) unless `allow_serial_mismatch`, as for a table fit. Throws InputError for bad input.
+// Reads `samples_path` (a samples CSV or a PX4 ULog, io/log_samples.h) as `input` says (its segment column,
+// if any, is not used) and fits it. `software` and the unit's serial go into the calibration: `serial` as
+// stated (--serial), else the samples header's; a stated serial that contradicts the header is refused
+// (InputError at the header) unless `allow_serial_mismatch`, as for a table fit. Throws InputError for bad
+// input.
 FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& input,
                            const FieldFitOptions& options, const std::string& software,
                            const std::string& serial, bool allow_serial_mismatch);
