@@ -1,6 +1,8 @@
 // imufit — the samples of a CSV or a ULog (log_samples.h).
 #include "imufit/io/log_samples.h"
 
+#include <utility>
+
 #include "imufit/io/error.h"
 #include "imufit/io/ulog_samples.h"
 
@@ -16,9 +18,9 @@ LogSamples ReadLogSamples(const std::string& path, const LogOptions& options, Sh
                            : csv.dialect.decimal_comma      ? "--decimal-comma"
                                                             : nullptr;
     if (csv_only) throw InputError(path, std::string(csv_only) + " reads a CSV; this file is a PX4 ULog");
-    const UlogSamples ulog = ReadUlogSamples(path, UlogOptions{options.ulog_instance, csv.temp_c}, digest);
+    UlogSamples ulog = ReadUlogSamples(path, UlogOptions{options.ulog_instance, csv.temp_c}, digest);
     log.format = LogFormat::kUlog;
-    log.samples = ulog.samples;
+    log.samples = std::move(ulog.samples);
     log.notes = UlogNotes(path, ulog);
     return log;
   }

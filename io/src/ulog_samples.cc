@@ -216,14 +216,6 @@ struct TopicLayout {
 
 enum class Topic { kOther, kAccel, kGyro };
 
-struct Subscription {
-  bool active = false;
-  Topic topic = Topic::kOther;
-  int multi_id = 0;
-  const Format* format = nullptr;
-  TopicLayout layout;
-};
-
 // One instance's messages of one topic.
 struct Series {
   std::vector<uint64_t> time_us;
@@ -235,6 +227,15 @@ struct Series {
   bool has_device = false;
   uint64_t last_time_us = 0;
   enum class Temp { kUnknown, kFinite, kNone } temp = Temp::kUnknown;
+};
+
+struct Subscription {
+  bool active = false;
+  Topic topic = Topic::kOther;
+  int multi_id = 0;
+  const Format* format = nullptr;
+  TopicLayout layout;
+  Series* series = nullptr;  // sensor_accel's or sensor_gyro's (the parser's map holds it)
 };
 
 class UlogParser {
@@ -458,7 +459,8 @@ void UlogParser::Subscribe(const uint8_t* p, size_t size, long long offset) {
   if (name == kAccelTopic || name == kGyroTopic) {
     subscription.topic = name == kAccelTopic ? Topic::kAccel : Topic::kGyro;
     subscription.layout = LayoutOf(format->second);
-    SeriesOf(subscription.topic, multi_id).stored = Stores(multi_id);
+    subscription.series = &SeriesOf(subscription.topic, multi_id);
+    subscription.series->stored = Stores(multi_id);
   }
 }
 
@@ -470,21 +472,23 @@ void UlogParser::Data(const uint8_t* p, size_t size, long long offset) {
   const Subscription& sub = subscriptions_[msg_id];
   const uint8_t* data = p + 2;
   const size_t bytes = size - 2;
-  const std::string topic = FormatText("%s[%d]", sub.format->name.c_str(), sub.multi_id);
+  // The topic as messages name it, made only for one (a message's formatting would cost more than
+  // its reading).
+  const auto topic = [&sub] { return FormatText("%s[%d]", sub.format->name.c_str(), sub.multi_id); };
   if (bytes < sub.format->min_bytes || bytes > sub.format->bytes)
-    Fail(offset, 'D', topic,
+    Fail(offset, 'D', topic(),
          FormatText("%zu data bytes, its format has %zu%s", bytes, sub.format->bytes,
                     bytes < sub.format->min_bytes ? " (message cut short)" : ""));
   if (sub.topic == Topic::kOther) return;
   const TopicLayout& layout = sub.layout;
-  Series& series = SeriesOf(sub.topic, sub.multi_id);
+  Series& series = *sub.series;
   const uint64_t time_us = Load<uint64_t>(data + layout.time);
   if (time_us > kMaxTimeUs)
-    Fail(offset, 'D', topic,
+    Fail(offset, 'D', topic(),
          FormatText("%s %llu us is later than any time since boot (over 31 years)", layout.time_name,
                     static_cast<unsigned long long>(time_us)));
   if (series.messages > 0 && time_us <= series.last_time_us)
-    Fail(offset, 'D', topic,
+    Fail(offset, 'D', topic(),
          FormatText("%s %llu us %s the previous message's %llu us", layout.time_name,
                     static_cast<unsigned long long>(time_us),
                     time_us == series.last_time_us ? "repeats" : "goes back from",
@@ -493,20 +497,20 @@ void UlogParser::Data(const uint8_t* p, size_t size, long long offset) {
   const char* axes = "xyz";
   for (int i = 0; i < 3; ++i) {
     xyz[i] = LoadNumber(data + layout.xyz[i], layout.xyz_type[i]);
-    if (!std::isfinite(xyz[i])) Fail(offset, 'D', topic, FormatText("%c is %g", axes[i], xyz[i]));
+    if (!std::isfinite(xyz[i])) Fail(offset, 'D', topic(), FormatText("%c is %g", axes[i], xyz[i]));
   }
   double temp_c = std::numeric_limits<double>::quiet_NaN();
   if (layout.temp_type != Basic::kNone) temp_c = LoadNumber(data + layout.temp, layout.temp_type);
   // A sensor without a thermometer reports NaN throughout: then the topic has no temperature.
   const Series::Temp temp = std::isfinite(temp_c) ? Series::Temp::kFinite : Series::Temp::kNone;
   if (series.temp != Series::Temp::kUnknown && series.temp != temp)
-    Fail(offset, 'D', topic,
+    Fail(offset, 'D', topic(),
          FormatText("temperature is %g, after messages %s", temp_c,
                     temp == Series::Temp::kNone ? "with a temperature" : "without one"));
   series.temp = temp;
   if (temp == Series::Temp::kFinite) {
     if (const std::string problem = TemperatureProblem(temp_c, series.messages == 0); !problem.empty())
-      Fail(offset, 'D', topic, "temperature: " + problem);
+      Fail(offset, 'D', topic(), "temperature: " + problem);
   }
   if (!series.has_device && layout.device_type != Basic::kNone) {
     series.device_id = static_cast<uint32_t>(LoadNumber(data + layout.device, layout.device_type));
