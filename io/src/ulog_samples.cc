@@ -64,7 +64,10 @@ class ByteStream {
       end_ -= begin_;
       begin_ = 0;
     }
-    if (buffer_.size() < std::max(n, kReadBlockBytes)) buffer_.resize(std::max(n, kReadBlockBytes));
+    // A block, or the whole of a smaller file (and a byte to see its end): a small log costs little.
+    const size_t block =
+        size_ >= 0 ? std::min(kReadBlockBytes, static_cast<size_t>(size_) + 1) : kReadBlockBytes;
+    if (buffer_.size() < std::max(n, block)) buffer_.resize(std::max(n, block));
     while (end_ < n && !eof_) {
       const ssize_t got = ::read(fd_, buffer_.data() + end_, buffer_.size() - end_);
       if (got < 0) {
