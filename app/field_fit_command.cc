@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iterator>
 
 #include "commands.h"
@@ -77,6 +78,17 @@ void PrintRepeatability(const std::string& repeat, const FieldFitSummary& first,
                               "the hand)");
 }
 
+// `input` with the ULog instance `instance` (--instance, "" for none); throws InputError unless 0..255.
+SamplesInput WithUlogInstance(SamplesInput input, const std::string& instance) {
+  if (instance.empty()) return input;
+  char* end = nullptr;
+  const long id = std::strtol(instance.c_str(), &end, 10);
+  if (*end != '\0' || id < 0 || id > 255)
+    throw InputError("--instance", QuoteForMessage(instance) + " is not a ULog multi_id (0..255)");
+  input.ulog_instance = static_cast<int>(id);
+  return input;
+}
+
 }  // namespace
 
 void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
@@ -105,6 +117,11 @@ void AddFieldFitOptions(CliCommand command, FieldFitArguments* args) {
               "--samples (given once per session, or as a list T1,T2,...)")
       .Delimiter(',')
       .Needs(field);
+  command
+      .Option("--instance", &args->instance,
+              "a PX4 ULog's IMU instance: the multi_id of sensor_accel and sensor_gyro to read (default: the "
+              "only one; docs/field.md)")
+      .Needs(field);
   args->options.Add(command, FieldFitOptionTable());
   for (const auto& entry : FieldFitOptionTable().entries()) args->options.Find(entry.key).Needs(field);
 }
@@ -121,7 +138,7 @@ void RefuseTableOptions(const FitRunArguments& run) {
 // How each session is read: as `run` says, with its own --session-temp-c when given.
 std::vector<SamplesInput> SessionInputs(const FieldFitArguments& args,
                                         const std::vector<std::string>& samples, const FitRunOptions& run) {
-  std::vector<SamplesInput> inputs(samples.size(), run.input);
+  std::vector<SamplesInput> inputs(samples.size(), WithUlogInstance(run.input, args.instance));
   if (args.session_temps_c.empty()) return inputs;
   if (run.input.temp_c) {
     throw InputError(
@@ -211,6 +228,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& s
   options.fit_g_sensitivity = run.fit.Fits(true, kGSensitivityCoefficient);
   if (const std::string problem = options.Validate(); !problem.empty())
     throw InputError("imufit fit --field", problem);
+  const SamplesInput input = WithUlogInstance(run.input, args.instance);
   const FieldRunResult result =
       FieldFitSessionsRun(samples, SessionInputs(args, samples, run), options, SoftwareVersion(), serial,
                           run.allow_serial_mismatch, args.topics);
@@ -230,6 +248,7 @@ int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& s
     std::fprintf(stderr, "imufit: warning: %s\n", warning.c_str());
   const std::string name = several ? std::to_string(samples.size()) + " sessions" : samples.front();
   if (several && fit.status == FieldFitStatus::kInconsistent) PrintSessions(result, quiet);
+  for (const std::string& note : result.read_notes) std::fprintf(stderr, "imufit: note: %s\n", note.c_str());
   if (!fit.IsSolutionUsable()) {
     std::fprintf(stderr, "imufit: %s: %s, nothing written\n", name.c_str(), fit.BriefReport().c_str());
     return 1;
@@ -261,8 +280,8 @@ int RunFieldFit(const FieldFitArguments& args, const std::vector<std::string>& s
   if (several) PrintSessions(result, quiet);
   if (!args.repeat.empty()) {
     RefuseToOverwriteInputs(output, {args.repeat});
-    const FieldRunResult second = FieldFitRun(args.repeat, run.input, options, SoftwareVersion(),
-                                              result.serial, run.allow_serial_mismatch, args.topics);
+    const FieldRunResult second = FieldFitRun(args.repeat, input, options, SoftwareVersion(), result.serial,
+                                              run.allow_serial_mismatch, args.topics);
     if (!second.fit.IsSolutionUsable()) {
       std::fprintf(stderr, "imufit: %s (--repeat): %s, nothing written\n", args.repeat.c_str(),
                    second.fit.BriefReport().c_str());

@@ -21,6 +21,7 @@ struct FieldFitArguments {
   std::string repeat;                   // --repeat: a second session of the unit, compared
   LogTopics topics;                     // --topic, --temp-topic: a ROS bag's topics
   std::vector<double> session_temps_c;  // --session-temp-c: each session's temperature, in order
+  std::string instance;                 // --instance: a PX4 ULog's sensor instance (multi_id)
 };
 
 // Adds --field and the field fit's own options (which need it) to `command`.

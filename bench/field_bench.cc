@@ -17,25 +17,13 @@
 #include <string>
 #include <vector>
 
+#include "bench_timing.h"
 #include "imufit/fit/field_fit.h"
 #include "imufit/io/calibration.h"
 #include "imufit/io/samples.h"
 #include "imufit/sim/field_session.h"
 
-namespace {
-
-// Best of `runs` wall-clock times of `f`, s.
-double BestSeconds(int runs, const std::function<void()>& f) {
-  double best = 1e300;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
-
-}  // namespace
+using imufit::bench::BestSeconds;
 
 int main() {
   using namespace imufit;

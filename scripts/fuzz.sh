@@ -21,7 +21,7 @@ while [[ $# -gt 0 ]]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[[ ${#targets[@]} -gt 0 ]] || targets=(fuzz_samples fuzz_plan fuzz_calibration fuzz_limits fuzz_series fuzz_rosbag)
+[[ ${#targets[@]} -gt 0 ]] || targets=(fuzz_samples fuzz_plan fuzz_calibration fuzz_limits fuzz_series fuzz_ulog fuzz_rosbag)
 
 imufit_fuzz_available || imufit_die "fuzzing needs clang++ with libFuzzer (Debian: apt-get install clang libfuzzer-14-dev)"
 
@@ -33,12 +33,15 @@ CC=clang CXX=clang++ imufit_build "$dir" imufit_fuzz -- -DCMAKE_C_COMPILER=clang
 # Seeds: the fixtures (plans, calibrations; the first rows of each samples file, plain and gzip).
 seeds=$dir/seeds
 rm -rf "$seeds"
-mkdir -p "$seeds"/{fuzz_samples,fuzz_plan,fuzz_calibration,fuzz_limits,fuzz_series,fuzz_rosbag}
+mkdir -p "$seeds"/{fuzz_samples,fuzz_plan,fuzz_calibration,fuzz_limits,fuzz_series,fuzz_ulog,fuzz_rosbag}
 cp "$IMUFIT_ROOT"/fixtures/plan_*.yaml "$IMUFIT_ROOT"/fixtures/hand_*.yaml "$seeds/fuzz_plan/"
 cp "$IMUFIT_ROOT"/fixtures/*_truth.yaml "$IMUFIT_ROOT"/fixtures/golden/*.yaml "$seeds/fuzz_calibration/"
 cp "$IMUFIT_ROOT"/fuzz/seeds/limits*.yaml "$seeds/fuzz_limits/"
 # Small bags written by ROS's own rosbag (plain, LZ4, BZ2; with and without a temperature topic).
 cp "$IMUFIT_ROOT"/fuzz/seeds/rosbag/*.bag "$seeds/fuzz_rosbag/"
+# PX4 ULogs written from the format specification (python/tests/ulog_writer.py): a session amid the
+# other message types, two instances, appended data after a message cut short.
+cp "$IMUFIT_ROOT"/fuzz/seeds/ulog_*.ulg "$seeds/fuzz_ulog/"
 # Inputs that once failed (fuzz/regressions/TARGET/): run first, every time.
 for regressions in "$IMUFIT_ROOT"/fuzz/regressions/*/; do
   cp "$regressions"* "$seeds/$(basename "$regressions")/"

@@ -761,5 +761,35 @@ TEST_F(CliTest, FieldSessionsTemperaturesSerialsAndRefusals) {
   EXPECT_NE(no_rest.err.find(moving + ": no pose at rest found"), std::string::npos) << no_rest.err;
 }
 
+// A PX4 ULog that breaks the format: one line naming its byte offset, message type and what is
+// wrong, exit 2, nothing written (python/tests/test_ulog.py fits whole ULog sessions).
+TEST_F(CliTest, FieldFitRefusesABadUlogAtItsByte) {
+  // The header, then a data message ('D', 4 bytes) of msg_id 7, which no subscription defines.
+  const std::string bad = Write("bad.ulg", std::string("ULog\x01\x12\x35\x01", 8) + std::string(8, '\0') +
+                                               std::string("\x04\x00"
+                                                           "D"
+                                                           "\x07\x00\x00\x00",
+                                                           7));
+  const RunResult r = Run({"fit", "--field", "--samples", bad, "-o", Path("cal.yaml")});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "imufit: " + bad + ": byte 16: 'D': msg_id 7, which no subscription ('A') defines\n");
+  EXPECT_FALSE(std::filesystem::exists(Path("cal.yaml")));
+  const RunResult unit =
+      Run({"fit", "--field", "--samples", bad, "--time-unit", "ms", "-o", Path("cal.yaml")});
+  EXPECT_EQ(unit.status, 2);
+  EXPECT_NE(unit.err.find("--time-unit reads a CSV; this file is a PX4 ULog"), std::string::npos) << unit.err;
+  const RunResult instance =
+      Run({"fit", "--field", "--samples", bad, "--instance", "300", "-o", Path("cal.yaml")});
+  EXPECT_EQ(instance.status, 2);
+  EXPECT_NE(instance.err.find("\"300\" is not a ULog multi_id (0..255)"), std::string::npos) << instance.err;
+  const std::string csv = Path("session.csv");
+  ASSERT_EQ(Run(FieldSessionArgs(csv, {})).status, 0);
+  const RunResult on_csv =
+      Run({"fit", "--field", "--samples", csv, "--instance", "1", "-o", Path("cal.yaml")});
+  EXPECT_EQ(on_csv.status, 2);
+  EXPECT_NE(on_csv.err.find("--instance chooses a PX4 ULog's sensors; this file is a CSV"), std::string::npos)
+      << on_csv.err;
+}
+
 }  // namespace
 }  // namespace imufit::testing

@@ -141,9 +141,11 @@ FieldRunResult FieldFitSessionsRun(const std::vector<std::string>& samples_paths
   RunHeader header;  // the first session's, as far as it goes for all
   for (size_t s = 0; s < samples_paths.size(); ++s) {
     Sha256 digest;
-    LogSamples log =
-        ReadLogSamples(samples_paths[s], {inputs[s].Format(), topics.topic, topics.temp_topic}, &digest);
+    LogSamples log = ReadLogSamples(
+        samples_paths[s], {inputs[s].Format(), topics.topic, topics.temp_topic, inputs[s].ulog_instance},
+        &digest);
     sessions[s] = std::move(log.samples);
+    result.read_notes.insert(result.read_notes.end(), log.notes.begin(), log.notes.end());
     if (s == 0) {
       result.format = log.format;
       result.topic = log.topic;

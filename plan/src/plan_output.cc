@@ -1,12 +1,12 @@
 // `imufit plan check`'s outputs (plan_check.h): a table for people, YAML or JSON for machines (one
 // document, written by io's writer of machine-readable text: machine_text.h).
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "imufit/base/text.h"
 #include "imufit/io/machine_text.h"
 #include "imufit/model/check.h"
 #include "imufit/plan/plan_check.h"
@@ -15,15 +15,7 @@
 namespace imufit {
 namespace {
 
-std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
-std::string Format(const char* format, ...) {
-  char text[512];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(text, sizeof text, format, args);
-  va_end(args);
-  return text;
-}
+constexpr auto Format = FormatText;  // base/text.h
 
 std::string Ids(const std::vector<int>& ids) {
   std::string text;

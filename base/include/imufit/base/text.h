@@ -1,13 +1,26 @@
-// imufit — small text helpers: one double through a printf format, a list joined, a CSV cell.
+// imufit — small text helpers: a printf format's text, one double through a printf format, a list
+// joined, a CSV cell.
 #ifndef IMUFIT_BASE_TEXT_H_
 #define IMUFIT_BASE_TEXT_H_
 
+#include <cstdarg>
 #include <cstddef>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 namespace imufit {
+
+// The text of a printf `format` with its arguments, at most 511 characters (messages, lines).
+inline std::string FormatText(const char* format, ...) __attribute__((format(printf, 1, 2)));
+inline std::string FormatText(const char* format, ...) {
+  char text[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(text, sizeof text, format, args);
+  va_end(args);
+  return text;
+}
 
 // `value` through `format`, a printf format of one double ("%.3g", "%+.1f").
 inline std::string NumberText(const char* format, double value) {

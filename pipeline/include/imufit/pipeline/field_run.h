@@ -37,6 +37,7 @@ struct FieldRunResult {
   std::vector<std::string> serial_warnings;
   LogFormat format = LogFormat::kSamplesCsv;  // the log's (io/log_samples.h)
   std::string topic, temp_topic;              // a bag's topics read ("" for a CSV)
+  std::vector<std::string> read_notes;        // what reading the logs noted (a ULog's dropouts, ...)
 };
 
 // A bag's topics to read (--topic, --temp-topic; "" = the bag's only one).
@@ -46,11 +47,10 @@ struct LogTopics {
 };
 
 // Reads `samples_path` as `input` says (its segment column, if any, is not used) and fits it. The
-// file is a samples CSV or a ROS 1 bag (told by its first bytes, io/log_samples.h; `topics` choose
-// the bag's topics).
-// `software` and the unit's serial go into the calibration: `serial` as stated (--serial), else the
-// samples header's; a stated serial that contradicts the header is refused (InputError at the
-// header) unless `allow_serial_mismatch`, as for a table fit. Throws InputError for bad input.
+// file is a samples CSV, a ROS 1 bag or a PX4 ULog (told by its first bytes, io/log_samples.h; `topics`
+// choose the bag's topics). `software` and the unit's serial go into the calibration: `serial` as stated
+// (--serial), else the samples header's; a stated serial that contradicts the header is refused (InputError
+// at the header) unless `allow_serial_mismatch`, as for a table fit. Throws InputError for bad input.
 FieldRunResult FieldFitRun(const std::string& samples_path, const SamplesInput& input,
                            const FieldFitOptions& options, const std::string& software,
                            const std::string& serial, bool allow_serial_mismatch,

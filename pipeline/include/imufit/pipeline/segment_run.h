@@ -26,6 +26,8 @@ struct SamplesInput {
   CsvDialect dialect;
   // Columns under the file's own names (--column time_s=Time).
   std::vector<ColumnName> column_names;
+  // A PX4 ULog's sensor instance, its multi_id (--instance; io/ulog_samples.h); none: the only one.
+  std::optional<int> ulog_instance;
   // How the segments are found in a file without a segment column.
   SegmentationOptions segmentation;
 
