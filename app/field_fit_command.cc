@@ -30,14 +30,16 @@ void PrintFieldCoefficients(const FieldFitSummary& fit) {
   const char* axes = "xyz";
   std::printf("  coefficients (+- 1 sigma):\n");
   for (int i = 0; i < 3; ++i) {
+    // Scales in significant digits: in counts (939.65 raw/(deg/s)) or in SI (0.017453 raw/(deg/s)
+    // for a bag's or a ULog's rad/s), the sigma stays readable.
     std::printf("    gyro %c   bias %s deg/s   scale %s raw/(deg/s)\n", axes[i],
                 text("%+.5f +- %.5f", Sensor::kGyro, kBiasCoefficient + i).c_str(),
-                text("%.5f +- %.5f", Sensor::kGyro, kScaleCoefficient + i).c_str());
+                text("%.8g +- %.2g", Sensor::kGyro, kScaleCoefficient + i).c_str());
   }
   for (int i = 0; i < 3; ++i) {
     std::printf("    accel %c  bias %s mg      scale %s raw/g\n", axes[i],
                 text("%+.4f +- %.4f", Sensor::kAccel, kBiasCoefficient + i).c_str(),
-                text("%.4f +- %.4f", Sensor::kAccel, kScaleCoefficient + i).c_str());
+                text("%.8g +- %.2g", Sensor::kAccel, kScaleCoefficient + i).c_str());
   }
   std::printf(
       "    misalignment, mrad:          gyro                      accel (xy, xz, yz: the body frame)\n");
