@@ -3,6 +3,7 @@
 // recovered within the sigmas over 50 sets, the sessions' own shares, a turn-on offset named, one
 // the temperature curve absorbs unseen reported as untested, and the refusals.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "field_test_classes.h"
 #include "imufit/fit/field_fit.h"
 #include "imufit/sim/field_session.h"
 #include "test_models.h"
@@ -94,39 +96,12 @@ constexpr double kTemperaturesC[] = {10.0, 25.0, 40.0};
 // bias or a scale factor (which follow temperature), at 25 degC (c0) for the constant ones; held
 // terms (sigma 0) give none.
 std::vector<double> ZScoresOf(const FieldFitSummary& fit, const SensorModel& truth, bool gyro, int c) {
-  std::vector<double> z;
-  const int i = c * kPolynomialTerms;
-  const double* fitted = (gyro ? fit.model.gyro.data() : fit.model.accel.data()) + i;
-  const double* true_value = (gyro ? truth.gyro.data() : truth.accel.data()) + i;
-  if (c >= kMisalignmentCoefficient) {
-    const double sigma = (gyro ? fit.sigma.gyro.data() : fit.sigma.accel.data())[i];
-    if (sigma > 0.0) z.push_back((fitted[0] - true_value[0]) / sigma);
-    return z;
+  if (c < kMisalignmentCoefficient) {
+    const std::array<double, 2> ends = testing::ZAtEnds(fit, truth, gyro, c);
+    return {ends[0], ends[1]};
   }
-  for (int end = 0; end < 2; ++end) {
-    const double x = fit.pose_temp_range_c[end] - kReferenceTempC;
-    const SensorModel& sigma = end == 0 ? fit.sigma_at_low : fit.sigma_at_high;
-    z.push_back((EvaluateTemperaturePolynomial(fitted, x) - EvaluateTemperaturePolynomial(true_value, x)) /
-                (gyro ? sigma.gyro.data() : sigma.accel.data())[i]);
-  }
-  return z;
+  return testing::ZScores(fit, truth, {"", gyro, c, 1});
 }
-
-struct JointClass {
-  const char* name;
-  bool gyro;
-  int first;
-  int count;
-};
-constexpr JointClass kJointClasses[] = {
-    {"gyro bias", true, kBiasCoefficient, 3},
-    {"gyro scale", true, kScaleCoefficient, 3},
-    {"gyro misalignment", true, kMisalignmentCoefficient, 6},
-    {"gyro g-sensitivity", true, kGSensitivityCoefficient, 9},
-    {"accel bias", false, kBiasCoefficient, 3},
-    {"accel scale", false, kScaleCoefficient, 3},
-    {"accel misalignment", false, kMisalignmentCoefficient, 6},
-};
 
 // Over 50 sets of three sessions (10, 25, 40 degC, each on its own power-on of one unit, no turn-on
 // offset), fitted jointly with biases and scale factors linear in temperature: every class's
@@ -134,8 +109,8 @@ constexpr JointClass kJointClasses[] = {
 // is calibrated: it names a session that agrees about once in 10 000).
 TEST(FieldSessionsTest, MonteCarloJointSessionsAtThreeTemperatures) {
   constexpr int kSets = 50;
-  std::vector<double> sum_z2(std::size(kJointClasses), 0.0);
-  std::vector<int> count(std::size(kJointClasses), 0);
+  std::vector<double> sum_z2(std::size(testing::kClasses), 0.0);
+  std::vector<int> count(std::size(testing::kClasses), 0);
   double sum_chi2 = 0.0;
   int tests = 0;
   for (int set = 0; set < kSets; ++set) {
@@ -146,8 +121,8 @@ TEST(FieldSessionsTest, MonteCarloJointSessionsAtThreeTemperatures) {
     const FieldFitSummary fit = FitFieldSessions(sessions, LinearOptions());
     ASSERT_TRUE(fit.IsSolutionUsable()) << "set " << set << ": " << fit.BriefReport();
     ASSERT_EQ(fit.sessions.size(), 3u);
-    for (size_t k = 0; k < std::size(kJointClasses); ++k) {
-      const JointClass& jc = kJointClasses[k];
+    for (size_t k = 0; k < std::size(testing::kClasses); ++k) {
+      const testing::CoefficientClass& jc = testing::kClasses[k];
       for (int c = jc.first; c < jc.first + jc.count; ++c) {
         for (const double z : ZScoresOf(fit, truth, jc.gyro, c)) {
           sum_z2[k] += z * z;
@@ -163,11 +138,11 @@ TEST(FieldSessionsTest, MonteCarloJointSessionsAtThreeTemperatures) {
       }
     }
   }
-  for (size_t k = 0; k < std::size(kJointClasses); ++k) {
+  for (size_t k = 0; k < std::size(testing::kClasses); ++k) {
     const double rms = std::sqrt(sum_z2[k] / count[k]);
-    std::printf("%-20s z-score RMS %.3f over %d (3 sessions)\n", kJointClasses[k].name, rms, count[k]);
-    EXPECT_GE(rms, kMinJointZRms) << kJointClasses[k].name;
-    EXPECT_LE(rms, kMaxJointZRms) << kJointClasses[k].name;
+    std::printf("%-20s z-score RMS %.3f over %d (3 sessions)\n", testing::kClasses[k].name, rms, count[k]);
+    EXPECT_GE(rms, kMinJointZRms) << testing::kClasses[k].name;
+    EXPECT_LE(rms, kMaxJointZRms) << testing::kClasses[k].name;
   }
   const double mean_chi2 = sum_chi2 / tests;
   std::printf("session offsets: chi-square mean %.3f over %d (3 expected)\n", mean_chi2, tests);

@@ -15,6 +15,7 @@
 
 #include "field_cost.h"
 #include "field_start.h"
+#include "field_test_classes.h"
 #include "imufit/fit/field_fit.h"
 #include "imufit/model/attitude_integration.h"
 #include "imufit/sim/field_session.h"
@@ -22,6 +23,11 @@
 
 namespace imufit {
 namespace {
+
+using testing::CoefficientClass;
+using testing::kClasses;
+using testing::ZAtEnds;
+using testing::ZScores;
 
 // A unit whose truth a field calibration can state: RandomMemsModel's coefficients at 25 degC (no
 // temperature terms: the fit is at one temperature) and the accelerometer's misalignment xy, xz,
@@ -95,37 +101,6 @@ SimulationOptions ShortSession(std::uint64_t seed) {
   options.gyro_noise_density = 2e-4;   // rad/s/sqrt(Hz)
   options.accel_noise_density = 1e-3;  // m/s^2/sqrt(Hz)
   return options;
-}
-
-// The coefficient classes whose z-scores are judged together.
-struct CoefficientClass {
-  const char* name;
-  bool gyro;
-  int first;  // coefficient index
-  int count;
-};
-constexpr CoefficientClass kClasses[] = {
-    {"gyro bias", true, kBiasCoefficient, 3},
-    {"gyro scale", true, kScaleCoefficient, 3},
-    {"gyro misalignment", true, kMisalignmentCoefficient, 6},
-    {"gyro g-sensitivity", true, kGSensitivityCoefficient, 9},
-    {"accel bias", false, kBiasCoefficient, 3},
-    {"accel scale", false, kScaleCoefficient, 3},
-    {"accel misalignment", false, kMisalignmentCoefficient, 6},
-};
-
-// (fitted - true) / sigma of every fitted coefficient (held ones, sigma 0, skipped) of a class.
-std::vector<double> ZScores(const FieldFitSummary& fit, const SensorModel& truth, const CoefficientClass& k) {
-  std::vector<double> z;
-  for (int c = k.first; c < k.first + k.count; ++c) {
-    const int i = c * kPolynomialTerms;
-    const double sigma = k.gyro ? fit.sigma.gyro[i] : fit.sigma.accel[i];
-    if (sigma == 0.0) continue;
-    z.push_back(
-        ((k.gyro ? fit.model.gyro[i] : fit.model.accel[i]) - (k.gyro ? truth.gyro[i] : truth.accel[i])) /
-        sigma);
-  }
-  return z;
 }
 
 // Every fitted coefficient of `fit` within kWorstZ of the truth.
@@ -519,23 +494,6 @@ FieldSessionOptions WarmUp() {
   warm.warmup_c = 15.0;
   warm.warmup_tau_s = 40.0;
   return warm;
-}
-
-// (fitted - true) / sigma of a coefficient's value at the coldest and the warmest pose.
-std::array<double, 2> ZAtEnds(const FieldFitSummary& fit, const SensorModel& truth, bool gyro,
-                              int coefficient) {
-  std::array<double, 2> z{};
-  const int i = coefficient * kPolynomialTerms;
-  for (int end = 0; end < 2; ++end) {
-    const double x = fit.pose_temp_range_c[end] - kReferenceTempC;
-    const double fitted =
-        EvaluateTemperaturePolynomial((gyro ? fit.model.gyro.data() : fit.model.accel.data()) + i, x);
-    const double true_value =
-        EvaluateTemperaturePolynomial((gyro ? truth.gyro.data() : truth.accel.data()) + i, x);
-    const SensorModel& sigma = end == 0 ? fit.sigma_at_low : fit.sigma_at_high;
-    z[end] = (fitted - true_value) / (gyro ? sigma.gyro.data() : sigma.accel.data())[i];
-  }
-  return z;
 }
 
 // A warm-up fitted with the biases cubic in temperature: the biases recovered along the curve
